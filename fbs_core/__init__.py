@@ -1,0 +1,32 @@
+"""fbs_core: Frequency Based Substructuring of a rolling tire and a chassis.
+
+Follows Rosholm & Westers, "Assembly of a tire and a vehicle model to predict
+vibrations at the bushings", Chalmers MSc thesis (2018).
+"""
+
+from .dofs import DIRECTIONS, node_labels, parse_label
+from .errors import (
+    DataFormatError,
+    DOFError,
+    FBSError,
+    FrequencyGridError,
+    QuantityError,
+    SingularInterfaceError,
+)
+from .frf import FRF, QUANTITIES
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "DIRECTIONS",
+    "FRF",
+    "QUANTITIES",
+    "DOFError",
+    "DataFormatError",
+    "FBSError",
+    "FrequencyGridError",
+    "QuantityError",
+    "SingularInterfaceError",
+    "node_labels",
+    "parse_label",
+]

@@ -1,0 +1,323 @@
+"""The FRF data object: complex frequency response data labelled by DOF.
+
+Data are stored frequency first, ``(n_freq, n_out, n_in)``, so that batched
+``@``, :func:`numpy.linalg.solve` and :func:`numpy.einsum` run over all lines at
+once (the layout of scikit-rf's ``Network.s``). Objects are immutable: every
+method returns a new :class:`FRF`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+
+from .dofs import index_of, validate_labels
+from .errors import DataFormatError, FrequencyGridError, QuantityError
+
+__all__ = ["FRF", "QUANTITIES", "UNITS", "check_grid"]
+
+#: FRF quantities (thesis table 2.1) and the power of ``j omega`` that turns a
+#: receptance into each of them.
+QUANTITIES: dict[str, int] = {"receptance": 0, "mobility": 1, "accelerance": 2}
+
+#: SI units of a translational response per force, by quantity.
+UNITS: dict[str, str] = {"receptance": "m/N", "mobility": "m/(N s)", "accelerance": "m/(N s^2)"}
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+def check_grid(freq: np.ndarray) -> np.ndarray:
+    """Validate a frequency grid in Hz: 1-D, finite, non-negative, strictly increasing.
+
+    Raises
+    ------
+    FrequencyGridError
+    """
+    f = np.asarray(freq)
+    if f.ndim != 1 or f.size == 0:
+        raise FrequencyGridError(f"frequencies must be a non-empty 1-D array, got shape {f.shape}")
+    if not np.issubdtype(f.dtype, np.number) or np.iscomplexobj(f):
+        raise FrequencyGridError(f"frequencies must be real numbers in Hz, got dtype {f.dtype}")
+    f = f.astype(float)
+    if not np.all(np.isfinite(f)):
+        raise FrequencyGridError("frequencies must be finite (found NaN or inf)")
+    if f[0] < 0:
+        raise FrequencyGridError(f"frequencies must be >= 0 Hz, got {f[0]:g} Hz")
+    d = np.diff(f)
+    if np.any(d <= 0):
+        k = int(np.argmax(d <= 0))
+        raise FrequencyGridError(
+            "frequencies must be strictly increasing; "
+            f"line {k + 1} ({f[k + 1]:g} Hz) does not exceed line {k} ({f[k]:g} Hz)"
+        )
+    return f
+
+
+class FRF:
+    """Frequency response functions between labelled DOFs.
+
+    Parameters
+    ----------
+    freq : array_like, shape (n_freq,)
+        Frequencies in Hz, strictly increasing.
+    data : array_like, shape (n_freq, n_out, n_in)
+        Complex response per unit input at each frequency.
+    outputs, inputs : sequence of str
+        DOF labels ``"node:dir"`` (e.g. ``"hub:z"``) or generalised names
+        (e.g. ``"patch"``); see :mod:`fbs_core.dofs`.
+    quantity : {"receptance", "mobility", "accelerance"}
+        What the response is per unit input (thesis table 2.1).
+
+    Raises
+    ------
+    FrequencyGridError, DataFormatError, DOFError, QuantityError
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.array([10.0, 20.0])
+    >>> Y = FRF(f, np.ones((2, 1, 1)), ["hub:z"], ["hub:z"])
+    >>> Y.sel(outputs="hub:z").shape
+    (2, 1, 1)
+    """
+
+    __slots__ = ("_freq", "_data", "_outputs", "_inputs", "_quantity")
+
+    def __init__(
+        self,
+        freq: Sequence[float] | np.ndarray,
+        data: np.ndarray,
+        outputs: Iterable[str],
+        inputs: Iterable[str],
+        quantity: str = "mobility",
+    ) -> None:
+        f = check_grid(freq)
+        d = np.asarray(data)
+        if not np.issubdtype(d.dtype, np.number):
+            raise DataFormatError(f"FRF data must be numeric, got dtype {d.dtype}")
+        outs = validate_labels(outputs, "output")
+        ins = validate_labels(inputs, "input")
+        expected = (f.size, len(outs), len(ins))
+        if d.shape != expected:
+            raise DataFormatError(
+                f"FRF data has shape {d.shape}, expected (n_freq, n_out, n_in) = {expected} "
+                f"from {f.size} frequencies, {len(outs)} outputs and {len(ins)} inputs"
+            )
+        if not np.all(np.isfinite(d)):
+            bad = np.argwhere(~np.isfinite(d))[0]
+            raise DataFormatError(
+                f"FRF data contain non-finite values (first at {f[bad[0]]:g} Hz, "
+                f"output {outs[bad[1]]!r}, input {ins[bad[2]]!r})"
+            )
+        if quantity not in QUANTITIES:
+            raise QuantityError(
+                f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}"
+            )
+        object.__setattr__(self, "_freq", _frozen(f))
+        object.__setattr__(self, "_data", _frozen(d.astype(complex)))
+        object.__setattr__(self, "_outputs", outs)
+        object.__setattr__(self, "_inputs", ins)
+        object.__setattr__(self, "_quantity", quantity)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("FRF objects are immutable; methods return new objects")
+
+    # -- properties ----------------------------------------------------------------
+    @property
+    def freq(self) -> np.ndarray:
+        """Frequencies in Hz, shape ``(n_freq,)`` (read-only)."""
+        return self._freq
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Angular frequencies ``2 pi f`` in rad/s, shape ``(n_freq,)``."""
+        return 2 * np.pi * self._freq
+
+    @property
+    def data(self) -> np.ndarray:
+        """Complex data, shape ``(n_freq, n_out, n_in)`` (read-only)."""
+        return self._data
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return self._outputs
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return self._inputs
+
+    @property
+    def quantity(self) -> str:
+        return self._quantity
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return self._data.shape
+
+    def __repr__(self) -> str:
+        f = self._freq
+        return (
+            f"<FRF {self._quantity} {self.shape[1]}x{self.shape[2]} at {f.size} lines "
+            f"{f[0]:g}-{f[-1]:g} Hz; outputs {list(self._outputs)}; inputs {list(self._inputs)}>"
+        )
+
+    # -- construction helpers ------------------------------------------------------
+    def replace(self, **changes) -> FRF:
+        """A new FRF with some of ``freq, data, outputs, inputs, quantity`` replaced."""
+        kw = dict(
+            freq=self._freq,
+            data=self._data,
+            outputs=self._outputs,
+            inputs=self._inputs,
+            quantity=self._quantity,
+        )
+        unknown = set(changes) - set(kw)
+        if unknown:
+            raise TypeError(f"unknown field(s) {sorted(unknown)}; allowed: {sorted(kw)}")
+        kw.update(changes)
+        return FRF(**kw)
+
+    # -- selection -----------------------------------------------------------------
+    def sel(self, outputs: str | Iterable[str] | None = None,
+            inputs: str | Iterable[str] | None = None) -> FRF:
+        """Select by DOF label (like xarray's ``sel``); ``None`` keeps all.
+
+        Raises
+        ------
+        DOFError
+            For an unknown label, naming the available ones.
+        """
+        oi = None if outputs is None else index_of(self._outputs, outputs, "output DOF")
+        ii = None if inputs is None else index_of(self._inputs, inputs, "input DOF")
+        return self.isel(outputs=oi, inputs=ii)
+
+    def isel(self, freq=None, outputs=None, inputs=None) -> FRF:
+        """Select by 0-based position (ints, slices or index lists); ``None`` keeps all."""
+
+        def norm(k, n):
+            if k is None:
+                return np.arange(n)
+            if isinstance(k, slice):
+                return np.arange(n)[k]
+            a = np.atleast_1d(np.asarray(k))
+            if a.dtype == bool:
+                return np.flatnonzero(a)
+            if not np.issubdtype(a.dtype, np.integer):
+                raise IndexError(f"positions must be integers, got {a.dtype}")
+            if np.any((a >= n) | (a < -n)):
+                raise IndexError(f"position out of range for axis of length {n}: {a.tolist()}")
+            return a % n
+
+        fi = norm(freq, self._freq.size)
+        oi = norm(outputs, len(self._outputs))
+        ii = norm(inputs, len(self._inputs))
+        return FRF(
+            self._freq[fi],
+            self._data[np.ix_(fi, oi, ii)],
+            [self._outputs[i] for i in oi],
+            [self._inputs[i] for i in ii],
+            self._quantity,
+        )
+
+    def crop(self, fmin: float | None = None, fmax: float | None = None) -> FRF:
+        """Keep the lines with ``fmin <= f <= fmax``."""
+        lo = -np.inf if fmin is None else fmin
+        hi = np.inf if fmax is None else fmax
+        keep = (self._freq >= lo) & (self._freq <= hi)
+        if not keep.any():
+            raise FrequencyGridError(
+                f"no lines in [{lo:g}, {hi:g}] Hz; the FRF spans "
+                f"{self._freq[0]:g}-{self._freq[-1]:g} Hz"
+            )
+        return self.isel(freq=keep)
+
+    # -- quantities ----------------------------------------------------------------
+    def to(self, quantity: str) -> FRF:
+        """Convert between receptance, mobility and accelerance.
+
+        Each step multiplies by ``j omega`` (receptance -> mobility ->
+        accelerance) or divides by it (thesis table 2.1).
+
+        Raises
+        ------
+        QuantityError
+            For an unknown quantity, or when dividing by ``j omega`` at 0 Hz.
+        """
+        if quantity not in QUANTITIES:
+            raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
+        p = QUANTITIES[quantity] - QUANTITIES[self._quantity]
+        if p == 0:
+            return self
+        jw = 1j * self.omega
+        if p < 0 and np.any(jw == 0):
+            raise QuantityError(
+                f"cannot convert {self._quantity} to {quantity}: the grid contains 0 Hz, "
+                "where dividing by j*omega is undefined; crop it first"
+            )
+        return self.replace(data=self._data * (jw**p)[:, None, None], quantity=quantity)
+
+    # -- grids ---------------------------------------------------------------------
+    def same_grid(self, other: FRF, rtol: float = 1e-12) -> bool:
+        """True when both FRFs share the frequency lines."""
+        return self._freq.shape == other._freq.shape and np.allclose(
+            self._freq, other._freq, rtol=rtol, atol=0.0
+        )
+
+    def require_grid(self, other: FRF, what: str = "FRFs") -> None:
+        """Raise :class:`FrequencyGridError` unless ``other`` has the same lines."""
+        if not self.same_grid(other):
+            raise FrequencyGridError(
+                f"{what} are on different frequency grids ({self._freq.size} lines "
+                f"{self._freq[0]:g}-{self._freq[-1]:g} Hz vs {other._freq.size} lines "
+                f"{other._freq[0]:g}-{other._freq[-1]:g} Hz); they are never interpolated "
+                "silently: call .interpolate(freq) explicitly"
+            )
+
+    def interpolate(self, freq: Sequence[float] | np.ndarray) -> FRF:
+        """Linear interpolation of real and imaginary parts onto ``freq``.
+
+        This is the explicit way to put FRFs on a common grid; nothing in
+        ``fbs_core`` interpolates silently.
+
+        Raises
+        ------
+        FrequencyGridError
+            If ``freq`` reaches outside the FRF's range (no extrapolation).
+        """
+        f = check_grid(freq)
+        if f[0] < self._freq[0] - 1e-9 or f[-1] > self._freq[-1] + 1e-9:
+            raise FrequencyGridError(
+                f"cannot interpolate onto {f[0]:g}-{f[-1]:g} Hz: the FRF spans "
+                f"{self._freq[0]:g}-{self._freq[-1]:g} Hz and is never extrapolated"
+            )
+        flat = self._data.reshape(self._freq.size, -1)
+        re = np.stack([np.interp(f, self._freq, c.real) for c in flat.T], axis=-1)
+        im = np.stack([np.interp(f, self._freq, c.imag) for c in flat.T], axis=-1)
+        return self.replace(freq=f, data=(re + 1j * im).reshape((f.size,) + self.shape[1:]))
+
+    # -- comparisons and arithmetic --------------------------------------------------
+    def allclose(self, other: FRF, rtol: float = 1e-10, atol: float = 0.0) -> bool:
+        """Same labels, quantity and grid, and data equal within tolerance."""
+        return (
+            self._outputs == other._outputs
+            and self._inputs == other._inputs
+            and self._quantity == other._quantity
+            and self.same_grid(other)
+            and np.allclose(self._data, other._data, rtol=rtol, atol=atol)
+        )
+
+    def transpose(self) -> FRF:
+        """Swap outputs and inputs (``Y^T`` at every line)."""
+        return self.replace(
+            data=np.swapaxes(self._data, 1, 2), outputs=self._inputs, inputs=self._outputs
+        )
+
+    def magnitude_db(self, ref: float = 1.0) -> np.ndarray:
+        """``20 log10(|data| / ref)``, shape ``(n_freq, n_out, n_in)``."""
+        with np.errstate(divide="ignore"):
+            return 20 * np.log10(np.abs(self._data) / ref)
