@@ -4,6 +4,15 @@ Follows Rosholm & Westers, "Assembly of a tire and a vehicle model to predict
 vibrations at the bushings", Chalmers MSc thesis (2018).
 """
 
+from .coupling import (
+    couple_generalized,
+    couple_impedance,
+    couple_lm,
+    couple_receptance,
+    couple_response,
+    interface_condition,
+)
+from .direct import SecondOrderSystem, assemble
 from .dofs import DIRECTIONS, node_labels, parse_label
 from .errors import (
     DataFormatError,
@@ -18,6 +27,14 @@ from .frf import FRF, QUANTITIES
 __version__ = "0.1.0"
 
 __all__ = [
+    "SecondOrderSystem",
+    "assemble",
+    "couple_generalized",
+    "couple_impedance",
+    "couple_lm",
+    "couple_receptance",
+    "couple_response",
+    "interface_condition",
     "DIRECTIONS",
     "FRF",
     "QUANTITIES",
