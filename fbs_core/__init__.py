@@ -23,6 +23,7 @@ from .errors import (
     SingularInterfaceError,
 )
 from .frf import FRF, QUANTITIES
+from .harmonics import HARMONICS, Harmonic, harmonic
 
 __version__ = "0.1.0"
 
@@ -37,6 +38,8 @@ __all__ = [
     "interface_condition",
     "DIRECTIONS",
     "FRF",
+    "HARMONICS",
+    "Harmonic",
     "QUANTITIES",
     "DOFError",
     "DataFormatError",
@@ -44,6 +47,7 @@ __all__ = [
     "FrequencyGridError",
     "QuantityError",
     "SingularInterfaceError",
+    "harmonic",
     "node_labels",
     "parse_label",
 ]
