@@ -1,0 +1,138 @@
+"""Parameters of the reference tire (a 205/60 R15 passenger-car tire).
+
+Every value has a source or a derivation; see ``docs/tire-model.md``. The ring
+values (R, rhoA, k_w, k_v, T_p, EI) reproduce the MF-Swift 205/60R15 default tire
+data (rim-fixed belt frequencies 80 Hz longitudinal, 40 Hz lateral, 50 Hz yaw,
+70 Hz wind-up; Schmeitz / TNO MF-Swift 6.1 data set, via
+``../shared/design/reference-models.md`` section 2.2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from ..errors import DataFormatError
+
+__all__ = ["TireParameters", "FAMILIES", "DEFAULT_PARAMETERS"]
+
+#: Belt mode families, in the order of :attr:`TireParameters.orders`:
+#: ``ip`` in-plane inextensible ring (u, w = -du/dtheta); ``op`` out-of-plane
+#: (lateral) ring v with plane cross-sections; ``w1`` cross-section tilt
+#: (w linear across the width); ``w2`` ... ``w6`` width-wise bending families
+#: (w ~ Legendre P_m(2y/b)), after Kropp (1989).
+FAMILIES: tuple[str, ...] = ("ip", "op", "w1", "w2", "w3", "w4", "w5", "w6")
+
+
+@dataclass(frozen=True)
+class TireParameters:
+    """Physical parameters of the reference rolling tire (SI units).
+
+    Attributes
+    ----------
+    R : float
+        Belt radius in m (also the rolling radius: ``Omega = v / R``).
+    b : float
+        Belt width in m.
+    m_belt : float
+        Belt (plus tread) mass in kg; ``rhoA = m_belt / (2 pi R)``.
+    EI : float
+        Circumferential bending stiffness of the belt in N m^2.
+    EI_lat : float
+        Lateral (in-surface) bending stiffness of the belt in N m^2; sets the
+        circumferential membrane stiffness ``E_m = 12 EI_lat / b^3`` (N/m).
+    D_y : float
+        Bending stiffness across the width per unit length, N m.
+    D_t : float
+        Twisting stiffness of the belt per unit length, N m.
+    T_p : float
+        Hoop tension from inflation, ``p b R``, in N.
+    n_y : float
+        Membrane tension across the width, N/m (acts on the width-wise bending).
+    k_w, k_v, k_lat : float
+        Radial, tangential and lateral sidewall foundation stiffness per unit
+        circumference, N/m^2, split equally over the two belt edges.
+    m_rim, I_rim_p, I_rim_d : float
+        Mass (kg), polar and diametral inertia (kg m^2) of the rigid rim with
+        the beads and sidewalls lumped onto it.
+    L_c, b_c : float
+        Contact patch length and width in m.
+    k_cx, k_cy, k_cz : float
+        Total contact stiffness of the patch, longitudinal, lateral and
+        vertical, N/m, spread uniformly over the patch.
+    F_z0 : float
+        Static wheel load in N (the contact pressure tilted by the road slope
+        gives the longitudinal part of the patch load).
+    zeta : float
+        Modal damping ratio of the non-rotating tire.
+    orders : tuple of int
+        Highest circumferential order kept in each family of :data:`FAMILIES`
+        (-1 drops the family).
+    """
+
+    R: float = 0.30
+    b: float = 0.16
+    m_belt: float = 7.0
+    EI: float = 5.0
+    EI_lat: float = 250.0
+    D_y: float = 1.0
+    D_t: float = 6.0
+    T_p: float = 10.6e3
+    n_y: float = 1.5e4
+    k_w: float = 1.19e6
+    k_v: float = 6.84e5
+    k_lat: float = 2.3e5
+    m_rim: float = 10.0
+    I_rim_p: float = 0.40
+    I_rim_d: float = 0.25
+    L_c: float = 0.15
+    b_c: float = 0.13
+    k_cx: float = 6.0e5
+    k_cy: float = 2.0e5
+    k_cz: float = 4.0e5
+    F_z0: float = 4000.0
+    zeta: float = 0.04
+    orders: tuple[int, ...] = (16, 6, 14, 14, 12, 11, 10, 10)
+
+    def __post_init__(self):
+        object.__setattr__(self, "orders", tuple(int(n) for n in self.orders))
+        if len(self.orders) != len(FAMILIES):
+            raise DataFormatError(
+                f"orders must give one entry per family {FAMILIES}, got {self.orders}"
+            )
+        for f in fields(self):
+            if f.name == "orders":
+                continue
+            v = getattr(self, f.name)
+            if not np.isfinite(v) or v < 0:
+                raise DataFormatError(f"tire parameter {f.name} must be finite and >= 0, got {v}")
+
+    @property
+    def rhoA(self) -> float:
+        """Belt mass per unit circumference, kg/m."""
+        return self.m_belt / (2 * np.pi * self.R)
+
+    @property
+    def n_belt(self) -> int:
+        """Number of belt generalised coordinates."""
+        return sum(2 * n + 1 for n in self.orders if n >= 0)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["orders"] = list(self.orders)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> TireParameters:
+        known = {f.name for f in fields(cls)}
+        unknown = set(d) - known
+        if unknown:
+            raise DataFormatError(
+                f"unknown tire parameter(s) {sorted(unknown)}; known: {sorted(known)}"
+            )
+        kw = {k: (tuple(int(x) for x in v) if k == "orders" else float(v)) for k, v in d.items()}
+        return cls(**kw)
+
+
+DEFAULT_PARAMETERS = TireParameters()

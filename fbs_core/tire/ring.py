@@ -1,0 +1,369 @@
+"""Mass, damping, gyroscopic and stiffness matrices of the rolling reference tire.
+
+The belt is a thin cylindrical band (radius ``R``, width ``b``) described in a
+space-fixed (Eulerian) frame, so that the contact patch stands still while the
+belt material flows through it at the spin ``Omega = v / R``. Its displacement
+field (tangential ``u``, lateral ``v``, radial ``w``) is expanded in
+circumferential Fourier orders ``n`` times width-wise shapes (a Ritz basis):
+
+* ``ip``: in-plane inextensible ring, ``u = a T(theta)``, ``w = -du/dtheta``
+  (Huang & Soedel 1987; Gong 1993);
+* ``op``: lateral ring ``v = a T`` with plane cross-sections, ``u = -y v_theta / R``
+  (out-of-plane ring, Kindt, Sas & Desmet 2009);
+* ``w1``: cross-section tilt, ``w = a (2y/b) T``;
+* ``w2`` .. ``w6``: width-wise bending families ``w = a cos(m pi (y/b + 1/2)) T``
+  (orthotropic plate on an elastic foundation, Kropp 1989),
+
+with ``T`` = ``cos(n theta)`` or ``sin(n theta)``. Energies are integrated by
+quadrature (exact for the trigonometric and polynomial products):
+
+* kinetic energy of the belt in the Eulerian frame,
+  ``1/2 int rhoA' |d_t d + Omega d_theta d|^2 dA`` (``d_theta`` acting on the
+  rotating base vectors too), gives M, the gyroscopic G(Omega) and the
+  centrifugal softening;
+* the hoop tension ``rhoA Omega^2 R^2`` of the spinning belt and the inflation
+  tension ``T_p`` (with the pressure acting as a follower load) give the
+  geometric stiffness; for the inextensible ring the Omega^2 terms cancel and the
+  ring's closed form (reference-models.md sec. 2.1) is reproduced exactly;
+* bending ``(w_thth + w)/R^2``, width bending ``w_yy``, twist
+  ``(w_thy - u_y)/R``, circumferential membrane strain ``(u_th + w)/R``
+  (lateral bending of the belt) and lateral tension on the width-wise bending;
+* sidewall foundation springs at the belt edges relative to the rigid rim;
+* contact springs spread over the space-fixed patch at the bottom.
+
+The rim is rigid, its mass and inertia belong to the tire, and its centre is the
+hub with 6 DOFs in vehicle coordinates (ISO 8855: x forward, y left, z up).
+Ring frame: ``e_r(theta) = (cos theta, 0, -sin theta)``,
+``e_theta = (-sin theta, 0, -cos theta)``, ``e_y = (0, 1, 0)``; theta is measured
+from the forward direction about +y, which is also the spin direction of a
+forward rolling wheel, and the patch centre lies at theta = pi/2. The hub DOFs
+are the rim's translations and small rotations in these vehicle axes, so no
+further transformation is needed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import scipy.linalg as sla
+from numpy.polynomial import legendre
+
+from ..direct import SecondOrderSystem
+from ..dofs import node_labels
+from .params import DEFAULT_PARAMETERS, FAMILIES, TireParameters
+
+__all__ = [
+    "HUB_DOFS",
+    "build_tire_system",
+    "patch_load",
+    "belt_labels",
+    "omega_of_speed",
+    "ring_closed_form",
+]
+
+#: Hub DOF labels in vehicle coordinates.
+HUB_DOFS: tuple[str, ...] = node_labels("hub")
+
+
+def omega_of_speed(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS) -> float:
+    """Spin in rad/s of a wheel rolling at ``speed_kmh`` (``Omega = v / R``)."""
+    return float(speed_kmh) / 3.6 / params.R
+
+
+@dataclass(frozen=True)
+class _Basis:
+    """Belt basis functions: family index, order and kind (0 = cos, 1 = sin)."""
+
+    fam: np.ndarray
+    n: np.ndarray
+    kind: np.ndarray
+
+    @property
+    def size(self) -> int:
+        return self.fam.size
+
+
+def _basis(params: TireParameters) -> _Basis:
+    fam, n, kind = [], [], []
+    for f, nmax in enumerate(params.orders):
+        for order in range(nmax + 1):
+            for k in (0, 1) if order else (0,):
+                fam.append(f)
+                n.append(order)
+                kind.append(k)
+    return _Basis(np.array(fam), np.array(n), np.array(kind))
+
+
+def belt_labels(params: TireParameters = DEFAULT_PARAMETERS) -> tuple[str, ...]:
+    """Generalised DOF labels of the belt, e.g. ``"belt.ip.n02s"``."""
+    b = _basis(params)
+    return tuple(
+        f"belt.{FAMILIES[f]}.n{n:02d}" + ("" if n == 0 else "cs"[k])
+        for f, n, k in zip(b.fam, b.n, b.kind, strict=True)
+    )
+
+
+def _trig(n, kind, theta, d):
+    """d-th theta-derivative of cos(n theta) (kind 0) or sin(n theta) (kind 1).
+
+    Returns shape (n_theta, n_basis).
+    """
+    # cos(x + d pi/2) is the d-th derivative of cos; sin(x) = cos(x - pi/2)
+    ph = np.outer(theta, n) - 0.5 * np.pi * kind[None, :] + 0.5 * np.pi * d
+    return np.cos(ph) * (n[None, :] ** d).astype(float)
+
+
+def _width(fam, y, b, d):
+    """d-th y-derivative of the width shape of each family, shape (n_y, n_basis)."""
+    eta = 2 * y / b
+    out = np.zeros((y.size, fam.size))
+    for f in np.unique(fam):
+        cols = fam == f
+        name = FAMILIES[f]
+        if name in ("ip", "op"):
+            g = np.ones_like(eta) if d == 0 else np.zeros_like(eta)
+        elif name == "w1":
+            g = eta if d == 0 else (np.full_like(eta, 2 / b) if d == 1 else np.zeros_like(eta))
+        else:  # cos(m pi (y/b + 1/2)): free-edge strip shapes across the width
+            k = int(name[1:]) * np.pi / b
+            g = k**d * np.cos(k * (y + b / 2) + 0.5 * np.pi * d)
+        out[:, cols] = g[:, None]
+    return out
+
+
+def _fields(params: TireParameters, basis: _Basis, theta, y):
+    """Local displacement components and derivatives at the grid ``theta x y``.
+
+    Returns a dict of arrays of shape (n_theta * n_y, n_basis), theta-major.
+    """
+    R = params.R
+    fam = basis.fam
+    T = [_trig(basis.n, basis.kind, theta, d) for d in range(4)]
+    g = [_width(fam, y, params.b, d) for d in range(3)]
+
+    def prod(t, w):  # (nth, nb) x (ny, nb) -> (nth*ny, nb)
+        return (t[:, None, :] * w[None, :, :]).reshape(-1, fam.size)
+
+    is_ = {name: (fam == i)[None, :].astype(float) for i, name in enumerate(FAMILIES)}
+    plate = np.isin(fam, [i for i, name in enumerate(FAMILIES) if name.startswith("w")])
+    bending = plate & (fam != FAMILIES.index("w1"))
+    yy = np.broadcast_to(y[None, :, None], (theta.size, y.size, 1)).reshape(-1, 1)
+    F = {}
+    # ip: u = T, w = -T'
+    # op: v = T, u = -y T' / R
+    # plate families: w = g(y) T
+    F["u"] = is_["ip"] * prod(T[0], g[0]) - is_["op"] * yy * prod(T[1], g[0]) / R
+    F["u_th"] = is_["ip"] * prod(T[1], g[0]) - is_["op"] * yy * prod(T[2], g[0]) / R
+    F["u_y"] = -is_["op"] * prod(T[1], g[0]) / R
+    F["v"] = is_["op"] * prod(T[0], g[0])
+    F["v_th"] = is_["op"] * prod(T[1], g[0])
+    F["w"] = -is_["ip"] * prod(T[1], g[0]) + plate * prod(T[0], g[0])
+    F["w_th"] = -is_["ip"] * prod(T[2], g[0]) + plate * prod(T[1], g[0])
+    F["w_thth"] = -is_["ip"] * prod(T[3], g[0]) + plate * prod(T[2], g[0])
+    F["w_y"] = plate * prod(T[0], g[1])
+    F["w_yy"] = plate * prod(T[0], g[2])
+    F["w_thy"] = plate * prod(T[1], g[1])
+    F["w_y_bend"] = bending * F["w_y"]
+    F["v_hat"] = F["v"] * (basis.n > 0)[None, :]
+    return F
+
+
+def _gram(a, wts, b=None):
+    """``sum_p wts_p a_p b_p^T`` for field arrays (n_p, n_basis)."""
+    b = a if b is None else b
+    return (a * wts[:, None]).T @ b
+
+
+def _rim_local(theta, y, R):
+    """Rim rigid-body displacement at (R, theta, y) in local components.
+
+    Returns three arrays (radial, tangential, lateral) of shape (n_theta, 6):
+    per hub DOF x, y, z, rx, ry, rz.
+    """
+    c, s = np.cos(theta), np.sin(theta)
+    er = np.stack([c, 0 * c, -s], -1)
+    et = np.stack([-s, 0 * c, -c], -1)
+    ey = np.broadcast_to([0.0, 1.0, 0.0], er.shape)
+    p = R * er + y * ey
+    out = []
+    for e in (er, et, ey):
+        cols = [e[:, i] for i in range(3)]  # translations
+        for i in range(3):  # rotations: (beta_i x p) . e
+            unit = np.zeros(3)
+            unit[i] = 1.0
+            cols.append(np.einsum("pi,pi->p", np.cross(unit, p), e))
+        out.append(np.stack(cols, -1))
+    return out
+
+
+@lru_cache(maxsize=8)
+def _operators(params: TireParameters):
+    """Speed-independent pieces: M, K0, the Omega-linear A, Omega^2 part, contact data."""
+    R, b = params.R, params.b
+    basis = _basis(params)
+    nb = basis.size
+    n_th = max(64, 2 * (max(params.orders) + 4))
+    theta = 2 * np.pi * np.arange(n_th) / n_th
+    yg, wy = legendre.leggauss(24)
+    y, wy = yg * b / 2, wy * b / 2
+    F = _fields(params, basis, theta, y)
+    wts = np.outer(np.full(n_th, 2 * np.pi / n_th * R), wy).ravel()  # dA = R dtheta dy
+    rho_s = params.m_belt / (2 * np.pi * R * b)
+
+    # belt local vector field and its theta-derivative (incl. rotating base vectors)
+    d_t, d_y, d_r = F["u"], F["v"], F["w"]
+    dd_t, dd_y, dd_r = F["u_th"] + F["w"], F["v_th"], F["w_th"] - F["u"]
+    Mb = rho_s * (_gram(d_t, wts) + _gram(d_y, wts) + _gram(d_r, wts))
+    A1 = rho_s * (_gram(d_t, wts, dd_t) + _gram(d_y, wts, dd_y) + _gram(d_r, wts, dd_r))
+    soft = -rho_s * (_gram(dd_t, wts) + _gram(dd_y, wts) + _gram(dd_r, wts))
+    hoop = rho_s * (_gram(dd_r, wts) + _gram(dd_y, wts))  # times Omega^2 R^2 / R^2
+    K2 = soft + hoop
+
+    n_p = params.T_p / b
+    E_m = 12 * params.EI_lat / b**3
+    Kb = (
+        n_p / R**2 * (_gram(dd_r, wts) + _gram(F["u_th"], wts) - _gram(F["u"], wts)
+                      + _gram(F["v_th"], wts) - _gram(F["v_hat"], wts))
+        + params.EI / b / R**4 * _gram(F["w_thth"] + F["w"], wts)
+        + params.D_y * _gram(F["w_yy"], wts)
+        + params.D_t / R**2 * _gram(F["w_thy"] - F["u_y"], wts)
+        + E_m / R**2 * _gram(F["u_th"] + F["w"], wts)
+        + params.n_y * _gram(F["w_y_bend"], wts)
+    )
+
+    n = 6 + nb
+    M = np.zeros((n, n))
+    K0 = np.zeros((n, n))
+    A = np.zeros((n, n))
+    Kw2 = np.zeros((n, n))
+    M[6:, 6:] = Mb
+    K0[6:, 6:] = Kb
+    A[6:, 6:] = A1
+    Kw2[6:, 6:] = K2
+    M[:6, :6] = np.diag([params.m_rim] * 3 + [params.I_rim_d, params.I_rim_p, params.I_rim_d])
+
+    # sidewall foundation at the two belt edges, relative to the rigid rim
+    wth = np.full(n_th, 2 * np.pi / n_th * R)
+    for ye in (-b / 2, b / 2):
+        Fe = _fields(params, basis, theta, np.array([ye]))
+        rr, rt, ry = _rim_local(theta, ye, R)
+        for belt, rim, k in ((Fe["w"], rr, params.k_w), (Fe["u"], rt, params.k_v),
+                             (Fe["v"], ry, params.k_lat)):
+            rel = np.hstack([-rim, belt])
+            K0 += 0.5 * k * _gram(rel, wth)
+
+    # contact patch: space-fixed springs at the bottom (theta = pi/2)
+    xg, wx = legendre.leggauss(48)
+    half = params.L_c / 2 / R
+    th_c = np.pi / 2 + half * xg
+    yc, wyc = legendre.leggauss(16)
+    Fc = _fields(params, basis, th_c, yc * params.b_c / 2)
+    wc = np.outer(wx * half * R, wyc * params.b_c / 2).ravel()
+    thp = np.repeat(th_c, yc.size)[:, None]
+    dx = Fc["w"] * np.cos(thp) - Fc["u"] * np.sin(thp)
+    dz = -Fc["w"] * np.sin(thp) - Fc["u"] * np.cos(thp)
+    area = params.L_c * params.b_c
+    Kc = (params.k_cx * _gram(dx, wc) + params.k_cy * _gram(Fc["v"], wc)
+          + params.k_cz * _gram(dz, wc)) / area
+    K0[6:, 6:] += Kc
+    x_patch = -R * (thp[:, 0] - np.pi / 2)  # forward coordinate in the patch
+    contact = (x_patch, wc, dx, dz)
+    return M, K0, A, Kw2, contact
+
+
+def _sym(a):
+    return 0.5 * (a + a.T)
+
+
+@lru_cache(maxsize=8)
+def _damping(params: TireParameters) -> np.ndarray:
+    """Viscous damping D with modal damping ratio ``zeta`` on every mode at 0 km/h.
+
+    ``D = M Phi diag(2 zeta omega_r) Phi^T M`` with the mass-normalised real
+    modes ``Phi`` of the non-rotating tire standing on the road.
+    """
+    M, K0, *_ = _operators(params)
+    w2, phi = sla.eigh(_sym(K0), _sym(M))
+    MP = M @ phi
+    return _sym(MP @ np.diag(2 * params.zeta * np.sqrt(np.maximum(w2, 0.0))) @ MP.T)
+
+
+def system_matrices(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS):
+    """``M, D, G, K`` of the rolling tire at ``speed_kmh`` (dense, real, shape (n, n)).
+
+    ``M x'' + (D + G(Omega)) x' + K(Omega) x = f`` with ``G`` skew and odd in
+    ``Omega``, ``K`` symmetric and even in ``Omega``.
+    """
+    Om = omega_of_speed(speed_kmh, params)
+    M, K0, A, Kw2, _ = _operators(params)
+    G = Om * (A - A.T)
+    # rigid rim spinning about +y: gyroscopic coupling of rx and rz
+    G[3, 5] -= Om * params.I_rim_p
+    G[5, 3] += Om * params.I_rim_p
+    K = _sym(K0 + Om**2 * Kw2)
+    return _sym(M), _damping(params), G, K
+
+
+def build_tire_system(speed_kmh: float,
+                      params: TireParameters = DEFAULT_PARAMETERS) -> SecondOrderSystem:
+    """The rolling tire as a labelled second-order system at ``speed_kmh``.
+
+    Parameters
+    ----------
+    speed_kmh : float
+        Vehicle speed in km/h (negative reverses the spin).
+    params : TireParameters
+
+    Returns
+    -------
+    SecondOrderSystem
+        ``M``, ``C = D + G(Omega)``, ``K(Omega)``; DOFs ``hub:x`` ... ``hub:rz``
+        (vehicle coordinates) followed by the belt coordinates
+        (:func:`belt_labels`).
+    """
+    M, D, G, K = system_matrices(speed_kmh, params)
+    return SecondOrderSystem(M, D + G, K, HUB_DOFS + belt_labels(params))
+
+
+def patch_load(wavelength: float, params: TireParameters = DEFAULT_PARAMETERS) -> np.ndarray:
+    """Load vector of a unit road wave rolled under the patch, shape (n_dof,).
+
+    The road profile ``h(x) = exp(j 2 pi x / lambda)`` (1 m amplitude, x forward
+    from the patch centre) is enforced through the vertical contact springs
+    (traction ``k_cz / (L_c b_c) h``), and the static contact pressure
+    ``F_z0 / (L_c b_c)`` acting normal to the inclined road adds the
+    longitudinal traction ``-p0 dh/dx``. The patch is space fixed, so the load
+    depends on the wavelength only; it oscillates at ``f = v / lambda``.
+    Units: N per metre of road amplitude.
+    """
+    M, *_, contact = _operators(params)
+    x, wc, dx, dz = contact
+    k = 2 * np.pi / wavelength
+    h = np.exp(1j * k * x)
+    area = params.L_c * params.b_c
+    qz = params.k_cz / area * h
+    qx = -params.F_z0 / area * 1j * k * h
+    f = np.zeros(M.shape[0], complex)
+    f[6:] = (wc * qz) @ dz + (wc * qx) @ dx
+    return f
+
+
+def ring_closed_form(n: int, speed_kmh: float,
+                     params: TireParameters = DEFAULT_PARAMETERS) -> tuple[float, float]:
+    """Forward and backward in-plane ring frequencies (Hz) of order ``n``, rim fixed.
+
+    ``M_n = rhoA (n^2+1)``, ``K_n = EI n^2 (n^2-1)^2/R^4 + T_p n^2 (n^2-1)/R^2
+    + k_w n^2 + k_v``, ``g_n = rhoA Omega n (n^2-1)``,
+    ``omega = (+/- g_n + sqrt(g_n^2 + M_n K_n)) / M_n`` (Huang & Soedel 1987;
+    reference-models.md sec. 2.1). Returns ``(f_plus, f_minus)``.
+    """
+    p = params
+    Om = omega_of_speed(speed_kmh, p)
+    Mn = p.rhoA * (n**2 + 1)
+    Kn = (p.EI * n**2 * (n**2 - 1) ** 2 / p.R**4 + p.T_p * n**2 * (n**2 - 1) / p.R**2
+          + p.k_w * n**2 + p.k_v)
+    g = p.rhoA * Om * n * (n**2 - 1)
+    r = np.sqrt(g**2 + Mn * Kn)
+    return (g + r) / Mn / (2 * np.pi), (-g + r) / Mn / (2 * np.pi)
