@@ -224,6 +224,9 @@ def couple_lm(subsystems: Mapping[str, FRF], connections: Sequence[Pair], *,
     connections : sequence of (str, str)
         Pairs of qualified labels ``"name/node:dir"``, e.g.
         ``("tire/hub:z", "chassis/spindle:z")``.
+    rcond, max_cond : float, optional
+        Truncated-SVD regularisation and condition limit of the interface
+        matrix ``B Y B^T`` (see :func:`couple_receptance`).
 
     Returns
     -------
@@ -248,6 +251,16 @@ def couple_generalized(subsystems: Mapping[str, FRF], connections: Sequence[Pair
     (J, K, L, M in thesis fig. 2.6), and the Boolean mapping matrix ``M``
     (subsystems x interfaces, eq. 2.50) is built from them: +1 for the first
     subsystem of a pair, -1 for the second.
+
+    Parameters
+    ----------
+    subsystems : dict of name -> FRF
+        Square FRFs (inputs in the same order as outputs), same grid and quantity.
+    connections : sequence of (str, str)
+        Pairs of qualified labels ``"name/node:dir"``.
+    rcond, max_cond : float, optional
+        Truncated-SVD regularisation and condition limit of the summed interface
+        matrix (see :func:`couple_receptance`).
 
     Returns
     -------

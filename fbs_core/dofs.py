@@ -105,5 +105,13 @@ def index_of(labels: Sequence[str], wanted: Iterable[str] | str, what: str = "DO
 
 
 def node_labels(node: str, directions: Iterable[str] = DIRECTIONS) -> tuple[str, ...]:
-    """All labels of one node, e.g. ``node_labels("hub")`` -> ``("hub:x", ..., "hub:rz")``."""
+    """All labels of one node, e.g. ``node_labels("hub")`` -> ``("hub:x", ..., "hub:rz")``.
+
+    Parameters
+    ----------
+    node : str
+        Node name.
+    directions : iterable of str
+        Directions to include; default all six of :data:`DIRECTIONS`.
+    """
     return validate_labels(f"{node}:{d}" for d in directions)
