@@ -1,0 +1,89 @@
+"""The servable page: ``panel serve app/main.py``.
+
+Every browser session gets its own :class:`~app.state.DashboardState`, synchronised with the
+URL query (``?h=5&N=150&dof=z...``), so that a link reproduces the view.
+"""
+
+from __future__ import annotations
+
+import holoviews as hv
+import panel as pn
+
+from app.state import URL_KEYS, DashboardState
+from app.views import (
+    Controls,
+    EigenView,
+    MobilityView,
+    ScatterBandView,
+    TruncationView,
+    UncoupledView,
+)
+
+hv.extension("bokeh", logo=False)
+pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
+
+ACCENT = "#1c7ed6"
+
+INTRO = """
+Prediction of the vibration at a rear-chassis bushing from a rolling-tire modal model
+coupled to a chassis FRF model at the hub (receptance coupling, thesis eq. 4.1), with the
+two sensitivity studies of the thesis: **modal truncation** of the tire (5.1) and **random
+noise** in the subsystem FRFs (5.2). Zoom and pan are linked across the frequency axes;
+every view downloads its data as CSV; the URL holds the page state.
+"""
+
+
+def sync_url(state: DashboardState) -> None:
+    """Keep the state in the URL query (only when served)."""
+    loc = pn.state.location
+    if loc is None:
+        return
+    for group, keys in URL_KEYS.items():
+        loc.sync(getattr(state, group), keys)
+
+
+def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemplate:
+    """Build one session's page around ``state`` (a new default state if omitted)."""
+    state = state or DashboardState()
+    case, noise, trunc = state.case, state.noise, state.truncation
+    sync_url(state)
+    scatter = ScatterBandView(case=case, noise=noise)
+
+    def card(title, view, **kw):
+        return pn.Card(view, title=title, collapsible=True, sizing_mode="stretch_both",
+                       header_background="#f1f3f5", margin=(5, 5), **kw)
+
+    main = pn.Column(
+        pn.Row(
+            card("Coupled response at the bushing", MobilityView(case=case), min_height=430),
+            card("Truncation error map and suggested modes",
+                 TruncationView(case=case, truncation=trunc), min_height=430),
+        ),
+        pn.Row(
+            card("Uncoupled subsystems (tire hub, chassis spindle to bushing)",
+                 UncoupledView(case=case), min_height=400),
+            visible=case.param.show_uncoupled,
+        ),
+        pn.Row(
+            card("Noise scatter band", scatter, min_height=430),
+            card("Eigenfrequency versus number of modes", EigenView(case=case),
+                 min_height=430, max_width=560),
+        ),
+        sizing_mode="stretch_width",
+    )
+    template = pn.template.BootstrapTemplate(
+        title="Tire-chassis FBS: bushing vibration dashboard",
+        sidebar=[pn.pane.Markdown(INTRO, styles={"font-size": "0.85em"}),
+                 Controls(state=state)],
+        main=[main], header_background=ACCENT, sidebar_width=330,
+    )
+    template.state = state  # for tests and benchmarks
+    if pn.state.curdoc is not None and pn.state.curdoc.session_context is not None:
+        pn.state.onload(scatter.start)
+    else:
+        scatter.compute_now()
+    return template
+
+
+if pn.state.served:
+    create_app().servable(title="tire-fbs dashboard")

@@ -1,0 +1,143 @@
+"""Dashboard state: one :class:`param.Parameterized` class per concern.
+
+The widgets are generated from these parameters (``Widget.from_param``); the views watch
+only the parameters they depend on. Everything here is plain state: no numerics (those live
+in :mod:`fbs_core`, reached through :mod:`app.compute`).
+"""
+
+from __future__ import annotations
+
+import param
+
+__all__ = [
+    "DIRECTIONS",
+    "COUPLINGS",
+    "MODE_COUNTS",
+    "MAP_MODES",
+    "NOISE_TARGETS",
+    "CaseState",
+    "NoiseState",
+    "TruncationState",
+    "DashboardState",
+    "URL_KEYS",
+]
+
+#: Bushing / hub DOF directions (vehicle coordinates, thesis fig. 4.5).
+DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+#: Hub coupling options: all 6 hub DOFs (braked wheel, as in the thesis) or 5 with the spin
+#: DOF released (free-rolling wheel).
+COUPLINGS = ("6dof", "5dof")
+#: Where the Monte-Carlo noise is applied (thesis eqs. 5.2-5.4).
+NOISE_TARGETS = ("both", "tire", "vehicle")
+#: Retained-mode counts offered (thesis 5.1: 10 to 400 in steps of 10).
+MODE_COUNTS = tuple(range(10, 401, 10))
+#: What the truncation error map shows.
+MAP_MODES = ("selected DOF", "max over 6 DOFs")
+
+
+class CaseState(param.Parameterized):
+    """The prediction case: harmonic, retained tire modes, response DOF, hub coupling."""
+
+    harmonic = param.Integer(
+        default=1, bounds=(1, 7), doc="Harmonic excitation case (thesis fig. 4.4)."
+    )
+    n_modes = param.Selector(
+        default=50, objects=list(MODE_COUNTS),
+        doc="Retained complex tire modes N, 10-400 in steps of 10 (in +/- pairs: N/2 "
+        "physical modes, lowest first; thesis 5.1).",
+    )
+    dof = param.Selector(
+        default="z", objects=list(DIRECTIONS), doc="Response DOF at the bushing."
+    )
+    coupling = param.Selector(
+        default="6dof", objects=list(COUPLINGS),
+        doc="Couple all 6 hub DOFs (braked wheel) or 5 with the spin (ry) released.",
+    )
+    show_uncoupled = param.Boolean(
+        default=False, doc="Also show the uncoupled tire (hub) and chassis FRFs."
+    )
+    spindle_input = param.Selector(
+        default="z", objects=list(DIRECTIONS),
+        doc="Spindle input DOF of the uncoupled chassis spindle-to-bushing mobility.",
+    )
+
+
+class NoiseState(param.Parameterized):
+    """Monte-Carlo noise study settings (thesis section 5.2)."""
+
+    noise = param.Number(
+        default=10.0, bounds=(0.0, 100.0), softbounds=(0.0, 10.0), step=0.1,
+        doc="Noise level p in percent: scaling factors uniform in [1-p, 1+p].",
+    )
+    target = param.Selector(
+        default="both", objects=list(NOISE_TARGETS), doc="Subsystem(s) that get noise."
+    )
+    frequency_dependent = param.Boolean(
+        default=False,
+        doc="New scaling matrix at every frequency line (else one per round).",
+    )
+    rounds = param.Integer(
+        default=10_000, bounds=(1, 200_000), softbounds=(100, 20_000),
+        doc="Number of Monte-Carlo rounds R.",
+    )
+    seed = param.Integer(default=0, bounds=(0, None), doc="Random seed of the study.")
+    single_round = param.Integer(
+        default=0, bounds=(0, 200_000 - 1),
+        doc="Index of the single polluted round drawn inside the band (0-based).",
+    )
+    percentile = param.Number(
+        default=90.0, bounds=(1.0, 99.9), step=1.0,
+        doc="Width of the central percentile band in percent (90 -> 5-95 %).",
+    )
+
+    @param.depends("rounds", watch=True, on_init=True)
+    def _clip_single_round(self):
+        # the single round must exist in the batch
+        self.param.single_round.bounds = (0, max(self.rounds - 1, 0))
+        if self.single_round > self.rounds - 1:
+            self.single_round = self.rounds - 1
+
+
+class TruncationState(param.Parameterized):
+    """Truncation study settings (thesis section 5.1)."""
+
+    threshold = param.Number(
+        default=20.0, bounds=(0.1, 1000.0), softbounds=(1.0, 50.0), step=1.0,
+        doc="Error threshold in percent: colour cap of the map and criterion of the table.",
+    )
+    f_max = param.Number(
+        default=160.0, bounds=(1.0, 1000.0), softbounds=(50.0, 450.0), step=10.0,
+        doc="Upper frequency in Hz for the suggested number of modes (table 5.1).",
+    )
+    map_mode = param.Selector(
+        default=MAP_MODES[0], objects=list(MAP_MODES),
+        doc="Error map of the selected DOF (fig. 5.3/5.7) or the maximum over 6 DOFs (fig. 5.6).",
+    )
+
+
+class DashboardState(param.Parameterized):
+    """All state of one browser session."""
+
+    case = param.ClassSelector(class_=CaseState, instantiate=False)
+    noise = param.ClassSelector(class_=NoiseState, instantiate=False)
+    truncation = param.ClassSelector(class_=TruncationState, instantiate=False)
+
+    def __init__(self, **params):
+        params.setdefault("case", CaseState())
+        params.setdefault("noise", NoiseState())
+        params.setdefault("truncation", TruncationState())
+        super().__init__(**params)
+
+
+#: URL query keys of each state parameter (short, stable: links are shared in reviews).
+URL_KEYS: dict[str, dict[str, str]] = {
+    "case": {
+        "harmonic": "h", "n_modes": "N", "dof": "dof", "coupling": "coupling",
+        "show_uncoupled": "uncoupled", "spindle_input": "input",
+    },
+    "noise": {
+        "noise": "noise", "target": "target", "frequency_dependent": "fdep",
+        "rounds": "rounds", "seed": "seed", "single_round": "round", "percentile": "pct",
+    },
+    "truncation": {"threshold": "thr", "f_max": "fmax", "map_mode": "map"},
+}

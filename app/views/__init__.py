@@ -1,0 +1,15 @@
+"""The dashboard's views (``pn.viewable.Viewer`` subclasses)."""
+
+from .controls import Controls
+from .mobility import MobilityView, UncoupledView
+from .scatter import ScatterBandView
+from .truncation import EigenView, TruncationView
+
+__all__ = [
+    "Controls",
+    "EigenView",
+    "MobilityView",
+    "ScatterBandView",
+    "TruncationView",
+    "UncoupledView",
+]

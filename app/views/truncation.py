@@ -1,0 +1,177 @@
+"""Truncation error map (thesis figs. 5.3, 5.6, 5.7), suggested modes (table 5.1) and
+eigenfrequency versus mode number (fig. 5.8)."""
+
+from __future__ import annotations
+
+import holoviews as hv
+import numpy as np
+import panel as pn
+import param
+from panel.viewable import Viewer
+
+from .. import compute
+from ..state import CaseState, TruncationState
+from .common import COLORS, CURVE_OPTS, FREQ, MODES, download_button, name_source
+
+ERROR = hv.Dimension("error", label="Truncation error", unit="%")
+EIGEN = hv.Dimension("eigenfrequency", label="Highest retained eigenfrequency", unit="Hz")
+
+
+class TruncationView(Viewer):
+    """Error over centre frequency and retained modes, colour capped at the threshold."""
+
+    case = param.ClassSelector(class_=CaseState)
+    truncation = param.ClassSelector(class_=TruncationState)
+
+    def data(self) -> dict:
+        c, t = self.case, self.truncation
+        dof = c.dof if t.map_mode == "selected DOF" else None
+        return compute.error_map_data(c.harmonic, c.coupling, dof)
+
+    def table(self) -> dict:
+        t = self.truncation
+        return compute.suggested_table(float(t.threshold), float(t.f_max), self.case.coupling)
+
+    def _map(self, harmonic, coupling, dof, map_mode, threshold):
+        d = compute.error_map_data(harmonic, coupling, dof if map_mode == "selected DOF" else None)
+        what = f"bushing:{dof}" if map_mode == "selected DOF" else "max over 6 DOFs"
+        img = hv.Image((d["centre_freq"], d["n_modes"], d["error_pct"]), [FREQ, MODES], ERROR)
+        return img.opts(
+            cmap="inferno_r", clim=(0.0, float(threshold)), colorbar=True,
+            clabel=f"Error (%), capped at {threshold:g} %", responsive=True, min_height=320,
+            tools=["hover"], title=f"Truncation error, harmonic {harmonic}, {what}",
+            hover_tooltips=[("Centre frequency", "$x{0.0} Hz"), ("N", "$y{0}"),
+                            ("Error", "@image{0.0} %")],
+            hooks=[name_source("truncation.map")], framewise=True,
+        )
+
+    def _chosen(self, n_modes):
+        return hv.HLine(float(n_modes), label="chosen N").opts(
+            color=COLORS["round"], line_width=2)
+
+    def _suggested(self, harmonic, coupling, threshold, f_max):
+        tab = compute.suggested_table(float(threshold), float(f_max), coupling)
+        n = float(tab["n_modes"][list(tab["harmonic"]).index(harmonic)])
+        return hv.HLine(n).opts(color="#0ca678", line_dash="dashed", line_width=2) * hv.VLine(
+            float(f_max)).opts(color="#0ca678", line_dash="dotted", line_width=2)
+
+    def table_frame(self):
+        """The suggested-modes table as a DataFrame (what the Tabulator shows)."""
+        import pandas as pd
+
+        t = self.truncation
+        tab = self.table()
+        return pd.DataFrame({
+            "Harmonic": tab["harmonic"],
+            "f range (Hz)": [f"{a:.1f}-{b:.1f}" for a, b in zip(tab["f_low"], tab["f_high"],
+                                                                 strict=True)],
+            f"N (error < {t.threshold:g} % up to {t.f_max:g} Hz)": tab["n_modes"],
+            "Highest eigenfreq. at 80 km/h (Hz)": tab["eigenfrequency"].round(1),
+        })
+
+    def __panel__(self):
+        c, t = self.case, self.truncation
+        img = hv.DynamicMap(self._map, streams=[
+            hv.streams.Params(c, ["harmonic", "coupling", "dof"]),
+            hv.streams.Params(t, ["map_mode", "threshold"])])
+        chosen = hv.DynamicMap(self._chosen, streams=[hv.streams.Params(c, ["n_modes"])])
+        sugg = hv.DynamicMap(self._suggested, streams=[
+            hv.streams.Params(c, ["harmonic", "coupling"]),
+            hv.streams.Params(t, ["threshold", "f_max"])])
+        table = pn.widgets.Tabulator(
+            self.table_frame(), disabled=True, show_index=False, selectable=False,
+            sizing_mode="stretch_width", height=250, css_classes=["suggested-table"],
+            layout="fit_columns")
+
+        def refresh(*_):
+            table.value = self.table_frame()
+
+        t.param.watch(refresh, ["threshold", "f_max"])
+        c.param.watch(refresh, ["coupling"])
+        dl = download_button("truncation", self._csv_columns, self._meta,
+                             lambda: f"truncation_map_h{c.harmonic}_{self._what()}.csv")
+        dl_tab = download_button(
+            "suggested", self._csv_table, self._meta_table,
+            lambda: f"suggested_modes_thr{t.threshold:g}_fmax{t.f_max:g}.csv")
+        return pn.Column(
+            pn.Row(pn.pane.Markdown("**Modal truncation error** (eq. 5.1, floating band)",
+                                    margin=(0, 10)), pn.layout.HSpacer(), dl),
+            pn.pane.HoloViews(img * sugg * chosen, sizing_mode="stretch_both", min_height=340),
+            pn.Row(pn.pane.Markdown("**Suggested number of modes** (table 5.1)",
+                                    margin=(0, 10)), pn.layout.HSpacer(), dl_tab),
+            table,
+            sizing_mode="stretch_both",
+        )
+
+    def _what(self) -> str:
+        return self.case.dof if self.truncation.map_mode == "selected DOF" else "maxdof"
+
+    def _meta(self) -> dict:
+        c, t = self.case, self.truncation
+        return {"view": "truncation error map (thesis eq. 5.1, figs. 5.3/5.6/5.7)",
+                "harmonic": c.harmonic, "coupling": c.coupling,
+                "response DOF": f"bushing:{c.dof}" if t.map_mode == "selected DOF"
+                else "max over 6 DOFs",
+                "reference": "all tire modes", "layout": "long: one row per (N, centre freq)"}
+
+    def _csv_columns(self) -> dict:
+        d = self.data()
+        nn, ff = np.meshgrid(d["n_modes"], d["centre_freq"], indexing="ij")
+        return {"n_modes": nn.ravel(), "centre_freq_Hz": ff.ravel(),
+                "error_pct": d["error_pct"].ravel()}
+
+    def _meta_table(self) -> dict:
+        c, t = self.case, self.truncation
+        return {"view": "suggested number of modes (thesis table 5.1)",
+                "threshold_pct": t.threshold, "f_max_Hz": t.f_max, "coupling": c.coupling,
+                "eigenfrequency": "highest retained eigenfrequency at 80 km/h"}
+
+    def _csv_table(self) -> dict:
+        tab = self.table()
+        return {"harmonic": tab["harmonic"], "f_low_Hz": tab["f_low"],
+                "f_high_Hz": tab["f_high"], "n_modes": tab["n_modes"],
+                "eigenfrequency_Hz": tab["eigenfrequency"]}
+
+
+class EigenView(Viewer):
+    """Highest retained eigenfrequency versus number of modes at 20/80/120 km/h (fig. 5.8)."""
+
+    case = param.ClassSelector(class_=CaseState)
+
+    def data(self) -> dict:
+        return compute.eigen_curves()
+
+    def _curves(self):
+        d = compute.eigen_curves()
+        styles = {"f_20": ("20 km/h", "#74c0fc"), "f_80": ("80 km/h", "#1c7ed6"),
+                  "f_120": ("120 km/h", "#0b3d91")}
+        layers = [
+            hv.Curve((d["n_modes"], d[k]), MODES, EIGEN, label=lab).opts(
+                color=col, hooks=[name_source(f"eigen.{k}")],
+                hover_tooltips=[("Speed", lab), ("N", "@n_modes"),
+                                ("Eigenfrequency", "@eigenfrequency{0.0} Hz")])
+            for k, (lab, col) in styles.items()
+        ]
+        return hv.Overlay(layers)
+
+    def _marker(self, n_modes):
+        return hv.VLine(float(n_modes)).opts(color=COLORS["round"], line_width=2)
+
+    def __panel__(self):
+        d = self.data()
+        static = self._curves().opts(
+            hv.opts.Curve(**{**CURVE_OPTS, "framewise": False}),
+            hv.opts.Overlay(legend_position="top_left", title="Eigenfrequency vs mode number",
+                            logy=False))
+        marker = hv.DynamicMap(self._marker, streams=[hv.streams.Params(self.case, ["n_modes"])])
+        dl = download_button(
+            "eigen", lambda: {"n_modes": d["n_modes"], "f_20kmh_Hz": d["f_20"],
+                              "f_80kmh_Hz": d["f_80"], "f_120kmh_Hz": d["f_120"]},
+            lambda: {"view": "highest retained eigenfrequency vs N (thesis fig. 5.8)"},
+            lambda: "eigenfrequency_vs_modes.csv")
+        return pn.Column(
+            pn.Row(pn.pane.Markdown("**Eigenfrequencies** (fig. 5.8)", margin=(0, 10)),
+                   pn.layout.HSpacer(), dl),
+            pn.pane.HoloViews(static * marker, sizing_mode="stretch_both", min_height=300),
+            sizing_mode="stretch_both",
+        )

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Start the dashboard on the shipped reference data (the README's "start the dashboard on a
+# fresh machine" command). Creates .venv if missing, installs the project if fbs_core is not
+# importable, then runs `panel serve app/main.py` and prints the URL.
+#
+# Environment: PORT (5006), ADDRESS (localhost; 0.0.0.0 to listen on all interfaces),
+# NUM_THREADS (4: one session's long computation does not block the others),
+# PYTHON (python3), SHOW=1 to open a browser (only where there is a display).
+# Serving to other machines: ADDRESS=0.0.0.0 and BOKEH_ALLOW_WS_ORIGIN=<host>:<port> (the
+# address the browsers use), or pass --allow-websocket-origin <host>:<port>.
+# Extra arguments are passed to `panel serve`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PY=${PYTHON:-python3}
+PORT=${PORT:-5006}
+ADDRESS=${ADDRESS:-localhost}
+NUM_THREADS=${NUM_THREADS:-4}
+
+if [ ! -x .venv/bin/python ]; then
+  echo "== creating .venv"
+  "$PY" -m venv .venv
+fi
+if ! .venv/bin/python -c "import fbs_core, panel, holoviews" >/dev/null 2>&1; then
+  echo "== installing the project into .venv"
+  .venv/bin/python -m pip install -q --upgrade pip
+  .venv/bin/python -m pip install -q -e .
+fi
+
+HOST=$ADDRESS
+if [ "$HOST" = "0.0.0.0" ]; then HOST=localhost; fi
+echo "== dashboard: http://${HOST}:${PORT}/main   (Ctrl-C stops it)"
+
+SHOW_ARG=()
+if [ "${SHOW:-0}" = 1 ] && { [ -n "${DISPLAY:-}" ] || [ "$(uname)" = Darwin ]; }; then
+  SHOW_ARG=(--show)
+fi
+exec .venv/bin/panel serve app/main.py --port "$PORT" --address "$ADDRESS" \
+  --num-threads "$NUM_THREADS" "${SHOW_ARG[@]}" "$@"
