@@ -1,0 +1,366 @@
+"""Compiled kernels of the noise study: small complex solves, noisy eq. 4.1, band statistics.
+
+Everything here works on plain arrays (no labels). Per frequency line ``l``:
+
+- ``A[l]`` ``(n_j, n_j)`` tire hub mobility ``Y_jj^A``,
+- ``a[l]`` ``(n_j,)`` free hub velocity of the tire ``Y_ja^A F_a``,
+- ``E[l]`` ``(n_j, n_j)`` chassis spindle mobility ``Y_jj^E``,
+- ``B[l]`` ``(n_e, n_j)`` chassis transfer mobility ``Y_ej^E``,
+
+and the noisy response of thesis eqs. 5.2-5.4 is
+
+    v_e = (S_B o B) [ (S_A o A) + (S_E o E) ]^-1 (s_a o a)
+
+(``o`` the element-wise product). The scaling factors of one round and line are
+consecutive segments of one counter-based stream (:mod:`._rng`)::
+
+    elements [0, n_j^2)                       S_A  (row major)
+             [n_j^2, n_j^2 + n_j)             s_a
+             [n_j^2 + n_j, 2 n_j^2 + n_j)     S_E  (row major)
+             [2 n_j^2 + n_j, ... + n_e n_j)   S_B  (row major)
+
+so tire-only noise uses exactly the tire factors of the same round with noise in
+both subsystems. ``n_j (n_j + 1)`` is even, so the tire part ends on a word boundary.
+
+Speed: the solves run on ``LANES`` rounds at once in structure-of-arrays layout
+(real and imaginary parts apart, rounds innermost), so that the compiler vectorises
+the elimination over rounds; partial pivoting is decided per round (lane).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ._rng import GOLDEN, mix64, stream_base
+
+_JIT = dict(cache=True, fastmath=False, error_model="numpy")
+
+#: Rounds solved together in one vectorised block.
+LANES = 32
+
+_ONE = np.uint64(1)
+_S32 = np.uint64(32)
+_LO32 = np.uint64(0xFFFFFFFF)
+_INV32 = 2.0**-32
+
+
+def n_elements(nj: int, ne: int) -> int:
+    """Number of scaling factors per round and line."""
+    return 2 * nj * nj + nj + ne * nj
+
+
+# -- one small system (reference implementation, used for the truncation study) ------------
+
+
+@njit(**_JIT)
+def lu_solve_inplace(W, x):
+    """Solve ``W y = x`` in place: Gaussian elimination with partial pivoting.
+
+    ``W (n, n)`` complex is overwritten by its LU factors, ``x (n,)`` by the
+    solution. Pivots are chosen by ``|Re| + |Im|`` as in LAPACK's ``zgetrf``. A zero
+    pivot gives ``inf``/``nan`` (no exception), which callers check.
+    """
+    n = W.shape[0]
+    for k in range(n):
+        piv = k
+        pmax = abs(W[k, k].real) + abs(W[k, k].imag)
+        for i in range(k + 1, n):
+            v = abs(W[i, k].real) + abs(W[i, k].imag)
+            if v > pmax:
+                pmax = v
+                piv = i
+        if piv != k:
+            for j in range(k, n):
+                t = W[k, j]
+                W[k, j] = W[piv, j]
+                W[piv, j] = t
+            t = x[k]
+            x[k] = x[piv]
+            x[piv] = t
+        inv = 1.0 / W[k, k]
+        for i in range(k + 1, n):
+            m = W[i, k] * inv
+            for j in range(k + 1, n):
+                W[i, j] -= m * W[k, j]
+            x[i] -= m * x[k]
+    for i in range(n - 1, -1, -1):
+        acc = x[i]
+        for j in range(i + 1, n):
+            acc -= W[i, j] * x[j]
+        x[i] = acc / W[i, i]
+
+
+@njit(parallel=True, **_JIT)
+def solve_batched(A, b):
+    """``np.linalg.solve(A, b[..., None])[..., 0]`` for ``A (m, n, n)``, ``b (m, n)``."""
+    m, n = b.shape
+    out = np.empty((m, n), np.complex128)
+    for i in prange(m):
+        W = A[i].copy()
+        x = b[i].copy()
+        lu_solve_inplace(W, x)
+        out[i] = x
+    return out
+
+
+# -- lanes of rounds ------------------------------------------------------------------------
+
+
+@njit(inline="always", **_JIT)
+def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
+    """Factors of words ``k0 .. k1-1`` of rounds ``rids[:nv]`` at stream line ``line``."""
+    n_el = s.shape[0]
+    for v in range(nv):
+        base[v] = stream_base(key, rids[v], line)
+    for k in range(k0, k1):
+        kk = (np.uint64(k) + _ONE) * GOLDEN
+        e = 2 * k
+        if e + 1 < n_el:
+            for v in range(nv):
+                w = mix64(base[v] + kk)
+                s[e, v] = 1.0 + p * (2.0 * (np.float64(w >> _S32) * _INV32) - 1.0)
+                s[e + 1, v] = 1.0 + p * (2.0 * (np.float64(w & _LO32) * _INV32) - 1.0)
+        else:
+            for v in range(nv):
+                w = mix64(base[v] + kk)
+                s[e, v] = 1.0 + p * (2.0 * (np.float64(w >> _S32) * _INV32) - 1.0)
+
+
+@njit(inline="always", **_JIT)
+def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, piv, pm, yr, yi):
+    """Noisy eq. 4.1 at one line for ``nv`` lanes: ``y (n_e, nv)`` from factors ``s``."""
+    nj = Ar.shape[0]
+    ne = Br.shape[0]
+    oa = nj * nj
+    oE = oa + nj
+    oB = oE + nj * nj
+    # interface matrix and right-hand side
+    for i in range(nj):
+        for k in range(nj):
+            sa = s[i * nj + k]
+            se = s[oE + i * nj + k]
+            A_r = Ar[i, k]
+            A_i = Ai[i, k]
+            E_r = Er[i, k]
+            E_i = Ei[i, k]
+            for v in range(nv):
+                Wr[i, k, v] = sa[v] * A_r + se[v] * E_r
+                Wi[i, k, v] = sa[v] * A_i + se[v] * E_i
+        sv = s[oa + i]
+        a_r = ar[i]
+        a_i = ai[i]
+        for v in range(nv):
+            xr[i, v] = sv[v] * a_r
+            xi[i, v] = sv[v] * a_i
+    # LU with partial pivoting per lane, applied to x on the fly
+    for k in range(nj):
+        for v in range(nv):
+            pm[v] = abs(Wr[k, k, v]) + abs(Wi[k, k, v])
+            piv[v] = k
+        for i in range(k + 1, nj):
+            for v in range(nv):
+                t = abs(Wr[i, k, v]) + abs(Wi[i, k, v])
+                if t > pm[v]:
+                    pm[v] = t
+                    piv[v] = i
+        for v in range(nv):
+            q = piv[v]
+            if q != k:
+                for j in range(k, nj):
+                    t = Wr[k, j, v]
+                    Wr[k, j, v] = Wr[q, j, v]
+                    Wr[q, j, v] = t
+                    t = Wi[k, j, v]
+                    Wi[k, j, v] = Wi[q, j, v]
+                    Wi[q, j, v] = t
+                t = xr[k, v]
+                xr[k, v] = xr[q, v]
+                xr[q, v] = t
+                t = xi[k, v]
+                xi[k, v] = xi[q, v]
+                xi[q, v] = t
+        for v in range(nv):
+            pr = Wr[k, k, v]
+            pi = Wi[k, k, v]
+            d = pr * pr + pi * pi
+            Pr[k, v] = pr / d
+            Pi[k, v] = -pi / d
+        for i in range(k + 1, nj):
+            for v in range(nv):
+                wr = Wr[i, k, v]
+                wi = Wi[i, k, v]
+                mr = wr * Pr[k, v] - wi * Pi[k, v]
+                mi = wr * Pi[k, v] + wi * Pr[k, v]
+                for j in range(k + 1, nj):
+                    Wr[i, j, v] -= mr * Wr[k, j, v] - mi * Wi[k, j, v]
+                    Wi[i, j, v] -= mr * Wi[k, j, v] + mi * Wr[k, j, v]
+                xr[i, v] -= mr * xr[k, v] - mi * xi[k, v]
+                xi[i, v] -= mr * xi[k, v] + mi * xr[k, v]
+    for i in range(nj - 1, -1, -1):
+        for v in range(nv):
+            cr = xr[i, v]
+            ci = xi[i, v]
+            for j in range(i + 1, nj):
+                cr -= Wr[i, j, v] * xr[j, v] - Wi[i, j, v] * xi[j, v]
+                ci -= Wr[i, j, v] * xi[j, v] + Wi[i, j, v] * xr[j, v]
+            xr[i, v] = cr * Pr[i, v] - ci * Pi[i, v]
+            xi[i, v] = cr * Pi[i, v] + ci * Pr[i, v]
+    # v_e = (S_B o B) x
+    for e in range(ne):
+        for v in range(nv):
+            yr[e, v] = 0.0
+            yi[e, v] = 0.0
+        for k in range(nj):
+            sb = s[oB + e * nj + k]
+            b_r = Br[e, k]
+            b_i = Bi[e, k]
+            for v in range(nv):
+                br = sb[v] * b_r
+                bi = sb[v] * b_i
+                yr[e, v] += br * xr[k, v] - bi * xi[k, v]
+                yi[e, v] += br * xi[k, v] + bi * xr[k, v]
+
+
+@njit(**_JIT)
+def _workspace(nj, ne, n_el):
+    s = np.ones((n_el, LANES))
+    base = np.empty(LANES, np.uint64)
+    W = np.empty((2, nj, nj, LANES))
+    X = np.empty((4, nj, LANES))
+    Y = np.empty((2, ne, LANES))
+    piv = np.empty(LANES, np.int64)
+    pm = np.empty(LANES)
+    return s, base, W, X, Y, piv, pm
+
+
+@njit(parallel=True, **_JIT)
+def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, l0, l1, key, rids, p, tire, vehicle,
+                    freq_dep, mag, cplx):
+    """Noisy responses of rounds ``rids`` at lines ``l0 .. l1-1``.
+
+    Writes ``|v_e|`` into ``mag (l1-l0, n_e, n_rounds)`` if ``mag.size`` (band mode),
+    else the complex response into ``cplx (n_rounds, n_f, n_e)`` (regeneration mode).
+    Lines are global indices, so a chunk of lines gives the same numbers as the whole.
+    ``tire``/``vehicle`` select which factors are random (the others are 1);
+    frequency-independent noise uses stream line 0 for every line.
+    """
+    nj = Ar.shape[1]
+    ne = Br.shape[1]
+    n_el = 2 * nj * nj + nj + ne * nj
+    k_tire = (nj * nj + nj) // 2
+    k_all = (n_el + 1) // 2
+    nr = rids.size
+    n_blocks = (nr + LANES - 1) // LANES
+    want_mag = mag.size > 0
+    for b in prange(n_blocks):
+        r0 = b * LANES
+        nv = min(LANES, nr - r0)
+        lane_ids = rids[r0:r0 + nv]
+        s, base, W, X, Y, piv, pm = _workspace(nj, ne, n_el)
+        for line in range(l0, l1):
+            if freq_dep or line == l0:
+                stream_line = line if freq_dep else 0
+                if tire:
+                    _lane_factors(key, lane_ids, nv, stream_line, p, 0, k_tire, s, base)
+                if vehicle:
+                    _lane_factors(key, lane_ids, nv, stream_line, p, k_tire, k_all, s, base)
+            _lane_solve(Ar[line], Ai[line], ar[line], ai[line], Er[line], Ei[line], Br[line],
+                        Bi[line], s, nv, W[0], W[1], X[0], X[1], X[2], X[3], piv, pm, Y[0], Y[1])
+            if want_mag:
+                for e in range(ne):
+                    for v in range(nv):
+                        mag[line - l0, e, r0 + v] = np.sqrt(Y[0, e, v] * Y[0, e, v]
+                                                            + Y[1, e, v] * Y[1, e, v])
+            else:
+                for e in range(ne):
+                    for v in range(nv):
+                        cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
+
+
+@njit(parallel=True, **_JIT)
+def noise_factors(key, rounds, lines, p, nj, ne, tire, vehicle):
+    """The scaling factors of ``(rounds[i], lines[i])``, shape ``(n, n_elements)``."""
+    n_el = 2 * nj * nj + nj + ne * nj
+    k_tire = (nj * nj + nj) // 2
+    k_all = (n_el + 1) // 2
+    out = np.ones((rounds.size, n_el))
+    for i in prange(rounds.size):
+        s = np.ones((n_el, 1))
+        base = np.empty(1, np.uint64)
+        rid = rounds[i:i + 1]
+        if tire:
+            _lane_factors(key, rid, 1, lines[i], p, 0, k_tire, s, base)
+        if vehicle:
+            _lane_factors(key, rid, 1, lines[i], p, k_tire, k_all, s, base)
+        out[i] = s[:, 0]
+    return out
+
+
+# -- statistics over rounds -----------------------------------------------------------------
+
+
+@njit(inline="always", **_JIT)
+def _order_stat_pair(col, k):
+    """``(x_(k), x_(k+1))``: 0-based order statistics of ``col`` (left unchanged)."""
+    n = col.size
+    part = np.partition(col, k)
+    lo = part[k]
+    hi = lo
+    if k + 1 < n:
+        hi = part[k + 1]
+        for i in range(k + 2, n):
+            if part[i] < hi:
+                hi = part[i]
+    return lo, hi
+
+
+@njit(parallel=True, **_JIT)
+def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_hi, l0):
+    """Band statistics over the rounds of ``mag (n_l, n_e, R)`` (rounds last).
+
+    Writes, for lines ``l0 .. l0 + n_l - 1`` of the outputs: minimum and maximum
+    (``lo``, ``hi`` ``(n_f, n_e)``) and the first rounds attaining them
+    (``arg_lo``, ``arg_hi``); the percentiles ``qs`` in % (``pct (n_q, n_f, n_e)``,
+    numpy's default "linear" method); the running minimum and maximum after the
+    first ``checkpoints[k]`` rounds (``conv_lo``, ``conv_hi`` ``(n_k, n_f, n_e)``,
+    checkpoints ascending, each in ``1 .. R``).
+    """
+    nl, ne, R = mag.shape
+    for c in prange(nl * ne):
+        li = c // ne
+        e = c - li * ne
+        col = mag[li, e]
+        line = l0 + li
+        mn = col[0]
+        mx = col[0]
+        imn = 0
+        imx = 0
+        kc = 0
+        for r in range(R):
+            v = col[r]
+            if v < mn:
+                mn = v
+                imn = r
+            if v > mx:
+                mx = v
+                imx = r
+            while kc < checkpoints.size and checkpoints[kc] == r + 1:
+                conv_lo[kc, line, e] = mn
+                conv_hi[kc, line, e] = mx
+                kc += 1
+        lo[line, e] = mn
+        hi[line, e] = mx
+        arg_lo[line, e] = imn
+        arg_hi[line, e] = imx
+        for iq in range(qs.size):
+            h = (R - 1) * qs[iq] / 100.0
+            k = int(np.floor(h))
+            if k >= R - 1:
+                pct[iq, line, e] = mx
+                continue
+            t = h - k
+            a0, b0 = _order_stat_pair(col, k)
+            d = b0 - a0
+            # numpy's _lerp: a + d t, evaluated from b for t >= 0.5
+            pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t

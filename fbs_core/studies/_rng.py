@@ -1,0 +1,99 @@
+"""Counter-based random numbers for the Monte-Carlo noise study (thesis 5.2).
+
+The noise factor of round ``r``, frequency line ``l`` and matrix element ``e`` is a
+pure function of ``(seed, r, l, e)``: no generator state is carried from one round
+to the next. Any round can therefore be regenerated alone, in any order, on any
+number of threads, and the rounds of a batch never have to be stored.
+
+The hash is the SplitMix64 output function (Steele, Lea & Flood, "Fast splittable
+pseudorandom number generators", OOPSLA 2014; finaliser constants of D. Stafford's
+"Mix13"), applied in three levels::
+
+    key        = mix(seed + G)
+    base(r, l) = mix(mix(key + (r + 1) G) + (l + 1) G)
+    word(k)    = mix(base(r, l) + (k + 1) G)           # k = e // 2
+
+with ``G = 0x9E3779B97F4A7C15`` and all arithmetic modulo 2**64. Each 64-bit word
+gives two uniforms in ``[0, 1)`` with 32-bit resolution: element ``2k`` from the high
+half, element ``2k + 1`` from the low half.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..errors import FBSError
+
+__all__ = ["GOLDEN", "mix64", "seed_key", "stream_base", "fill_uniform", "as_seed"]
+
+GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+_S27 = np.uint64(27)
+_S30 = np.uint64(30)
+_S31 = np.uint64(31)
+_S32 = np.uint64(32)
+_LO32 = np.uint64(0xFFFFFFFF)
+_ONE = np.uint64(1)
+_INV32 = 2.0**-32
+
+
+@njit(cache=True, inline="always")
+def mix64(z):
+    """SplitMix64 output function (a bijection of the 64-bit integers)."""
+    z = (z ^ (z >> _S30)) * _M1
+    z = (z ^ (z >> _S27)) * _M2
+    return z ^ (z >> _S31)
+
+
+@njit(cache=True)
+def seed_key(seed):
+    """The 64-bit key of an integer seed."""
+    return mix64(np.uint64(seed) + GOLDEN)
+
+
+@njit(cache=True, inline="always")
+def stream_base(key, r, line):
+    """The base counter of round ``r`` at frequency line ``line``."""
+    a = mix64(key + (np.uint64(r) + _ONE) * GOLDEN)
+    return mix64(a + (np.uint64(line) + _ONE) * GOLDEN)
+
+
+@njit(cache=True, inline="always")
+def fill_uniform(base, k0, k1, p, out):
+    """Write ``1 + p (2 u - 1)`` for elements ``2 k0 .. 2 k1 - 1`` into ``out``.
+
+    ``u`` are the uniforms of words ``k0 .. k1 - 1`` of the stream ``base``; an
+    element index beyond ``out.size`` (odd element counts) is skipped.
+    """
+    n = out.size
+    for k in range(k0, k1):
+        w = mix64(base + (np.uint64(k) + _ONE) * GOLDEN)
+        hi = np.float64(w >> _S32) * _INV32
+        lo = np.float64(w & _LO32) * _INV32
+        e = 2 * k
+        out[e] = 1.0 + p * (2.0 * hi - 1.0)
+        if e + 1 < n:
+            out[e + 1] = 1.0 + p * (2.0 * lo - 1.0)
+
+
+def as_seed(seed) -> int:
+    """An integer seed in ``[0, 2**64)`` from an int or a :class:`numpy.random.Generator`.
+
+    A generator contributes one draw, so that ``scatter_band(..., seed=rng)`` is
+    reproducible from the generator's own seed.
+
+    Raises
+    ------
+    FBSError
+        For negative, too large or non-integer seeds.
+    """
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(0, 2**63))
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise FBSError(f"seed must be a non-negative integer or a numpy Generator, got {seed!r}")
+    s = int(seed)
+    if not 0 <= s < 2**64:
+        raise FBSError(f"seed must be in [0, 2**64), got {s}")
+    return s

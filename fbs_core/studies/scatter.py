@@ -1,0 +1,420 @@
+"""Monte-Carlo noise scatter band of the coupled response (thesis section 5.2).
+
+Every element of the subsystem FRFs is scaled by a factor uniform in
+``[1 - p, 1 + p]`` and the bushing response of eq. 4.1 is recomputed, ``R`` times:
+
+- tire only (eq. 5.2):     ``Y_ej^E [S o Y_jj^A + Y_jj^E]^-1 S o (Y_ja^A F_a)``
+- vehicle only (eq. 5.3):  ``S o Y_ej^E [Y_jj^A + S o Y_jj^E]^-1 Y_ja^A F_a``
+- both (eq. 5.4):          ``S o Y_ej^E [S o Y_jj^A + S o Y_jj^E]^-1 S o (Y_ja^A F_a)``
+
+The thesis writes one symbol ``S`` but describes it as "a scaling matrix ... with
+the dimension of the FRF matrix or response matrix of the considered subsystems",
+each element multiplied by "a corresponding error element". Here every element of
+every matrix gets its own independent factor: ``S_A`` for ``Y_jj^A``, ``s_a`` for
+``Y_ja^A F_a``, ``S_E`` for ``Y_jj^E`` and ``S_B`` for ``Y_ej^E`` (the same symbol
+cannot be one matrix: the factors multiply a 6x6 matrix and a 6-vector). The FRFs
+are scaled element by element, without symmetrising (rotating tires are not
+reciprocal). ``frequency_dependent=False`` draws one set per round (the curves shift
+up or down, thesis fig. 5.10); ``True`` draws a new set at every line (imitates
+measurement noise, fig. 5.11).
+
+The band is the minimum and maximum of ``|v_e|`` over the rounds at every line and
+DOF (the thesis' corridor), plus percentiles. Random numbers are counter based
+(:mod:`._rng`): the factors of round ``r`` at line ``l`` are a pure function of
+``(seed, r, l)``, so :meth:`ScatterBand.round` regenerates any round alone, and the
+rounds are processed in chunks of lines whose size is bounded by ``max_chunk_bytes``
+(R = 10,000 rounds over 2,000 lines and 6 DOFs: about 64 MB of working memory).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataFormatError, FBSError, SingularInterfaceError
+from ..frf import check_grid
+from . import _kernels, _models
+from ._rng import as_seed, seed_key
+
+__all__ = ["TARGETS", "ScatterBand", "Convergence", "scatter_band", "scatter_band_arrays"]
+
+#: Where the noise goes.
+TARGETS = ("tire", "vehicle", "both")
+
+_EMPTY_MAG = np.empty((0, 0, 0))
+_EMPTY_CPLX = np.empty((0, 0, 0), np.complex128)
+
+
+def _ro(a, dtype=None):
+    a = np.array(a, dtype=dtype, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+def _db(x):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 20 * np.log10(x)
+
+
+@dataclass(frozen=True, eq=False)
+class Convergence:
+    """Band edges after the first ``rounds[k]`` rounds, to judge whether ``R`` is enough.
+
+    The thesis chose ``R`` "so that the borders stopped changing"; here the edges
+    are recorded at checkpoints as rounds are added.
+
+    Attributes
+    ----------
+    rounds : ndarray of int, shape (n_k,)
+        Checkpoints, ascending; the last is the total number of rounds.
+    lower, upper : ndarray, shape (n_k, n_f, n_dof)
+        Running minimum and maximum of ``|v_e|``.
+    """
+
+    rounds: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+    @property
+    def upper_change_db(self) -> np.ndarray:
+        """Largest gap (dB, over lines and DOFs) between the upper edge at each
+        checkpoint and the final one, shape ``(n_k,)``; 0 at the last checkpoint."""
+        return np.nanmax(_db(self.upper[-1] / self.upper), axis=(1, 2))
+
+    @property
+    def lower_change_db(self) -> np.ndarray:
+        """Largest gap (dB) between the lower edge at each checkpoint and the final one."""
+        return np.nanmax(_db(self.lower / self.lower[-1]), axis=(1, 2))
+
+    @property
+    def step_change_db(self) -> np.ndarray:
+        """Largest change (dB) of either edge from one checkpoint to the next, ``(n_k - 1,)``."""
+        up = np.nanmax(_db(self.upper[1:] / self.upper[:-1]), axis=(1, 2))
+        lo = np.nanmax(_db(self.lower[:-1] / self.lower[1:]), axis=(1, 2))
+        return np.maximum(up, lo)
+
+    def summary(self) -> str:
+        """One line per checkpoint: rounds and the remaining change of both edges in dB."""
+        lines = ["rounds   upper edge to final (dB)   lower edge to final (dB)"]
+        for r, u, lo in zip(self.rounds, self.upper_change_db, self.lower_change_db,
+                            strict=True):
+            lines.append(f"{int(r):>6d}   {u:24.3f}   {lo:24.3f}")
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True, eq=False)
+class ScatterBand:
+    """Noise corridor of the coupled response (thesis figs. 5.9-5.11).
+
+    Attributes
+    ----------
+    freq : ndarray, shape (n_f,)
+        Frequency lines in Hz.
+    dofs : tuple of str, length n_dof
+        Response DOF labels.
+    reference : ndarray, shape (n_f, n_dof)
+        Unpolluted complex response (exactly the kernel's result with all factors 1).
+    lower, upper : ndarray, shape (n_f, n_dof)
+        Minimum and maximum of ``|v_e|`` over the rounds.
+    argmin_round, argmax_round : ndarray of int, shape (n_f, n_dof)
+        First round attaining them (regenerate it with :meth:`round`).
+    q : ndarray, shape (n_q,)
+        Percentile levels in % (e.g. 5, 95).
+    percentiles : ndarray, shape (n_q, n_f, n_dof)
+        Percentiles of ``|v_e|`` over the rounds (numpy's "linear" definition).
+    convergence : Convergence
+    noise, target, rounds, frequency_dependent, seed, harmonic
+        The settings.
+    """
+
+    freq: np.ndarray
+    dofs: tuple[str, ...]
+    reference: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    argmin_round: np.ndarray
+    argmax_round: np.ndarray
+    q: np.ndarray
+    percentiles: np.ndarray
+    convergence: Convergence
+    noise: float
+    target: str
+    rounds: int
+    frequency_dependent: bool
+    seed: int
+    harmonic: int | None
+    _inputs: tuple
+
+    def _dof(self, dof) -> int:
+        if isinstance(dof, str):
+            if dof not in self.dofs:
+                from ..errors import DOFError
+
+                raise DOFError(f"unknown response DOF {dof!r}; available: {', '.join(self.dofs)}")
+            return self.dofs.index(dof)
+        return int(dof)
+
+    def round(self, r: int) -> np.ndarray:
+        """The complex response of round ``r``, shape ``(n_f, n_dof)``, regenerated alone.
+
+        Identical (bit for bit) to the round inside the batch.
+
+        Raises
+        ------
+        FBSError
+            For ``r`` outside ``0 .. rounds - 1``.
+        """
+        return self.rounds_response([r])[0]
+
+    def rounds_response(self, rounds) -> np.ndarray:
+        """Complex responses of several rounds, shape ``(n, n_f, n_dof)``."""
+        rids = np.atleast_1d(np.asarray(rounds, np.int64))
+        if rids.ndim != 1 or np.any((rids < 0) | (rids >= self.rounds)):
+            raise FBSError(f"round indices must be in 0..{self.rounds - 1}, got {rids.tolist()}")
+        arrays, key = self._inputs
+        tire, vehicle = _flags(self.target)
+        return _run_complex(arrays, key, rids, self.noise, tire, vehicle,
+                            self.frequency_dependent)
+
+    def peak_round(self, freq: float, dof, which: str = "max") -> int:
+        """The round giving the highest (``"max"``) or lowest (``"min"``) ``|v_e|`` at the
+        line nearest ``freq`` (the curves of thesis figs. 5.10-5.11)."""
+        if which not in ("max", "min"):
+            raise FBSError(f"which must be 'max' or 'min', got {which!r}")
+        line = int(np.argmin(np.abs(self.freq - freq)))
+        arr = self.argmax_round if which == "max" else self.argmin_round
+        return int(arr[line, self._dof(dof)])
+
+    def factors(self, r: int, line: int = 0) -> dict[str, np.ndarray]:
+        """The scaling factors of round ``r`` at line index ``line``:
+        ``{"Yjj_A": (n_j, n_j), "vj_A": (n_j,), "Yjj_E": (n_j, n_j), "Yej_E": (n_e, n_j)}``
+        (1 where no noise is applied; ``line`` is ignored without frequency dependence)."""
+        arrays, key = self._inputs
+        nj, ne = arrays[2].shape[1], arrays[6].shape[1]
+        tire, vehicle = _flags(self.target)
+        stream_line = line if self.frequency_dependent else 0
+        s = _kernels.noise_factors(key, np.array([r], np.int64), np.array([stream_line]),
+                                   self.noise, nj, ne, tire, vehicle)[0]
+        return split_factors(s, nj, ne)
+
+
+def split_factors(s: np.ndarray, nj: int, ne: int) -> dict[str, np.ndarray]:
+    """Split one stream of factors into the four scaling arrays (layout of :mod:`._kernels`)."""
+    o1, o2, o3 = nj * nj, nj * nj + nj, 2 * nj * nj + nj
+    return {
+        "Yjj_A": s[..., :o1].reshape(s.shape[:-1] + (nj, nj)),
+        "vj_A": s[..., o1:o2],
+        "Yjj_E": s[..., o2:o3].reshape(s.shape[:-1] + (nj, nj)),
+        "Yej_E": s[..., o3:o3 + ne * nj].reshape(s.shape[:-1] + (ne, nj)),
+    }
+
+
+def _flags(target: str) -> tuple[bool, bool]:
+    if target not in TARGETS:
+        raise FBSError(f"unknown noise target {target!r}; allowed: {', '.join(TARGETS)}")
+    return target in ("tire", "both"), target in ("vehicle", "both")
+
+
+def _split(z):
+    return np.ascontiguousarray(z.real, float), np.ascontiguousarray(z.imag, float)
+
+
+def _run_complex(arrays, key, rids, p, tire, vehicle, freq_dep):
+    nf, ne = arrays[0].shape[0], arrays[6].shape[1]
+    out = np.empty((rids.size, nf, ne), np.complex128)
+    _kernels.noisy_block_run(*arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep,
+                             _EMPTY_MAG, out)
+    return out
+
+
+def default_checkpoints(rounds: int) -> np.ndarray:
+    """1-2-5 steps from 10 up to ``rounds`` (always ending at ``rounds``)."""
+    out = []
+    dec = 10
+    while dec < rounds:
+        out += [m * dec for m in (1, 2, 5) if m * dec < rounds]
+        dec *= 10
+    return np.array(out + [rounds], np.int64)
+
+
+def _check_inputs(YjjA, vj, YjjE, YejE):
+    YjjA, vj, YjjE, YejE = (np.asarray(x) for x in (YjjA, vj, YjjE, YejE))
+    if YjjA.ndim != 3 or YjjA.shape[1] != YjjA.shape[2]:
+        raise DataFormatError(f"YjjA must have shape (n_f, n_j, n_j), got {YjjA.shape}")
+    nf, nj = YjjA.shape[:2]
+    if vj.shape != (nf, nj):
+        raise DataFormatError(f"vj must have shape (n_f, n_j) = {(nf, nj)}, got {vj.shape}")
+    if YjjE.shape != (nf, nj, nj):
+        raise DataFormatError(f"YjjE must have shape {(nf, nj, nj)}, got {YjjE.shape}")
+    if YejE.ndim != 3 or YejE.shape[0] != nf or YejE.shape[2] != nj:
+        raise DataFormatError(f"YejE must have shape (n_f, n_e, {nj}) with n_f = {nf}, "
+                              f"got {YejE.shape}")
+    for name, x in (("YjjA", YjjA), ("vj", vj), ("YjjE", YjjE), ("YejE", YejE)):
+        if not np.all(np.isfinite(x)):
+            raise DataFormatError(f"{name} contains non-finite values")
+    return (*_split(YjjA), *_split(vj), *_split(YjjE), *_split(YejE))
+
+
+def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = "both",
+                        rounds: int = 10_000, frequency_dependent: bool = False, seed=0, *,
+                        freq=None, dofs=None, harmonic=None, percentiles=(5.0, 95.0),
+                        checkpoints=None, max_chunk_bytes: float = 64e6) -> ScatterBand:
+    """The scatter band from arrays (the kernel behind :func:`scatter_band`).
+
+    Parameters
+    ----------
+    YjjA : ndarray, shape (n_f, n_j, n_j)
+        Tire mobility at the interface ``Y_jj^A``.
+    vj : ndarray, shape (n_f, n_j)
+        Free interface velocity of the tire ``Y_ja^A F_a``.
+    YjjE : ndarray, shape (n_f, n_j, n_j)
+        Chassis mobility at the interface ``Y_jj^E``.
+    YejE : ndarray, shape (n_f, n_e, n_j)
+        Chassis transfer mobility ``Y_ej^E``.
+    noise : float
+        ``p``: factors uniform in ``[1 - p, 1 + p]`` (0.1 = +-10 %), ``0 <= p < 1``.
+    target : {"tire", "vehicle", "both"}
+        Eq. 5.2, 5.3 or 5.4.
+    rounds : int
+        Number of rounds ``R``.
+    frequency_dependent : bool
+        New factors at every line (True) or one set per round (False).
+    seed : int or numpy.random.Generator
+        Reproducibility key (a generator contributes one draw).
+    freq : array_like, optional
+        Frequencies of the lines (default ``0, 1, ...``); ``dofs`` response labels.
+    percentiles : sequence of float
+        Percentile levels in %.
+    checkpoints : sequence of int, optional
+        Round counts at which the band edges are recorded (default 10, 20, 50, ...).
+    max_chunk_bytes : float
+        Working-memory bound of one chunk of lines (``8 R n_e`` bytes per line).
+
+    Returns
+    -------
+    ScatterBand
+
+    Raises
+    ------
+    FBSError
+        For a bad noise level, target, round count, percentile or checkpoint.
+    DataFormatError
+        For arrays of the wrong shapes or with non-finite values.
+    SingularInterfaceError
+        If the (noisy) interface matrix is singular at some line.
+    """
+    arrays = _check_inputs(YjjA, vj, YjjE, YejE)
+    nf, nj = arrays[2].shape
+    ne = arrays[6].shape[1]
+    if not (0.0 <= noise < 1.0):
+        raise FBSError(f"noise must be in [0, 1) (0.1 = +-10 %), got {noise!r}")
+    tire, vehicle = _flags(target)
+    if isinstance(rounds, bool) or not isinstance(rounds, int | np.integer) or rounds < 1:
+        raise FBSError(f"rounds must be a positive integer, got {rounds!r}")
+    rounds = int(rounds)
+    qs = np.atleast_1d(np.asarray(percentiles, float))
+    if qs.ndim != 1 or np.any(~np.isfinite(qs) | (qs < 0) | (qs > 100)):
+        raise FBSError(f"percentiles must be levels in [0, 100] %, got {qs.tolist()}")
+    ck = default_checkpoints(rounds) if checkpoints is None else np.asarray(checkpoints, np.int64)
+    if ck.ndim != 1 or ck.size == 0 or np.any(np.diff(ck) <= 0) or ck[0] < 1 or ck[-1] > rounds:
+        raise FBSError(f"checkpoints must be ascending round counts in 1..{rounds}, "
+                       f"got {np.asarray(checkpoints).tolist()}")
+    if ck[-1] != rounds:
+        ck = np.append(ck, rounds)
+    f = np.arange(nf, dtype=float) if freq is None else check_grid(freq)
+    if f.size != nf:
+        raise DataFormatError(f"{f.size} frequencies for {nf} lines")
+    if dofs is None:
+        dofs = tuple(f"bushing:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))[:ne]
+    dofs = tuple(dofs)
+    if len(dofs) != ne:
+        raise DataFormatError(f"{len(dofs)} response labels for {ne} response DOFs")
+    seed = as_seed(seed)
+    key = seed_key(seed)
+
+    ref = _run_complex(arrays, key, np.zeros(1, np.int64), 0.0, False, False, False)[0]
+    lo = np.empty((nf, ne))
+    hi = np.empty((nf, ne))
+    alo = np.empty((nf, ne), np.int64)
+    ahi = np.empty((nf, ne), np.int64)
+    pct = np.empty((qs.size, nf, ne))
+    clo = np.empty((ck.size, nf, ne))
+    chi = np.empty((ck.size, nf, ne))
+    per_line = 8 * ne * rounds
+    chunk = int(max(1, min(nf, max_chunk_bytes // per_line)))
+    mag = np.empty((chunk, ne, rounds))
+    rids = np.arange(rounds, dtype=np.int64)
+    for l0 in range(0, nf, chunk):
+        l1 = min(nf, l0 + chunk)
+        m = mag[: l1 - l0]
+        _kernels.noisy_block_run(*arrays, l0, l1, key, rids, float(noise), tire, vehicle,
+                                 bool(frequency_dependent), m, _EMPTY_CPLX)
+        _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
+    del mag
+    for name, x in (("reference", np.abs(ref)), ("upper edge", hi), ("lower edge", lo)):
+        if not np.all(np.isfinite(x)):
+            line = int(np.argwhere(~np.isfinite(x))[0][0])
+            raise SingularInterfaceError(
+                f"{name} of the scatter band is not finite at {f[line]:g} Hz: the (noisy) "
+                "interface matrix Y_jj^A + Y_jj^E is singular there"
+            )
+    frozen_arrays = tuple(_ro(a) for a in arrays)
+    return ScatterBand(
+        freq=_ro(f), dofs=dofs, reference=_ro(ref), lower=_ro(lo), upper=_ro(hi),
+        argmin_round=_ro(alo), argmax_round=_ro(ahi), q=_ro(qs), percentiles=_ro(pct),
+        convergence=Convergence(_ro(ck), _ro(clo), _ro(chi)), noise=float(noise),
+        target=target, rounds=rounds, frequency_dependent=bool(frequency_dependent),
+        seed=seed, harmonic=harmonic, _inputs=(frozen_arrays, key),
+    )
+
+
+def scatter_band(harmonic, noise: float = 0.1, target: str = "both", rounds: int = 10_000,
+                 frequency_dependent: bool = False, seed=0, *, n_modes=None, freq=None,
+                 df: float = 0.5, tire=None, chassis=None, coupling="6dof",
+                 percentiles=(5.0, 95.0), checkpoints=None,
+                 max_chunk_bytes: float = 64e6) -> ScatterBand:
+    """Noise scatter band of the bushing response for one harmonic (thesis 5.2, eqs. 5.2-5.4).
+
+    Parameters
+    ----------
+    harmonic : int or Harmonic
+        Excitation case 1..7.
+    noise, target, rounds, frequency_dependent, seed
+        See :func:`scatter_band_arrays`.
+    n_modes : int, optional
+        Retained tire modes (default all).
+    freq : array_like, optional
+        Frequency lines in Hz; default ``harmonic.frequencies(df)``.
+    tire, chassis : optional
+        Models (default the reference ones); ``chassis`` may be an FRF on ``freq``.
+    coupling : {"6dof", "5dof"} or sequence of directions
+    percentiles, checkpoints, max_chunk_bytes
+        See :func:`scatter_band_arrays`.
+
+    Returns
+    -------
+    ScatterBand
+
+    Examples
+    --------
+    >>> import fbs_core
+    >>> band = fbs_core.scatter_band(4, noise=0.1, rounds=1000)    # doctest: +SKIP
+    >>> r = band.peak_round(42.0, "bushing:z")                     # doctest: +SKIP
+    >>> curve = band.round(r)                                      # doctest: +SKIP
+    """
+    h = _models.resolve_harmonic(harmonic)
+    tire = _models.resolve_tire(tire)
+    dirs = _models.coupled_directions(coupling)
+    f = h.frequencies(df) if freq is None else check_grid(freq)
+    n_total = _models.total_modes(tire)
+    n = n_total if n_modes is None else int(n_modes)
+    if not 1 <= n <= n_total:
+        raise FBSError(f"n_modes must be in 1..{n_total} (the tire's modes), got {n_modes!r}")
+    YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
+    YjjA, vj = _models.tire_arrays(tire, f, h, [n], dirs)
+    return scatter_band_arrays(
+        YjjA[0], vj[0], YjjE, YejE, noise, target, rounds, frequency_dependent, seed,
+        freq=f, dofs=resp, harmonic=h.k, percentiles=percentiles, checkpoints=checkpoints,
+        max_chunk_bytes=max_chunk_bytes,
+    )

@@ -1,0 +1,404 @@
+"""Modal truncation study of the tire model (thesis section 5.1).
+
+The coupled bushing response of eq. 4.1 is computed with the tire's modal sum cut
+after ``N`` modes (pairs of positive and negative eigenfrequencies, lowest first;
+``N = 10, 20, ..., 400`` in the thesis) and compared with the response using all
+modes by the floating-band error of eq. 5.1. All ``N`` come from one cumulative
+modal sum of the tire (``tire.truncations``), not from separate syntheses, and all
+couplings from one batched solve.
+
+Public entry points: :func:`truncation_map` (thesis figs. 5.3, 5.6, 5.7),
+:func:`suggest_modes` (table 5.1) and :func:`mode_frequencies` (fig. 5.8).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import kernels
+from ..errors import DOFError, FBSError
+from ..frf import check_grid
+from . import _models
+from .metric import floating_band_error
+
+__all__ = [
+    "TruncationMap",
+    "SuggestedModes",
+    "ModeFrequencies",
+    "truncation_map",
+    "truncation_map_arrays",
+    "suggest_n_modes",
+    "suggest_modes",
+    "mode_frequencies",
+]
+
+
+def _ro(a, dtype=None):
+    a = np.array(a, dtype=dtype, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class TruncationMap:
+    """Truncation error versus retained modes and centre frequency, for one harmonic.
+
+    Attributes
+    ----------
+    harmonic : int or None
+        Harmonic case number (``None`` for user arrays).
+    n_modes : ndarray of int, shape (n_N,)
+        Retained-mode counts.
+    n_modes_total : int or None
+        Modes of the reference (all modes).
+    centres : ndarray, shape (n_c,)
+        Centre frequencies of the floating band in Hz.
+    dofs : tuple of str, length n_dof
+        Response DOF labels (e.g. ``bushing:x`` ...).
+    error : ndarray, shape (n_N, n_c, n_dof)
+        Eq. 5.1 error (0.2 = 20 %).
+    freq : ndarray, shape (n_f,)
+        Frequency lines of the responses.
+    response : ndarray, shape (n_N, n_f, n_dof)
+        Coupled responses (eq. 4.1) with ``n_modes`` retained modes.
+    reference : ndarray, shape (n_f, n_dof)
+        Coupled response with all modes.
+    width, step : float
+        Band width and step in Hz; ``edges`` the band-edge treatment.
+    """
+
+    harmonic: int | None
+    n_modes: np.ndarray
+    n_modes_total: int | None
+    centres: np.ndarray
+    dofs: tuple[str, ...]
+    error: np.ndarray
+    freq: np.ndarray
+    response: np.ndarray
+    reference: np.ndarray
+    width: float
+    step: float
+    edges: str
+
+    @property
+    def max_error(self) -> np.ndarray:
+        """Maximum error over the response DOFs, shape ``(n_N, n_c)`` (thesis fig. 5.6)."""
+        return self.error.max(axis=-1)
+
+    def dof_error(self, dof: str) -> np.ndarray:
+        """Error of one response DOF, shape ``(n_N, n_c)`` (e.g. ``"bushing:z"``, fig. 5.7).
+
+        Raises
+        ------
+        DOFError
+            For a label that is not a response DOF.
+        """
+        if dof not in self.dofs:
+            raise DOFError(f"unknown response DOF {dof!r}; available: {', '.join(self.dofs)}")
+        return self.error[:, :, self.dofs.index(dof)]
+
+    def suggest(self, threshold: float = 0.2, f_max: float = 160.0, dof: str | None = None):
+        """Smallest retained-mode count from which the error stays below ``threshold``.
+
+        See :func:`suggest_n_modes`; ``dof=None`` uses the maximum over DOFs.
+        """
+        err = self.max_error if dof is None else self.dof_error(dof)
+        return suggest_n_modes(err, self.centres, self.n_modes, threshold, f_max,
+                               self.n_modes_total)
+
+
+def suggest_n_modes(error, centres, n_modes, threshold: float = 0.2, f_max: float = 160.0,
+                    n_total: int | None = None) -> int:
+    """Thesis table 5.1: the smallest ``N`` from which the error stays below the threshold.
+
+    ``N`` qualifies when, for it and for every larger count in ``n_modes``, the error
+    at all centres ``<= f_max`` is below ``threshold``. Adding modes can raise the
+    error again (thesis 5.1.2), hence "from which ... stays". The reference (all
+    modes, ``n_total``) always qualifies. Larger thresholds never give larger ``N``.
+
+    Parameters
+    ----------
+    error : ndarray, shape (n_N, n_c)
+    centres : ndarray, shape (n_c,)
+    n_modes : ndarray of int, shape (n_N,), ascending
+    threshold, f_max : float
+    n_total : int, optional
+        Modes of the reference; returned when no count in ``n_modes`` qualifies
+        (default: ``max(n_modes)``).
+
+    Returns
+    -------
+    int
+        ``0`` when no centre lies at or below ``f_max`` (nothing to predict there).
+
+    Raises
+    ------
+    FBSError
+        For a negative threshold or counts that are not ascending.
+    """
+    err = np.asarray(error, float)
+    c = np.asarray(centres, float)
+    n = np.asarray(n_modes)
+    if not threshold >= 0:
+        raise FBSError(f"threshold must be >= 0 (0.2 = 20 %), got {threshold!r}")
+    if n.ndim != 1 or np.any(np.diff(n) <= 0):
+        raise FBSError(f"n_modes must be strictly ascending, got {n.tolist()}")
+    if err.shape != (n.size, c.size):
+        raise FBSError(f"error has shape {err.shape}, expected (n_N, n_c) = {(n.size, c.size)}")
+    sel = c <= f_max + 1e-9
+    if not sel.any():
+        return 0
+    ok = np.all(err[:, sel] < threshold, axis=1)
+    # ok from index i on: suffix-and
+    stays = np.flip(np.logical_and.accumulate(np.flip(ok)))
+    if stays.any():
+        return int(n[np.argmax(stays)])
+    return int(n_total if n_total is not None else n[-1])
+
+
+def truncation_map_arrays(freq, YjjA, vj, YjjA_ref, vj_ref, YjjE, YejE, n_modes, *,
+                          dofs=None, harmonic=None, n_modes_total=None, width: float = 12.0,
+                          step: float = 1.0, edges: str = "clip", centres=None) -> TruncationMap:
+    """The error map from arrays (the kernel behind :func:`truncation_map`).
+
+    Parameters
+    ----------
+    freq : ndarray, shape (n_f,)
+    YjjA : ndarray, shape (n_N, n_f, n_j, n_j)
+        Tire hub mobility with ``n_modes[i]`` retained modes.
+    vj : ndarray, shape (n_N, n_f, n_j)
+        Free hub velocity ``Y_ja^A F_a`` with ``n_modes[i]`` retained modes.
+    YjjA_ref, vj_ref : ndarray, shapes (n_f, n_j, n_j), (n_f, n_j)
+        The same with all modes (the reference).
+    YjjE : ndarray, shape (n_f, n_j, n_j)
+        Chassis mobility at the interface.
+    YejE : ndarray, shape (n_f, n_e, n_j)
+        Chassis transfer mobility interface -> responses.
+    n_modes : array_like of int, shape (n_N,)
+    dofs : sequence of str, optional
+        Response labels (default ``bushing:x`` ...).
+
+    Returns
+    -------
+    TruncationMap
+    """
+    f = check_grid(freq)
+    n = np.asarray(n_modes)
+    YjjA = np.asarray(YjjA)
+    if YjjA.ndim != 4 or YjjA.shape[:2] != (n.size, f.size):
+        raise FBSError(
+            f"YjjA has shape {YjjA.shape}, expected (n_N, n_f, n_j, n_j) with n_N = {n.size} "
+            f"and n_f = {f.size}"
+        )
+    resp = kernels.couple_response_kernel(YejE[None], YjjA, YjjE[None], vj)
+    ref = kernels.couple_response_kernel(YejE, YjjA_ref, YjjE, vj_ref)
+    if not (np.all(np.isfinite(resp)) and np.all(np.isfinite(ref))):
+        bad = np.argwhere(~np.isfinite(resp))
+        line = int(bad[0][1]) if bad.size else int(np.argwhere(~np.isfinite(ref))[0][0])
+        raise FBSError(f"coupled response is not finite at {f[line]:g} Hz (singular interface?)")
+    c, err = floating_band_error(f, ref, resp, width, step, edges, centres)
+    if dofs is None:
+        dofs = tuple(f"bushing:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))[: ref.shape[-1]]
+    if len(dofs) != ref.shape[-1]:
+        raise DOFError(f"{len(dofs)} response labels for {ref.shape[-1]} response DOFs")
+    return TruncationMap(
+        harmonic=harmonic,
+        n_modes=_ro(n, int),
+        n_modes_total=n_modes_total,
+        centres=_ro(c),
+        dofs=tuple(dofs),
+        error=_ro(err),
+        freq=_ro(f),
+        response=_ro(resp),
+        reference=_ro(ref),
+        width=float(width),
+        step=float(step),
+        edges=edges,
+    )
+
+
+def default_n_modes(n_total: int, step: int = 10) -> np.ndarray:
+    """``step, 2 step, ...`` up to ``n_total`` (thesis: 10, 20, ..., 400)."""
+    return np.arange(step, n_total + 1, step)
+
+
+def truncation_map(harmonic, n_modes=None, *, freq=None, df: float = 0.5, width: float = 12.0,
+                   step: float = 1.0, edges: str = "clip", centres=None, tire=None,
+                   chassis=None, coupling="6dof") -> TruncationMap:
+    """Truncation error map of one harmonic (thesis figs. 5.3, 5.6, 5.7).
+
+    Parameters
+    ----------
+    harmonic : int or Harmonic
+        Excitation case 1..7.
+    n_modes : array_like of int, optional
+        Retained-mode counts (ascending); default ``10, 20, ...`` up to all modes.
+    freq : array_like, optional
+        Frequency lines in Hz; default ``harmonic.frequencies(df)``.
+    width, step, edges, centres
+        Floating band (see :func:`~fbs_core.studies.metric.floating_band_error`).
+    tire, chassis : optional
+        Models (default: the reference tire and chassis); ``chassis`` may also be an
+        FRF on ``freq`` (inputs ``spindle:*``).
+    coupling : {"6dof", "5dof"} or sequence of directions
+        Coupled hub directions.
+
+    Returns
+    -------
+    TruncationMap
+
+    Examples
+    --------
+    >>> import fbs_core
+    >>> m = fbs_core.truncation_map(1)                    # doctest: +SKIP
+    >>> m.max_error.shape == (m.n_modes.size, m.centres.size)  # doctest: +SKIP
+    True
+    """
+    h = _models.resolve_harmonic(harmonic)
+    tire = _models.resolve_tire(tire)
+    dirs = _models.coupled_directions(coupling)
+    f = h.frequencies(df) if freq is None else check_grid(freq)
+    n_total = _models.total_modes(tire)
+    n = default_n_modes(n_total) if n_modes is None else np.asarray(n_modes, int)
+    if n.ndim != 1 or n.size == 0 or np.any(np.diff(n) <= 0) or n[0] < 1 or n[-1] > n_total:
+        raise FBSError(
+            f"n_modes must be ascending counts in 1..{n_total} (the tire's modes), "
+            f"got {np.asarray(n_modes).tolist()}"
+        )
+    YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
+    YjjA, vj = _models.tire_arrays(tire, f, h, list(n) + [n_total], dirs)
+    return truncation_map_arrays(
+        f, YjjA[:-1], vj[:-1], YjjA[-1], vj[-1], YjjE, YejE, n, dofs=resp, harmonic=h.k,
+        n_modes_total=n_total, width=width, step=step, edges=edges, centres=centres,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class ModeFrequencies:
+    """Highest eigenfrequency among the first ``N`` modes (thesis fig. 5.8).
+
+    Attributes
+    ----------
+    n_modes : ndarray of int, shape (n_N,)
+    speeds : ndarray, shape (n_s,)
+        Operating points in km/h.
+    frequency : ndarray, shape (n_s, n_N)
+        Highest eigenfrequency in Hz among ``N`` retained modes (``N / 2`` pairs).
+    """
+
+    n_modes: np.ndarray
+    speeds: np.ndarray
+    frequency: np.ndarray
+
+
+def _highest_retained(eig: np.ndarray, n: np.ndarray) -> np.ndarray:
+    pairs = np.maximum(n // 2, 1)
+    if pairs.max() > eig.size:
+        raise FBSError(f"{int(n.max())} modes requested, the tire has {2 * eig.size}")
+    return eig[pairs - 1]
+
+
+def mode_frequencies(speeds=(20.0, 80.0, 120.0), n_modes=None, tire=None) -> ModeFrequencies:
+    """Eigenfrequency versus number of retained modes at some speeds (thesis fig. 5.8).
+
+    ``N`` modes are ``N / 2`` pairs of positive and negative eigenfrequencies, lowest
+    first; the value is the ``N / 2``-th positive eigenfrequency at each speed.
+    """
+    tire = _models.resolve_tire(tire)
+    n_total = _models.total_modes(tire)
+    n = default_n_modes(n_total) if n_modes is None else np.asarray(n_modes, int)
+    sp = np.atleast_1d(np.asarray(speeds, float))
+    fr = np.stack([_highest_retained(np.sort(np.asarray(tire.eigenfrequencies(float(v)))), n)
+                   for v in sp])
+    return ModeFrequencies(_ro(n, int), _ro(sp), _ro(fr))
+
+
+@dataclass(frozen=True, eq=False)
+class SuggestedModes:
+    """Suggested number of modes per harmonic (thesis table 5.1).
+
+    Attributes
+    ----------
+    harmonics : tuple of int
+    n_modes : ndarray of int, shape (n_h,)
+        Smallest retained-mode count from which the error stays below ``threshold``
+        up to ``f_max`` (0: the harmonic has no centre at or below ``f_max``).
+    eigenfrequency : ndarray, shape (n_h,)
+        Highest eigenfrequency among those modes at ``speed`` (NaN where n_modes is 0).
+    freq_range : ndarray, shape (n_h, 2)
+        Excitation band of each harmonic in Hz.
+    threshold, f_max, speed : float
+    dof : str or None
+        Response DOF judged (None: maximum over DOFs).
+    maps : tuple of TruncationMap
+        The maps the table was read from (reusable: ``suggest_modes(maps=...)``).
+    """
+
+    harmonics: tuple[int, ...]
+    n_modes: np.ndarray
+    eigenfrequency: np.ndarray
+    freq_range: np.ndarray
+    threshold: float
+    f_max: float
+    speed: float
+    dof: str | None
+    maps: tuple[TruncationMap, ...]
+
+    def table(self) -> str:
+        """Plain-text table in the layout of thesis table 5.1."""
+        head = "harmonic            " + "".join(f"{k:>8d}" for k in self.harmonics)
+        rows = [
+            ("lowest freq. (Hz)", [f"{a:8.1f}" for a in self.freq_range[:, 0]]),
+            ("highest freq. (Hz)", [f"{b:8.1f}" for b in self.freq_range[:, 1]]),
+            (f"modes to {self.f_max:g} Hz", [f"{n:8d}" for n in self.n_modes]),
+            ("eigenfreq. (Hz)", [f"{e:8.0f}" for e in self.eigenfrequency]),
+        ]
+        return "\n".join([head] + [f"{t:<20s}" + "".join(v) for t, v in rows])
+
+
+def suggest_modes(threshold: float = 0.2, f_max: float = 160.0, *, harmonics=(1, 2, 3, 4, 5, 6, 7),
+                  dof: str | None = None, speed: float = 80.0, maps=None, n_modes=None,
+                  df: float = 0.5, width: float = 12.0, step: float = 1.0, edges: str = "clip",
+                  tire=None, chassis=None, coupling="6dof") -> SuggestedModes:
+    """Suggested number of tire modes for every harmonic (thesis table 5.1).
+
+    Parameters
+    ----------
+    threshold : float
+        Largest acceptable eq. 5.1 error (0.2 = 20 %, the thesis' choice).
+    f_max : float
+        Upper frequency of the predictions in Hz (130 and 160 Hz in the thesis).
+    harmonics : sequence of int
+    dof : str, optional
+        Judge one response DOF (e.g. ``"bushing:z"``); default the maximum over DOFs.
+    speed : float
+        Operating point (km/h) of the reported highest eigenfrequency (thesis: 80).
+    maps : sequence of TruncationMap, optional
+        Precomputed maps (one per harmonic, e.g. ``result.maps`` of an earlier call),
+        so that several thresholds or ``f_max`` cost no new coupling.
+    n_modes, df, width, step, edges, tire, chassis, coupling
+        Passed to :func:`truncation_map`.
+
+    Returns
+    -------
+    SuggestedModes
+    """
+    tire = _models.resolve_tire(tire)
+    if maps is None:
+        maps = tuple(
+            truncation_map(k, n_modes, df=df, width=width, step=step, edges=edges, tire=tire,
+                           chassis=chassis, coupling=coupling)
+            for k in harmonics
+        )
+    else:
+        maps = tuple(maps)
+        harmonics = tuple(m.harmonic for m in maps)
+    n = np.array([m.suggest(threshold, f_max, dof) for m in maps], int)
+    eig = np.sort(np.asarray(tire.eigenfrequencies(float(speed))))
+    ef = np.array([_highest_retained(eig, np.array([k]))[0] if k > 0 else np.nan for k in n])
+    hs = [_models.resolve_harmonic(k) for k in harmonics]
+    fr = np.array([h.freq_range for h in hs])
+    return SuggestedModes(tuple(int(k) for k in harmonics), _ro(n, int), _ro(ef), _ro(fr),
+                          float(threshold), float(f_max), float(speed), dof, maps)
