@@ -4,6 +4,7 @@ Follows Rosholm & Westers, "Assembly of a tire and a vehicle model to predict
 vibrations at the bushings", Chalmers MSc thesis (2018).
 """
 
+from .chassis import ChassisModel, reference_chassis
 from .coupling import (
     couple_generalized,
     couple_impedance,
@@ -48,6 +49,8 @@ __all__ = [
     "QuantityError",
     "SingularInterfaceError",
     "harmonic",
+    "ChassisModel",
+    "reference_chassis",
     "node_labels",
     "parse_label",
 ]

@@ -102,6 +102,20 @@ class Section:
         return cls(A=b * h, Iy=b * h**3 / 12, Iz=h * b**3 / 12, J=J)
 
     @classmethod
+    def box(cls, b: float, h: float, t: float) -> Section:
+        """Thin-walled rectangular hollow section ``b`` (local y) x ``h`` (local z), wall ``t``.
+
+        Torsion constant by Bredt's formula ``J = 4 A_m^2 t / p_m`` on the wall's
+        mid-line (area ``A_m``, perimeter ``p_m``).
+        """
+        if not 0 < 2 * t < min(b, h):
+            raise DataFormatError(f"box wall t={t} must be positive and < min(b, h)/2")
+        bi, hi = b - 2 * t, h - 2 * t
+        Am, pm = (b - t) * (h - t), 2 * (b + h - 2 * t)
+        return cls(A=b * h - bi * hi, Iy=(b * h**3 - bi * hi**3) / 12,
+                   Iz=(h * b**3 - hi * bi**3) / 12, J=4 * Am**2 * t / pm)
+
+    @classmethod
     def tube(cls, d: float, t: float) -> Section:
         """Thin or thick circular tube of outer diameter ``d`` and wall ``t``."""
         if not 0 < t <= d / 2:
