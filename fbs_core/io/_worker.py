@@ -1,0 +1,337 @@
+"""Sandboxed parser process for untrusted binary files (MATLAB v5, HDF5, MATLAB v7.3).
+
+The HDF5 C library and scipy's MAT-file reader crash (segfault, abort) or hang on
+some malformed files; a fuzzing run of a few thousand mutated files finds such
+inputs within seconds. This script therefore runs as a separate interpreter
+(``python _worker.py``) that imports only numpy, scipy.io and h5py, never
+``fbs_core``. For every request it forks a child that parses the bytes under a
+memory limit; the worker kills the child after the timeout and reports crashes,
+so the calling process never dies with the parser.
+
+Protocol on stdin / stdout (all integers unsigned 64-bit little endian):
+
+- request: ``kind`` (8 ASCII bytes, ``"mat5    "`` or ``"hdf5    "``), ``timeout_ms``,
+  ``mem_bytes``, ``n``, then ``n`` bytes of file content;
+- reply: ``status`` (0 ok, 1 refused, 2 crash, 3 timeout, 4 library error), ``n``, then ``n``
+  bytes: for status 0 an encoded dump (see :func:`encode`), else a UTF-8 message.
+
+A dump is a JSON header (length-prefixed) followed by ``.npy`` blobs written with
+``allow_pickle=False``; nothing in this protocol is ever unpickled.
+"""
+
+from __future__ import annotations
+
+import sys
+
+if __name__ == "__main__":  # never import this package's modules (csv.py!) by accident
+    _here = __file__.rsplit("/", 1)[0]
+    sys.path[:] = [p for p in sys.path if p not in ("", ".", _here)]
+
+import io  # noqa: E402
+import json  # noqa: E402
+import os  # noqa: E402
+import select  # noqa: E402
+import signal  # noqa: E402
+import struct  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+_U64 = struct.Struct("<Q")
+_NUMERIC_KINDS = "biufc"
+MAX_OBJECTS = 20_000
+
+
+class ParseError(Exception):
+    """A well-formed refusal with a message for the user."""
+
+
+# -- encoding ------------------------------------------------------------------------
+def encode(meta: dict, arrays: list[np.ndarray]) -> bytes:
+    """JSON header + npy blobs; the header lists the byte length of every blob."""
+    blobs = []
+    for a in arrays:
+        b = io.BytesIO()
+        np.save(b, np.ascontiguousarray(a), allow_pickle=False)
+        blobs.append(b.getvalue())
+    meta = dict(meta, _blob_sizes=[len(b) for b in blobs])
+    head = json.dumps(meta).encode()
+    return _U64.pack(len(head)) + head + b"".join(blobs)
+
+
+def decode(payload: bytes) -> tuple[dict, list[np.ndarray]]:
+    """Inverse of :func:`encode` (``allow_pickle=False``)."""
+    (n,) = _U64.unpack_from(payload, 0)
+    meta = json.loads(payload[8 : 8 + n].decode())
+    pos = 8 + n
+    arrays = []
+    for size in meta.pop("_blob_sizes"):
+        arrays.append(np.load(io.BytesIO(payload[pos : pos + size]), allow_pickle=False))
+        pos += size
+    return meta, arrays
+
+
+def _jsonable(v):
+    if isinstance(v, bytes):
+        return v.decode("utf-8", "replace")
+    if isinstance(v, np.ndarray):
+        if v.dtype.kind in "SO":
+            return [_jsonable(x) for x in v.ravel().tolist()]
+        if v.dtype.kind in _NUMERIC_KINDS and v.dtype.kind != "c":
+            return v.tolist()
+        if v.dtype.kind == "U":
+            return v.tolist()
+        return "<unsupported>"
+    if isinstance(v, np.generic):
+        return v.item() if v.dtype.kind in "biuf" else _jsonable(np.asarray(v))
+    if isinstance(v, str | int | float | bool) or v is None:
+        return v
+    return "<unsupported>"
+
+
+# -- MATLAB v5 -----------------------------------------------------------------------
+_MAT_NUMERIC = {
+    "double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
+    "int64", "uint64", "logical",
+}
+
+
+def _strings(a) -> list[str]:
+    """Char array or cell array of char arrays -> list of str."""
+    a = np.asarray(a)
+    if a.dtype.kind == "U":
+        return [str(s).rstrip() for s in a.ravel(order="F").tolist()] if a.ndim else [str(a)]
+    if a.dtype == object:
+        out = []
+        for el in a.ravel(order="F"):
+            el = np.asarray(el)
+            if el.dtype.kind != "U" or el.size > 1:
+                raise ParseError("a cell array may only hold character strings")
+            out.append(str(el.ravel()[0]).rstrip() if el.size else "")
+        return out
+    raise ParseError("expected characters")
+
+
+def parse_mat5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
+    import scipy.io
+
+    info = scipy.io.whosmat(io.BytesIO(raw))
+    variables, arrays = {}, []
+    for name, _shape, cls in info:
+        if cls not in _MAT_NUMERIC | {"char", "cell"}:
+            raise ParseError(
+                f"variable {name!r} is of MATLAB class {cls!r}; only numeric, logical, char "
+                "and cell arrays of char are read (objects, function handles, structs, "
+                "sparse and opaque classes are rejected)"
+            )
+    names = [n for n, _, _ in info]
+    data = scipy.io.loadmat(
+        io.BytesIO(raw), mat_dtype=False, squeeze_me=False, chars_as_strings=True,
+        variable_names=names, verify_compressed_data_integrity=True,
+    )
+    for name in names:
+        v = data.get(name)
+        if not isinstance(v, np.ndarray) or type(v) is not np.ndarray:
+            raise ParseError(f"variable {name!r} is not a plain array")
+        if v.dtype.kind in _NUMERIC_KINDS:
+            variables[name] = {"array": len(arrays)}
+            arrays.append(v)
+        elif v.dtype.kind == "U" or v.dtype == object:
+            try:
+                variables[name] = {"strings": _strings(v)}
+            except ParseError as e:
+                raise ParseError(f"variable {name!r}: {e}") from None
+        else:
+            raise ParseError(f"variable {name!r} has unsupported type {v.dtype}")
+    return {"format": "mat5", "variables": variables}, arrays
+
+
+# -- HDF5 (and MATLAB v7.3) ------------------------------------------------------------
+def _complex_fields(dt):
+    names = dt.names or ()
+    for re, im in (("real", "imag"), ("r", "i"), ("re", "im")):
+        if names == (re, im):
+            return re, im
+    return None
+
+
+def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
+    import h5py
+
+    datasets, groups, arrays = {}, {}, []
+    with h5py.File(io.BytesIO(raw), "r") as f:
+
+        def check_link(name, link):
+            if not isinstance(link, h5py.HardLink):
+                raise ParseError(
+                    f"object {name!r} is a {type(link).__name__}; links to other objects or "
+                    "files are not followed"
+                )
+
+        f.visititems_links(check_link)
+        count = [0]
+
+        def attrs_of(obj):
+            out = {}
+            for k in list(obj.attrs.keys())[:200]:
+                try:
+                    out[k] = _jsonable(obj.attrs[k])
+                except Exception:  # an attribute of an unsupported type
+                    out[k] = "<unsupported>"
+            return out
+
+        def visit(name, obj):
+            count[0] += 1
+            if count[0] > MAX_OBJECTS:
+                raise ParseError(f"more than {MAX_OBJECTS} objects in the file")
+            path = "/" + name
+            if isinstance(obj, h5py.Group):
+                groups[path] = attrs_of(obj)
+                return
+            if not isinstance(obj, h5py.Dataset):
+                raise ParseError(f"object {path!r} is of an unsupported kind")
+            if obj.is_virtual or obj.external:
+                raise ParseError(f"dataset {path!r} stores its data in other files; refused")
+            dt = obj.dtype
+            entry = {"attrs": attrs_of(obj), "shape": list(obj.shape)}
+            if h5py.check_string_dtype(dt) is not None:
+                a = obj[()]
+                a = np.asarray(a, dtype=object)
+                entry["strings"] = [
+                    x.decode("utf-8", "replace") if isinstance(x, bytes) else str(x)
+                    for x in a.ravel().tolist()
+                ]
+            elif h5py.check_ref_dtype(dt) is h5py.Reference:
+                refs = np.asarray(obj[()], dtype=object)
+                names = []
+                for r in refs.ravel():
+                    target = f[r] if r else None
+                    names.append(None if target is None else target.name)
+                entry["refs"] = names
+            elif dt.kind in _NUMERIC_KINDS:
+                a = np.asarray(obj[()])
+                entry["array"] = len(arrays)
+                arrays.append(a)
+            elif dt.kind == "V" and _complex_fields(dt):
+                re, im = _complex_fields(dt)
+                a = obj[()]
+                c = np.asarray(a[re], dtype=float) + 1j * np.asarray(a[im], dtype=float)
+                entry["array"] = len(arrays)
+                arrays.append(c)
+            else:
+                raise ParseError(f"dataset {path!r} has an unsupported data type {dt}")
+            datasets[path] = entry
+
+        groups["/"] = attrs_of(f)
+        f.visititems(visit)
+    return {"format": "hdf5", "datasets": datasets, "groups": groups}, arrays
+
+
+HANDLERS = {"mat5": parse_mat5, "hdf5": parse_hdf5}
+
+
+# -- process plumbing ------------------------------------------------------------------
+def _read_exact(stream, n: int) -> bytes:
+    chunks, got = [], 0
+    while got < n:
+        b = stream.read(n - got)
+        if not b:
+            raise EOFError
+        chunks.append(b)
+        got += len(b)
+    return b"".join(chunks)
+
+
+def _limit_memory(mem_bytes: int) -> None:
+    try:
+        import resource
+
+        with open("/proc/self/statm") as fh:
+            vm = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        resource.setrlimit(resource.RLIMIT_AS, (vm + mem_bytes, vm + mem_bytes))
+    except Exception:  # no /proc or no resource module: no limit
+        pass
+
+
+def _child(kind: str, raw: bytes, mem_bytes: int, w: int) -> None:
+    _limit_memory(mem_bytes)
+    try:
+        meta, arrays = HANDLERS[kind](raw)
+        status, payload = 0, encode(meta, arrays)
+    except ParseError as e:
+        status, payload = 1, str(e).encode()
+    except MemoryError:
+        status, payload = 1, b"the file needs more memory to parse than allowed"
+    except Exception as e:  # any failure of the third-party parser
+        msg = f"{type(e).__name__}: {e}"[:300]
+        status, payload = 4, msg.encode("utf-8", "replace")
+    with os.fdopen(w, "wb") as out:
+        out.write(_U64.pack(status) + _U64.pack(len(payload)) + payload)
+
+
+def _serve_one(kind: str, raw: bytes, timeout: float, mem_bytes: int) -> tuple[int, bytes]:
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - runs in the forked child
+        os.close(r)
+        try:
+            _child(kind, raw, mem_bytes, w)
+        finally:
+            os._exit(0)
+    os.close(w)
+    buf = bytearray()
+    deadline = time.monotonic() + timeout
+    timed_out = False
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            timed_out = True
+            break
+        ready, _, _ = select.select([r], [], [], left)
+        if not ready:
+            continue
+        chunk = os.read(r, 1 << 20)
+        if not chunk:
+            break
+        buf += chunk
+    os.close(r)
+    if timed_out:
+        os.kill(pid, signal.SIGKILL)
+    _, status = os.waitpid(pid, 0)
+    if timed_out:
+        return 3, f"the parser did not finish within {timeout:g} s".encode()
+    if len(buf) >= 16:
+        (st,) = _U64.unpack_from(buf, 0)
+        (n,) = _U64.unpack_from(buf, 8)
+        if len(buf) == 16 + n:
+            return int(st), bytes(buf[16:])
+    sig = os.WTERMSIG(status) if os.WIFSIGNALED(status) else None
+    what = f"signal {sig}" if sig else f"exit status {os.WEXITSTATUS(status)}"
+    return 2, f"the parser crashed ({what})".encode()
+
+
+def main() -> None:
+    import h5py  # noqa: F401  (preload, so forks are fast)
+    import scipy.io  # noqa: F401
+
+    # the protocol owns the original stdout; anything a library prints goes nowhere
+    stdout = os.fdopen(os.dup(1), "wb")
+    os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
+    stdin = sys.stdin.buffer
+    while True:
+        try:
+            kind = _read_exact(stdin, 8).decode().strip()
+            timeout_ms, mem_bytes, n = (_U64.unpack(_read_exact(stdin, 8))[0] for _ in range(3))
+            raw = _read_exact(stdin, n)
+        except EOFError:
+            return
+        if kind not in HANDLERS:
+            status, payload = 1, f"unknown request {kind!r}".encode()
+        else:
+            status, payload = _serve_one(kind, raw, timeout_ms / 1000.0, mem_bytes)
+        stdout.write(_U64.pack(status) + _U64.pack(len(payload)) + payload)
+        stdout.flush()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,592 @@
+"""Input checks shared by the importers: size, magic bytes, labels, units, quantity.
+
+Every check raises a subclass of :class:`~fbs_core.errors.FBSError` whose
+message names the offending thing and what is allowed. Nothing is converted or
+interpolated silently: unit conversions that are applied are reported in the
+import notes, and frequency grids are only unified through the explicit
+:func:`common_grid` (which calls :meth:`fbs_core.FRF.interpolate`).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..dofs import DIRECTIONS, parse_label
+from ..errors import (
+    DataFormatError,
+    DOFError,
+    FrequencyGridError,
+    QuantityError,
+    SingularInterfaceError,
+)
+from ..frf import FRF, QUANTITIES
+
+__all__ = [
+    "DEFAULT_MAX_BYTES",
+    "FORMATS",
+    "Source",
+    "read_source",
+    "sniff",
+    "detect_format",
+    "normalize_label",
+    "rename_node",
+    "Units",
+    "parse_units",
+    "si_factors",
+    "check_finite",
+    "require_dofs",
+    "common_grid",
+    "low_frequency_slope",
+    "quantity_notes",
+    "interface_check",
+    "describe",
+]
+
+#: Default upper limit of a file's size in bytes (100 MiB).
+DEFAULT_MAX_BYTES = 100 * 1024 * 1024
+
+#: File formats by name and the file-name endings that select them.
+FORMATS: dict[str, tuple[str, ...]] = {
+    "uff": (".uff", ".unv", ".uf", ".58"),
+    "mat": (".mat",),
+    "csv": (".csv", ".txt"),
+    "hdf5": (".h5", ".hdf5", ".hdf"),
+}
+
+
+@dataclass(frozen=True)
+class Source:
+    """File content and the name used in messages."""
+
+    raw: bytes
+    name: str
+
+    @property
+    def suffix(self) -> str:
+        return Path(self.name).suffix.lower()
+
+
+def read_source(source, filename: str | None = None,
+                max_bytes: int = DEFAULT_MAX_BYTES) -> Source:
+    """Read a path, or take bytes (an upload) with the file name they came with.
+
+    Parameters
+    ----------
+    source : str, os.PathLike, bytes, bytearray or memoryview
+        A path to read, or the file content.
+    filename : str, optional
+        Name of the uploaded file (for bytes; used for the format and messages).
+    max_bytes : int
+        Largest accepted size; the file is not read when it is larger.
+
+    Raises
+    ------
+    DataFormatError
+        For a file that is too large, empty, missing or of an unsupported type.
+    """
+    if max_bytes <= 0:
+        raise DataFormatError(f"max_bytes must be positive, got {max_bytes}")
+    if isinstance(source, bytes | bytearray | memoryview):
+        raw = bytes(source)
+        name = filename or "<uploaded bytes>"
+    elif isinstance(source, str | os.PathLike):
+        path = Path(source)
+        name = filename or path.name
+        try:
+            size = path.stat().st_size
+            if size > max_bytes:
+                raise DataFormatError(_too_large(name, size, max_bytes))
+            if not path.is_file():
+                raise DataFormatError(f"{name!r} is not a regular file")
+            raw = path.read_bytes()
+        except OSError as e:
+            raise DataFormatError(f"cannot read {str(path)!r}: {e.strerror or e}") from None
+    else:
+        raise DataFormatError(
+            f"expected a path or the file's bytes, got {type(source).__name__}"
+        )
+    if len(raw) > max_bytes:
+        raise DataFormatError(_too_large(name, len(raw), max_bytes))
+    if not raw:
+        raise DataFormatError(f"file {name!r} is empty")
+    return Source(raw, name)
+
+
+def _too_large(name: str, size: int, max_bytes: int) -> str:
+    return (
+        f"file {name!r} is {size / 2**20:.1f} MiB, larger than the limit of "
+        f"{max_bytes / 2**20:.1f} MiB; pass a larger max_bytes to accept it"
+    )
+
+
+_HDF5_SIG = b"\x89HDF\r\n\x1a\n"
+_MAGIC = [
+    (b"PK\x03\x04", "a ZIP archive (or an Office document)"),
+    (b"\x1f\x8b", "a gzip archive"),
+    (b"%PDF", "a PDF document"),
+    (b"\x89PNG", "a PNG image"),
+    (b"\xff\xd8\xff", "a JPEG image"),
+    (b"\x7fELF", "an executable"),
+    (b"MZ", "a Windows executable"),
+    (b"\x80\x02", "a Python pickle"),
+    (b"\x80\x03", "a Python pickle"),
+    (b"\x80\x04", "a Python pickle"),
+    (b"\x80\x05", "a Python pickle"),
+    (b"\x93NUMPY", "a NumPy .npy file"),
+    (b"\xd0\xcf\x11\xe0", "an old Office document"),
+]
+
+
+def sniff(raw: bytes) -> str:
+    """What the content is, judged from its first bytes.
+
+    Returns one of ``"mat5"``, ``"mat73"``, ``"hdf5"``, ``"uff"``, ``"text"`` or a
+    description such as ``"a ZIP archive"`` / ``"binary data"``.
+    """
+    head = raw[:1024]
+    if head.startswith(b"MATLAB 7.3 MAT-file") and raw[512:520] == _HDF5_SIG:
+        return "mat73"
+    if head.startswith(b"MATLAB 5.0 MAT-file") or (
+        len(raw) >= 128 and raw[126:128] in (b"IM", b"MI") and raw[:116].isascii()
+        and head[:6] == b"MATLAB"
+    ):
+        return "mat5"
+    for off in (0, 512, 1024, 2048):
+        if raw[off : off + 8] == _HDF5_SIG:
+            return "hdf5"
+    for sig, what in _MAGIC:
+        if head.startswith(sig):
+            return what
+    if b"\x00" in head:
+        return "binary data"
+    try:
+        text = head.decode("utf-8")
+    except UnicodeDecodeError as e:
+        if e.start < len(head) - 4:  # not a character cut at the end of the sample
+            return "binary data"
+        text = head[: e.start].decode("utf-8")
+    first = next((ln for ln in text.splitlines() if ln.strip()), "")
+    if first.strip() == "-1":
+        return "uff"
+    return "text"
+
+
+_EXPECTED = {
+    "uff": ("uff",),
+    "mat": ("mat5", "mat73"),
+    "csv": ("text",),
+    "hdf5": ("hdf5", "mat73"),
+}
+_NAMES = {
+    "uff": "Universal File (dataset 58)",
+    "mat": "MATLAB MAT-file (v5 or v7.3)",
+    "csv": "CSV text file",
+    "hdf5": "HDF5 file",
+    "mat5": "a MATLAB v5 MAT-file",
+    "mat73": "a MATLAB v7.3 MAT-file",
+    "hdf5-content": "an HDF5 file",
+    "text": "a text file",
+}
+
+
+def detect_format(src: Source, format: str | None = None) -> tuple[str, str]:
+    """Choose the format from ``format`` or the file-name ending and check the content.
+
+    Returns
+    -------
+    (format, kind) : tuple of str
+        ``format`` in :data:`FORMATS`; ``kind`` what :func:`sniff` found.
+
+    Raises
+    ------
+    DataFormatError
+        For an unknown format or ending, or content that is not what the name says
+        (e.g. a ZIP archive named ``.uff``).
+    """
+    if format is None:
+        for fmt, endings in FORMATS.items():
+            if src.suffix in endings:
+                format = fmt
+                break
+        else:
+            known = ", ".join(e for ends in FORMATS.values() for e in ends)
+            raise DataFormatError(
+                f"cannot tell the format of {src.name!r} from its name; "
+                f"known endings: {known} (or pass format=...)"
+            )
+    if format not in FORMATS:
+        raise DataFormatError(f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
+    kind = sniff(src.raw)
+    if kind not in _EXPECTED[format]:
+        found = _NAMES.get(kind, _NAMES.get(kind + "-content", kind))
+        raise DataFormatError(
+            f"file {src.name!r} should be a {_NAMES[format]} but its content is {found}"
+        )
+    return format, kind
+
+
+# -- DOF labels ------------------------------------------------------------------------
+_DIR_ALIASES = {d: d for d in DIRECTIONS}
+_DIR_ALIASES.update({"tx": "x", "ty": "y", "tz": "z"})
+
+
+def normalize_label(text: str, what: str = "DOF") -> tuple[str, int]:
+    """Normalise a DOF label from a file to ``"node:dir"`` and a sign.
+
+    Accepts directions in any case, ``tx``/``ty``/``tz`` for translations and a
+    leading ``+`` or ``-`` (``"hub:-z"`` is ``"hub:z"`` with sign -1).
+
+    Raises
+    ------
+    DOFError
+        For an unknown direction or a malformed node name.
+    """
+    if not isinstance(text, str):
+        raise DOFError(f"{what} label must be text, got {text!r}")
+    s = text.strip()
+    node, sep, d = s.partition(":")
+    sign = 1
+    if sep:
+        d = d.strip().lower()
+        if d[:1] in "+-" and d:
+            sign = -1 if d[0] == "-" else 1
+            d = d[1:]
+        if d not in _DIR_ALIASES:
+            raise DOFError(
+                f"unknown direction {d!r} in {what} label {text!r}; allowed: "
+                f"{', '.join(DIRECTIONS)} (any case, optional sign +/-)"
+            )
+        s = f"{node.strip()}:{_DIR_ALIASES[d]}"
+    parse_label(s)
+    return s, sign
+
+
+def rename_node(label: str, nodes: Mapping | None) -> str:
+    """Apply a user node map (e.g. ``{1: "spindle", "101": "bushing"}``) to a label."""
+    if not nodes:
+        return label
+    node, sep, d = label.partition(":")
+    for key in (node, int(node) if node.isdigit() else None):
+        if key is not None and key in nodes:
+            new = str(nodes[key]) + sep + d
+            parse_label(new)
+            return new
+    return label
+
+
+# -- units -----------------------------------------------------------------------------
+_LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "µm": 1e-6, "μm": 1e-6,
+           "in": 0.0254, "ft": 0.3048}
+_FORCE = {"n": 1.0, "kn": 1e3, "lbf": 4.4482216152605}
+_G = 9.80665
+
+
+@dataclass(frozen=True)
+class Units:
+    """An FRF units label and what it means in SI.
+
+    ``quantity`` is None when the label does not identify one; the scales turn
+    file units into SI (a length of 1 file unit is ``length`` m, and so on).
+    """
+
+    label: str
+    quantity: str | None
+    length: float = 1.0
+    force: float = 1.0
+    g: bool = False
+
+    @property
+    def is_si(self) -> bool:
+        return self.length == 1.0 and self.force == 1.0 and not self.g
+
+
+def parse_units(label: str | None) -> Units | None:
+    """Read an FRF units label such as ``"m/(N s)"``, ``"mm/s/N"`` or ``"g/N"``.
+
+    Exponents as ``s^2``, ``s2`` or ``s**2``; ``/`` divides the next factor or
+    parenthesised group. Returns None for an empty label or one that is not
+    understood (the caller reports it as unchecked).
+
+    Raises
+    ------
+    QuantityError
+        For units that are an inverse FRF (dynamic stiffness, impedance, apparent
+        mass), so that they are not mistaken for an FRF.
+    """
+    if label is None or not str(label).strip() or str(label).strip().upper() == "NONE":
+        return None
+    s = str(label).strip().replace("**", "^").replace("·", " ").replace("*", " ")
+    tokens = re.findall(r"\(|\)|/|[A-Za-zµμ]+\^?-?\d*", s)
+    if "".join(tokens).replace(" ", "") != re.sub(r"[\s.]", "", s):
+        return None
+    dims = {"L": 0, "T": 0, "F": 0}
+    scale = {"L": 1.0, "F": 1.0}
+    g = [False]
+
+    def factor(tok: str, power: int) -> bool:
+        m = re.fullmatch(r"([A-Za-zµμ]+)\^?(-?\d*)", tok)
+        name, e = m.group(1), int(m.group(2) or 1)
+        p = power * e
+        low = name.lower()
+        if name in _LENGTH or low in ("m", "mm", "cm", "um"):
+            dims["L"] += p
+            scale["L"] *= _LENGTH.get(name, _LENGTH.get(low, 1.0)) ** p
+        elif low in ("s", "sec"):
+            dims["T"] += p
+        elif low in _FORCE:
+            dims["F"] += p
+            scale["F"] *= _FORCE[low] ** p
+        elif name == "g":
+            dims["L"] += p
+            dims["T"] -= 2 * p
+            g[0] = True
+        elif low == "rad":
+            pass
+        else:
+            return False
+        return True
+
+    def group(i: int, power: int) -> int | None:
+        sign = 1
+        while i < len(tokens):
+            t = tokens[i]
+            if t == ")":
+                return i
+            if t == "/":
+                sign = -1
+                i += 1
+                continue
+            if t == "(":
+                j = group(i + 1, power * sign)
+                if j is None or j >= len(tokens):
+                    return None
+                i = j + 1
+            elif not factor(t, power * sign):
+                return None
+            else:
+                i += 1
+            sign = 1
+        return i
+
+    end = group(0, 1)
+    if end is None or end != len(tokens):
+        return None
+    L, T, F = dims["L"], dims["T"], dims["F"]
+    if (L, F) == (-1, 1) or (L, F) == (0, 1):
+        kind = {0: "dynamic stiffness", -1: "impedance", -2: "apparent mass"}.get(-T, "inverse")
+        raise QuantityError(
+            f"units {label!r} are those of a {kind} (force per motion), not of an FRF; "
+            "invert the data to receptance, mobility or accelerance first"
+        )
+    quantity = None
+    if L == 1 and F == -1:
+        quantity = {0: "receptance", -1: "mobility", -2: "accelerance"}.get(T)
+    length = scale["L"] if L == 1 else 1.0
+    force = 1.0 / scale["F"] if F == -1 else 1.0
+    return Units(str(label).strip(), quantity, length, force, g[0])
+
+
+def si_factors(units: Units, outputs: Sequence[str], inputs: Sequence[str]) -> np.ndarray:
+    """Factors ``(n_out, n_in)`` turning each entry from file units into SI.
+
+    A translational output scales with the length unit (and ``g``), a moment input
+    with force x length, a force input with the force unit; rotations in rad do not
+    scale.
+    """
+    t_out = np.array([parse_label(o)[1] in ("x", "y", "z") for o in outputs], dtype=float)
+    r_in = np.array([parse_label(i)[1] in ("rx", "ry", "rz") for i in inputs], dtype=float)
+    length = units.length * (_G if units.g else 1.0)
+    out = length ** t_out
+    inn = (1.0 / units.force) * (units.length ** r_in)
+    return out[:, None] / inn[None, :]
+
+
+# -- values ----------------------------------------------------------------------------
+def check_finite(a: np.ndarray, what: str) -> np.ndarray:
+    """Raise DataFormatError naming the first non-finite entry of ``a``."""
+    a = np.asarray(a)
+    if a.dtype.kind not in "biufc":
+        raise DataFormatError(f"{what} must be numeric, got {a.dtype}")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        pos = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise DataFormatError(
+            f"{what} contains {int(bad.sum())} non-finite value(s) (NaN or inf), "
+            f"first at index {pos}"
+        )
+    return a
+
+
+def require_dofs(frf: FRF, outputs: Iterable[str] = (), inputs: Iterable[str] = (),
+                 what: str = "FRF") -> None:
+    """Raise DOFError listing every required output/input label the FRF lacks."""
+    miss_o = [o for o in outputs if o not in frf.outputs]
+    miss_i = [i for i in inputs if i not in frf.inputs]
+    if miss_o or miss_i:
+        parts = []
+        if miss_o:
+            parts.append(f"outputs {', '.join(miss_o)} (has {', '.join(frf.outputs)})")
+        if miss_i:
+            parts.append(f"inputs {', '.join(miss_i)} (has {', '.join(frf.inputs)})")
+        raise DOFError(f"{what} lacks " + "; ".join(parts))
+
+
+def common_grid(frfs: Sequence[FRF], freq=None) -> list[FRF]:
+    """Put FRFs on one grid, explicitly.
+
+    With ``freq=None`` the FRFs must already share their grid (else
+    FrequencyGridError naming both grids). With ``freq`` given, every FRF is
+    interpolated onto it with :meth:`fbs_core.FRF.interpolate` (linear in real and
+    imaginary part, no extrapolation).
+    """
+    frfs = list(frfs)
+    if freq is None:
+        for k, f in enumerate(frfs[1:], start=1):
+            frfs[0].require_grid(f, what=f"FRF 0 and FRF {k}")
+        return frfs
+    return [f.interpolate(freq) for f in frfs]
+
+
+def low_frequency_slope(frf: FRF) -> float | None:
+    """Median log-log slope of the driving-point magnitudes over the lowest lines.
+
+    A grounded structure's receptance is flat (slope 0), its mobility rises with
+    slope +1 and its accelerance with +2 (thesis table 2.1: each step multiplies by
+    ``j omega``); a free-free one has slopes -2, -1, 0. Uses the lines up to twice
+    the lowest positive frequency (at least 3). None when there are no driving
+    points or too few lines.
+    """
+    pts = [(frf.outputs.index(d), frf.inputs.index(d)) for d in frf.inputs if d in frf.outputs]
+    pos = np.flatnonzero(frf.freq > 0)
+    if not pts or pos.size < 3:
+        return None
+    f = frf.freq[pos]
+    n = max(3, int(np.searchsorted(f, 2 * f[0], side="right")))
+    n = min(n, f.size)
+    slopes = []
+    for o, i in pts:
+        m = np.abs(frf.data[pos[:n], o, i])
+        if np.all(m > 0):
+            slopes.append(np.polyfit(np.log(f[:n]), np.log(m), 1)[0])
+    return float(np.median(slopes)) if slopes else None
+
+
+def quantity_notes(frf: FRF) -> list[str]:
+    """Plausibility notes on the declared quantity from the low-frequency slope."""
+    s = low_frequency_slope(frf)
+    if s is None:
+        return []
+    p = QUANTITIES[frf.quantity]
+    expected = (p, p - 2)
+    if min(abs(s - e) for e in expected) <= 0.5:
+        return []
+    fits = [q for q, pq in QUANTITIES.items() if min(abs(s - pq), abs(s - pq + 2)) <= 0.5]
+    hint = f"; it fits a {' or '.join(fits)}" if fits else ""
+    return [
+        f"check the quantity: the driving points rise with slope {s:+.1f} per decade at "
+        f"the lowest lines, while a {frf.quantity} has {expected[0]:+d} (grounded) or "
+        f"{expected[1]:+d} (free){hint}"
+    ]
+
+
+def interface_check(a: FRF, b: FRF, interface=None, max_cond: float = 1e8) -> np.ndarray:
+    """Condition of the interface matrix ``Y_jj^A + Y_jj^B`` (eq. 2.44) at every line.
+
+    Calls :func:`fbs_core.coupling.interface_condition`.
+
+    Raises
+    ------
+    SingularInterfaceError
+        When the matrix is singular or its condition number exceeds ``max_cond`` at
+        some line, naming the worst line.
+    """
+    from ..coupling import interface_condition
+
+    cond = np.asarray(interface_condition(a, b, interface), dtype=float)
+    bad = ~np.isfinite(cond) | (cond > max_cond)
+    if bad.any():
+        k = int(np.argmax(np.where(np.isfinite(cond), cond, np.inf)))
+        raise SingularInterfaceError(
+            f"the interface matrix Y_jj^A + Y_jj^B is singular or ill-conditioned at "
+            f"{int(bad.sum())} of {cond.size} lines (worst: condition {cond[k]:.3g} at "
+            f"{a.freq[k]:g} Hz; limit {max_cond:.3g}); check the interface DOFs and units"
+        )
+    return cond
+
+
+def describe(frf: FRF, operating_points: Sequence[float] | None = None) -> str:
+    """A short human-readable summary: quantity, DOFs, frequency range."""
+    f = frf.freq
+    d = np.diff(f)
+    step = f", step {d[0]:g} Hz" if d.size and np.allclose(d, d[0], rtol=1e-6) else ""
+    nodes: dict[str, list[str]] = {}
+    for lab in dict.fromkeys(frf.outputs + frf.inputs):
+        node, dr = parse_label(lab)
+        nodes.setdefault(node, []).append(dr or "(generalised)")
+    lines = [
+        f"{frf.quantity} FRF, {frf.shape[1]} outputs x {frf.shape[2]} inputs, "
+        f"{f.size} lines from {f[0]:g} to {f[-1]:g} Hz{step}",
+        "outputs: " + ", ".join(frf.outputs),
+        "inputs: " + ", ".join(frf.inputs),
+        "nodes: " + "; ".join(f"{n} ({', '.join(v)})" for n, v in nodes.items()),
+    ]
+    if operating_points is not None:
+        lines.append("operating points: " + ", ".join(f"{v:g}" for v in operating_points)
+                     + " km/h")
+    return "\n".join(lines)
+
+
+def check_quantity_arg(quantity: str | None) -> str | None:
+    """Validate a user-given quantity (None passes)."""
+    if quantity is not None and quantity not in QUANTITIES:
+        raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
+    return quantity
+
+
+def reconcile_quantity(declared: str | None, units: Units | None, given: str | None,
+                       where: str) -> str:
+    """Decide the quantity from the file's declaration, its units and the caller.
+
+    Raises
+    ------
+    QuantityError
+        When two of them disagree, or none says what the data are.
+    """
+    check_quantity_arg(given)
+    from_units = units.quantity if units is not None else None
+    if declared and from_units and declared != from_units:
+        raise QuantityError(
+            f"{where} declares a {declared} but its units {units.label!r} are those of a "
+            f"{from_units}"
+        )
+    q = declared or from_units
+    if given and q and given != q:
+        raise QuantityError(
+            f"{where} holds a {q}, but quantity={given!r} was requested; convert after "
+            f"loading with FRF.to({given!r}) instead"
+        )
+    q = q or given
+    if q is None:
+        raise QuantityError(
+            f"{where} does not say whether it holds receptance, mobility or accelerance; "
+            "pass quantity=..."
+        )
+    return q
+
+
+def frequency_from_units(freq: np.ndarray, unit: str | None, where: str) -> np.ndarray:
+    """Convert an abscissa in Hz, rad/s, kHz or cpm to Hz (anything else raises)."""
+    u = (unit or "Hz").strip().lower().replace(" ", "")
+    factors = {"hz": 1.0, "1/s": 1.0, "khz": 1e3, "rad/s": 1 / (2 * np.pi), "cpm": 1 / 60.0,
+               "none": 1.0, "": 1.0}
+    if u not in factors:
+        raise FrequencyGridError(
+            f"{where}: unknown frequency unit {unit!r}; allowed: Hz, kHz, rad/s, cpm"
+        )
+    return np.asarray(freq, dtype=float) * factors[u]

@@ -1,0 +1,246 @@
+"""CSV with a documented layout: FRFs in and out, and results out.
+
+FRF layout (``docs/file-formats.md``)::
+
+    # tire-fbs FRF
+    # quantity: mobility
+    # units: m/(N s)
+    # layout: re-im
+    freq [Hz],Re(bushing:z / spindle:x),Im(bushing:z / spindle:x),...
+    0.5,1.25e-05,-3.5e-06,...
+
+Header lines start with ``#`` and hold ``key: value`` pairs: ``quantity``
+(receptance, mobility, accelerance), ``units``, ``layout`` (``re-im`` or
+``mag-phase``), ``phase_unit`` (``deg`` or ``rad``), ``freq_unit`` (``Hz``,
+``rad/s``); other keys are kept as metadata. Then one header row: the frequency
+column first, then two columns per output/input pair, ``Re(out / in)`` and
+``Im(out / in)`` (or ``Mag(...)`` and ``Phase(...)``), in any order. Comma,
+semicolon or tab separated; UTF-8.
+"""
+
+from __future__ import annotations
+
+import csv as _csv
+import io
+import re
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import DataFormatError
+from ..frf import FRF, UNITS
+from .checks import (
+    Source,
+    frequency_from_units,
+    normalize_label,
+    parse_units,
+    reconcile_quantity,
+    rename_node,
+    si_factors,
+)
+
+__all__ = ["read_csv", "write_csv", "write_csv_tables"]
+
+_COL = re.compile(r"^\s*(re|im|mag|abs|phase|ph)\s*[\(\[]\s*(.+?)\s*[\)\]]\s*$", re.I)
+_FREQ = re.compile(r"^\s*(freq|frequency|f)\s*(?:[\[\(]\s*([^\]\)]*)\s*[\]\)])?\s*$", re.I)
+
+
+def _split_pair(text: str, where: str) -> tuple[str, str]:
+    if " / " in text:
+        o, _, i = text.partition(" / ")
+    elif text.count("/") == 1:
+        o, _, i = text.partition("/")
+    else:
+        raise DataFormatError(f"{where}: cannot split {text!r} into 'output / input'")
+    return o.strip(), i.strip()
+
+
+def read_csv(src: Source, *, nodes: Mapping | None = None,
+             quantity: str | None = None) -> tuple[FRF, list[str], dict]:
+    """Read an FRF from CSV in the documented layout.
+
+    Raises
+    ------
+    DataFormatError, DOFError, QuantityError, FrequencyGridError
+        Naming the line and column of the problem.
+    """
+    name = src.name
+    try:
+        text = src.raw.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise DataFormatError(f"{name!r} is not UTF-8 text (byte {e.start})") from None
+    if "\x00" in text:
+        raise DataFormatError(f"{name!r} contains NUL bytes; not a text file")
+    lines = text.splitlines()
+    meta: dict[str, str] = {}
+    k = 0
+    while k < len(lines) and (not lines[k].strip() or lines[k].lstrip().startswith("#")):
+        body = lines[k].lstrip()[1:].strip()
+        if ":" in body:
+            key, _, val = body.partition(":")
+            meta[key.strip().lower()] = val.strip()
+        k += 1
+    if k >= len(lines):
+        raise DataFormatError(f"{name!r} has no header row (after the '#' lines)")
+    header_line = lines[k]
+    delim = max((",", ";", "\t"), key=header_line.count)
+    rows = list(_csv.reader(lines[k:], delimiter=delim))
+    header = [h.strip() for h in rows[0]]
+    m = _FREQ.match(header[0]) if header else None
+    if not m:
+        raise DataFormatError(
+            f"{name!r} line {k + 1}: the first column must be the frequency ('freq' or "
+            f"'freq [Hz]'), got {header[0] if header else ''!r}"
+        )
+    freq_unit = m.group(2) or meta.get("freq_unit")
+    layout = meta.get("layout", "").lower()
+    phase_unit = meta.get("phase_unit", "deg").lower()
+    if phase_unit not in ("deg", "rad"):
+        raise DataFormatError(f"{name!r}: phase_unit {phase_unit!r}; allowed: deg, rad")
+    cols: dict[tuple[str, str], dict[str, int]] = {}
+    for c, h in enumerate(header[1:], start=1):
+        mm = _COL.match(h)
+        if not mm:
+            raise DataFormatError(
+                f"{name!r} line {k + 1} column {c + 1}: header {h!r} is not Re(out / in), "
+                "Im(out / in), Mag(out / in) or Phase(out / in)"
+            )
+        part = {"re": "re", "im": "im", "mag": "mag", "abs": "mag", "phase": "ph",
+                "ph": "ph"}[mm.group(1).lower()]
+        o, i = _split_pair(mm.group(2), f"{name!r} column {c + 1}")
+        key = (o, i)
+        if part in cols.setdefault(key, {}):
+            raise DataFormatError(f"{name!r}: column {h!r} appears twice")
+        cols[key][part] = c
+    if not cols:
+        raise DataFormatError(f"{name!r} has a frequency column but no FRF columns")
+    kinds = {frozenset(v) for v in cols.values()}
+    if kinds == {frozenset({"re", "im"})}:
+        got = "re-im"
+    elif kinds == {frozenset({"mag", "ph"})}:
+        got = "mag-phase"
+    else:
+        bad = next(k for k, v in cols.items() if set(v) not in ({"re", "im"}, {"mag", "ph"}))
+        raise DataFormatError(
+            f"{name!r}: pair {bad[0]} / {bad[1]} has columns {sorted(cols[bad])}; every pair "
+            "needs Re and Im, or Mag and Phase, and all pairs the same layout"
+        )
+    if layout and layout != got:
+        raise DataFormatError(f"{name!r}: header says layout {layout!r} but columns are {got}")
+
+    values = []
+    for r, row in enumerate(rows[1:], start=k + 2):
+        if not row or all(not x.strip() for x in row):
+            continue
+        if len(row) != len(header):
+            raise DataFormatError(
+                f"{name!r} line {r}: {len(row)} fields, the header has {len(header)}"
+            )
+        try:
+            values.append([float(x) for x in row])
+        except ValueError:
+            c = next(j for j, x in enumerate(row) if not _is_float(x))
+            raise DataFormatError(
+                f"{name!r} line {r} column {c + 1}: {row[c]!r} is not a number"
+            ) from None
+    if not values:
+        raise DataFormatError(f"{name!r} has no data rows")
+    a = np.array(values)
+    if not np.all(np.isfinite(a)):
+        r, c = np.argwhere(~np.isfinite(a))[0]
+        raise DataFormatError(
+            f"{name!r}: non-finite value (NaN or inf) in data row {r + 1}, column {c + 1} "
+            f"({header[c]!r})"
+        )
+    freq = frequency_from_units(a[:, 0], freq_unit, repr(name))
+
+    norm = {}
+    for (o, i), v in cols.items():
+        (lo, so), (li, si) = normalize_label(o, "output"), normalize_label(i, "input")
+        key = (rename_node(lo, nodes), rename_node(li, nodes))
+        if key in norm:
+            raise DataFormatError(f"{name!r}: two column pairs for {key[0]} / {key[1]}")
+        norm[key] = (v, so * si)
+    outputs = list(dict.fromkeys(o for o, _ in norm))
+    inputs = list(dict.fromkeys(i for _, i in norm))
+    missing = [(o, i) for o in outputs for i in inputs if (o, i) not in norm]
+    if missing:
+        shown = ", ".join(f"{o} / {i}" for o, i in missing[:8])
+        raise DataFormatError(
+            f"{name!r}: {len(missing)} output/input pairs have no columns: {shown}; a full "
+            "matrix of outputs x inputs is needed"
+        )
+    data = np.empty((a.shape[0], len(outputs), len(inputs)), dtype=complex)
+    for (o, i), (v, sign) in norm.items():
+        if got == "re-im":
+            z = a[:, v["re"]] + 1j * a[:, v["im"]]
+        else:
+            ph = a[:, v["ph"]] * (np.pi / 180 if phase_unit == "deg" else 1.0)
+            z = a[:, v["mag"]] * np.exp(1j * ph)
+        data[:, outputs.index(o), inputs.index(i)] = sign * z
+    notes = []
+    units = parse_units(meta.get("units"))
+    if meta.get("units") and units is None:
+        notes.append(f"units {meta['units']!r} not understood; not checked")
+    q = reconcile_quantity(meta.get("quantity") or None, units, quantity, repr(name))
+    frf = FRF(freq, data, outputs, inputs, q)
+    if units is not None and not units.is_si:
+        frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs)[None])
+        notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
+    extra = {k: v for k, v in meta.items() if k not in
+             ("quantity", "units", "layout", "phase_unit", "freq_unit")}
+    return frf, notes, extra
+
+
+def _is_float(x: str) -> bool:
+    try:
+        float(x)
+        return True
+    except ValueError:
+        return False
+
+
+def _header(metadata: Mapping | None, title: str) -> list[str]:
+    from .. import __version__
+
+    lines = [f"# tire-fbs {title}", f"# fbs_core_version: {__version__}"]
+    for k, v in (metadata or {}).items():
+        lines.append(f"# {k}: {str(v).replace(chr(10), ' ')}")
+    return lines
+
+
+def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
+    """An FRF as CSV in the documented ``re-im`` layout (full double precision)."""
+    lines = _header(metadata, "FRF") + [
+        f"# quantity: {frf.quantity}", f"# units: {UNITS[frf.quantity]}", "# layout: re-im",
+    ]
+    cols = ["freq [Hz]"]
+    for o in frf.outputs:
+        for i in frf.inputs:
+            cols += [f"Re({o} / {i})", f"Im({o} / {i})"]
+    lines.append(",".join(cols))
+    d = frf.data.reshape(frf.freq.size, -1)
+    block = np.empty((frf.freq.size, 1 + 2 * d.shape[1]))
+    block[:, 0] = frf.freq
+    block[:, 1::2], block[:, 2::2] = d.real, d.imag
+    lines += [",".join(repr(float(x)) for x in row) for row in block]
+    return ("\n".join(lines) + "\n").encode()
+
+
+def write_csv_tables(tables: list[tuple[str, list[str], np.ndarray]],
+                     metadata: Mapping | None = None, title: str = "result") -> bytes:
+    """Several tables in one CSV text, each introduced by ``# table: <name>``.
+
+    ``tables`` holds ``(name, column_names, rows)`` with ``rows`` a 2-D array;
+    tables are separated by a blank line.
+    """
+    out = io.StringIO()
+    out.write("\n".join(_header(metadata, title)) + "\n")
+    for name, columns, rows in tables:
+        out.write(f"\n# table: {name}\n")
+        w = _csv.writer(out, lineterminator="\n")
+        w.writerow(columns)
+        for row in np.atleast_2d(rows):
+            w.writerow([x if isinstance(x, str) else repr(float(x)) if np.isreal(x)
+                        else repr(complex(x)) for x in row])
+    return out.getvalue().encode()

@@ -1,0 +1,211 @@
+"""HDF5: FRFs and results with metadata, in a documented layout.
+
+Layout (``docs/file-formats.md``)::
+
+    /                     attrs: format = "tire-fbs", format_version = 1,
+                                 fbs_core_version, created (UTC), metadata (JSON text)
+    /frf/freq             (n_freq,) float64, Hz
+    /frf/data             (n_freq, n_out, n_in) complex128
+    /frf                  attrs: quantity, units, outputs, inputs (arrays of str)
+    /frfs/<name>/...      further FRFs of a result, same layout as /frf
+    /arrays/<path>        result arrays; attr dims (axis names)
+    /coords/<dim>         coordinate values of an axis (numbers or str)
+
+Reading goes through the sandboxed parser (:mod:`fbs_core.io._sandbox`) and never
+follows soft or external links nor reads data stored in other files.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import time
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import DataFormatError
+from ..frf import FRF, UNITS
+from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
+from .checks import (
+    Source,
+    check_finite,
+    frequency_from_units,
+    normalize_label,
+    parse_units,
+    reconcile_quantity,
+    rename_node,
+    si_factors,
+)
+
+__all__ = ["read_hdf5", "write_hdf5", "write_hdf5_result", "root_attrs"]
+
+FORMAT_VERSION = 1
+
+
+def root_attrs(metadata: Mapping | None, kind: str) -> dict:
+    """Attributes every file written here carries, for traceability."""
+    from .. import __version__
+
+    md = dict(metadata or {})
+    return {
+        "format": "tire-fbs",
+        "format_version": FORMAT_VERSION,
+        "content": kind,
+        "fbs_core_version": __version__,
+        "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "metadata": json.dumps(md, default=str, sort_keys=True),
+    }
+
+
+def _put_frf(g, frf: FRF) -> None:
+    import h5py
+
+    g.create_dataset("freq", data=np.asarray(frf.freq, dtype=float))
+    g["freq"].attrs["unit"] = "Hz"
+    g.create_dataset("data", data=np.asarray(frf.data, dtype=complex))
+    g.attrs["quantity"] = frf.quantity
+    g.attrs["units"] = UNITS[frf.quantity]
+    s = h5py.string_dtype()
+    g.attrs.create("outputs", np.array(frf.outputs, dtype=object), dtype=s)
+    g.attrs.create("inputs", np.array(frf.inputs, dtype=object), dtype=s)
+
+
+def _set_attrs(obj, attrs: Mapping) -> None:
+    for k, v in attrs.items():
+        if isinstance(v, bool | int | float | str | np.number):
+            obj.attrs[k] = v
+
+
+def write_hdf5(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
+    """An FRF as HDF5 content in the documented layout (group ``/frf``)."""
+    import h5py
+
+    b = io.BytesIO()
+    with h5py.File(b, "w") as h:
+        _set_attrs(h, root_attrs(metadata, "FRF"))
+        _put_frf(h.create_group("frf"), frf)
+    return b.getvalue()
+
+
+def write_hdf5_result(result, metadata: Mapping) -> bytes:
+    """A :class:`~fbs_core.io.results.ResultData` as HDF5 content."""
+    import h5py
+
+    b = io.BytesIO()
+    s = h5py.string_dtype()
+    with h5py.File(b, "w") as h:
+        _set_attrs(h, root_attrs(metadata, result.kind))
+        for k, v in metadata.items():
+            if isinstance(v, bool | int | float | str) and k not in h.attrs:
+                h.attrs[k] = v
+        for name, frf in result.frfs.items():
+            _put_frf(h.require_group("frfs").create_group(name), frf)
+        for dim, values in result.coords.items():
+            v = np.asarray(values)
+            if v.dtype.kind == "U":
+                h.require_group("coords").create_dataset(dim, data=v.astype(object), dtype=s)
+            else:
+                h.require_group("coords").create_dataset(dim, data=v)
+        for name, (dims, values) in result.arrays.items():
+            d = h.require_group("arrays").create_dataset(name, data=np.asarray(values))
+            d.attrs.create("dims", np.array(dims, dtype=object), dtype=s)
+    return b.getvalue()
+
+
+def _strings(v, what: str) -> list[str]:
+    if isinstance(v, str):
+        return [v]
+    if isinstance(v, list) and all(isinstance(x, str) for x in v):
+        return v
+    raise DataFormatError(f"{what} must be a list of DOF labels")
+
+
+def read_hdf5(src: Source, *, nodes: Mapping | None = None, quantity: str | None = None,
+              name: str | None = None, timeout: float = DEFAULT_TIMEOUT
+              ) -> tuple[FRF, list[str], dict]:
+    """Read an FRF group (``/frf``, ``/frfs/<name>`` or ``name``) from HDF5 content.
+
+    Raises
+    ------
+    DataFormatError, DOFError, QuantityError, FrequencyGridError
+    """
+    what = f"HDF5 file {src.name!r}"
+    meta, arrays = parse_isolated("hdf5", src.raw, what, timeout=timeout)
+    ds, groups = meta["datasets"], meta["groups"]
+    cands = [g for g in groups if f"{g.rstrip('/')}/freq" in ds and
+             f"{g.rstrip('/')}/data" in ds]
+    if name is not None:
+        g = "/" + name.strip("/")
+        if g not in cands and f"/frfs{g}" in cands:
+            g = f"/frfs{g}"
+        if g not in cands:
+            raise DataFormatError(
+                f"{what} has no FRF group {name!r}; FRF groups: {', '.join(cands) or 'none'}"
+            )
+    elif "/frf" in cands:
+        g = "/frf"
+    elif len(cands) == 1:
+        g = cands[0]
+    else:
+        raise DataFormatError(
+            f"{what}: " + (f"several FRF groups ({', '.join(cands)}); pass name=..." if cands
+                           else "no FRF group (a group with datasets 'freq' and 'data')")
+        )
+    base = g.rstrip("/")
+    attrs = groups[g]
+    fe, de = ds[f"{base}/freq"], ds[f"{base}/data"]
+    if "array" not in fe or "array" not in de:
+        raise DataFormatError(f"{what}: {base}/freq and {base}/data must be numeric")
+    freq = np.asarray(arrays[fe["array"]])
+    data = np.asarray(arrays[de["array"]])
+    check_finite(freq, f"{what} {base}/freq")
+    check_finite(data, f"{what} {base}/data")
+    if freq.ndim != 1 or np.iscomplexobj(freq):
+        raise DataFormatError(f"{what}: {base}/freq must be a real vector, got {freq.shape}")
+    freq = frequency_from_units(freq, fe["attrs"].get("unit"), what)
+
+    def labels(key):
+        if key in attrs:
+            return _strings(attrs[key], f"{what} {base} attribute {key!r}")
+        e = ds.get(f"{base}/{key}")
+        if e and "strings" in e:
+            return e["strings"]
+        raise DataFormatError(f"{what}: {base} lacks the DOF labels {key!r}")
+
+    raw_o, raw_i = labels("outputs"), labels("inputs")
+    expected = (freq.size, len(raw_o), len(raw_i))
+    if data.shape != expected:
+        raise DataFormatError(
+            f"{what}: {base}/data has shape {data.shape}, expected (n_freq, n_out, n_in) = "
+            f"{expected} from freq, outputs and inputs"
+        )
+    (outs, so), (ins, si) = (
+        zip(*(normalize_label(x, w) for x in lab), strict=True)
+        for lab, w in ((raw_o, "output"), (raw_i, "input"))
+    )
+    outs = [rename_node(x, nodes) for x in outs]
+    ins = [rename_node(x, nodes) for x in ins]
+    notes = []
+    ul = attrs.get("units")
+    units = parse_units(ul if isinstance(ul, str) else None)
+    if isinstance(ul, str) and ul.strip() and units is None:
+        notes.append(f"units {ul!r} not understood; not checked")
+    decl = attrs.get("quantity")
+    q = reconcile_quantity(decl if isinstance(decl, str) and decl else None, units, quantity,
+                           what)
+    frf = FRF(freq, data * np.outer(so, si)[None], outs, ins, q)
+    if units is not None and not units.is_si:
+        frf = frf.replace(data=frf.data * si_factors(units, outs, ins)[None])
+        notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
+    md = {}
+    root = groups.get("/", {})
+    if isinstance(root.get("metadata"), str):
+        try:
+            md = json.loads(root["metadata"])
+        except ValueError:
+            md = {"metadata": root["metadata"]}
+    for k in ("fbs_core_version", "created"):
+        if k in root:
+            md.setdefault(k, root[k])
+    return frf, notes, md

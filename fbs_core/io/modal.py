@@ -1,0 +1,130 @@
+"""Modal tire models from files: the project's own format and MATLAB.
+
+MATLAB variable layout (``docs/file-formats.md``; the arrays of
+:class:`fbs_core.tire.model.TireModel`, MATLAB index order):
+
+``speeds``
+    Operating points in km/h, ``n_s`` increasing values.
+``poles``
+    ``n_s x n_m`` complex poles ``lambda_r`` in rad/s, conjugate pairs
+    ``[r, conj(r), ...]`` lowest first, the same mode in every row (tracked).
+``psi``, ``chi``
+    ``n_s x n_m x 6`` right and left mode shapes at the hub DOFs (``a_r = 1``).
+``wavelengths``
+    Road wavelengths in m of the stored patch participations, ``n_h`` values.
+``participation``
+    ``n_s x n_h x n_m`` complex ``chi_r^T f_patch``.
+``hub_dofs`` (optional)
+    Six labels of the hub DOFs in vehicle axes, default ``hub:x`` ... ``hub:rz``.
+``metadata`` (optional)
+    JSON text with provenance.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..errors import DataFormatError, FBSError
+from .checks import Source, check_finite, normalize_label
+from .matlab import MatVars, read_mat_vars, write_mat_vars
+
+__all__ = ["tire_from_vars", "read_tire_mat", "write_tire_mat", "TIRE_VARIABLES"]
+
+TIRE_VARIABLES = ("speeds", "poles", "psi", "chi", "wavelengths", "participation")
+
+
+def _num(v: MatVars, key: str, name: str) -> np.ndarray:
+    if key not in v:
+        raise DataFormatError(
+            f"tire model {name!r} lacks the variable {key!r}; needed: "
+            f"{', '.join(TIRE_VARIABLES)} (found: {', '.join(v) or 'none'})"
+        )
+    a = v[key]
+    if isinstance(a, list):
+        raise DataFormatError(f"tire model {name!r}: {key!r} must be numeric, got text")
+    return check_finite(np.asarray(a), f"tire model {name!r} variable {key!r}")
+
+
+def _shaped(a: np.ndarray, shape: tuple, key: str, name: str, meaning: str) -> np.ndarray:
+    def strip(s):
+        s = list(s)
+        while len(s) > 1 and s[-1] == 1:
+            s.pop()
+        return tuple(s)
+
+    if strip(a.shape) != strip(shape):
+        raise DataFormatError(
+            f"tire model {name!r}: {key!r} has size {'x'.join(map(str, a.shape))}, "
+            f"expected {meaning} = {'x'.join(map(str, shape))}"
+        )
+    return a.reshape(shape)
+
+
+def tire_from_vars(v: MatVars, name: str):
+    """Build a :class:`~fbs_core.tire.model.TireModel` from MAT-file variables."""
+    from ..tire.model import TireModel
+
+    speeds = _num(v, "speeds", name).ravel().astype(float)
+    poles = _num(v, "poles", name)
+    n_s = speeds.size
+    if poles.ndim != 2 or poles.shape[0] != n_s:
+        raise DataFormatError(
+            f"tire model {name!r}: 'poles' has size {'x'.join(map(str, poles.shape))}, "
+            f"expected n_speeds x n_modes with n_speeds = {n_s} (from 'speeds')"
+        )
+    n_m = poles.shape[1]
+    lam = _num(v, "wavelengths", name).ravel().astype(float)
+    psi = _shaped(_num(v, "psi", name), (n_s, n_m, 6), "psi", name, "n_speeds x n_modes x 6")
+    chi = _shaped(_num(v, "chi", name), (n_s, n_m, 6), "chi", name, "n_speeds x n_modes x 6")
+    part = _shaped(_num(v, "participation", name), (n_s, lam.size, n_m), "participation",
+                   name, "n_speeds x n_wavelengths x n_modes")
+    hub = tuple(f"hub:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))
+    if "hub_dofs" in v:
+        labels = v["hub_dofs"]
+        if not isinstance(labels, list) or len(labels) != 6:
+            raise DataFormatError(f"tire model {name!r}: 'hub_dofs' must be 6 DOF labels")
+        hub = tuple(normalize_label(s, "hub")[0] for s in labels)
+    meta = {"source": name}
+    if isinstance(v.get("metadata"), list):
+        try:
+            meta.update(json.loads(" ".join(v["metadata"])))
+        except ValueError:
+            meta["metadata"] = " ".join(v["metadata"])
+    try:
+        return TireModel(speeds, poles, psi, chi, lam, part, meta=meta, hub_dofs=hub)
+    except FBSError as e:
+        raise type(e)(f"tire model {name!r}: {e}") from None
+    except (ValueError, TypeError) as e:
+        raise DataFormatError(f"tire model {name!r}: {e}") from None
+
+
+def read_tire_mat(src: Source, kind: str, **kw):
+    """Read a tire model from a MAT-file (v5 or v7.3) in the documented layout."""
+    return tire_from_vars(read_mat_vars(src, kind, **kw), src.name)
+
+
+def write_tire_mat(model, *, version: str = "5") -> bytes:
+    """A tire model as MAT-file content in the documented layout."""
+    return write_mat_vars({
+        "speeds": np.asarray(model.speeds, float),
+        "poles": np.asarray(model.poles),
+        "psi": np.asarray(model.psi),
+        "chi": np.asarray(model.chi),
+        "wavelengths": np.asarray(model.wavelengths, float),
+        "participation": np.asarray(model.participation),
+        "hub_dofs": list(model.hub_dofs),
+        "metadata": json.dumps(dict(model.meta), default=str),
+    }, version=version)
+
+
+def read_tire_native(src: Source, **kw):
+    """Read a tire model stored in the project's own format (``fbs_core.tire.storage``)."""
+    try:
+        from ..tire import storage
+    except ImportError:
+        raise DataFormatError(
+            "this version has no reader for the project's tire model format"
+        ) from None
+    return storage.load_model(src, **kw)

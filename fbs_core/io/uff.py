@@ -1,0 +1,448 @@
+"""Universal File Format dataset 58 ("function at nodal DOF"): FRFs in and out.
+
+Reading and writing go through pyuff; this module adds the checks. One dataset
+58 record holds one function between a response DOF and a reference DOF
+(record 6: node numbers and direction codes 1..3 = +X..+Z translation,
+4..6 = +X..+Z rotation, negative = opposite sign, 0 = scalar). Records 9 and 10
+say what the ordinate is (specific data type 8 displacement, 11 velocity,
+12 acceleration over 13 excitation force), which decides receptance, mobility
+or accelerance (thesis table 2.1). Dataset 164, when present, gives the unit
+system. Abscissa values are single precision in the format (E13.5).
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+import warnings
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ..dofs import DIRECTIONS, parse_label
+from ..errors import DataFormatError, DOFError, FBSError, FrequencyGridError, QuantityError
+from ..frf import FRF, UNITS
+from .checks import (
+    Source,
+    Units,
+    check_finite,
+    frequency_from_units,
+    parse_units,
+    reconcile_quantity,
+    si_factors,
+)
+
+__all__ = ["read_uff", "write_uff", "write_uff_records", "DIR_CODES"]
+
+#: UFF direction codes of the labelled directions (record 6 fields 7 and 10).
+DIR_CODES: dict[str, int] = {d: k + 1 for k, d in enumerate(DIRECTIONS)}
+_CODE_DIRS = {v: k for k, v in DIR_CODES.items()}
+
+#: Ordinate specific data types (record 9 field 1) of the three FRF quantities.
+SPEC_TYPES: dict[str, int] = {"receptance": 8, "mobility": 11, "accelerance": 12}
+_SPEC_QUANTITY = {v: k for k, v in SPEC_TYPES.items()}
+_FORCE_TYPES = (9, 13)
+_FUNC_NAMES = {0: "general", 1: "time response", 2: "auto spectrum", 3: "cross spectrum",
+               4: "FRF", 5: "transmissibility", 6: "coherence", 9: "PSD", 12: "spectrum"}
+
+_REQUIRED = ("func_type", "rsp_node", "rsp_dir", "ref_node", "ref_dir", "ord_data_type",
+             "num_pts", "abscissa_spacing", "x", "data")
+
+
+def _read_sets(src: Source) -> list[dict]:
+    import pyuff
+
+    with tempfile.TemporaryDirectory(prefix="fbs_uff_") as d:
+        path = Path(d) / "upload.uff"
+        path.write_bytes(src.raw)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                uff = pyuff.UFF(str(path))
+                n = uff.get_n_sets()
+                sets = uff.read_sets() if n else []
+        except Exception as e:
+            raise DataFormatError(
+                f"{src.name!r} is not a readable Universal File: {e}"
+            ) from None
+    if isinstance(sets, dict):
+        sets = [sets]
+    if not sets:
+        raise DataFormatError(
+            f"{src.name!r} contains no UFF datasets (blocks between '    -1' lines)"
+        )
+    return sets
+
+
+def _dof(node, code, ent, what: str, nodes: Mapping | None, ent_names: dict) -> tuple[str, int]:
+    try:
+        node, code = int(node), int(code)
+    except (TypeError, ValueError):
+        raise DataFormatError(f"{what}: node {node!r} / direction {code!r} are not integers")\
+            from None
+    if abs(code) > 6:
+        raise DOFError(
+            f"{what}: unknown direction code {code}; allowed: 0 (scalar), 1..3 (+X..+Z "
+            "translation), 4..6 (+X..+Z rotation), negative for the opposite sign"
+        )
+    name = ent_names.get(node, str(node))
+    if nodes and (node in nodes or str(node) in nodes):
+        name = str(nodes.get(node, nodes.get(str(node))))
+    label = name if code == 0 else f"{name}:{_CODE_DIRS[abs(code)]}"
+    try:
+        parse_label(label)
+    except DOFError as e:
+        raise DOFError(f"{what}: {e}") from None
+    return label, (-1 if code < 0 else 1)
+
+
+def _entity_names(frf_sets: list[dict]) -> dict[int, str]:
+    """Node number -> entity name, used only when the names map one-to-one to nodes."""
+    by_node: dict[int, set] = {}
+    for s in frf_sets:
+        for nk, ek in (("rsp_node", "rsp_ent_name"), ("ref_node", "ref_ent_name")):
+            ent = str(s.get(ek, "") or "").strip()
+            try:
+                by_node.setdefault(int(s[nk]), set()).add(ent)
+            except (TypeError, ValueError):
+                return {}
+    names = {}
+    for node, ents in by_node.items():
+        if len(ents) != 1:
+            return {}
+        ent = next(iter(ents))
+        if not ent or ent.upper() == "NONE":
+            return {}
+        try:
+            parse_label(ent)
+        except DOFError:
+            return {}
+        names[node] = ent
+    if len(set(names.values())) != len(names):
+        return {}
+    return names
+
+
+def _quantity_of(s: dict, what: str) -> str | None:
+    num = int(s.get("ordinate_spec_data_type", 0) or 0)
+    den = int(s.get("orddenom_spec_data_type", 0) or 0)
+    if num in _FORCE_TYPES and den in _SPEC_QUANTITY:
+        raise QuantityError(
+            f"{what} is force per {_SPEC_QUANTITY[den]} motion (an inverse FRF: dynamic "
+            "stiffness, impedance or apparent mass); invert it to an FRF first"
+        )
+    if den not in (0, 1) + _FORCE_TYPES:
+        raise QuantityError(
+            f"{what}: ordinate denominator specific data type {den} is not a force "
+            "(allowed: 9 reaction force, 13 excitation force, 0 unknown)"
+        )
+    if num in _SPEC_QUANTITY:
+        return _SPEC_QUANTITY[num]
+    if num in (0, 1):
+        return None
+    raise QuantityError(
+        f"{what}: ordinate specific data type {num} is not a motion; allowed: "
+        "8 displacement (receptance), 11 velocity (mobility), 12 acceleration (accelerance)"
+    )
+
+
+def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None = None,
+             freq=None) -> tuple[FRF, list[str], dict]:
+    """Read the FRF records (dataset 58, function type 4) of a Universal File.
+
+    Parameters
+    ----------
+    src : Source
+        File content and name.
+    nodes : mapping, optional
+        Node number -> name, e.g. ``{1: "spindle", 2: "bushing"}``. Without it, nodes
+        are named by the record's entity names when those map one-to-one to node
+        numbers, else by their numbers (``"1:z"``).
+    quantity : str, optional
+        Required when the file does not say what the ordinate is; checked otherwise.
+    freq : array_like, optional
+        Common grid (Hz) onto which records on different grids are interpolated
+        explicitly with :meth:`FRF.interpolate`; without it such records raise.
+
+    Returns
+    -------
+    frf : FRF
+        Shape ``(n_freq, n_out, n_in)``, SI units.
+    notes : list of str
+        What was skipped or converted.
+    metadata : dict
+        ID lines of the first record.
+
+    Raises
+    ------
+    DataFormatError, DOFError, FrequencyGridError, QuantityError
+    """
+    sets = _read_sets(src)
+    notes: list[str] = []
+    units164 = [s for s in sets if s.get("type") == 164]
+    f58 = [s for s in sets if s.get("type") == 58]
+    other = sorted({int(s.get("type", -1)) for s in sets} - {58, 164})
+    if other:
+        notes.append(f"ignored datasets of type {', '.join(map(str, other))}")
+    for k, s in enumerate(f58):
+        missing = [key for key in _REQUIRED if key not in s]
+        if missing:
+            raise DataFormatError(
+                f"{src.name!r}: dataset 58 number {k + 1} lacks {', '.join(missing)}"
+            )
+    frf_sets = [s for s in f58 if int(s["func_type"]) == 4]
+    if len(frf_sets) < len(f58):
+        kinds = sorted({_FUNC_NAMES.get(int(s["func_type"]), str(s["func_type"]))
+                        for s in f58 if int(s["func_type"]) != 4})
+        notes.append(f"skipped {len(f58) - len(frf_sets)} non-FRF records ({', '.join(kinds)})")
+    if not frf_sets:
+        raise DataFormatError(
+            f"{src.name!r} holds no FRF records (dataset 58 with function type 4); "
+            f"found {len(f58)} dataset-58 records and dataset types "
+            f"{sorted({int(s.get('type', -1)) for s in sets})}"
+        )
+    ent_names = {} if nodes else _entity_names(frf_sets)
+
+    entries: dict[tuple[str, str], np.ndarray] = {}
+    outputs: list[str] = []
+    inputs: list[str] = []
+    grid = None
+    declared: set[str] = set()
+    unit_labels: set[str] = set()
+    n_flipped = 0
+    for k, s in enumerate(frf_sets):
+        what = f"{src.name!r} FRF record {k + 1}"
+        out, so = _dof(s["rsp_node"], s["rsp_dir"], s.get("rsp_ent_name"), what, nodes,
+                       ent_names)
+        inp, si = _dof(s["ref_node"], s["ref_dir"], s.get("ref_ent_name"), what, nodes,
+                       ent_names)
+        what = f"{what} ({out} / {inp})"
+        x = np.asarray(s["x"])
+        y = np.asarray(s["data"])
+        n = int(s["num_pts"])
+        if x.ndim != 1 or y.ndim != 1 or x.size != y.size or y.size != n or n < 1:
+            raise DataFormatError(
+                f"{what}: the header announces {n} values but {y.size} ordinates and "
+                f"{x.size} abscissae were read (truncated or damaged file?)"
+            )
+        odt = int(s["ord_data_type"])
+        if odt not in (2, 4, 5, 6):
+            raise DataFormatError(f"{what}: ordinate data type {odt}; allowed: 2, 4, 5, 6")
+        if odt in (2, 4) and "real-valued" not in " ".join(notes):
+            notes.append("real-valued records were read as complex with zero imaginary part")
+        check_finite(x, f"{what} abscissa")
+        check_finite(y, f"{what} ordinate")
+        ast = int(s.get("abscissa_spec_data_type", 0) or 0)
+        if ast not in (0, 1, 18):
+            raise DataFormatError(
+                f"{what}: the abscissa has specific data type {ast} (17 time, 19 rpm, "
+                "20 order); an FRF needs frequency (18)"
+            )
+        x = frequency_from_units(x, s.get("abscissa_axis_units_lab"), what)
+        q = _quantity_of(s, what)
+        if q:
+            declared.add(q)
+        lab = str(s.get("ordinate_axis_units_lab", "") or "").strip()
+        if lab and lab.upper() != "NONE":
+            unit_labels.add(lab)
+        if (out, inp) in entries:
+            raise DataFormatError(f"{what}: a second record for the same output/input pair")
+        if grid is None:
+            grid = x
+        elif x.shape != grid.shape or not np.allclose(x, grid, rtol=1e-9, atol=0):
+            if freq is None:
+                raise FrequencyGridError(
+                    f"{what} is on a different frequency grid ({x.size} lines "
+                    f"{x[0]:g}-{x[-1]:g} Hz) than record 1 ({grid.size} lines "
+                    f"{grid[0]:g}-{grid[-1]:g} Hz); pass freq=<common grid> to interpolate "
+                    "all records onto it explicitly"
+                )
+        if so * si < 0:
+            n_flipped += 1
+        entries[(out, inp)] = (x, y.astype(complex) * so * si)
+        outputs += [out] if out not in outputs else []
+        inputs += [inp] if inp not in inputs else []
+    if n_flipped:
+        notes.append(f"{n_flipped} records had negative direction codes; their sign was flipped")
+
+    missing = [(o, i) for o in outputs for i in inputs if (o, i) not in entries]
+    if missing:
+        shown = ", ".join(f"{o}/{i}" for o, i in missing[:8])
+        more = f" and {len(missing) - 8} more" if len(missing) > 8 else ""
+        raise DataFormatError(
+            f"{src.name!r}: {len(missing)} of {len(outputs) * len(inputs)} output/input "
+            f"pairs have no record: {shown}{more}; a full matrix of outputs x inputs is needed"
+        )
+    target = grid if freq is None else np.asarray(freq, dtype=float)
+    data = np.empty((len(target), len(outputs), len(inputs)), dtype=complex)
+    for (o, i), (x, y) in entries.items():
+        if freq is not None:
+            try:
+                y = FRF(x, y[:, None, None], ["a"], ["b"]).interpolate(target).data[:, 0, 0]
+            except FBSError as e:
+                raise type(e)(f"{src.name!r} record {o}/{i}: {e}") from None
+        data[:, outputs.index(o), inputs.index(i)] = y
+    if freq is not None:
+        notes.append(f"records interpolated onto the requested grid of {len(target)} lines")
+
+    if len(declared) > 1:
+        raise QuantityError(
+            f"{src.name!r} mixes quantities across records: {', '.join(sorted(declared))}"
+        )
+    if len(unit_labels) > 1:
+        parsed = {lab: parse_units(lab) for lab in unit_labels}
+        if len({(u.quantity, u.length, u.force, u.g) if u else lab
+                for lab, u in parsed.items()}) > 1:
+            raise QuantityError(
+                f"{src.name!r} mixes units across records: {', '.join(sorted(unit_labels))}"
+            )
+    units = parse_units(next(iter(unit_labels))) if unit_labels else None
+    if unit_labels and units is None:
+        notes.append(f"units {next(iter(unit_labels))!r} not understood; not checked")
+    if (units is None or units.is_si) and units164:
+        u = units164[0]
+        try:
+            lf, ff = float(u["length"]), float(u["force"])
+        except (KeyError, TypeError, ValueError):
+            raise DataFormatError(f"{src.name!r}: damaged units dataset 164") from None
+        if not (lf > 0 and ff > 0 and math.isfinite(lf) and math.isfinite(ff)):
+            raise DataFormatError(f"{src.name!r}: dataset 164 has invalid unit factors")
+        if (lf, ff) != (1.0, 1.0):
+            units = Units(f"dataset 164 ({str(u.get('units_description', '')).strip()})",
+                          units.quantity if units else None, 1.0 / lf, 1.0 / ff)
+    q = reconcile_quantity(next(iter(declared)) if declared else None, units, quantity,
+                           repr(src.name))
+    frf = FRF(target, data, outputs, inputs, q)
+    if units is not None and not units.is_si:
+        frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs)[None])
+        notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
+    first = frf_sets[0]
+    meta = {f"id{k}": str(first.get(f"id{k}", "")).strip() for k in range(1, 6)}
+    return frf, notes, meta
+
+
+# -- writing ---------------------------------------------------------------------------
+def _e13(v: float) -> float:
+    return float(f"{v:13.5e}")
+
+
+def _abscissa(freq: np.ndarray, round_abscissa: bool) -> int:
+    """1 for even spacing, 0 for uneven; raise when E13.5 would change the grid."""
+    f = np.asarray(freq, dtype=float)
+    d = np.diff(f)
+    even = f.size > 1 and np.allclose(d, d[0], rtol=1e-9, atol=0)
+    if even:
+        back = _e13(f[0]) + np.arange(f.size) * _e13(d[0])
+    else:
+        back = np.array([_e13(v) for v in f])
+    err = np.max(np.abs(back - f))
+    if err > 1e-9 * max(1.0, np.max(np.abs(f))) and not round_abscissa:
+        raise DataFormatError(
+            "UFF dataset 58 stores frequencies with 6 significant digits (E13.5); this "
+            f"grid would move by up to {err:.3g} Hz. Interpolate onto a representable grid "
+            "(FRF.interpolate), export as HDF5 or MATLAB, or pass round_abscissa=True"
+        )
+    return int(even)
+
+
+def _node_numbers(labels: Sequence[str], nodes: Mapping | None) -> dict[str, int]:
+    """Node name -> UFF node number, from ``nodes`` (number -> name) or in order."""
+    names = list(dict.fromkeys(parse_label(lab)[0] for lab in labels))
+    given = {str(v): int(k) for k, v in (nodes or {}).items()}
+    numbers = {}
+    used = set(given.values())
+    nxt = 1
+    for n in names:
+        if n in given:
+            numbers[n] = given[n]
+        elif n.isdigit():
+            numbers[n] = int(n)
+        else:
+            while nxt in used:
+                nxt += 1
+            numbers[n] = nxt
+        used.add(numbers[n])
+    return numbers
+
+
+def _ent(name: str) -> str:
+    return name if len(name) <= 10 and " " not in name else "NONE"
+
+
+def write_uff_records(records: list[dict], *, binary: bool = False) -> bytes:
+    """Write dataset-58 records given as pyuff dictionaries; returns the file content."""
+    import pyuff
+
+    with tempfile.TemporaryDirectory(prefix="fbs_uff_") as d:
+        path = Path(d) / "out.uff"
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                uff = pyuff.UFF(str(path))
+                for r in records:
+                    r = dict(r, binary=int(binary))
+                    uff.write_sets(pyuff.prepare_58(**r), mode="add")
+        except Exception as e:  # pyuff raises bare Exceptions
+            raise DataFormatError(f"cannot write UFF dataset 58: {e}") from None
+        return path.read_bytes()
+
+
+def frf_records(frf: FRF, *, nodes: Mapping | None = None, id_lines: Sequence[str] = (),
+                round_abscissa: bool = False) -> list[dict]:
+    """pyuff dictionaries of one dataset 58 per output/input pair of ``frf``."""
+    even = _abscissa(frf.freq, round_abscissa)
+    numbers = _node_numbers(frf.outputs + frf.inputs, nodes)
+    ids = list(id_lines)[:4] + ["NONE"] * 4
+    recs = []
+    for o, out in enumerate(frf.outputs):
+        for i, inp in enumerate(frf.inputs):
+            (no, do), (ni, di) = parse_label(out), parse_label(inp)
+            recs.append(dict(
+                func_type=4, ver_num=0, load_case_id=0,
+                id1=f"{frf.quantity} {out} / {inp}"[:80],
+                id2=ids[0][:80], id3=ids[1][:80], id4=ids[2][:80], id5=ids[3][:80],
+                rsp_node=numbers[no], rsp_dir=DIR_CODES.get(do, 0), rsp_ent_name=_ent(no),
+                ref_node=numbers[ni], ref_dir=DIR_CODES.get(di, 0), ref_ent_name=_ent(ni),
+                data=np.array(frf.data[:, o, i], dtype=complex), x=np.array(frf.freq),
+                abscissa_spacing=even, abscissa_spec_data_type=18,
+                abscissa_axis_units_lab="Hz",
+                ordinate_spec_data_type=SPEC_TYPES[frf.quantity],
+                ordinate_axis_units_lab=UNITS[frf.quantity],
+                orddenom_spec_data_type=13, orddenom_axis_units_lab="N",
+                z_axis_spec_data_type=0,
+            ))
+    return recs
+
+
+def write_uff(frf: FRF, *, nodes: Mapping | None = None, metadata: Mapping | None = None,
+              binary: bool = False, round_abscissa: bool = False) -> bytes:
+    """An FRF as a Universal File of dataset-58 records (one per output/input pair).
+
+    Node names become entity names (when at most 10 characters) and node numbers from
+    ``nodes`` (number -> name) or 1, 2, ... in order of appearance. ID line 1 holds
+    the quantity and the pair, lines 2-5 the producer, date and ``metadata``.
+
+    Raises
+    ------
+    DataFormatError
+        When the grid is not representable in E13.5 (see ``round_abscissa``).
+    """
+    return write_uff_records(
+        frf_records(frf, nodes=nodes, id_lines=id_lines(metadata),
+                    round_abscissa=round_abscissa),
+        binary=binary,
+    )
+
+
+def id_lines(metadata: Mapping | None) -> list[str]:
+    """ID lines 2-5: producer and date, then ``key=value`` pairs of ``metadata``."""
+    from .. import __version__
+
+    lines = [f"tire-fbs fbs_core {__version__}", time.strftime("%d-%b-%y %H:%M:%S")]
+    text = "; ".join(f"{k}={v}" for k, v in (metadata or {}).items())
+    while text and len(lines) < 4:
+        lines.append(text[:80])
+        text = text[80:]
+    return lines
