@@ -47,10 +47,13 @@ def mix64(z):
     return z ^ (z >> _S31)
 
 
-@njit(cache=True)
-def seed_key(seed):
-    """The 64-bit key of an integer seed."""
-    return mix64(np.uint64(seed) + GOLDEN)
+def seed_key(seed: int) -> np.uint64:
+    """The 64-bit key ``mix(seed + G)`` of an integer seed (computed in Python)."""
+    mask = (1 << 64) - 1
+    z = (int(seed) + int(GOLDEN)) & mask
+    z = ((z ^ (z >> 30)) * int(_M1)) & mask
+    z = ((z ^ (z >> 27)) * int(_M2)) & mask
+    return np.uint64(z ^ (z >> 31))
 
 
 @njit(cache=True, inline="always")

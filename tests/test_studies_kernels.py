@@ -1,0 +1,121 @@
+"""Compiled kernels of the studies: small complex solves and the counter-based RNG."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import fbs_core as fc
+from fbs_core.studies import _kernels, _rng
+
+MASK = (1 << 64) - 1
+G = 0x9E3779B97F4A7C15
+
+
+def _mix(z):
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK
+    return z ^ (z >> 31)
+
+
+def _factors_python(seed, r, line, p, n_el):
+    """Pure-Python SplitMix64 streams, as documented in fbs_core.studies._rng."""
+    key = _mix((seed + G) & MASK)
+    base = _mix((_mix((key + (r + 1) * G) & MASK) + (line + 1) * G) & MASK)
+    out = []
+    for k in range((n_el + 1) // 2):
+        w = _mix((base + (k + 1) * G) & MASK)
+        out += [1 + p * (2 * ((w >> 32) * 2.0**-32) - 1), 1 + p * (2 * ((w & 0xFFFFFFFF) * 2.0**-32) - 1)]
+    return np.array(out[:n_el])
+
+
+def _rand_c(rng, *shape):
+    return rng.normal(size=shape) + 1j * rng.normal(size=shape)
+
+
+def test_numba_solve_equals_numpy_solve():
+    rng = np.random.default_rng(0)
+    A = _rand_c(rng, 500, 6, 6)
+    A[:50, 0, 0] = 0.0  # forces a row exchange
+    A[50:100] *= np.logspace(-6, 6, 6)  # badly scaled columns
+    b = _rand_c(rng, 500, 6)
+    x = _kernels.solve_batched(A, b)
+    ref = np.linalg.solve(A, b[..., None])[..., 0]
+    np.testing.assert_allclose(x, ref, rtol=1e-9, atol=0)
+    np.testing.assert_allclose(np.einsum("mij,mj->mi", A, x), b, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 6])
+def test_numba_solve_any_small_size(n):
+    rng = np.random.default_rng(n)
+    A = _rand_c(rng, 40, n, n)
+    b = _rand_c(rng, 40, n)
+    np.testing.assert_allclose(_kernels.solve_batched(A, b),
+                               np.linalg.solve(A, b[..., None])[..., 0], rtol=1e-10)
+
+
+def test_lane_kernel_equals_numpy_on_random_systems():
+    """Noisy eq. 4.1 of the vectorised kernel == np.linalg.solve with the same factors."""
+    rng = np.random.default_rng(2)
+    nf, nj, ne = 7, 6, 6
+    A, E, B = _rand_c(rng, nf, nj, nj), _rand_c(rng, nf, nj, nj), _rand_c(rng, nf, ne, nj)
+    a = _rand_c(rng, nf, nj)
+    A[:, 0, 0] = -E[:, 0, 0]  # zero pivot in the noise-free matrix
+    key = _rng.seed_key(5)
+    rids = np.array([0, 3, 40, 41, 77], np.int64)  # spans two lane blocks
+    for fd in (False, True):
+        out = np.empty((rids.size, nf, ne), complex)
+        args = [x for z in (A, a, E, B) for x in (z.real.copy(), z.imag.copy())]
+        _kernels.noisy_block_run(*args, 0, nf, key, rids, 0.1, True, True, fd,
+                                 np.empty((0, 0, 0)), out)
+        lines = np.tile(np.arange(nf) if fd else np.zeros(nf, np.int64), rids.size)
+        s = _kernels.noise_factors(key, np.repeat(rids, nf), lines, 0.1, nj, ne, True, True)
+        S = fc.studies.scatter.split_factors(s.reshape(rids.size, nf, -1), nj, ne)
+        x = np.linalg.solve(S["Yjj_A"] * A + S["Yjj_E"] * E, (S["vj_A"] * a)[..., None])
+        y = np.einsum("rfek,rfk->rfe", S["Yej_E"] * B, x[..., 0])
+        np.testing.assert_allclose(out, y, rtol=1e-10, atol=1e-12 * np.abs(y).max())
+
+
+def test_rng_matches_python_reference():
+    n_el = _kernels.n_elements(6, 6)
+    for seed, r, line in [(0, 0, 0), (1, 9999, 0), (12345, 17, 1999), (2**63 + 5, 3, 7)]:
+        key = _rng.seed_key(seed)
+        s = _kernels.noise_factors(key, np.array([r]), np.array([line]), 0.1, 6, 6, True, True)
+        np.testing.assert_array_equal(s[0], _factors_python(seed, r, line, 0.1, n_el))
+
+
+def test_rng_is_uniform_on_the_interval_and_independent():
+    p = 0.1
+    n = 4000
+    key = _rng.seed_key(0)
+    s = _kernels.noise_factors(key, np.arange(n), np.zeros(n, np.int64), p, 6, 6, True, True)
+    assert s.min() >= 1 - p and s.max() < 1 + p
+    u = (s.ravel() - (1 - p)) / (2 * p)
+    # mean 1/2, variance 1/12 of U(0, 1); histogram flat (chi-square, 20 bins)
+    assert abs(u.mean() - 0.5) < 5 * np.sqrt(1 / 12 / u.size)
+    assert abs(u.var() - 1 / 12) < 0.002
+    hist = np.histogram(u, bins=20, range=(0, 1))[0]
+    expected = u.size / 20
+    chi2 = ((hist - expected) ** 2 / expected).sum()
+    assert chi2 < 50  # 19 dof: P(chi2 > 50) ~ 1e-4
+    # neighbouring elements and rounds are uncorrelated
+    assert abs(np.corrcoef(s[:, 0], s[:, 1])[0, 1]) < 0.06
+    assert abs(np.corrcoef(s[:-1, 0], s[1:, 0])[0, 1]) < 0.06
+
+
+def test_rng_streams_differ_by_seed_round_and_line():
+    key0, key1 = _rng.seed_key(0), _rng.seed_key(1)
+    r = np.array([0, 0, 1]), np.array([0, 1, 0])
+    s0 = _kernels.noise_factors(key0, *r, 0.1, 6, 6, True, True)
+    s1 = _kernels.noise_factors(key1, *r, 0.1, 6, 6, True, True)
+    assert not np.any(s0[0] == s0[1]) and not np.any(s0[0] == s0[2])
+    assert not np.any(s0 == s1)
+
+
+def test_seed_validation():
+    assert _rng.as_seed(7) == 7
+    g1, g2 = np.random.default_rng(3), np.random.default_rng(3)
+    assert _rng.as_seed(g1) == _rng.as_seed(g2)
+    for bad in (-1, 2**64, 1.5, "1", True):
+        with pytest.raises(fc.FBSError, match="seed"):
+            _rng.as_seed(bad)
