@@ -25,7 +25,8 @@ def _factors_python(seed, r, line, p, n_el):
     out = []
     for k in range((n_el + 1) // 2):
         w = _mix((base + (k + 1) * G) & MASK)
-        out += [1 + p * (2 * ((w >> 32) * 2.0**-32) - 1), 1 + p * (2 * ((w & 0xFFFFFFFF) * 2.0**-32) - 1)]
+        hi, lo = (w >> 32) * 2.0**-32, (w & 0xFFFFFFFF) * 2.0**-32
+        out += [1 + p * (2 * hi - 1), 1 + p * (2 * lo - 1)]
     return np.array(out[:n_el])
 
 
