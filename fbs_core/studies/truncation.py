@@ -293,7 +293,20 @@ class ModeFrequencies:
     frequency: np.ndarray
 
 
-def _highest_retained(eig: np.ndarray, n: np.ndarray) -> np.ndarray:
+def _highest_retained(tire, speed: float, n: np.ndarray) -> np.ndarray:
+    """Highest eigenfrequency (Hz) among the first ``n`` modes at ``speed``, per count.
+
+    With ``tire.poles_at`` the retained modes are taken in the model's own order
+    (the order of truncation); otherwise the ``n / 2``-th positive eigenfrequency.
+    """
+    n = np.asarray(n, int)
+    if hasattr(tire, "poles_at"):
+        p = np.asarray(tire.poles_at(float(speed)))
+        if n.max() > p.size:
+            raise FBSError(f"{int(n.max())} modes requested, the tire has {p.size}")
+        run = np.maximum.accumulate(np.abs(p.imag)) / (2 * np.pi)
+        return run[np.maximum(n, 1) - 1]
+    eig = np.sort(np.asarray(tire.eigenfrequencies(float(speed))))
     pairs = np.maximum(n // 2, 1)
     if pairs.max() > eig.size:
         raise FBSError(f"{int(n.max())} modes requested, the tire has {2 * eig.size}")
@@ -304,14 +317,27 @@ def mode_frequencies(speeds=(20.0, 80.0, 120.0), n_modes=None, tire=None) -> Mod
     """Eigenfrequency versus number of retained modes at some speeds (thesis fig. 5.8).
 
     ``N`` modes are ``N / 2`` pairs of positive and negative eigenfrequencies, lowest
-    first; the value is the ``N / 2``-th positive eigenfrequency at each speed.
+    first; the value is the highest ``|Im lambda| / 2 pi`` among the first ``N`` modes
+    at each speed (the ``N / 2``-th positive eigenfrequency when they are sorted).
+
+    Parameters
+    ----------
+    speeds : sequence of float
+        Operating points in km/h (thesis: 20, 80 and 120).
+    n_modes : array_like of int, optional
+        Mode counts (default 10, 20, ... up to all modes).
+    tire : optional
+        Default the reference tire.
+
+    Returns
+    -------
+    ModeFrequencies
     """
     tire = _models.resolve_tire(tire)
     n_total = _models.total_modes(tire)
     n = default_n_modes(n_total) if n_modes is None else np.asarray(n_modes, int)
     sp = np.atleast_1d(np.asarray(speeds, float))
-    fr = np.stack([_highest_retained(np.sort(np.asarray(tire.eigenfrequencies(float(v)))), n)
-                   for v in sp])
+    fr = np.stack([_highest_retained(tire, v, n) for v in sp])
     return ModeFrequencies(_ro(n, int), _ro(sp), _ro(fr))
 
 
@@ -396,8 +422,9 @@ def suggest_modes(threshold: float = 0.2, f_max: float = 160.0, *, harmonics=(1,
         maps = tuple(maps)
         harmonics = tuple(m.harmonic for m in maps)
     n = np.array([m.suggest(threshold, f_max, dof) for m in maps], int)
-    eig = np.sort(np.asarray(tire.eigenfrequencies(float(speed))))
-    ef = np.array([_highest_retained(eig, np.array([k]))[0] if k > 0 else np.nan for k in n])
+    ef = np.full(n.size, np.nan)
+    if np.any(n > 0):
+        ef[n > 0] = _highest_retained(tire, speed, n[n > 0])
     hs = [_models.resolve_harmonic(k) for k in harmonics]
     fr = np.array([h.freq_range for h in hs])
     return SuggestedModes(tuple(int(k) for k in harmonics), _ro(n, int), _ro(ef), _ro(fr),
