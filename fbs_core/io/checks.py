@@ -163,6 +163,8 @@ def sniff(raw: bytes) -> str:
     for sig, what in _MAGIC:
         if head.startswith(sig):
             return what
+    if re.match(rb"^\s*-1[ \t]*\r?\n\s*\d+", head):  # UFF, also binary 58b
+        return "uff"
     if b"\x00" in head:
         return "binary data"
     try:

@@ -13,6 +13,7 @@ system. Abscissa values are single precision in the format (E13.5).
 from __future__ import annotations
 
 import math
+import re
 import tempfile
 import time
 import warnings
@@ -148,6 +149,17 @@ def _quantity_of(s: dict, what: str) -> str | None:
     )
 
 
+def _units_label(s: dict) -> str:
+    """The FRF units of a record: record 9's label, over record 10's when that is a force."""
+    num = str(s.get("ordinate_axis_units_lab", "") or "").strip()
+    den = str(s.get("orddenom_axis_units_lab", "") or "").strip()
+    if not num or num.upper() == "NONE":
+        return ""
+    if den.lower() in ("n", "kn", "lbf") and not re.search(r"(?i)\b(k?n|lbf)\b", num):
+        return f"({num})/{den}"
+    return num
+
+
 def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None = None,
              freq=None) -> tuple[FRF, list[str], dict]:
     """Read the FRF records (dataset 58, function type 4) of a Universal File.
@@ -244,8 +256,8 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
         q = _quantity_of(s, what)
         if q:
             declared.add(q)
-        lab = str(s.get("ordinate_axis_units_lab", "") or "").strip()
-        if lab and lab.upper() != "NONE":
+        lab = _units_label(s)
+        if lab:
             unit_labels.add(lab)
         if (out, inp) in entries:
             raise DataFormatError(f"{what}: a second record for the same output/input pair")
