@@ -161,6 +161,21 @@ def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
     datasets, groups, arrays = {}, {}, []
     with h5py.File(io.BytesIO(raw), "r") as f:
 
+        errors: list[Exception] = []
+
+        def guarded(func):
+            # an exception raised inside an h5py visitor comes out mangled; stop the
+            # visit by returning a value and re-raise afterwards
+            def call(name, obj):
+                try:
+                    func(name, obj)
+                except Exception as e:
+                    errors.append(e)
+                    return True
+                return None
+
+            return call
+
         def check_link(name, link):
             if not isinstance(link, h5py.HardLink):
                 raise ParseError(
@@ -168,7 +183,9 @@ def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
                     "files are not followed"
                 )
 
-        f.visititems_links(check_link)
+        f.visititems_links(guarded(check_link))
+        if errors:
+            raise errors[0]
         count = [0]
 
         def attrs_of(obj):
@@ -223,7 +240,9 @@ def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
             datasets[path] = entry
 
         groups["/"] = attrs_of(f)
-        f.visititems(visit)
+        f.visititems(guarded(visit))
+        if errors:
+            raise errors[0]
     return {"format": "hdf5", "datasets": datasets, "groups": groups}, arrays
 
 
