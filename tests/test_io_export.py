@@ -1,0 +1,133 @@
+"""Export of coupled and study results with metadata (CSV, UFF 58, HDF5)."""
+
+from __future__ import annotations
+
+import io
+
+import h5py
+import numpy as np
+import pytest
+
+import fbs_core
+from fbs_core import FRF
+from fbs_core.errors import DataFormatError
+from fbs_core.io import as_result_data, export_result, load_frf
+from fbs_core.studies import Convergence, ScatterBand, TruncationMap
+
+DOFS = ("bushing:x", "bushing:z")
+F = np.arange(20, 41) * 1.0
+
+
+def truncation_map() -> TruncationMap:
+    rng = np.random.default_rng(1)
+    n = np.array([10, 20, 30])
+    centres = np.array([26.0, 30.0, 34.0])
+    resp = rng.normal(size=(3, F.size, 2)) + 1j * rng.normal(size=(3, F.size, 2))
+    return TruncationMap(
+        harmonic=3, n_modes=n, n_modes_total=30, centres=centres, dofs=DOFS,
+        error=rng.uniform(size=(3, 3, 2)), freq=F, response=resp, reference=resp[-1],
+        width=12.0, step=4.0, edges="clip",
+    )
+
+
+def scatter() -> ScatterBand:
+    rng = np.random.default_rng(2)
+    ref = rng.normal(size=(F.size, 2)) + 1j * rng.normal(size=(F.size, 2))
+    lo, hi = 0.8 * abs(ref), 1.2 * abs(ref)
+    conv = Convergence(np.array([10, 100]), np.stack([lo, lo]), np.stack([hi, hi]))
+    arg = np.zeros((F.size, 2), int)
+    return ScatterBand(
+        freq=F, dofs=DOFS, reference=ref, lower=lo, upper=hi, argmin_round=arg,
+        argmax_round=arg, q=np.array([5.0, 95.0]), percentiles=np.stack([lo, hi]),
+        convergence=conv, noise=0.1, target="both", rounds=100, frequency_dependent=True,
+        seed=42, harmonic=1, _inputs=(),
+    )
+
+
+def test_study_result_is_flattened_with_named_axes():
+    res = as_result_data(truncation_map(), {"speed_kmh": 80})
+    dims, err = res.arrays["error"]
+    assert dims == ("n_modes", "centres", "dofs") and err.shape == (3, 3, 2)
+    assert res.arrays["response"][0] == ("n_modes", "freq", "dofs")
+    np.testing.assert_array_equal(res.coords["n_modes"], [10, 20, 30])
+    md = res.metadata
+    assert md["harmonic"] == 3 and md["width"] == 12.0 and md["speed_kmh"] == 80
+    assert md["fbs_core_version"] == fbs_core.__version__ and md["kind"] == "TruncationMap"
+    band = as_result_data(scatter())
+    assert band.arrays["percentiles"][0] == ("q", "freq", "dofs")
+    assert "convergence/lower" in band.arrays
+    assert band.metadata["seed"] == 42 and band.metadata["noise"] == 0.1
+
+
+def test_hdf5_export_holds_arrays_axes_and_metadata():
+    tm = truncation_map()
+    raw = export_result(tm, format="hdf5", metadata={"seed": 5})
+    with h5py.File(io.BytesIO(raw), "r") as h:
+        assert list(h["arrays/error"].attrs["dims"]) == ["n_modes", "centres", "dofs"]
+        np.testing.assert_array_equal(h["arrays/error"][()], tm.error)
+        np.testing.assert_array_equal(h["coords/dofs"].asstr()[()], DOFS)
+        assert h.attrs["harmonic"] == 3 and h.attrs["seed"] == 5
+        assert h.attrs["fbs_core_version"] == fbs_core.__version__
+        assert '"width": 12.0' in h.attrs["metadata"]
+
+
+def test_csv_export_tables_and_metadata_header():
+    tm = truncation_map()
+    text = export_result(tm, format="csv", metadata={"N": 40}).decode()
+    assert "# harmonic: 3" in text and "# N: 40" in text
+    assert f"# fbs_core_version: {fbs_core.__version__}" in text
+    block = text.split("# table: error\n")[1].split("\n\n")[0].splitlines()
+    assert block[0] == "n_modes,centres,dofs,value"
+    assert len(block) == 1 + tm.error.size
+    first = block[1].split(",")
+    assert first[:3] == ["10", "26.0", "bushing:x"] and float(first[3]) == tm.error[0, 0, 0]
+    resp = text.split("# table: response\n")[1].splitlines()
+    assert resp[0] == "n_modes,freq,dofs,re,im"
+
+
+def test_uff_export_of_functions_of_frequency(tmp_path):
+    import pyuff
+
+    tm = truncation_map()
+    p = export_result(tm, tmp_path / "r.uff", metadata={"seed": 1})
+    sets = pyuff.UFF(str(p)).read_sets()
+    ids = [s["id1"] for s in sets]
+    # error over centres (3 x 2), response (3 x 2), reference (2)
+    assert len(sets) == 6 + 6 + 2
+    k = ids.index("response [n_modes=20, dofs=bushing:z]")
+    np.testing.assert_allclose(sets[k]["data"], tm.response[1, :, 1], rtol=1e-10)
+    np.testing.assert_allclose(sets[k]["x"], F)
+    assert sets[k]["rsp_dir"] == 3
+    assert any("seed=1" in s["id4"] for s in sets)
+
+
+def test_coupled_frf_result_round_trips_through_every_export():
+    w = 2 * np.pi * F
+    Y = FRF(F, (1j * w / (5e4 - 2 * w**2 + 3j * w))[:, None, None], ["bushing:z"],
+            ["patch"], "mobility")
+    for fmt, end in (("csv", "csv"), ("uff", "uff"), ("hdf5", "h5")):
+        raw = export_result(Y, format=fmt, metadata={"harmonic": 1, "N": 40})
+        if fmt == "csv":  # a result CSV holds one table per item; the FRF table loads
+            raw = raw.split(b"# table: frf\n")[1]
+        r = load_frf(raw, filename=f"r.{end}")
+        assert r.frf.allclose(Y, rtol=1e-10)
+
+
+def test_mapping_results_and_refusals(tmp_path):
+    res = {"error": (("n_modes", "freq"), np.ones((2, 3))),
+           "coords": {"n_modes": [10, 20], "freq": [1.0, 2.0, 3.0]},
+           "metadata": {"noise": 0.1}}
+    p = export_result(res, tmp_path / "m.h5")
+    with h5py.File(p, "r") as h:
+        assert h.attrs["noise"] == 0.1
+    with pytest.raises(DataFormatError, match="cannot export a object"):
+        export_result(object(), format="csv")
+    with pytest.raises(DataFormatError, match="coordinate has 4"):
+        export_result({"e": (("a",), np.ones(3)), "coords": {"a": [1, 2, 3, 4]}},
+                      format="csv")
+    with pytest.raises(DataFormatError, match="no function of frequency"):
+        export_result({"e": (("a",), np.ones(3))}, format="uff")
+    with pytest.raises(DataFormatError, match="not 'mat'"):
+        export_result(res, format="mat")
+    with pytest.raises(DataFormatError, match="no arrays"):
+        export_result({"metadata": {"a": 1}}, format="csv")
