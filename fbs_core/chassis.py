@@ -146,11 +146,21 @@ def _modal(p: ChassisParameters):
     """Complex modes of ``M^-1 K`` (hysteretic K): ``K V = M V diag(lam)``."""
     s = build_chassis(p).system()
     K, M = s.K.toarray(), s.M.toarray()
-    lam, V = sla.eig(K, M)
+    # M = L L^T turns K v = lam M v into the standard problem A u = lam u with
+    # A = L^-1 K L^-T (complex symmetric), v = L^-T u: much cheaper than QZ.
+    L = np.linalg.cholesky(M)
+    A = sla.solve_triangular(L, sla.solve_triangular(L, K, lower=True).T, lower=True).T
+    lam, U = np.linalg.eig(A)
+    V = sla.solve_triangular(L.T, U, lower=False)
+    # Rayleigh quotients on the original matrices (complex symmetric: left = right
+    # vector): second-order accurate, they restore the relative accuracy of the low
+    # eigenvalues that the reduction spends on the stiff high ones.
+    lam = np.einsum("ir,ir->r", V, K @ V) / np.einsum("ir,ir->r", V, M @ V)
     order = np.argsort(lam.real)
-    lam, V = lam[order], V[:, order]
-    # left factor: V^-1 M^-1, so that (K - w^2 M)^-1 = V diag(1/(lam - w^2)) V^-1 M^-1
-    W = np.linalg.solve(V, np.linalg.solve(M, np.eye(s.n)))
+    lam, U, V = lam[order], U[:, order], V[:, order]
+    # left factor V^-1 M^-1 = U^-1 L^-1, so that
+    # (K - w^2 M)^-1 = V diag(1 / (lam - w^2)) V^-1 M^-1
+    W = np.linalg.solve(U, sla.solve_triangular(L, np.eye(s.n), lower=True))
     for a in (lam, V, W):
         a.setflags(write=False)
     return s, lam, V, W
@@ -251,6 +261,9 @@ def _synth(p: ChassisParameters, fbytes: bytes, outputs: tuple, inputs: tuple) -
 def read_chassis_frf(path) -> FRF:
     """Read the FRF stored by ``scripts/build_reference_chassis.py`` (HDF5, no pickle).
 
+    The file follows the project's HDF5 layout (``fbs_core.io.hdf5``), so
+    ``fbs_core.io`` reads its ``/frf`` group as well.
+
     Parameters
     ----------
     path : str or pathlib.Path
@@ -264,14 +277,18 @@ def read_chassis_frf(path) -> FRF:
     import h5py
 
     with h5py.File(path, "r") as h:
-        if h.attrs.get("format") != "tire-fbs chassis" or h.attrs.get("version") != 1:
+        if h.attrs.get("format") != "tire-fbs" or h.attrs.get("model") != "reference chassis":
             raise DataFormatError(
-                f"{path}: not a 'tire-fbs chassis' file of version 1 "
-                f"(format={h.attrs.get('format')!r}, version={h.attrs.get('version')!r})"
+                f"{path}: not a 'tire-fbs' reference chassis file "
+                f"(format={h.attrs.get('format')!r}, model={h.attrs.get('model')!r})"
             )
         g = h["frf"]
-        return FRF(g["freq"][()], g["data"][()], [s.decode() for s in g["outputs"][()]],
-                   [s.decode() for s in g["inputs"][()]], str(g.attrs["quantity"]))
+
+        def labels(key):
+            return [v.decode() if isinstance(v, bytes) else str(v) for v in g.attrs[key]]
+
+        return FRF(g["freq"][()], g["data"][()], labels("outputs"), labels("inputs"),
+                   str(g.attrs["quantity"]))
 
 
 @functools.lru_cache(maxsize=1)

@@ -33,7 +33,9 @@ from fbs_core.chassis import (  # noqa: E402
     ChassisModel,
     ChassisParameters,
 )
+from fbs_core.io.hdf5 import write_hdf5  # noqa: E402
 
+COORDINATES = "ISO 8855 vehicle axes: x forward, y left, z up; origin at the subframe centre"
 TARGETS = {"x": 14.0, "y": 37.0, "ry": 47.0}
 LINK_INDEX = {"x": (0,), "y": (1, 3, 5), "ry": (4,)}  # lateral mode: k_y, k_rx, k_rz
 
@@ -50,18 +52,21 @@ def tune(p: ChassisParameters, iters: int = 20) -> ChassisParameters:
 
 
 def write_h5(ch: ChassisModel, path: Path, freq: np.ndarray) -> None:
+    """The project's HDF5 FRF layout (``fbs_core.io.hdf5``: root attributes and
+    ``/frf``) plus the model itself: ``/parameters``, ``/system`` (sparse M, K)
+    and ``/modes``."""
     s = ch.system()
     Y = ch.mobility(freq)
-    with h5py.File(path, "w") as h:
-        h.attrs["format"] = "tire-fbs chassis"
-        h.attrs["version"] = 1
-        h.attrs["units"] = "SI; mobility in m/(N s), rad/(N m s) and mixed"
-        h.attrs["coordinates"] = "ISO 8855 vehicle axes: x forward, y left, z up"
+    meta = {"model": "reference rear-corner chassis", "coordinates": COORDINATES,
+            "script": "scripts/build_reference_chassis.py"}
+    path.write_bytes(write_hdf5(Y, metadata=meta))
+    with h5py.File(path, "a") as h:
+        h.attrs["model"] = "reference chassis"
         g = h.create_group("parameters")
         for key, val in dataclasses.asdict(ch.params).items():
             g.attrs[key] = np.asarray(val, float)
         g = h.create_group("system")
-        g["dofs"] = np.array(s.dofs, dtype="S")
+        g.attrs.create("dofs", np.array(s.dofs, dtype=object), dtype=h5py.string_dtype())
         for name in ("M", "K"):
             a = getattr(s, name).tocsr()
             sub = g.create_group(name)
@@ -70,12 +75,6 @@ def write_h5(ch: ChassisModel, path: Path, freq: np.ndarray) -> None:
         g = h.create_group("modes")
         g["eigenvalues"] = ch.eigenvalues()
         g["frequency_hz"] = ch.eigenfrequencies()
-        g = h.create_group("frf")
-        g["freq"] = Y.freq
-        g.create_dataset("data", data=Y.data, compression="gzip", shuffle=True)
-        g["outputs"] = np.array(Y.outputs, dtype="S")
-        g["inputs"] = np.array(Y.inputs, dtype="S")
-        g.attrs["quantity"] = Y.quantity
 
 
 def main(argv=None) -> int:

@@ -122,7 +122,7 @@ def test_bad_input(chassis, tmp_path):
 
     with h5py.File(bad, "w") as h:
         h.attrs["format"] = "something else"
-    with pytest.raises(DataFormatError, match="not a 'tire-fbs chassis'"):
+    with pytest.raises(DataFormatError, match="not a 'tire-fbs' reference chassis"):
         read_chassis_frf(bad)
 
 
