@@ -25,6 +25,7 @@ from .errors import (
 )
 from .frf import FRF, QUANTITIES
 from .harmonics import HARMONICS, Harmonic, harmonic
+from .tire import TireModel, reference_tire
 
 __version__ = "0.1.0"
 
@@ -41,6 +42,7 @@ __all__ = [
     "FRF",
     "HARMONICS",
     "Harmonic",
+    "TireModel",
     "QUANTITIES",
     "DOFError",
     "DataFormatError",
@@ -49,6 +51,7 @@ __all__ = [
     "QuantityError",
     "SingularInterfaceError",
     "harmonic",
+    "reference_tire",
     "ChassisModel",
     "reference_chassis",
     "node_labels",

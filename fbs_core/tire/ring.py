@@ -57,6 +57,7 @@ from .params import DEFAULT_PARAMETERS, FAMILIES, TireParameters
 __all__ = [
     "HUB_DOFS",
     "build_tire_system",
+    "system_matrices",
     "patch_load",
     "belt_labels",
     "omega_of_speed",

@@ -1,0 +1,143 @@
+"""HDF5 file format of a modal tire model (format ``tire-fbs/modal-tire``, version 1).
+
+The layout, described for suppliers in ``docs/tire-model.md``::
+
+    /                      attrs: format, format_version, description, source
+    /speeds                (n_s,)            float64  km/h
+    /poles                 (n_s, n_m)        complex128 rad/s, pairs [r, conj(r), ...]
+    /psi                   (n_s, n_m, 6)     complex128 right shapes at the hub
+    /chi                   (n_s, n_m, 6)     complex128 left shapes at the hub
+    /hub_dofs              (6,)              str  hub:x ... hub:rz (vehicle axes)
+    /wavelengths           (n_h,)            float64  m
+    /participation         (n_s, n_h, n_m)   complex128 chi_r^T f_patch
+    /parameters            group, attrs: the physical parameters (optional)
+
+Complex data use h5py's native compound type with fields ``r`` and ``i``.
+Every dataset carries ``unit`` and ``description`` attributes. No pickles.
+"""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from ..errors import DataFormatError
+from .model import TireModel
+from .params import TireParameters
+from .ring import HUB_DOFS
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "DATA_FILE", "save_tire_model", "load_tire_model",
+           "reference_tire"]
+
+FORMAT = "tire-fbs/modal-tire"
+FORMAT_VERSION = 1
+
+#: The shipped reference model.
+DATA_FILE = Path(__file__).resolve().parents[2] / "data" / "reference_tire.h5"
+
+_DATASETS = {
+    "speeds": ("km/h", "operating points (vehicle speed)"),
+    "poles": ("rad/s", "complex poles lambda_r in conjugate pairs [r, conj(r), ...], pairs "
+                       "ordered by eigenfrequency averaged over the speeds; mode r is the same "
+                       "tracked mode at every speed"),
+    "psi": ("m or rad per unit modal coordinate",
+            "right mode shapes at the hub DOFs, normalised with the left ones so that "
+            "a_r = chi_r^T (2 lambda_r M + C) psi_r = 1"),
+    "chi": ("m or rad per unit modal coordinate",
+            "left mode shapes at the hub DOFs (a_r = 1); receptance "
+            "H = sum_r psi_r chi_r^T / (j omega - lambda_r)"),
+    "wavelengths": ("m", "road wavelengths of the patch loads"),
+    "participation": ("N/m (load per metre of road amplitude, per unit modal coordinate)",
+                      "modal participation chi_r^T f_patch of the distributed patch load "
+                      "exp(j 2 pi x / lambda) per speed and wavelength"),
+}
+
+
+def save_tire_model(model: TireModel, path, description: str = "") -> Path:
+    """Write a :class:`TireModel` to HDF5 (format version 1).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with h5py.File(path, "w", track_order=True) as f:
+        f.attrs["format"] = FORMAT
+        f.attrs["format_version"] = FORMAT_VERSION
+        f.attrs["description"] = description
+        f.attrs["meta"] = json.dumps(model.meta, sort_keys=True)
+        for name, (unit, desc) in _DATASETS.items():
+            ds = f.create_dataset(name, data=np.asarray(getattr(model, name)))
+            ds.attrs["unit"] = unit
+            ds.attrs["description"] = desc
+        ds = f.create_dataset("hub_dofs", data=np.array(model.hub_dofs, dtype=object),
+                              dtype=h5py.string_dtype())
+        ds.attrs["description"] = ("hub DOF labels, vehicle coordinates ISO 8855: x forward, "
+                                   "y left, z up; rotations about these axes")
+        if model.params is not None:
+            g = f.create_group("parameters")
+            g.attrs["description"] = "physical parameters (SI units), fbs_core.tire.TireParameters"
+            for k, v in model.params.to_dict().items():
+                g.attrs[k] = np.asarray(v)
+    return path
+
+
+def load_tire_model(path) -> TireModel:
+    """Read a modal tire model written in format ``tire-fbs/modal-tire``.
+
+    Raises
+    ------
+    DataFormatError
+        If the file is missing, not this format, of an unknown version, or has
+        inconsistent data.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise DataFormatError(f"no modal tire file at {path}")
+    try:
+        with h5py.File(path, "r") as f:
+            fmt = f.attrs.get("format")
+            ver = int(f.attrs.get("format_version", -1))
+            if fmt != FORMAT:
+                raise DataFormatError(f"{path} is not a {FORMAT!r} file (format={fmt!r})")
+            if ver != FORMAT_VERSION:
+                raise DataFormatError(
+                    f"{path} has format_version {ver}; this code reads {FORMAT_VERSION}"
+                )
+            missing = [k for k in (*_DATASETS, "hub_dofs") if k not in f]
+            if missing:
+                raise DataFormatError(f"{path} lacks dataset(s) {missing}")
+            data = {k: f[k][()] for k in _DATASETS}
+            hub = tuple(s.decode() if isinstance(s, bytes) else str(s) for s in f["hub_dofs"][()])
+            params = None
+            if "parameters" in f:
+                attrs = {k: v for k, v in f["parameters"].attrs.items() if k != "description"}
+                params = TireParameters.from_dict(
+                    {k: (v.tolist() if k == "orders" else float(v)) for k, v in attrs.items()}
+                )
+            meta = json.loads(f.attrs.get("meta", "{}"))
+    except OSError as e:
+        raise DataFormatError(f"cannot read {path} as HDF5: {e}") from e
+    if hub != HUB_DOFS:
+        raise DataFormatError(f"hub_dofs must be {list(HUB_DOFS)}, got {list(hub)}")
+    return TireModel(data["speeds"], data["poles"], data["psi"], data["chi"],
+                     data["wavelengths"], data["participation"], params=params, meta=meta,
+                     hub_dofs=hub)
+
+
+@lru_cache(maxsize=1)
+def reference_tire() -> TireModel:
+    """The shipped reference tire model (``data/reference_tire.h5``), loaded once.
+
+    Examples
+    --------
+    >>> tire = reference_tire()
+    >>> tire.n_modes
+    400
+    """
+    return load_tire_model(DATA_FILE)
