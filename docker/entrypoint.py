@@ -1,0 +1,259 @@
+"""Container entrypoint: deployment settings from environment variables -> ``panel serve``.
+
+The image's exec-form ENTRYPOINT runs this script, which validates the ``FBS_*`` variables,
+builds the ``panel serve`` command line and replaces itself with it (``os.execv``), so the
+server is PID 1 and receives ``docker stop``'s SIGTERM. Arguments given after the image name
+in ``docker run`` are appended to the ``panel serve`` command line. ``--healthcheck`` instead
+probes the server's ``/liveness`` endpoint (the image's HEALTHCHECK); ``--print-command``
+prints the command line without running it (secrets masked).
+
+Variables (all optional; the table with examples is in docs/deployment.md):
+
+``BOKEH_ALLOW_WS_ORIGIN``
+    Read by Bokeh itself: comma-separated ``host:port`` values that browsers may open the
+    websocket from (the address in the browser's location bar). Image default
+    ``localhost:5006,127.0.0.1:5006``.
+``FBS_NUM_THREADS``
+    Worker threads for session callbacks (``--num-threads``), integer >= 1, default 4.
+``FBS_BASIC_AUTH``
+    Turns on Panel's basic authentication (login form): ``user:password`` entries separated
+    by commas or newlines. The passwords are written to a private file, never onto the
+    command line.
+``FBS_BASIC_AUTH_FILE``
+    Same, from a mounted JSON file ``{"user": "password", ...}`` (e.g. a Docker secret).
+``FBS_COOKIE_SECRET``
+    Secret (>= 32 characters) that signs the login cookies (``--cookie-secret``). With
+    authentication on and no secret, a random one is made at start: logins then end when the
+    container restarts. ``PANEL_COOKIE_SECRET`` is accepted as well.
+``PANEL_OAUTH_PROVIDER``, ``PANEL_OAUTH_KEY``, ``PANEL_OAUTH_SECRET``, ...
+    Read by Panel itself: OAuth login instead of basic authentication.
+``FBS_PREFIX``
+    URL prefix when served behind a reverse proxy under a sub-path (``--prefix``).
+``FBS_USE_XHEADERS``
+    ``true`` behind a TLS-terminating reverse proxy (``--use-xheaders``).
+``FBS_WEBSOCKET_MAX_MESSAGE_MB``
+    Largest websocket message (file uploads travel in one), default Bokeh's 20.
+``FBS_LOG_LEVEL``
+    ``debug``, ``info`` (default), ``warning``, ``error`` or ``critical``.
+``FBS_APP``
+    Path of the Panel script to serve; default the installed ``app/main.py``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import secrets
+import sys
+import tempfile
+import urllib.request
+from pathlib import Path
+
+PORT = 5006
+LOG_LEVELS = ("debug", "info", "warning", "error", "critical")
+TRUE = ("1", "true", "yes", "on")
+FALSE = ("", "0", "false", "no", "off")
+MIN_SECRET_LEN = 32
+
+
+class SettingError(ValueError):
+    """A deployment environment variable has a value that cannot be used."""
+
+
+def _flag(env: dict[str, str], name: str) -> bool:
+    value = env.get(name, "").strip().lower()
+    if value in TRUE:
+        return True
+    if value in FALSE:
+        return False
+    raise SettingError(f"{name}={env[name]!r}: allowed values are {', '.join(TRUE + FALSE[1:])}")
+
+
+def _positive_int(env: dict[str, str], name: str, default: int | None) -> int | None:
+    raw = env.get(name, "").strip()
+    if not raw:
+        return default
+    try:
+        value = int(raw)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise SettingError(f"{name}={raw!r}: must be an integer >= 1")
+    return value
+
+
+def parse_users(text: str, name: str = "FBS_BASIC_AUTH") -> dict[str, str]:
+    """Parse ``user:password`` entries separated by commas or newlines.
+
+    Raises
+    ------
+    SettingError
+        If an entry has no ``:``, an empty user or password, or a user appears twice.
+    """
+    users: dict[str, str] = {}
+    for entry in text.replace("\n", ",").split(","):
+        entry = entry.strip()
+        if not entry:
+            continue
+        user, sep, password = entry.partition(":")
+        user = user.strip()
+        if not sep or not user or not password:
+            raise SettingError(
+                f"{name}: entry {user or entry[:1] + '...'!r} is not of the form user:password"
+            )
+        if user in users:
+            raise SettingError(f"{name}: user {user!r} is given twice")
+        users[user] = password
+    if not users:
+        raise SettingError(f"{name} is set but holds no user:password entry")
+    return users
+
+
+def _check_users_file(path: str) -> None:
+    try:
+        with open(path, encoding="utf-8") as f:
+            users = json.load(f)
+    except OSError as exc:
+        raise SettingError(f"FBS_BASIC_AUTH_FILE={path!r} cannot be read: {exc}") from exc
+    except json.JSONDecodeError as exc:
+        raise SettingError(f"FBS_BASIC_AUTH_FILE={path!r} is not JSON: {exc}") from exc
+    if (
+        not isinstance(users, dict)
+        or not users
+        or not all(isinstance(k, str) and isinstance(v, str) and k and v for k, v in users.items())
+    ):
+        raise SettingError(
+            f'FBS_BASIC_AUTH_FILE={path!r} must hold a JSON object {{"user": "password", ...}}'
+        )
+
+
+def _write_users(users: dict[str, str]) -> str:
+    folder = tempfile.mkdtemp(prefix="fbs-auth-")  # mode 0700
+    path = os.path.join(folder, "users.json")
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    with os.fdopen(fd, "w", encoding="utf-8") as f:
+        json.dump(users, f)
+    return path
+
+
+def default_app() -> str:
+    """Path of the installed dashboard script ``app/main.py``."""
+    spec = importlib.util.find_spec("app")
+    if spec is None or not spec.submodule_search_locations:
+        raise SettingError("the package 'app' is not installed; set FBS_APP to a Panel script")
+    return str(Path(next(iter(spec.submodule_search_locations))) / "main.py")
+
+
+def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], list[str]]:
+    """Command line of ``panel serve`` and the warnings to print, from the environment.
+
+    Raises
+    ------
+    SettingError
+        For a variable with a value that cannot be used (the message names it).
+    """
+    warnings: list[str] = []
+    app = env.get("FBS_APP") or default_app()
+    if not os.path.isfile(app):
+        raise SettingError(f"FBS_APP: the Panel script {app!r} does not exist")
+    cmd = [
+        str(Path(sys.executable).with_name("panel")), "serve", app,
+        "--address", "0.0.0.0", "--port", str(PORT), "--liveness",
+    ]
+    threads = _positive_int(env, "FBS_NUM_THREADS", 4)
+    if env.get("PANEL_NUM_THREADS"):
+        warnings.append("PANEL_NUM_THREADS is set and wins over FBS_NUM_THREADS")
+    else:
+        cmd += ["--num-threads", str(threads)]
+
+    if "PANEL_BASIC_AUTH" in env:
+        raise SettingError(
+            "PANEL_BASIC_AUTH is not supported here (Panel lower-cases its value); "
+            "use FBS_BASIC_AUTH or FBS_BASIC_AUTH_FILE"
+        )
+    if env.get("FBS_BASIC_AUTH") and env.get("FBS_BASIC_AUTH_FILE"):
+        raise SettingError("set FBS_BASIC_AUTH or FBS_BASIC_AUTH_FILE, not both")
+    users_file = None
+    if env.get("FBS_BASIC_AUTH_FILE"):
+        users_file = env["FBS_BASIC_AUTH_FILE"]
+        _check_users_file(users_file)
+    elif env.get("FBS_BASIC_AUTH"):
+        users_file = _write_users(parse_users(env["FBS_BASIC_AUTH"]))
+    oauth = bool(env.get("PANEL_OAUTH_PROVIDER"))
+    if users_file and oauth:
+        raise SettingError("basic authentication (FBS_BASIC_AUTH*) and PANEL_OAUTH_PROVIDER "
+                           "exclude each other: choose one")
+    if users_file:
+        cmd += ["--basic-auth", users_file]
+
+    secret = env.get("FBS_COOKIE_SECRET", "")
+    if secret and env.get("PANEL_COOKIE_SECRET"):
+        raise SettingError("set FBS_COOKIE_SECRET or PANEL_COOKIE_SECRET, not both")
+    secret = secret or env.get("PANEL_COOKIE_SECRET", "")
+    if secret and len(secret) < MIN_SECRET_LEN:
+        raise SettingError(f"the cookie secret must have at least {MIN_SECRET_LEN} characters "
+                           f"(has {len(secret)}); make one with "
+                           "python3 -c 'import secrets; print(secrets.token_urlsafe(32))'")
+    if not secret and (users_file or oauth):
+        secret = secrets.token_urlsafe(32)
+        warnings.append("no FBS_COOKIE_SECRET: made a random one, logins end at restart")
+    if secret and not env.get("PANEL_COOKIE_SECRET"):
+        cmd += ["--cookie-secret", secret]
+
+    prefix = env.get("FBS_PREFIX", "").strip("/")
+    if prefix:
+        cmd += ["--prefix", prefix]
+    if _flag(env, "FBS_USE_XHEADERS"):
+        cmd += ["--use-xheaders"]
+    size = _positive_int(env, "FBS_WEBSOCKET_MAX_MESSAGE_MB", None)
+    if size is not None:
+        cmd += ["--websocket-max-message-size", str(size * 1024 * 1024)]
+    level = env.get("FBS_LOG_LEVEL", "info").strip().lower()
+    if level not in LOG_LEVELS:
+        raise SettingError(f"FBS_LOG_LEVEL={level!r}: allowed values are {', '.join(LOG_LEVELS)}")
+    cmd += ["--log-level", level]
+    return cmd + list(extra), warnings
+
+
+def masked(cmd: list[str]) -> list[str]:
+    """The command line with the value of ``--cookie-secret`` hidden."""
+    return [
+        "***" if i > 0 and cmd[i - 1] == "--cookie-secret" else arg for i, arg in enumerate(cmd)
+    ]
+
+
+def healthcheck(env: dict[str, str]) -> int:
+    """Exit status 0 when ``/liveness`` answers 200 with all applications alive, else 1."""
+    prefix = env.get("FBS_PREFIX", "").strip("/")
+    url = f"http://127.0.0.1:{PORT}/{prefix + '/' if prefix else ''}liveness"
+    try:
+        with urllib.request.urlopen(url, timeout=4) as resp:
+            ok = resp.status == 200 and all(json.load(resp).values())
+    except Exception as exc:  # any failure means unhealthy
+        print(f"unhealthy: {url}: {exc}", file=sys.stderr)
+        return 1
+    return 0 if ok else 1
+
+
+def main(argv: list[str]) -> int:
+    env = dict(os.environ)
+    if argv[:1] == ["--healthcheck"]:
+        return healthcheck(env)
+    dry = argv[:1] == ["--print-command"]
+    try:
+        cmd, warnings = build_command(env, argv[1:] if dry else argv)
+    except SettingError as exc:
+        print(f"tire-fbs: configuration error: {exc}", file=sys.stderr)
+        return 2
+    for w in warnings:
+        print(f"tire-fbs: warning: {w}", file=sys.stderr)
+    print("tire-fbs: " + " ".join(masked(cmd)), file=sys.stderr, flush=True)
+    if dry:
+        return 0
+    os.execv(cmd[0], cmd)
+    return 0  # not reached
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

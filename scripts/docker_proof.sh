@@ -1,0 +1,214 @@
+#!/usr/bin/env bash
+# End-to-end proof that the Docker deployment works (CI runs it; docs/deployment.md).
+#
+#  1. installs docker.io and debootstrap with apt-get when missing (needs root), and
+#     chromium for the browser test;
+#  2. starts dockerd in the background when no daemon answers;
+#  3. makes sure the base image python:3.11-slim-bookworm exists: pulled when a registry is
+#     reachable, else a local stand-in (Debian bookworm minbase made with debootstrap,
+#     `docker import`, python3 + python3-venv from docker/standin-base.Dockerfile);
+#  4. makes the wheelhouse on the host (scripts/make_wheelhouse.sh) and builds the image with
+#     the offline build path (--build-arg WHEELHOUSE=wheelhouse: pip uses no index);
+#  5. runs the container on a loopback port, waits for Docker to report it healthy, checks
+#     that the app document can be created (/liveness?endpoint=/main) and runs the browser
+#     smoke test (docker/smoke_test.py: page renders, a slider change updates a plot);
+#  6. runs a second container with basic authentication on (FBS_BASIC_AUTH): without
+#     credentials only the login form, after logging in the same smoke test passes;
+#  7. stops everything it started, by container ID and PID (dockerd only if it started it),
+#     also on failure or interruption, and prints the timings.
+#
+# Environment: FBS_IMAGE (image tag, default tire-fbs:proof), FBS_PROOF_CPUS (docker run
+# --cpus, default 2), FBS_PROOF_HEALTH_TIMEOUT (s, default 180), FBS_PROOF_STANDIN
+# (auto: pull, else stand-in | always | never), FBS_PROOF_KEEP_IMAGE (1 keeps the built
+# image, default 1: later runs reuse its layers).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+repo=$(pwd)
+
+image=${FBS_IMAGE:-tire-fbs:proof}
+cpus=${FBS_PROOF_CPUS:-$(( $(nproc) < 2 ? $(nproc) : 2 ))}
+health_timeout=${FBS_PROOF_HEALTH_TIMEOUT:-180}
+standin=${FBS_PROOF_STANDIN:-auto}
+base_image=python:3.11-slim-bookworm
+export DOCKER_BUILDKIT=0   # the classic builder: no buildx plugin needed, same Dockerfile
+if [[ -x .venv/bin/python ]]; then PY=$repo/.venv/bin/python; else PY=python3; fi
+
+work=$(mktemp -d /tmp/docker-proof.XXXXXX)
+containers=()
+dockerd_pid=""
+timings=()
+t_start=$SECONDS
+
+log() { printf '[docker-proof %4ds] %s\n' "$((SECONDS - t_start))" "$*"; }
+fail() { log "FAILED: $*"; exit 1; }
+timed() {  # timed "label" cmd...: run, record the duration
+    local label=$1 t=$SECONDS
+    shift
+    "$@"
+    timings+=("$(printf '%-44s %5d s' "$label" "$((SECONDS - t))")")
+}
+
+cleanup() {
+    local rc=$?
+    trap - EXIT INT TERM
+    set +e
+    for cid in "${containers[@]}"; do
+        if [[ $rc -ne 0 ]]; then
+            log "logs of container ${cid:0:12}:"
+            docker logs --tail 40 "$cid" 2>&1 | sed 's/^/    /'
+        fi
+        docker rm -f "$cid" >/dev/null 2>&1 && log "removed container ${cid:0:12}"
+    done
+    if [[ "${FBS_PROOF_KEEP_IMAGE:-1}" != 1 ]]; then docker rmi "$image" >/dev/null 2>&1; fi
+    if [[ -n "$dockerd_pid" ]]; then
+        kill "$dockerd_pid" 2>/dev/null
+        for _ in $(seq 1 30); do kill -0 "$dockerd_pid" 2>/dev/null || break; sleep 1; done
+        kill -0 "$dockerd_pid" 2>/dev/null && kill -9 "$dockerd_pid"
+        log "stopped dockerd (pid $dockerd_pid)"
+    fi
+    rm -rf "$work"
+    echo "---- docker proof timings ----"
+    printf '%s\n' "${timings[@]}"
+    printf '%-44s %5d s\n' "total" "$((SECONDS - t_start))"
+    if [[ $rc -eq 0 ]]; then echo "docker proof: OK"; else echo "docker proof: FAILED (exit $rc)"; fi
+    exit "$rc"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+install_tools() {
+    local pkgs=()
+    command -v dockerd >/dev/null || pkgs+=(docker.io)
+    command -v docker >/dev/null || pkgs+=(docker.io)
+    command -v debootstrap >/dev/null || pkgs+=(debootstrap)
+    [[ -x /usr/bin/chromium ]] || pkgs+=(chromium)
+    if [[ ${#pkgs[@]} -gt 0 ]]; then
+        [[ $(id -u) -eq 0 ]] || fail "need root to install: ${pkgs[*]}"
+        log "apt-get install ${pkgs[*]}"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${pkgs[@]}" >/dev/null
+    fi
+    "$PY" -c "import playwright" 2>/dev/null \
+        || fail "playwright is not installed for $PY (pip install -e '.[test]')"
+}
+
+start_dockerd() {
+    if docker info >/dev/null 2>&1; then
+        log "using the running Docker daemon"
+        return
+    fi
+    [[ $(id -u) -eq 0 ]] || fail "no Docker daemon answers and not root to start one"
+    log "starting dockerd"
+    dockerd >"$work/dockerd.log" 2>&1 &
+    dockerd_pid=$!
+    for _ in $(seq 1 60); do
+        docker info >/dev/null 2>&1 && { log "dockerd ready (pid $dockerd_pid)"; return; }
+        kill -0 "$dockerd_pid" 2>/dev/null || break
+        sleep 1
+    done
+    tail -20 "$work/dockerd.log"
+    fail "dockerd did not become ready"
+}
+
+build_standin() {
+    log "building the stand-in base image $base_image (debootstrap bookworm minbase)"
+    [[ $(id -u) -eq 0 ]] || fail "debootstrap needs root"
+    debootstrap --variant=minbase bookworm "$work/rootfs" >"$work/debootstrap.log" 2>&1 \
+        || { tail -20 "$work/debootstrap.log"; fail "debootstrap failed"; }
+    tar -C "$work/rootfs" -c . | docker import - local/debian:bookworm-minbase >/dev/null
+    rm -rf "$work/rootfs"
+    docker build --force-rm -q -t "$base_image" - <docker/standin-base.Dockerfile >/dev/null
+}
+
+ensure_base() {
+    if docker image inspect "$base_image" >/dev/null 2>&1; then
+        log "base image $base_image present"
+        return
+    fi
+    if [[ "$standin" != always ]] && timeout 120 docker pull "$base_image" >/dev/null 2>&1; then
+        log "pulled $base_image"
+        return
+    fi
+    [[ "$standin" != never ]] || fail "cannot pull $base_image and FBS_PROOF_STANDIN=never"
+    build_standin
+}
+
+build_image() {
+    scripts/make_wheelhouse.sh wheelhouse 2> >(grep -v "is ignored" >&2)
+    log "docker build -t $image --build-arg WHEELHOUSE=wheelhouse ."
+    docker build --force-rm --build-arg WHEELHOUSE=wheelhouse -t "$image" . \
+        >"$work/build.log" 2>&1 || { tail -40 "$work/build.log"; fail "docker build failed"; }
+    grep -E "offline install|^installed" "$work/build.log" | sed 's/^/    /'
+    log "image size: $(docker image inspect -f '{{.Size}}' "$image" | awk '{printf "%.0f MB", $1/1e6}')"
+}
+
+free_port() {
+    "$PY" -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
+}
+
+run_container() {  # run_container PORT [docker run options...]: echo the container ID
+    local port=$1
+    shift
+    docker run -d --cpus "$cpus" -p "127.0.0.1:$port:5006" \
+        -e "BOKEH_ALLOW_WS_ORIGIN=127.0.0.1:$port" "$@" "$image"
+}
+
+wait_healthy() {  # wait_healthy CID
+    local cid=$1 status
+    for _ in $(seq 1 "$health_timeout"); do
+        status=$(docker inspect -f '{{.State.Status}} {{.State.Health.Status}}' "$cid")
+        case "$status" in
+            "running healthy") log "container ${cid:0:12} healthy"; return ;;
+            *unhealthy* | exited* | dead*) fail "container ${cid:0:12}: $status" ;;
+        esac
+        sleep 1
+    done
+    fail "container ${cid:0:12} not healthy after ${health_timeout} s ($status)"
+}
+
+check_app_document() {  # the app script builds a document without error
+    "$PY" - "$1" <<'PY'
+import sys, urllib.request
+url = f"http://127.0.0.1:{sys.argv[1]}/liveness?endpoint=/main"
+with urllib.request.urlopen(url, timeout=120) as r:
+    body = r.read().decode()
+    assert r.status == 200 and "true" in body, body
+print(f"    {url} -> {body}")
+PY
+}
+
+proof_open() {
+    local port cid
+    port=$(free_port)
+    cid=$(run_container "$port")
+    containers+=("$cid")
+    log "container ${cid:0:12} on 127.0.0.1:$port (--cpus $cpus)"
+    timed "start -> healthy (no auth)" wait_healthy "$cid"
+    timed "app document (/liveness?endpoint=/main)" check_app_document "$port"
+    timed "browser smoke test (no auth)" "$PY" docker/smoke_test.py "http://127.0.0.1:$port/"
+    docker stop -t 20 "$cid" >/dev/null
+    log "stopped container ${cid:0:12}"
+}
+
+proof_auth() {
+    local port cid password
+    port=$(free_port)
+    password=$("$PY" -c 'import secrets; print(secrets.token_urlsafe(12))')
+    cid=$(run_container "$port" -e "FBS_BASIC_AUTH=reviewer:$password" \
+        -e "FBS_COOKIE_SECRET=$("$PY" -c 'import secrets; print(secrets.token_urlsafe(32))')")
+    containers+=("$cid")
+    log "container ${cid:0:12} with basic auth on 127.0.0.1:$port"
+    timed "start -> healthy (basic auth)" wait_healthy "$cid"
+    timed "browser smoke test (login first)" "$PY" docker/smoke_test.py \
+        "http://127.0.0.1:$port/" --expect-login --user reviewer --password "$password"
+    docker stop -t 20 "$cid" >/dev/null
+    log "stopped container ${cid:0:12}"
+}
+
+timed "install tools (apt-get when missing)" install_tools
+timed "Docker daemon" start_dockerd
+timed "base image $base_image" ensure_base
+timed "wheelhouse + docker build" build_image
+proof_open
+proof_auth
+log "all checks passed"
