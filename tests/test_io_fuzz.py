@@ -1,0 +1,114 @@
+"""Fuzzing the importers: random bytes, truncated files and mutated valid files end in
+the project's own error type (an FBSError subclass), never another exception, a crash
+of the test process or a hang.
+
+The MATLAB and HDF5 parsers run in a sandbox process (crashes and hangs of the HDF5
+library and of scipy's MAT reader on such inputs are real: a few thousand mutations
+find them); a parse that takes longer than ``TIMEOUT`` is killed and reported.
+"""
+
+from __future__ import annotations
+
+import os
+from datetime import timedelta
+from functools import cache
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from fbs_core import FRF
+from fbs_core.errors import FBSError
+from fbs_core.io import load_frf, load_tire_model, save_frf
+from fbs_core.io.modal import write_tire_mat
+
+TIMEOUT = 3.0
+#: examples per test; raise for a longer campaign: FBS_FUZZ_EXAMPLES=2000 pytest ...
+EXAMPLES = int(os.environ.get("FBS_FUZZ_EXAMPLES", "20"))
+FUZZ = settings(max_examples=EXAMPLES, deadline=timedelta(seconds=2 * TIMEOUT + 5), database=None,
+                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+
+
+def _frf() -> FRF:
+    f = np.arange(1, 9) * 2.0
+    w = 2 * np.pi * f
+    H = 1j * w / (2e4 - w**2 + 4j * w)
+    return FRF(f, H[:, None, None] * np.array([[[1.0, 0.5], [0.5, 2.0]]]),
+               ["spindle:z", "bushing:x"], ["spindle:z", "patch"], "mobility")
+
+
+@cache
+def seeds() -> dict[str, tuple[bytes, str]]:
+    from test_io_modal import small_tire
+
+    Y = _frf()
+    return {
+        "uff": (save_frf(Y, format="uff"), "f.uff"),
+        "uff58b": (save_frf(Y, format="uff", binary=True), "f.uff"),
+        "mat5": (save_frf(Y, format="mat"), "f.mat"),
+        "mat73": (save_frf(Y, format="mat", mat_version="7.3"), "f.mat"),
+        "csv": (save_frf(Y, format="csv"), "f.csv"),
+        "hdf5": (save_frf(Y, format="hdf5"), "f.h5"),
+        "tire": (write_tire_mat(small_tire(), version="5"), "t.mat"),
+        "tire73": (write_tire_mat(small_tire(), version="7.3"), "t.mat"),
+    }
+
+
+def run(kind: str, raw: bytes) -> None:
+    """Import; success or an FBSError are fine, anything else fails the test."""
+    name = seeds()[kind][1]
+    try:
+        if kind.startswith("tire"):
+            load_tire_model(raw, filename=name, timeout=TIMEOUT)
+        else:
+            load_frf(raw, filename=name, timeout=TIMEOUT)
+    except FBSError as e:
+        assert str(e)  # a message for the user
+
+
+KINDS = ["uff", "uff58b", "mat5", "mat73", "csv", "hdf5", "tire", "tire73"]
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_seeds_are_valid(kind):
+    run(kind, seeds()[kind][0])
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@FUZZ
+@given(data=st.data())
+def test_random_bytes(kind, data):
+    raw = data.draw(st.one_of(
+        st.binary(min_size=1, max_size=3000),
+        # random bytes behind a valid signature, so the content sniffing lets them through
+        st.binary(max_size=3000).map(lambda b: seeds()[kind][0][:128] + b),
+    ))
+    run(kind, raw)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@FUZZ
+@given(data=st.data())
+def test_truncated(kind, data):
+    raw = seeds()[kind][0]
+    n = data.draw(st.integers(1, len(raw) - 1))
+    run(kind, raw[:n])
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@FUZZ
+@given(data=st.data())
+def test_mutated(kind, data):
+    raw = bytearray(seeds()[kind][0])
+    edits = data.draw(st.lists(st.tuples(st.integers(0, len(raw) - 1), st.integers(0, 255)),
+                               min_size=1, max_size=12))
+    for pos, byte in edits:
+        raw[pos] = byte
+    if data.draw(st.booleans()):  # text formats: also swap in characters that matter
+        text_edits = data.draw(st.lists(st.tuples(st.integers(0, len(raw) - 1),
+                                                  st.sampled_from(b"-+.eE0159 ,;\n#:/()NnI")),
+                                        max_size=6))
+        for pos, byte in text_edits:
+            raw[pos] = byte
+    run(kind, bytes(raw))

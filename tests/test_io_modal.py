@@ -1,0 +1,81 @@
+"""Modal tire models from MATLAB files in the documented variable layout."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+import scipy.io
+
+from fbs_core.errors import DataFormatError
+from fbs_core.io import load_tire_model
+from fbs_core.io.modal import write_tire_mat
+from fbs_core.tire.model import TireModel
+
+
+def small_tire(seed=0) -> TireModel:
+    """Five damped mode pairs at two speeds; shapes random but fixed."""
+    rng = np.random.default_rng(seed)
+    n_s, n_p = 2, 5
+    wn = 2 * np.pi * np.array([17.0, 38.0, 55.0, 80.0, 120.0])
+    poles = np.empty((n_s, 2 * n_p), complex)
+    for s in range(n_s):
+        lam = -0.04 * wn * (1 + 0.1 * s) + 1j * wn * (1 + 0.02 * s)
+        poles[s, 0::2], poles[s, 1::2] = lam, lam.conj()
+    psi = rng.normal(size=(n_s, 2 * n_p, 6)) + 1j * rng.normal(size=(n_s, 2 * n_p, 6))
+    psi[:, 1::2] = psi[:, 0::2].conj()
+    chi = psi.copy()
+    part = rng.normal(size=(n_s, 1, 2 * n_p)) + 0j
+    return TireModel(np.array([20.0, 120.0]), poles, psi, chi, np.array([0.646]), part,
+                     meta={"supplier": "test"})
+
+
+def mat5(**v) -> bytes:
+    b = io.BytesIO()
+    scipy.io.savemat(b, v)
+    return b.getvalue()
+
+
+@pytest.mark.parametrize("version", ["5", "7.3"])
+def test_tire_model_round_trip_gives_the_same_mobility(version):
+    tire = small_tire()
+    r = load_tire_model(write_tire_mat(tire, version=version), filename="tire.mat")
+    model, summary = r
+    f = np.linspace(5.0, 150.0, 60)
+    for v in (20.0, 70.0):
+        a, b = tire.hub_mobility(f, v), model.hub_mobility(f, v)
+        assert b.allclose(a, rtol=1e-12)
+    assert "operating points: 20, 120 km/h" in summary
+    assert "10 complex modes" in summary and model.meta["supplier"] == "test"
+    assert r.frf is None and r.model is model
+
+
+def _vars(tire=None, **changes):
+    t = tire or small_tire()
+    v = dict(speeds=t.speeds, poles=t.poles, psi=t.psi, chi=t.chi,
+             wavelengths=t.wavelengths, participation=t.participation)
+    v.update(changes)
+    return {k: val for k, val in v.items() if val is not None}
+
+
+def test_tire_model_layout_errors():
+    t = small_tire()
+    with pytest.raises(DataFormatError, match="lacks the variable 'chi'"):
+        load_tire_model(mat5(**_vars(chi=None)), filename="t.mat")
+    with pytest.raises(DataFormatError, match="'psi' has size 2x10x5"):
+        load_tire_model(mat5(**_vars(psi=t.psi[:, :, :5])), filename="t.mat")
+    with pytest.raises(DataFormatError, match="n_speeds = 3"):
+        load_tire_model(mat5(**_vars(speeds=np.array([20.0, 60.0, 120.0]))), filename="t.mat")
+    bad = np.array(t.poles)
+    bad[0, 0] = np.inf
+    with pytest.raises(DataFormatError, match="non-finite"):
+        load_tire_model(mat5(**_vars(poles=bad)), filename="t.mat")
+    bad = np.array(t.poles)
+    bad[0, 1] = bad[0, 0]
+    with pytest.raises(DataFormatError, match="conjugate pairs"):
+        load_tire_model(mat5(**_vars(poles=bad)), filename="t.mat")
+    with pytest.raises(DataFormatError, match="'hub_dofs' must be 6"):
+        load_tire_model(mat5(**_vars(), hub_dofs=np.array(["hub:x"])), filename="t.mat")
+    with pytest.raises(DataFormatError, match="tire models are read from MATLAB"):
+        load_tire_model(b"freq,Re(a:x / a:x)\n1,2,3\n", filename="t.csv")
