@@ -40,8 +40,15 @@ def _frf() -> FRF:
 
 @cache
 def seeds() -> dict[str, tuple[bytes, str]]:
+    import tempfile
+    from pathlib import Path
+
     from test_io_modal import small_tire
 
+    from fbs_core.tire import storage
+
+    with tempfile.TemporaryDirectory() as d:
+        tire_h5 = storage.save_tire_model(small_tire(), Path(d) / "t.h5").read_bytes()
     Y = _frf()
     return {
         "uff": (save_frf(Y, format="uff"), "f.uff"),
@@ -52,6 +59,7 @@ def seeds() -> dict[str, tuple[bytes, str]]:
         "hdf5": (save_frf(Y, format="hdf5"), "f.h5"),
         "tire": (write_tire_mat(small_tire(), version="5"), "t.mat"),
         "tire73": (write_tire_mat(small_tire(), version="7.3"), "t.mat"),
+        "tire_h5": (tire_h5, "t.h5"),
     }
 
 
@@ -67,7 +75,7 @@ def run(kind: str, raw: bytes) -> None:
         assert str(e)  # a message for the user
 
 
-KINDS = ["uff", "uff58b", "mat5", "mat73", "csv", "hdf5", "tire", "tire73"]
+KINDS = ["uff", "uff58b", "mat5", "mat73", "csv", "hdf5", "tire", "tire73", "tire_h5"]
 
 
 @pytest.mark.parametrize("kind", KINDS)

@@ -79,3 +79,46 @@ def test_tire_model_layout_errors():
         load_tire_model(mat5(**_vars(), hub_dofs=np.array(["hub:x"])), filename="t.mat")
     with pytest.raises(DataFormatError, match="tire models are read from MATLAB"):
         load_tire_model(b"freq,Re(a:x / a:x)\n1,2,3\n", filename="t.csv")
+
+
+def test_project_format_is_read_through_the_owners_reader(tmp_path):
+    from fbs_core.tire import storage
+
+    tire = small_tire()
+    p = storage.save_tire_model(tire, tmp_path / "t.h5")
+    model, summary = load_tire_model(p.read_bytes(), filename="upload.h5")
+    f = np.linspace(5.0, 150.0, 40)
+    assert model.hub_mobility(f, 50.0).allclose(tire.hub_mobility(f, 50.0), rtol=1e-12)
+    assert "tire-fbs tire model" in summary
+
+
+def test_shipped_reference_tire_reads_unchanged():
+    from fbs_core.tire import storage
+
+    before = storage.DATA_FILE.read_bytes()
+    model = load_tire_model(storage.DATA_FILE).model
+    np.testing.assert_array_equal(model.poles, storage.reference_tire().poles)
+    assert storage.DATA_FILE.read_bytes() == before
+
+
+def test_project_format_refusals():
+    import h5py
+
+    from fbs_core.io import save_frf
+    from fbs_core.tire import storage
+
+    with pytest.raises(DataFormatError, match="is not a 'tire-fbs/modal-tire' file"):
+        load_tire_model(save_frf(_frf_for_refusal(), format="hdf5"), filename="t.h5")
+    b = io.BytesIO()
+    with h5py.File(b, "w") as h:
+        h.attrs["format"] = storage.FORMAT
+        h.attrs["format_version"] = 99
+        h["speeds"] = np.array([20.0, np.nan])
+    with pytest.raises(DataFormatError, match="non-finite"):
+        load_tire_model(b.getvalue(), filename="t.h5")
+
+
+def _frf_for_refusal():
+    from fbs_core import FRF
+
+    return FRF([1.0, 2.0], np.ones((2, 1, 1)), ["hub:z"], ["hub:z"], "mobility")

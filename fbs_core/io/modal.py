@@ -23,10 +23,13 @@ MATLAB variable layout (``docs/file-formats.md``; the arrays of
 from __future__ import annotations
 
 import json
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import DataFormatError, FBSError
+from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import Source, check_finite, normalize_label
 from .matlab import MatVars, read_mat_vars, write_mat_vars
 
@@ -119,12 +122,40 @@ def write_tire_mat(model, *, version: str = "5") -> bytes:
     }, version=version)
 
 
-def read_tire_native(src: Source, **kw):
-    """Read a tire model stored in the project's own format (``fbs_core.tire.storage``)."""
-    try:
-        from ..tire import storage
-    except ImportError:
+
+def read_tire_native(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
+    """Read a tire model in the project's format (``fbs_core.tire.storage``, HDF5).
+
+    The file is first parsed completely in the sandbox (every dataset and attribute,
+    refusing links and external storage, checking values are finite); only a file
+    that passed is handed to the owner's reader
+    :func:`fbs_core.tire.storage.load_tire_model`, from a private temporary copy.
+
+    Raises
+    ------
+    DataFormatError
+        For damaged files, another format or version, non-finite values.
+    """
+    from ..tire import storage
+
+    what = f"tire model {src.name!r}"
+    meta, arrays = parse_isolated("hdf5", src.raw, what, timeout=timeout)
+    fmt = meta["groups"].get("/", {}).get("format")
+    if fmt != storage.FORMAT:
         raise DataFormatError(
-            "this version has no reader for the project's tire model format"
-        ) from None
-    return storage.load_model(src, **kw)
+            f"{what} is not a {storage.FORMAT!r} file (its format attribute is {fmt!r}); "
+            "tire models are read from that format or from MATLAB (.mat)"
+        )
+    for path, e in meta["datasets"].items():
+        if "array" in e:
+            check_finite(arrays[e["array"]], f"{what} dataset {path}")
+    with tempfile.TemporaryDirectory(prefix="fbs_tire_") as d:
+        p = Path(d) / "upload.h5"
+        p.write_bytes(src.raw)
+        try:
+            model = storage.load_tire_model(p)
+        except FBSError as e:
+            raise type(e)(str(e).replace(str(p), repr(src.name))) from None
+        except (KeyError, ValueError, TypeError, OSError) as e:
+            raise DataFormatError(f"{what}: {e}".replace(str(p), repr(src.name))) from None
+    return model
