@@ -25,6 +25,7 @@ from .errors import (
 )
 from .frf import FRF, QUANTITIES
 from .harmonics import HARMONICS, Harmonic, harmonic
+from .prediction import bushing_response
 from .tire import TireModel, reference_tire
 
 __version__ = "0.1.0"
@@ -54,6 +55,7 @@ __all__ = [
     "reference_tire",
     "ChassisModel",
     "reference_chassis",
+    "bushing_response",
     "node_labels",
     "parse_label",
 ]

