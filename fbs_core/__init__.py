@@ -4,6 +4,7 @@ Follows Rosholm & Westers, "Assembly of a tire and a vehicle model to predict
 vibrations at the bushings", Chalmers MSc thesis (2018).
 """
 
+from . import io as io
 from .chassis import ChassisModel, reference_chassis
 from .coupling import (
     couple_generalized,
@@ -25,6 +26,7 @@ from .errors import (
 )
 from .frf import FRF, QUANTITIES
 from .harmonics import HARMONICS, Harmonic, harmonic
+from .io import load_frf, save_frf
 from .prediction import bushing_response
 from .tire import TireModel, reference_tire
 
@@ -58,4 +60,6 @@ __all__ = [
     "bushing_response",
     "node_labels",
     "parse_label",
+    "load_frf",
+    "save_frf",
 ]

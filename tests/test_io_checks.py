@@ -201,6 +201,10 @@ def test_quantity_must_be_known_and_consistent():
         load_frf(mat5(**dict(GOOD, units="m/N")), filename="a.mat")
     with pytest.raises(QuantityError, match="dynamic stiffness"):
         load_frf(mat5(**dict(GOOD, units="N/m")), filename="a.mat")
+    with pytest.raises(QuantityError, match="impedance"):
+        load_frf(mat5(**dict(GOOD, units="N s/m")), filename="a.mat")
+    with pytest.raises(QuantityError, match="apparent mass"):
+        load_frf(mat5(**dict(GOOD, units="kg")), filename="a.mat")
     with pytest.raises(QuantityError, match="unknown quantity"):
         load_frf(mat5(**GOOD), filename="a.mat", quantity="velocity")
 

@@ -344,6 +344,10 @@ def parse_units(label: str | None) -> Units | None:
         elif low in _FORCE:
             dims["F"] += p
             scale["F"] *= _FORCE[low] ** p
+        elif low == "kg":  # N s^2 / m
+            dims["F"] += p
+            dims["T"] += 2 * p
+            dims["L"] -= p
         elif name == "g":
             dims["L"] += p
             dims["T"] -= 2 * p
