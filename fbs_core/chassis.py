@@ -44,6 +44,7 @@ __all__ = [
     "ChassisModel",
     "reference_chassis",
     "carrier_mode_table",
+    "modal_energy",
     "read_chassis_frf",
     "SPINDLE",
     "BUSHING",

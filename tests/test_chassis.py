@@ -13,6 +13,8 @@ from fbs_core.chassis import (
     STEEL_RHO,
     ChassisModel,
     ChassisParameters,
+    carrier_mode_table,
+    modal_energy,
     read_chassis_frf,
 )
 from fbs_core.errors import DataFormatError, DOFError, FrequencyGridError, QuantityError
@@ -130,3 +132,13 @@ def test_bad_input(chassis, tmp_path):
 def test_parameters_make_a_different_model():
     soft = ChassisModel(ChassisParameters(bushing_stiffness=(3e5, 3e5, 4e5, 300.0, 300.0, 300.0)))
     assert soft.eigenfrequencies()[4] < reference_chassis().eigenfrequencies()[4]
+
+
+def test_target_modes_are_carrier_fore_aft_lateral_and_pitch(chassis):
+    table = carrier_mode_table(chassis)
+    assert table["x"] == pytest.approx(14.0, abs=1.0)
+    assert table["y"] == pytest.approx(37.0, abs=1.0)
+    assert table["ry"] == pytest.approx(47.0, abs=1.0)
+    e = modal_energy(chassis)  # carrier kinetic energy share per direction
+    assert e[:4].sum(axis=1).min() > 0.8  # the four lowest modes are carrier modes
+    assert e[15:].sum(axis=1).max() < 0.2  # modes from ~230 Hz up are arm / subframe modes
