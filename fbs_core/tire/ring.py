@@ -172,9 +172,13 @@ def _fields(params: TireParameters, basis: _Basis, theta, y):
 
 
 def _gram(a, wts, b=None):
-    """``sum_p wts_p a_p b_p^T`` for field arrays (n_p, n_basis)."""
+    """``sum_p wts_p a_p b_p^T`` for field arrays (n_p, n_basis), on non-zero columns only."""
     b = a if b is None else b
-    return (a * wts[:, None]).T @ b
+    ia = np.flatnonzero(np.any(a != 0, axis=0))
+    ib = ia if b is a else np.flatnonzero(np.any(b != 0, axis=0))
+    out = np.zeros((a.shape[1], b.shape[1]))
+    out[np.ix_(ia, ib)] = (a[:, ia] * wts[:, None]).T @ b[:, ib]
+    return out
 
 
 def _rim_local(theta, y, R):
@@ -205,7 +209,7 @@ def _operators(params: TireParameters):
     R, b = params.R, params.b
     basis = _basis(params)
     nb = basis.size
-    n_th = max(64, 2 * (max(params.orders) + 4))
+    n_th = 2 * max(params.orders) + 8  # trapezoid rule exact for the products
     theta = 2 * np.pi * np.arange(n_th) / n_th
     yg, wy = legendre.leggauss(24)
     y, wy = yg * b / 2, wy * b / 2
