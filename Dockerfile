@@ -23,19 +23,30 @@ ARG EXTRA_PACKAGES=""
 ENV PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_CACHE_DIR=1 PYTHONDONTWRITEBYTECODE=1
 RUN python3 -m venv /opt/venv
 COPY ${WHEELHOUSE}/ /wheelhouse/
-COPY pyproject.toml README.md* /src/
-COPY fbs_core/ /src/fbs_core/
-COPY app/ /src/app/
-RUN set -eu; \
-    if ls /wheelhouse/*.whl >/dev/null 2>&1; then \
+# With wheels in the wheelhouse, pip of this venv is configured to use nothing else.
+RUN if ls /wheelhouse/*.whl >/dev/null 2>&1; then \
+        printf '[global]\nno-index = true\nfind-links = /wheelhouse\n' > /opt/venv/pip.conf; \
         echo "offline install from the wheelhouse ($(ls /wheelhouse/*.whl | wc -l) wheels)"; \
-        set -- --no-index --find-links /wheelhouse; \
+    elif [ "$WHEELHOUSE" != docker/no-wheelhouse ]; then \
+        echo "WHEELHOUSE=$WHEELHOUSE holds no wheels (make it with scripts/make_wheelhouse.sh)"; \
+        exit 1; \
     else \
         echo "online install from pip's configured index"; \
-        set --; \
-    fi; \
-    /opt/venv/bin/python -m pip install "$@" /src ${EXTRA_PACKAGES}; \
-    /opt/venv/bin/python -c "import app.main, fbs_core; print('installed', fbs_core.__name__)"
+    fi
+# Dependencies first (from pyproject.toml alone: this layer is reused while they do not
+# change), then the project itself.
+COPY pyproject.toml /src/
+RUN touch /src/README.md \
+    && /opt/venv/bin/python -m pip install --no-compile /src ${EXTRA_PACKAGES} \
+    && /opt/venv/bin/python -m compileall -q -j 0 /opt/venv/lib >/dev/null
+COPY README.md* /src/
+COPY fbs_core/ /src/fbs_core/
+COPY app/ /src/app/
+COPY data/ /src/data/
+COPY docker/prepare.py /src/docker/prepare.py
+RUN /opt/venv/bin/python -m pip install --no-deps --force-reinstall /src \
+    && /opt/venv/bin/python /src/docker/prepare.py data /src/data \
+    && rm -f /opt/venv/pip.conf
 
 # ---- runtime stage -------------------------------------------------------------------------
 FROM ${PYTHON_IMAGE}
@@ -44,7 +55,7 @@ LABEL org.opencontainers.image.title="tire-fbs dashboard" \
       org.opencontainers.image.licenses="BSD-3-Clause"
 RUN useradd --system --create-home --home-dir /home/fbs --uid 10001 --user-group fbs
 COPY --from=build /opt/venv /opt/venv
-COPY docker/entrypoint.py /opt/fbs/entrypoint.py
+COPY docker/entrypoint.py docker/prepare.py /opt/fbs/
 ENV PATH=/opt/venv/bin:$PATH \
     PYTHONUNBUFFERED=1 \
     NUMBA_CACHE_DIR=/home/fbs/.cache/numba \
@@ -52,6 +63,8 @@ ENV PATH=/opt/venv/bin:$PATH \
     FBS_NUM_THREADS=4
 USER fbs
 WORKDIR /home/fbs
+# Compile the numba kernels into NUMBA_CACHE_DIR now, not in the first user's session.
+RUN python /opt/fbs/prepare.py warmup
 EXPOSE 5006
 HEALTHCHECK --interval=10s --timeout=5s --start-period=30s --retries=3 \
     CMD ["/opt/venv/bin/python", "/opt/fbs/entrypoint.py", "--healthcheck"]

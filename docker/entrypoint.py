@@ -37,6 +37,9 @@ Variables (all optional; the table with examples is in docs/deployment.md):
     ``debug``, ``info`` (default), ``warning``, ``error`` or ``critical``.
 ``FBS_APP``
     Path of the Panel script to serve; default the installed ``app/main.py``.
+``FBS_PORT``, ``FBS_ADDRESS``
+    Port and address the server listens on inside the container, default 5006 and 0.0.0.0
+    (publish another host port with ``docker run -p HOSTPORT:5006`` instead).
 """
 
 from __future__ import annotations
@@ -50,7 +53,7 @@ import tempfile
 import urllib.request
 from pathlib import Path
 
-PORT = 5006
+DEFAULT_PORT = 5006
 LOG_LEVELS = ("debug", "info", "warning", "error", "critical")
 TRUE = ("1", "true", "yes", "on")
 FALSE = ("", "0", "false", "no", "off")
@@ -157,9 +160,11 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
     app = env.get("FBS_APP") or default_app()
     if not os.path.isfile(app):
         raise SettingError(f"FBS_APP: the Panel script {app!r} does not exist")
+    port = _positive_int(env, "FBS_PORT", DEFAULT_PORT)
+    address = env.get("FBS_ADDRESS", "0.0.0.0").strip() or "0.0.0.0"
     cmd = [
         str(Path(sys.executable).with_name("panel")), "serve", app,
-        "--address", "0.0.0.0", "--port", str(PORT), "--liveness",
+        "--address", address, "--port", str(port), "--liveness",
     ]
     threads = _positive_int(env, "FBS_NUM_THREADS", 4)
     if env.get("PANEL_NUM_THREADS"):
@@ -226,7 +231,8 @@ def masked(cmd: list[str]) -> list[str]:
 def healthcheck(env: dict[str, str]) -> int:
     """Exit status 0 when ``/liveness`` answers 200 with all applications alive, else 1."""
     prefix = env.get("FBS_PREFIX", "").strip("/")
-    url = f"http://127.0.0.1:{PORT}/{prefix + '/' if prefix else ''}liveness"
+    port = _positive_int(env, "FBS_PORT", DEFAULT_PORT)
+    url = f"http://127.0.0.1:{port}/{prefix + '/' if prefix else ''}liveness"
     try:
         with urllib.request.urlopen(url, timeout=4) as resp:
             ok = resp.status == 200 and all(json.load(resp).values())
