@@ -223,7 +223,7 @@ def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
     block = np.empty((frf.freq.size, 1 + 2 * d.shape[1]))
     block[:, 0] = frf.freq
     block[:, 1::2], block[:, 2::2] = d.real, d.imag
-    lines += [",".join(repr(float(x)) for x in row) for row in block]
+    lines += [",".join(map(repr, row)) for row in block.tolist()]
     return ("\n".join(lines) + "\n").encode()
 
 

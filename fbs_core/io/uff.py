@@ -387,18 +387,22 @@ def write_uff_records(records: list[dict], *, binary: bool = False) -> bytes:
     """Write dataset-58 records given as pyuff dictionaries; returns the file content."""
     import pyuff
 
+    parts = []
     with tempfile.TemporaryDirectory(prefix="fbs_uff_") as d:
-        path = Path(d) / "out.uff"
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                uff = pyuff.UFF(str(path))
-                for r in records:
+                # one small file per record: pyuff re-reads the whole file after every
+                # write, which is quadratic in the number of records
+                for k, r in enumerate(records):
+                    path = Path(d) / f"r{k}.uff"
                     r = dict(r, binary=int(binary))
-                    uff.write_sets(pyuff.prepare_58(**r), mode="add")
+                    pyuff.UFF(str(path)).write_sets(pyuff.prepare_58(**r), mode="add")
+                    parts.append(path.read_bytes())
+                    path.unlink()
         except Exception as e:  # pyuff raises bare Exceptions
             raise DataFormatError(f"cannot write UFF dataset 58: {e}") from None
-        return path.read_bytes()
+    return b"".join(parts)
 
 
 def frf_records(frf: FRF, *, nodes: Mapping | None = None, id_lines: Sequence[str] = (),
