@@ -104,8 +104,12 @@ class TireModel:
             raise DataFormatError(
                 f"participation has shape {part.shape}, expected {(n_s, lam.size, n_m)}"
             )
-        if not np.allclose(poles[:, 1::2], np.conj(poles[:, 0::2])):
-            raise DataFormatError("poles must come in conjugate pairs [r, conj(r), ...]")
+        if not np.allclose(poles[:, 1::2], np.conj(poles[:, 0::2])) or np.any(
+                poles[:, 0::2].imag <= 0):
+            raise DataFormatError(
+                "poles must come in conjugate pairs [r, conj(r), ...] with the member of "
+                "positive eigenfrequency first"
+            )
         for name, val in (("speeds", sp), ("poles", poles), ("psi", self.psi),
                           ("chi", self.chi), ("wavelengths", lam), ("participation", part)):
             object.__setattr__(self, name, _ro(np.asarray(val)))
