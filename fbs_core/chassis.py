@@ -241,6 +241,26 @@ class ChassisModel:
         return FRF(f, data * (jw ** QUANTITIES[quantity])[:, None, None], outputs, inputs,
                    quantity)
 
+    def driving_point(self, freq) -> FRF:
+        """``Y_jj^E``: spindle mobility, 6 x 6 (``spindle:*`` to ``spindle:*``).
+
+        Parameters
+        ----------
+        freq : array_like, shape (n_freq,)
+            Frequencies in Hz.
+        """
+        return self.mobility(freq, outputs=SPINDLE, inputs=SPINDLE)
+
+    def transfer(self, freq) -> FRF:
+        """``Y_ej^E``: spindle-to-bushing mobility, 6 x 6 (``spindle:*`` to ``bushing:*``).
+
+        Parameters
+        ----------
+        freq : array_like, shape (n_freq,)
+            Frequencies in Hz.
+        """
+        return self.mobility(freq, outputs=BUSHING, inputs=SPINDLE)
+
     def to_dict(self) -> dict:
         """The parameters as a plain dict (for storage)."""
         return asdict(self._p)

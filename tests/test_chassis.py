@@ -69,6 +69,9 @@ def test_reciprocal_and_labelled(chassis):
     Y = chassis.mobility(f)
     assert Y.outputs == SPINDLE + BUSHING and Y.inputs == SPINDLE
     assert Y.quantity == "mobility"
+    np.testing.assert_array_equal(chassis.driving_point(f).data, Y.sel(outputs=SPINDLE).data)
+    np.testing.assert_array_equal(chassis.transfer(f).data, Y.sel(outputs=BUSHING).data)
+    assert chassis.transfer(f).outputs == BUSHING
     R = chassis.mobility(f, quantity="receptance")
     np.testing.assert_allclose(R.to("mobility").data, Y.data, rtol=1e-12)
 
