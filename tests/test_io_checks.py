@@ -338,3 +338,11 @@ def test_all_errors_are_value_errors_too():
     with pytest.raises(ValueError):
         load_frf(b"junk", filename="a.mat")
     assert issubclass(DataFormatError, FBSError)
+
+
+def test_named_nodes_are_renamed_to_spindle_and_bushing():
+    Y = sdof(labels=("knuckle:z", "mount3:z"))
+    r = load_frf(save_frf(Y, format="csv"), filename="a.csv",
+                 nodes={"knuckle": "spindle", "mount3": "bushing"})
+    assert r.frf.outputs == ("spindle:z", "bushing:z") == r.frf.inputs
+    np.testing.assert_array_equal(r.frf.data, Y.data)

@@ -195,3 +195,9 @@ def test_units_in_mm_are_converted_to_si_per_entry():
     # translational output over force input: mm -> m
     np.testing.assert_allclose(r.frf.data, 1e-3 * si.frf.data, rtol=1e-12)
     assert any("converted from" in n for n in r.notes)
+
+
+def test_node_map_entries_missing_from_the_file_are_reported():
+    r = load_frf(HAND_WRITTEN.encode(), filename="hand.uff", nodes={1: "spindle", 7: "bushing"})
+    assert r.frf.outputs == ("2:z", "2:x")
+    assert any("node numbers 7" in n and "nodes in the file: 1, 2" in n for n in r.notes)

@@ -589,8 +589,8 @@ def reconcile_quantity(declared: str | None, units: Units | None, given: str | N
 def frequency_from_units(freq: np.ndarray, unit: str | None, where: str) -> np.ndarray:
     """Convert an abscissa in Hz, rad/s, kHz or cpm to Hz (anything else raises)."""
     u = (unit or "Hz").strip().lower().replace(" ", "")
-    factors = {"hz": 1.0, "1/s": 1.0, "khz": 1e3, "rad/s": 1 / (2 * np.pi), "cpm": 1 / 60.0,
-               "none": 1.0, "": 1.0}
+    factors = {"hz": 1.0, "hertz": 1.0, "1/s": 1.0, "khz": 1e3, "rad/s": 1 / (2 * np.pi),
+               "cpm": 1 / 60.0, "none": 1.0, "": 1.0}
     if u not in factors:
         raise FrequencyGridError(
             f"{where}: unknown frequency unit {unit!r}; allowed: Hz, kHz, rad/s, cpm"

@@ -278,6 +278,12 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
         inputs += [inp] if inp not in inputs else []
     if n_flipped:
         notes.append(f"{n_flipped} records had negative direction codes; their sign was flipped")
+    if nodes:
+        present = {str(int(s[k])) for s in frf_sets for k in ("rsp_node", "ref_node")}
+        unused = [str(k) for k in nodes if str(k) not in present]
+        if unused:
+            notes.append(f"node numbers {', '.join(unused)} of the node map are not in the file "
+                         f"(nodes in the file: {', '.join(sorted(present, key=int))})")
 
     missing = [(o, i) for o in outputs for i in inputs if (o, i) not in entries]
     if missing:
