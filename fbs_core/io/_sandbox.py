@@ -37,8 +37,12 @@ class _Worker:
     def __init__(self) -> None:
         self.lock = threading.Lock()
         self.proc: subprocess.Popen | None = None
+        self.owner = os.getpid()
 
     def _start(self) -> subprocess.Popen:
+        if self.owner != os.getpid():
+            # a forked copy of this process: the pipes belong to the parent, leave them
+            self.proc, self.owner = None, os.getpid()
         if self.proc is None or self.proc.poll() is not None:
             self.proc = subprocess.Popen(
                 [sys.executable, "-s", "-P", str(_WORKER)],
@@ -50,6 +54,8 @@ class _Worker:
         return self.proc
 
     def stop(self) -> None:
+        if self.owner != os.getpid():
+            return
         if self.proc is not None and self.proc.poll() is None:
             self.proc.kill()
             self.proc.wait()
@@ -90,6 +96,15 @@ class _Worker:
 
 _worker = _Worker()
 atexit.register(_worker.stop)
+
+
+def _after_fork() -> None:
+    # a forked child gets a fresh lock and its own worker; the parent's stays its own
+    _worker.lock = threading.Lock()
+    _worker.proc, _worker.owner = None, os.getpid()
+
+
+os.register_at_fork(after_in_child=_after_fork)
 
 
 def parse_isolated(
