@@ -346,3 +346,24 @@ def test_named_nodes_are_renamed_to_spindle_and_bushing():
                  nodes={"knuckle": "spindle", "mount3": "bushing"})
     assert r.frf.outputs == ("spindle:z", "bushing:z") == r.frf.inputs
     np.testing.assert_array_equal(r.frf.data, Y.data)
+
+
+def test_prepare_chassis_renames_selects_and_converts():
+    from fbs_core.dofs import node_labels
+    from fbs_core.io import prepare_chassis
+
+    outs = node_labels("knuckle") + ("mount:z", "mount:x")
+    ins = node_labels("knuckle")
+    rng = np.random.default_rng(0)
+    A = FRF(F, rng.normal(size=(F.size, 8, 6)) + 0j, outs, ins, "accelerance")
+    Y, notes = prepare_chassis(A, spindle="knuckle", bushing="mount")
+    assert Y.inputs == node_labels("spindle") and Y.quantity == "mobility"
+    assert Y.outputs == node_labels("spindle") + ("bushing:x", "bushing:z")
+    np.testing.assert_allclose(Y.data[:, 6], A.data[:, 7] / (2j * np.pi * F)[:, None])
+    assert len(notes) == 2
+    with pytest.raises(DOFError, match="no node 'hub'"):
+        prepare_chassis(A, spindle="hub", bushing="mount")
+    with pytest.raises(DOFError, match="no bushing output"):
+        prepare_chassis(Y.sel(outputs=node_labels("spindle")))
+    with pytest.raises(DOFError, match="lacks outputs spindle:rz"):
+        prepare_chassis(A.sel(outputs=outs[:5] + outs[6:]), spindle="knuckle", bushing="mount")

@@ -33,6 +33,7 @@ from .checks import (
     describe,
     detect_format,
     interface_check,
+    prepare_chassis,
     quantity_notes,
     read_source,
     require_dofs,
@@ -51,6 +52,7 @@ __all__ = [
     "interface_check",
     "load_frf",
     "load_tire_model",
+    "prepare_chassis",
     "require_dofs",
     "save_frf",
 ]

@@ -45,6 +45,7 @@ __all__ = [
     "low_frequency_slope",
     "quantity_notes",
     "interface_check",
+    "prepare_chassis",
     "describe",
 ]
 
@@ -524,6 +525,67 @@ def interface_check(a: FRF, b: FRF, interface=None, max_cond: float = 1e8) -> np
             f"{a.freq[k]:g} Hz; limit {max_cond:.3g}); check the interface DOFs and units"
         )
     return cond
+
+
+def prepare_chassis(frf: FRF, spindle: str = "spindle", bushing: str = "bushing",
+                    directions: Sequence[str] = DIRECTIONS) -> tuple[FRF, list[str]]:
+    """Make a user's chassis FRF fit the contract of ``ChassisModel.mobility``.
+
+    Parameters
+    ----------
+    frf : FRF
+        Imported chassis FRF.
+    spindle, bushing : str
+        Node names in ``frf`` of the spindle (the coupling node) and the bushing
+        (the response node); they are renamed to ``"spindle"`` and ``"bushing"``.
+    directions : sequence of str
+        Coupled spindle directions (default all six).
+
+    Returns
+    -------
+    frf : FRF
+        Mobility with outputs ``spindle:*`` then the ``bushing:*`` present, inputs
+        ``spindle:*`` (thesis eq. 4.1 needs ``Y_jj^E`` and ``Y_ej^E``).
+    notes : list of str
+        Conversions applied.
+
+    Raises
+    ------
+    DOFError
+        Listing the missing spindle or bushing DOFs.
+    QuantityError
+        When the FRF cannot be converted to mobility (0 Hz line of an accelerance).
+    """
+    notes: list[str] = []
+    ren = {spindle: "spindle", bushing: "bushing"}
+    if spindle == bushing:
+        raise DOFError(f"the spindle and the bushing must be different nodes, got {spindle!r}")
+    if any(k != v for k, v in ren.items()):
+        for name in ren:
+            if name not in {parse_label(x)[0] for x in frf.outputs + frf.inputs}:
+                nodes = sorted({parse_label(x)[0] for x in frf.outputs + frf.inputs})
+                raise DOFError(f"no node {name!r} in the FRF; nodes: {', '.join(nodes)}")
+        taken = {"spindle", "bushing"} - {spindle, bushing}
+        clash = [x for x in frf.outputs + frf.inputs if parse_label(x)[0] in taken]
+        if clash:
+            raise DOFError(f"cannot rename: labels {', '.join(clash[:4])} already use "
+                           f"{'/'.join(sorted(taken))}")
+        frf = frf.replace(outputs=[rename_node(x, ren) for x in frf.outputs],
+                          inputs=[rename_node(x, ren) for x in frf.inputs])
+        notes.append(f"nodes {spindle!r} -> 'spindle', {bushing!r} -> 'bushing'")
+    sp = [f"spindle:{d}" for d in directions]
+    require_dofs(frf, outputs=sp, inputs=sp, what="the chassis FRF")
+    bush = [f"bushing:{d}" for d in DIRECTIONS if f"bushing:{d}" in frf.outputs]
+    if not bush:
+        raise DOFError(
+            "the chassis FRF has no bushing output (bushing:x ... bushing:rz); outputs: "
+            + ", ".join(frf.outputs)
+        )
+    frf = frf.sel(outputs=sp + bush, inputs=sp)
+    if frf.quantity != "mobility":
+        notes.append(f"converted from {frf.quantity} to mobility (thesis table 2.1)")
+        frf = frf.to("mobility")
+    return frf, notes
 
 
 def describe(frf: FRF, operating_points: Sequence[float] | None = None) -> str:
