@@ -120,3 +120,26 @@ def test_mutated(kind, data):
         for pos, byte in text_edits:
             raw[pos] = byte
     run(kind, bytes(raw))
+
+
+@FUZZ
+@given(text=st.text(alphabet=st.sampled_from("mMnNsSkgGu/()^*.-+ 0123456789µ²radHzc:xyzw"),
+                    max_size=30))
+def test_header_texts(text):
+    """Units, labels and frequency units from file headers: own errors only."""
+    from fbs_core.errors import DOFError, FrequencyGridError, QuantityError
+    from fbs_core.io.checks import frequency_from_units, normalize_label, parse_units
+
+    try:
+        u = parse_units(text)
+        assert u is None or u.length > 0 and u.force > 0
+    except QuantityError:
+        pass
+    try:
+        normalize_label(text)
+    except DOFError:
+        pass
+    try:
+        frequency_from_units(np.ones(2), text, "t")
+    except FrequencyGridError:
+        pass

@@ -333,8 +333,12 @@ def parse_units(label: str | None) -> Units | None:
     g = [False]
 
     def factor(tok: str, power: int) -> bool:
-        m = re.fullmatch(r"([A-Za-zµμ]+)\^?(-?\d*)", tok)
+        m = re.fullmatch(r"([A-Za-zµμ]+)\^?(-?\d{0,2})", tok)
+        if m is None or m.group(2) == "-":
+            return False
         name, e = m.group(1), int(m.group(2) or 1)
+        if abs(e) > 4:
+            return False
         p = power * e
         low = name.lower()
         if name in _LENGTH or low in ("m", "mm", "cm", "um"):
