@@ -34,13 +34,29 @@ def _rand_c(rng, *shape):
     return rng.normal(size=shape) + 1j * rng.normal(size=shape)
 
 
+def _numba_solve(A, b):
+    """Solve ``A x = b`` with the production kernel: eq. 4.1 with ``Y_jj^E = 0``,
+    ``Y_ej^E = I`` and no noise gives ``x = A^-1 b`` at every "line"."""
+    m, n = b.shape
+    eye = np.broadcast_to(np.eye(n), (m, n, n))
+    zero = np.zeros((m, n, n))
+    args = [np.ascontiguousarray(x) for z in (A, b) for x in (z.real, z.imag)]
+    args[4:4] = [zero, zero]
+    args += [np.ascontiguousarray(eye), zero]
+    out = np.empty((1, m, n), complex)
+    _kernels.noisy_block_run(*args, 0, m, _rng.seed_key(0), np.zeros(1, np.int64), 0.0, False,
+                             False, False, np.empty((0, 0, 0)), out)
+    return out[0]
+
+
 def test_numba_solve_equals_numpy_solve():
     rng = np.random.default_rng(0)
     A = _rand_c(rng, 500, 6, 6)
     A[:50, 0, 0] = 0.0  # forces a row exchange
     A[50:100] *= np.logspace(-6, 6, 6)  # badly scaled columns
+    A[100:150, :, :3] *= 1e-8  # small leading pivots
     b = _rand_c(rng, 500, 6)
-    x = _kernels.solve_batched(A, b)
+    x = _numba_solve(A, b)
     ref = np.linalg.solve(A, b[..., None])[..., 0]
     np.testing.assert_allclose(x, ref, rtol=1e-9, atol=0)
     np.testing.assert_allclose(np.einsum("mij,mj->mi", A, x), b, rtol=1e-9, atol=1e-9)
@@ -51,8 +67,29 @@ def test_numba_solve_any_small_size(n):
     rng = np.random.default_rng(n)
     A = _rand_c(rng, 40, n, n)
     b = _rand_c(rng, 40, n)
-    np.testing.assert_allclose(_kernels.solve_batched(A, b),
-                               np.linalg.solve(A, b[..., None])[..., 0], rtol=1e-10)
+    np.testing.assert_allclose(_numba_solve(A, b), np.linalg.solve(A, b[..., None])[..., 0],
+                               rtol=1e-10)
+
+
+def test_numpy_factors_equal_kernel_factors():
+    """noise_factors (numpy) and the compiled lanes draw the same numbers: a kernel run with
+    A = I, E = 0, B = I gives y = s_a o a, i.e. the factors of the load vector."""
+    n, m = 6, 3
+    a = np.ones((m, n), complex)
+    eye = np.ascontiguousarray(np.broadcast_to(np.eye(n), (m, n, n)))
+    zero = np.zeros((m, n, n))
+    args = [eye, zero, a.real.copy(), a.imag.copy(), zero, zero, eye, zero]
+    rids = np.array([0, 7, 33], np.int64)
+    out = np.empty((3, m, n), complex)
+    key = _rng.seed_key(9)
+    _kernels.noisy_block_run(*args, 0, m, key, rids, 0.1, True, False, True,
+                             np.empty((0, 0, 0)), out)
+    lines = np.tile(np.arange(m), 3)
+    s = _kernels.noise_factors(key, np.repeat(rids, m), lines, 0.1, n, n, True, False)
+    S = fc.studies.scatter.split_factors(s.reshape(3, m, -1), n, n)
+    # y = S_A^-1-free: with A = I scaled by S_A (diagonal only matters), x = s_a / diag(S_A)
+    d = np.einsum("rfii->rfi", S["Yjj_A"])
+    np.testing.assert_allclose(out, S["vj_A"] / d, rtol=1e-13)
 
 
 def test_lane_kernel_equals_numpy_on_random_systems():

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._rng import GOLDEN, mix64, stream_base
+from ._rng import GOLDEN, mix64, mix64_np, stream_base
 
 _JIT = dict(cache=True, fastmath=False, error_model="numpy")
 
@@ -50,64 +50,10 @@ def n_elements(nj: int, ne: int) -> int:
     return 2 * nj * nj + nj + ne * nj
 
 
-# -- one small system (reference implementation, used for the truncation study) ------------
-
-
-@njit(**_JIT)
-def lu_solve_inplace(W, x):
-    """Solve ``W y = x`` in place: Gaussian elimination with partial pivoting.
-
-    ``W (n, n)`` complex is overwritten by its LU factors, ``x (n,)`` by the
-    solution. Pivots are chosen by ``|Re| + |Im|`` as in LAPACK's ``zgetrf``. A zero
-    pivot gives ``inf``/``nan`` (no exception), which callers check.
-    """
-    n = W.shape[0]
-    for k in range(n):
-        piv = k
-        pmax = abs(W[k, k].real) + abs(W[k, k].imag)
-        for i in range(k + 1, n):
-            v = abs(W[i, k].real) + abs(W[i, k].imag)
-            if v > pmax:
-                pmax = v
-                piv = i
-        if piv != k:
-            for j in range(k, n):
-                t = W[k, j]
-                W[k, j] = W[piv, j]
-                W[piv, j] = t
-            t = x[k]
-            x[k] = x[piv]
-            x[piv] = t
-        inv = 1.0 / W[k, k]
-        for i in range(k + 1, n):
-            m = W[i, k] * inv
-            for j in range(k + 1, n):
-                W[i, j] -= m * W[k, j]
-            x[i] -= m * x[k]
-    for i in range(n - 1, -1, -1):
-        acc = x[i]
-        for j in range(i + 1, n):
-            acc -= W[i, j] * x[j]
-        x[i] = acc / W[i, i]
-
-
-@njit(parallel=True, **_JIT)
-def solve_batched(A, b):
-    """``np.linalg.solve(A, b[..., None])[..., 0]`` for ``A (m, n, n)``, ``b (m, n)``."""
-    m, n = b.shape
-    out = np.empty((m, n), np.complex128)
-    for i in prange(m):
-        W = A[i].copy()
-        x = b[i].copy()
-        lu_solve_inplace(W, x)
-        out[i] = x
-    return out
-
-
 # -- lanes of rounds ------------------------------------------------------------------------
 
 
-@njit(inline="always", **_JIT)
+@njit(**_JIT)
 def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
     """Factors of words ``k0 .. k1-1`` of rounds ``rids[:nv]`` at stream line ``line``."""
     n_el = s.shape[0]
@@ -127,7 +73,7 @@ def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
                 s[e, v] = 1.0 + p * (2.0 * (np.float64(w >> _S32) * _INV32) - 1.0)
 
 
-@njit(inline="always", **_JIT)
+@njit(**_JIT)
 def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, piv, pm, yr, yi):
     """Noisy eq. 4.1 at one line for ``nv`` lanes: ``y (n_e, nv)`` from factors ``s``."""
     nj = Ar.shape[0]
@@ -187,23 +133,31 @@ def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, p
             Pr[k, v] = pr / d
             Pi[k, v] = -pi / d
         for i in range(k + 1, nj):
+            # multipliers m = W[i, k] / W[k, k], stored in place of W[i, k]
             for v in range(nv):
                 wr = Wr[i, k, v]
                 wi = Wi[i, k, v]
-                mr = wr * Pr[k, v] - wi * Pi[k, v]
-                mi = wr * Pi[k, v] + wi * Pr[k, v]
-                for j in range(k + 1, nj):
+                Wr[i, k, v] = wr * Pr[k, v] - wi * Pi[k, v]
+                Wi[i, k, v] = wr * Pi[k, v] + wi * Pr[k, v]
+            for j in range(k + 1, nj):
+                for v in range(nv):
+                    mr = Wr[i, k, v]
+                    mi = Wi[i, k, v]
                     Wr[i, j, v] -= mr * Wr[k, j, v] - mi * Wi[k, j, v]
                     Wi[i, j, v] -= mr * Wi[k, j, v] + mi * Wr[k, j, v]
+            for v in range(nv):
+                mr = Wr[i, k, v]
+                mi = Wi[i, k, v]
                 xr[i, v] -= mr * xr[k, v] - mi * xi[k, v]
                 xi[i, v] -= mr * xi[k, v] + mi * xr[k, v]
     for i in range(nj - 1, -1, -1):
+        for j in range(i + 1, nj):
+            for v in range(nv):
+                xr[i, v] -= Wr[i, j, v] * xr[j, v] - Wi[i, j, v] * xi[j, v]
+                xi[i, v] -= Wr[i, j, v] * xi[j, v] + Wi[i, j, v] * xr[j, v]
         for v in range(nv):
             cr = xr[i, v]
             ci = xi[i, v]
-            for j in range(i + 1, nj):
-                cr -= Wr[i, j, v] * xr[j, v] - Wi[i, j, v] * xi[j, v]
-                ci -= Wr[i, j, v] * xi[j, v] + Wi[i, j, v] * xr[j, v]
             xr[i, v] = cr * Pr[i, v] - ci * Pi[i, v]
             xi[i, v] = cr * Pi[i, v] + ci * Pr[i, v]
     # v_e = (S_B o B) x
@@ -278,40 +232,75 @@ def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, l0, l1, key, rids, p, tire, 
                         cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
 
 
-@njit(parallel=True, **_JIT)
 def noise_factors(key, rounds, lines, p, nj, ne, tire, vehicle):
-    """The scaling factors of ``(rounds[i], lines[i])``, shape ``(n, n_elements)``."""
-    n_el = 2 * nj * nj + nj + ne * nj
+    """The scaling factors of ``(rounds[i], lines[i])``, shape ``(n, n_elements)``.
+
+    Plain numpy (uint64 arithmetic wraps modulo 2**64), bit-identical to the factors
+    the compiled kernel draws; for inspecting single rounds.
+    """
+    n_el = n_elements(nj, ne)
     k_tire = (nj * nj + nj) // 2
     k_all = (n_el + 1) // 2
-    out = np.ones((rounds.size, n_el))
-    for i in prange(rounds.size):
-        s = np.ones((n_el, 1))
-        base = np.empty(1, np.uint64)
-        rid = rounds[i:i + 1]
-        if tire:
-            _lane_factors(key, rid, 1, lines[i], p, 0, k_tire, s, base)
-        if vehicle:
-            _lane_factors(key, rid, 1, lines[i], p, k_tire, k_all, s, base)
-        out[i] = s[:, 0]
+    r = np.asarray(rounds, np.int64).astype(np.uint64)
+    ln = np.asarray(lines, np.int64).astype(np.uint64)
+    with np.errstate(over="ignore"):
+        base = mix64_np(mix64_np(np.uint64(key) + (r + _ONE) * GOLDEN) + (ln + _ONE) * GOLDEN)
+        k = np.arange(k_all, dtype=np.uint64)
+        w = mix64_np(base[:, None] + (k[None, :] + _ONE) * GOLDEN)
+    u = np.empty((r.size, 2 * k_all))
+    u[:, 0::2] = (w >> _S32).astype(np.float64) * _INV32
+    u[:, 1::2] = (w & _LO32).astype(np.float64) * _INV32
+    s = 1.0 + p * (2.0 * u[:, :n_el] - 1.0)
+    out = np.ones((r.size, n_el))
+    if tire:
+        out[:, : 2 * k_tire] = s[:, : 2 * k_tire]
+    if vehicle:
+        out[:, 2 * k_tire:] = s[:, 2 * k_tire:]
     return out
 
 
 # -- statistics over rounds -----------------------------------------------------------------
 
 
-@njit(inline="always", **_JIT)
-def _order_stat_pair(col, k):
-    """``(x_(k), x_(k+1))``: 0-based order statistics of ``col`` (left unchanged)."""
-    n = col.size
-    part = np.partition(col, k)
-    lo = part[k]
+@njit(**_JIT)
+def _select(buf, k):
+    """Partially sort ``buf`` in place so that ``buf[k]`` is its k-th smallest (Hoare)."""
+    lo = 0
+    hi = buf.size - 1
+    while lo < hi:
+        pivot = buf[(lo + hi) // 2]
+        i = lo
+        j = hi
+        while i <= j:
+            while buf[i] < pivot:
+                i += 1
+            while buf[j] > pivot:
+                j -= 1
+            if i <= j:
+                t = buf[i]
+                buf[i] = buf[j]
+                buf[j] = t
+                i += 1
+                j -= 1
+        if k <= j:
+            hi = j
+        elif k >= i:
+            lo = i
+        else:
+            return
+
+
+@njit(**_JIT)
+def _order_stat_pair(buf, k):
+    """``(x_(k), x_(k+1))``, 0-based order statistics of ``buf`` (reordered in place)."""
+    _select(buf, k)
+    lo = buf[k]
     hi = lo
-    if k + 1 < n:
-        hi = part[k + 1]
-        for i in range(k + 2, n):
-            if part[i] < hi:
-                hi = part[i]
+    if k + 1 < buf.size:
+        hi = buf[k + 1]
+        for i in range(k + 2, buf.size):
+            if buf[i] < hi:
+                hi = buf[i]
     return lo, hi
 
 
@@ -360,7 +349,8 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
                 pct[iq, line, e] = mx
                 continue
             t = h - k
-            a0, b0 = _order_stat_pair(col, k)
+            buf = col.copy()
+            a0, b0 = _order_stat_pair(buf, k)
             d = b0 - a0
             # numpy's _lerp: a + d t, evaluated from b for t >= 0.5
             pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t

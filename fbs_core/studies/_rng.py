@@ -25,7 +25,7 @@ from numba import njit
 
 from ..errors import FBSError
 
-__all__ = ["GOLDEN", "mix64", "seed_key", "stream_base", "fill_uniform", "as_seed"]
+__all__ = ["GOLDEN", "mix64", "mix64_np", "seed_key", "stream_base", "as_seed"]
 
 GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -39,7 +39,14 @@ _ONE = np.uint64(1)
 _INV32 = 2.0**-32
 
 
-@njit(cache=True, inline="always")
+def mix64_np(z):
+    """:func:`mix64` on numpy ``uint64`` arrays (call under ``np.errstate(over="ignore")``)."""
+    z = (z ^ (z >> _S30)) * _M1
+    z = (z ^ (z >> _S27)) * _M2
+    return z ^ (z >> _S31)
+
+
+@njit(cache=True)
 def mix64(z):
     """SplitMix64 output function (a bijection of the 64-bit integers)."""
     z = (z ^ (z >> _S30)) * _M1
@@ -56,29 +63,11 @@ def seed_key(seed: int) -> np.uint64:
     return np.uint64(z ^ (z >> 31))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def stream_base(key, r, line):
     """The base counter of round ``r`` at frequency line ``line``."""
     a = mix64(key + (np.uint64(r) + _ONE) * GOLDEN)
     return mix64(a + (np.uint64(line) + _ONE) * GOLDEN)
-
-
-@njit(cache=True, inline="always")
-def fill_uniform(base, k0, k1, p, out):
-    """Write ``1 + p (2 u - 1)`` for elements ``2 k0 .. 2 k1 - 1`` into ``out``.
-
-    ``u`` are the uniforms of words ``k0 .. k1 - 1`` of the stream ``base``; an
-    element index beyond ``out.size`` (odd element counts) is skipped.
-    """
-    n = out.size
-    for k in range(k0, k1):
-        w = mix64(base + (np.uint64(k) + _ONE) * GOLDEN)
-        hi = np.float64(w >> _S32) * _INV32
-        lo = np.float64(w & _LO32) * _INV32
-        e = 2 * k
-        out[e] = 1.0 + p * (2.0 * hi - 1.0)
-        if e + 1 < n:
-            out[e + 1] = 1.0 + p * (2.0 * lo - 1.0)
 
 
 def as_seed(seed) -> int:
