@@ -117,9 +117,11 @@ def test_mapping_results_and_refusals(tmp_path):
     res = {"error": (("n_modes", "freq"), np.ones((2, 3))),
            "coords": {"n_modes": [10, 20], "freq": [1.0, 2.0, 3.0]},
            "metadata": {"noise": 0.1}}
+    res["labels"] = (("n_modes", "k"), np.array([["a", "b"], ["c", "d"]]))
     p = export_result(res, tmp_path / "m.h5")
     with h5py.File(p, "r") as h:
         assert h.attrs["noise"] == 0.1
+        assert h["arrays/labels"].asstr()[1, 0] == "c"
     with pytest.raises(DataFormatError, match="cannot export a object"):
         export_result(object(), format="csv")
     with pytest.raises(DataFormatError, match="coordinate has 4"):

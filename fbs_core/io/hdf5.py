@@ -108,7 +108,12 @@ def write_hdf5_result(result, metadata: Mapping) -> bytes:
             else:
                 h.require_group("coords").create_dataset(dim, data=v)
         for name, (dims, values) in result.arrays.items():
-            d = h.require_group("arrays").create_dataset(name, data=np.asarray(values))
+            v = np.asarray(values)
+            if v.dtype.kind == "U":
+                d = h.require_group("arrays").create_dataset(name, data=v.astype(object),
+                                                             dtype=s)
+            else:
+                d = h.require_group("arrays").create_dataset(name, data=v)
             d.attrs.create("dims", np.array(dims, dtype=object), dtype=s)
     return b.getvalue()
 
