@@ -71,6 +71,8 @@ class TireModel:
         :meth:`system` and :meth:`patch_load`).
     meta : dict
         Free-form provenance (source, format version, ...).
+    hub_dofs : tuple of str
+        Labels of the 6 hub DOFs, ``hub:x`` ... ``hub:rz`` in vehicle coordinates.
     """
 
     speeds: np.ndarray
