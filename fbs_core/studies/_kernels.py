@@ -57,18 +57,18 @@ def n_elements(nj: int, ne: int) -> int:
 def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
     """Factors of words ``k0 .. k1-1`` of rounds ``rids[:nv]`` at stream line ``line``."""
     n_el = s.shape[0]
-    for v in range(nv):
+    for v in range(LANES):
         base[v] = stream_base(key, rids[v], line)
     for k in range(k0, k1):
         kk = (np.uint64(k) + _ONE) * GOLDEN
         e = 2 * k
         if e + 1 < n_el:
-            for v in range(nv):
+            for v in range(LANES):
                 w = mix64(base[v] + kk)
                 s[e, v] = 1.0 + p * (2.0 * (np.float64(w >> _S32) * _INV32) - 1.0)
                 s[e + 1, v] = 1.0 + p * (2.0 * (np.float64(w & _LO32) * _INV32) - 1.0)
         else:
-            for v in range(nv):
+            for v in range(LANES):
                 w = mix64(base[v] + kk)
                 s[e, v] = 1.0 + p * (2.0 * (np.float64(w >> _S32) * _INV32) - 1.0)
 
@@ -90,27 +90,27 @@ def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, p
             A_i = Ai[i, k]
             E_r = Er[i, k]
             E_i = Ei[i, k]
-            for v in range(nv):
+            for v in range(LANES):
                 Wr[i, k, v] = sa[v] * A_r + se[v] * E_r
                 Wi[i, k, v] = sa[v] * A_i + se[v] * E_i
         sv = s[oa + i]
         a_r = ar[i]
         a_i = ai[i]
-        for v in range(nv):
+        for v in range(LANES):
             xr[i, v] = sv[v] * a_r
             xi[i, v] = sv[v] * a_i
     # LU with partial pivoting per lane, applied to x on the fly
     for k in range(nj):
-        for v in range(nv):
+        for v in range(LANES):
             pm[v] = abs(Wr[k, k, v]) + abs(Wi[k, k, v])
             piv[v] = k
         for i in range(k + 1, nj):
-            for v in range(nv):
+            for v in range(LANES):
                 t = abs(Wr[i, k, v]) + abs(Wi[i, k, v])
                 if t > pm[v]:
                     pm[v] = t
                     piv[v] = i
-        for v in range(nv):
+        for v in range(LANES):
             q = piv[v]
             if q != k:
                 for j in range(k, nj):
@@ -126,7 +126,7 @@ def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, p
                 t = xi[k, v]
                 xi[k, v] = xi[q, v]
                 xi[q, v] = t
-        for v in range(nv):
+        for v in range(LANES):
             pr = Wr[k, k, v]
             pi = Wi[k, k, v]
             d = pr * pr + pi * pi
@@ -134,42 +134,42 @@ def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, p
             Pi[k, v] = -pi / d
         for i in range(k + 1, nj):
             # multipliers m = W[i, k] / W[k, k], stored in place of W[i, k]
-            for v in range(nv):
+            for v in range(LANES):
                 wr = Wr[i, k, v]
                 wi = Wi[i, k, v]
                 Wr[i, k, v] = wr * Pr[k, v] - wi * Pi[k, v]
                 Wi[i, k, v] = wr * Pi[k, v] + wi * Pr[k, v]
             for j in range(k + 1, nj):
-                for v in range(nv):
+                for v in range(LANES):
                     mr = Wr[i, k, v]
                     mi = Wi[i, k, v]
                     Wr[i, j, v] -= mr * Wr[k, j, v] - mi * Wi[k, j, v]
                     Wi[i, j, v] -= mr * Wi[k, j, v] + mi * Wr[k, j, v]
-            for v in range(nv):
+            for v in range(LANES):
                 mr = Wr[i, k, v]
                 mi = Wi[i, k, v]
                 xr[i, v] -= mr * xr[k, v] - mi * xi[k, v]
                 xi[i, v] -= mr * xi[k, v] + mi * xr[k, v]
     for i in range(nj - 1, -1, -1):
         for j in range(i + 1, nj):
-            for v in range(nv):
+            for v in range(LANES):
                 xr[i, v] -= Wr[i, j, v] * xr[j, v] - Wi[i, j, v] * xi[j, v]
                 xi[i, v] -= Wr[i, j, v] * xi[j, v] + Wi[i, j, v] * xr[j, v]
-        for v in range(nv):
+        for v in range(LANES):
             cr = xr[i, v]
             ci = xi[i, v]
             xr[i, v] = cr * Pr[i, v] - ci * Pi[i, v]
             xi[i, v] = cr * Pi[i, v] + ci * Pr[i, v]
     # v_e = (S_B o B) x
     for e in range(ne):
-        for v in range(nv):
+        for v in range(LANES):
             yr[e, v] = 0.0
             yi[e, v] = 0.0
         for k in range(nj):
             sb = s[oB + e * nj + k]
             b_r = Br[e, k]
             b_i = Bi[e, k]
-            for v in range(nv):
+            for v in range(LANES):
                 br = sb[v] * b_r
                 bi = sb[v] * b_i
                 yr[e, v] += br * xr[k, v] - bi * xi[k, v]
@@ -210,7 +210,9 @@ def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, l0, l1, key, rids, p, tire, 
     for b in prange(n_blocks):
         r0 = b * LANES
         nv = min(LANES, nr - r0)
-        lane_ids = rids[r0:r0 + nv]
+        lane_ids = np.empty(LANES, np.int64)
+        for v in range(LANES):
+            lane_ids[v] = rids[r0 + min(v, nv - 1)]  # pad with the last round (not written)
         s, base, W, X, Y, piv, pm = _workspace(nj, ne, n_el)
         for line in range(l0, l1):
             if freq_dep or line == l0:
