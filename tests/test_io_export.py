@@ -12,7 +12,7 @@ import fbs_core
 from fbs_core import FRF
 from fbs_core.errors import DataFormatError
 from fbs_core.io import as_result_data, export_result, load_frf
-from fbs_core.studies import Convergence, ScatterBand, TruncationMap
+from fbs_core.studies import Convergence, ScatterBand, SuggestedModes, TruncationMap
 
 DOFS = ("bushing:x", "bushing:z")
 F = np.arange(20, 41) * 1.0
@@ -55,7 +55,7 @@ def test_study_result_is_flattened_with_named_axes():
     assert md["fbs_core_version"] == fbs_core.__version__ and md["kind"] == "TruncationMap"
     band = as_result_data(scatter())
     assert band.arrays["percentiles"][0] == ("q", "freq", "dofs")
-    assert "convergence/lower" in band.arrays
+    assert band.arrays["convergence/lower"][0] == ("convergence/rounds", "freq", "dofs")
     assert band.metadata["seed"] == 42 and band.metadata["noise"] == 0.1
 
 
@@ -133,3 +133,16 @@ def test_mapping_results_and_refusals(tmp_path):
         export_result(res, format="mat")
     with pytest.raises(DataFormatError, match="no arrays"):
         export_result({"metadata": {"a": 1}}, format="csv")
+
+
+def test_suggested_modes_table_is_indexed_by_harmonic():
+    sm = SuggestedModes(harmonics=(1, 2, 3), n_modes=np.array([40, 70, 130]),
+                        eigenfrequency=np.array([144.0, 236.0, 347.0]),
+                        freq_range=np.array([[12.9, 51.5], [16.7, 67.0], [24.6, 97.9]]),
+                        threshold=0.2, f_max=160.0, speed=80.0, dof=None, maps=())
+    res = as_result_data(sm)
+    assert res.arrays["n_modes"][0] == ("harmonics",)
+    assert res.arrays["freq_range"][0] == ("harmonics", "freq_range_dim1")
+    text = export_result(sm, format="csv").decode()
+    assert "# table: n_modes\nharmonics,value\n1,40\n2,70\n3,130\n" in text
+    assert text.count("fbs_core_version") == 1 and "# threshold: 0.2" in text

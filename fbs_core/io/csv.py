@@ -203,7 +203,9 @@ def _is_float(x: str) -> bool:
 def _header(metadata: Mapping | None, title: str) -> list[str]:
     from .. import __version__
 
-    lines = [f"# tire-fbs {title}", f"# fbs_core_version: {__version__}"]
+    lines = [f"# tire-fbs {title}"]
+    if "fbs_core_version" not in (metadata or {}):
+        lines.append(f"# fbs_core_version: {__version__}")
     for k, v in (metadata or {}).items():
         lines.append(f"# {k}: {str(v).replace(chr(10), ' ')}")
     return lines

@@ -96,7 +96,7 @@ def _jsonable(v):
     return v if _scalar(v) else str(v)
 
 
-def _flatten(obj, prefix: str, out: ResultData) -> None:
+def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -> None:
     if isinstance(obj, FRF):
         out.frfs[prefix.rstrip("/") or "frf"] = obj
         return
@@ -117,16 +117,43 @@ def _flatten(obj, prefix: str, out: ResultData) -> None:
             f"cannot export a {type(obj).__name__}: expected an FRF, a mapping of arrays, a "
             "ResultData or a dataclass of arrays"
         )
-    # coordinates: 1-D fields documented with a single symbol label that axis
-    axis_coord = {}
+    # coordinates: 1-D fields documented with a single symbol label that axis; nested
+    # results see the axes of their parent (ScatterBand.convergence shares n_f, n_dof)
+    local: dict[str, str] = {}
     for k, syms in docdims.items():
         if len(syms) == 1 and k in items and (_labels(items[k]) or (
                 isinstance(items[k], np.ndarray) and items[k].ndim == 1)):
-            axis_coord.setdefault(syms[0], prefix + k)
+            local.setdefault(syms[0], prefix + k)  # the first documented field labels it
+    # an undocumented tuple of numbers or labels ahead of that field labels an axis when
+    # its length fits exactly one symbol (SuggestedModes.harmonics for n_h)
+    order = list(items)
+    sizes: dict[str, set] = {}
+    for k, syms in docdims.items():
+        v = items.get(k)
+        if isinstance(v, np.ndarray) and v.ndim == len(syms):
+            for sym, n in zip(syms, v.shape, strict=True):
+                sizes.setdefault(sym, set()).add(n)
+    for k, v in items.items():
+        if k in docdims or not isinstance(v, tuple | list) or not v or not all(
+                isinstance(x, int | float | str | np.number) for x in v):
+            continue
+        fits = [sym for sym, n in sizes.items() if n == {len(v)}]
+        if len(fits) == 1 and (fits[0] not in local or order.index(k) <
+                               order.index(local[fits[0]][len(prefix):])):
+            local[fits[0]] = prefix + k
+            out.coords[prefix + k] = np.asarray(v)
+    axis_coord = {**(inherited or {}), **local}
     for k, v in items.items():
         key = prefix + str(k)
+        if key in out.coords and key in axis_coord.values():
+            continue
         if isinstance(v, FRF):
             out.frfs[key] = v
+        elif isinstance(v, tuple | list) and v and all(
+                isinstance(x, FRF) or (dataclasses.is_dataclass(x) and not isinstance(x, type))
+                for x in v):
+            for i, x in enumerate(v):
+                _flatten(x, f"{key}/{i}/", out, axis_coord)
         elif isinstance(v, tuple) and len(v) == 2 and _labels(v[0]) and hasattr(v[1], "shape"):
             out.arrays[key] = (tuple(prefix + d for d in v[0]), np.asarray(v[1]))
         elif _labels(v):
@@ -135,7 +162,8 @@ def _flatten(obj, prefix: str, out: ResultData) -> None:
                                                            == "U"):
             syms = docdims.get(k, ())
             if len(syms) == v.ndim:
-                dims = tuple(axis_coord.get(s, prefix + s) for s in syms)
+                dims = tuple(f"{key}_dim{i}" if s.isdigit() else axis_coord.get(s, prefix + s)
+                             for i, s in enumerate(syms))
             else:
                 dims = tuple(f"{key}_dim{d}" for d in range(v.ndim))
             if v.ndim == 1 and dims[0] == key:
@@ -144,7 +172,7 @@ def _flatten(obj, prefix: str, out: ResultData) -> None:
                 out.arrays[key] = (dims, v)
         elif (dataclasses.is_dataclass(v) and not isinstance(v, type)) or (
                 isinstance(v, Mapping) and not all(_scalar(x) for x in v.values())):
-            _flatten(v, key + "/", out)
+            _flatten(v, key + "/", out, axis_coord)
         elif _scalar(v) or isinstance(v, Mapping | tuple | list | np.ndarray):
             out.metadata[key] = _jsonable(v)
     for name, (dims, v) in out.arrays.items():
