@@ -102,3 +102,21 @@ def test_bad_input():
         bushing_response(1, freq=[100.0, 200.0])  # outside the 1st harmonic's band
     with pytest.raises(FBSError):
         bushing_response(1, freq=[10.0, 20.0], speed_kmh=200.0)  # beyond the operating points
+
+
+def test_peak_listing_of_the_appendix_a_script():
+    """scripts/print_bushing_peaks.py finds the maxima of two resonances, strongest first."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / "print_bushing_peaks.py"
+    spec = importlib.util.spec_from_file_location("print_bushing_peaks", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    f = np.arange(10.0, 100.0, 0.25)
+    v = 2.0 / (1 - (f / 30) ** 2 + 0.05j * f / 30) + 1.0 / (1 - (f / 70) ** 2 + 0.05j * f / 70)
+    (f1, db1), (f2, db2) = mod.peaks(f, v, 2)
+    assert f1 == pytest.approx(30.0, abs=0.5) and f2 == pytest.approx(70.0, abs=0.5)
+    assert db1 == pytest.approx(20 * np.log10(np.abs(v).max()))
+    assert db1 > db2
+    assert mod.peaks(f, 1.0 / f, 3) == [(10.0, pytest.approx(-20.0))]  # monotonic: band maximum
