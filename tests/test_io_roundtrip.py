@@ -120,3 +120,29 @@ def test_reads_the_shipped_reference_chassis_file_without_changing_it():
     assert r.frf.quantity == "mobility"
     assert "spindle:z" in r.frf.inputs and any(o.startswith("bushing:") for o in r.frf.outputs)
     assert p.read_bytes() == before
+
+
+def test_mat73_cell_array_labels_as_matlab_writes_them():
+    """MATLAB v7.3 stores a cell array as object references into '#refs#', each a
+    uint16 char dataset; arrays are column-major (h5py sees the axes reversed)."""
+    import io
+
+    import h5py
+
+    Y = two_dof(FREQ)
+    raw = bytearray(save_frf(Y, format="mat", mat_version="7.3"))
+    b = io.BytesIO(bytes(raw))
+    with h5py.File(b, "r+") as h:
+        for var in ("outputs", "inputs"):
+            del h[var]
+            refs = []
+            for k, lab in enumerate(getattr(Y, var)):
+                d = h.create_dataset(f"#refs#/{var}{k}",
+                                     data=np.array([[ord(c)] for c in lab], np.uint16))
+                d.attrs["MATLAB_class"] = np.bytes_("char")
+                d.attrs["MATLAB_int_decode"] = np.int32(2)
+                refs.append(d.ref)
+            c = h.create_dataset(var, data=np.array([refs]).T, dtype=h5py.ref_dtype)
+            c.attrs["MATLAB_class"] = np.bytes_("cell")
+    r = load_frf(b.getvalue(), filename="cells.mat")
+    assert r.frf.allclose(Y, rtol=1e-15)
