@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -146,3 +147,30 @@ def test_suggested_modes_table_is_indexed_by_harmonic():
     text = export_result(sm, format="csv").decode()
     assert "# table: n_modes\nharmonics,value\n1,40\n2,70\n3,130\n" in text
     assert text.count("fbs_core_version") == 1 and "# threshold: 0.2" in text
+
+
+def test_hdf5_result_reads_back_with_axes_and_metadata(tmp_path):
+    from fbs_core.io import load_result
+
+    band = scatter()
+    p = export_result(band, tmp_path / "band.h5", metadata={"note": "run 7"})
+    res = load_result(p)
+    assert res.kind == "ScatterBand" and res.metadata["seed"] == 42
+    assert res.metadata["note"] == "run 7"
+    dims, v = res.arrays["percentiles"]
+    assert dims == ("q", "freq", "dofs")
+    np.testing.assert_array_equal(v, band.percentiles)
+    np.testing.assert_array_equal(res.coords["dofs"], DOFS)
+    w = 2 * np.pi * F
+    Y = FRF(F, (1j * w / (5e4 - 2 * w**2 + 3j * w))[:, None, None], ["bushing:z"],
+            ["patch"], "mobility")
+    back = load_result(export_result({"coupled": Y, "metadata": {"N": 40}}, format="hdf5"),
+                       filename="r.h5")
+    assert back.frfs["coupled"].allclose(Y) and back.metadata["N"] == 40
+    b = io.BytesIO()
+    with h5py.File(b, "w") as h:
+        h["x"] = np.ones(3)
+    with pytest.raises(DataFormatError, match="not written by tire-fbs"):
+        load_result(b.getvalue(), filename="foreign.h5")
+    chassis = load_result(Path(__file__).parents[1] / "data" / "reference_chassis.h5")
+    assert "spindle:z" in chassis.frfs["frf"].inputs

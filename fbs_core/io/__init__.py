@@ -51,6 +51,7 @@ __all__ = [
     "export_result",
     "interface_check",
     "load_frf",
+    "load_result",
     "load_tire_model",
     "prepare_chassis",
     "require_dofs",
@@ -315,6 +316,34 @@ def export_result(result, path=None, *, format: str | None = None,
     else:
         raise DataFormatError(f"results are exported as csv, uff or hdf5, not {fmt!r}")
     return _deliver(raw, path)
+
+
+def load_result(source, *, filename: str | None = None, max_bytes: int = DEFAULT_MAX_BYTES,
+                timeout: float = DEFAULT_TIMEOUT) -> ResultData:
+    """Read a result exported with :func:`export_result` as HDF5 back.
+
+    Parameters
+    ----------
+    source : path or bytes
+        A file path, or the content of an upload (then pass ``filename``).
+    filename, max_bytes, timeout
+        As in :func:`load_frf`.
+
+    Returns
+    -------
+    ResultData
+        Arrays with their axis names, coordinates, FRFs and the metadata of the export.
+
+    Raises
+    ------
+    DataFormatError
+        For other formats or layouts and damaged files.
+    """
+    src = read_source(source, filename, max_bytes)
+    fmt, _ = detect_format(src, None if src.suffix in FORMATS["hdf5"] else "hdf5")
+    from .hdf5 import read_hdf5_result
+
+    return read_hdf5_result(src, timeout=timeout)
 
 
 def load_tire_model(source, *, filename: str | None = None, format: str | None = None,

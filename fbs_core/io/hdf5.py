@@ -38,7 +38,7 @@ from .checks import (
     si_factors,
 )
 
-__all__ = ["read_hdf5", "write_hdf5", "write_hdf5_result", "root_attrs"]
+__all__ = ["read_hdf5", "read_hdf5_result", "write_hdf5", "write_hdf5_result", "root_attrs"]
 
 FORMAT_VERSION = 1
 
@@ -214,3 +214,49 @@ def read_hdf5(src: Source, *, nodes: Mapping | None = None, quantity: str | None
         if k in root:
             md.setdefault(k, root[k])
     return frf, notes, md
+
+
+def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
+    """Read a result written by :func:`write_hdf5_result` back as ``ResultData``.
+
+    Raises
+    ------
+    DataFormatError
+        For files of another layout or damaged ones.
+    """
+    from .results import ResultData
+
+    what = f"HDF5 file {src.name!r}"
+    meta, arrays = parse_isolated("hdf5", src.raw, what, timeout=timeout)
+    ds, groups = meta["datasets"], meta["groups"]
+    root = groups.get("/", {})
+    if root.get("format") != "tire-fbs":
+        raise DataFormatError(f"{what} was not written by tire-fbs (no format attribute)")
+    try:
+        md = json.loads(root.get("metadata", "{}"))
+    except (TypeError, ValueError):
+        raise DataFormatError(f"{what}: the metadata attribute is not JSON") from None
+    res = ResultData(str(root.get("content", "result")), metadata=md)
+
+    def values(e):
+        return arrays[e["array"]] if "array" in e else np.asarray(e.get("strings", []))
+
+    for path, e in ds.items():
+        if path.startswith("/coords/"):
+            res.coords[path[len("/coords/"):]] = values(e)
+        elif path.startswith("/arrays/"):
+            dims = e["attrs"].get("dims")
+            v = values(e)
+            if isinstance(dims, str):
+                dims = [dims]
+            if not isinstance(dims, list) or len(dims) != v.ndim:
+                raise DataFormatError(f"{what}: {path} lacks its axis names (attribute dims)")
+            if "strings" in e:
+                v = v.reshape(e["shape"])
+            res.arrays[path[len("/arrays/"):]] = (tuple(dims), v)
+    for g in groups:
+        if g.startswith("/frfs/") and f"{g}/freq" in ds:
+            res.frfs[g[len("/frfs/"):]] = read_hdf5(src, name=g, timeout=timeout)[0]
+    if "/frf/freq" in ds:
+        res.frfs["frf"] = read_hdf5(src, name="frf", timeout=timeout)[0]
+    return res
