@@ -26,6 +26,10 @@ echo "== installing the project and its test dependencies"
 .venv/bin/python -m pip install -q -e ".[test]"
 if [ "${NEED_PW_BROWSER:-0}" = 1 ]; then .venv/bin/playwright install chromium; fi
 
+# One BLAS thread per process: the tests' many small dense solves gain nothing from
+# threading, and on 2 cores with numba kernels beside them threads only oversubscribe.
+export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}" OMP_NUM_THREADS="${OMP_NUM_THREADS:-1}"
+
 echo "== ruff"
 .venv/bin/ruff check .
 echo "== pytest"
