@@ -201,3 +201,8 @@ def test_node_map_entries_missing_from_the_file_are_reported():
     r = load_frf(HAND_WRITTEN.encode(), filename="hand.uff", nodes={1: "spindle", 7: "bushing"})
     assert r.frf.outputs == ("2:z", "2:x")
     assert any("node numbers 7" in n and "nodes in the file: 1, 2" in n for n in r.notes)
+
+
+def test_node_map_must_map_numbers_to_names():
+    with pytest.raises(DataFormatError, match="maps UFF node numbers to names"):
+        load_frf(HAND_WRITTEN.encode(), filename="hand.uff", nodes={"spindle": 1})

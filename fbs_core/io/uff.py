@@ -191,6 +191,13 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
     ------
     DataFormatError, DOFError, FrequencyGridError, QuantityError
     """
+    if nodes:
+        bad = [k for k in nodes if not (isinstance(k, int) or str(k).strip().isdigit())]
+        if bad:
+            raise DataFormatError(
+                f"nodes maps UFF node numbers to names, e.g. {{1: 'spindle', 2: 'bushing'}}; "
+                f"got keys {', '.join(map(repr, bad[:4]))}"
+            )
     sets = _read_sets(src)
     notes: list[str] = []
     units164 = [s for s in sets if s.get("type") == 164]
