@@ -28,6 +28,18 @@ from .frf import FRF, QUANTITIES
 from .harmonics import HARMONICS, Harmonic, harmonic
 from .io import load_frf, save_frf
 from .prediction import bushing_response
+from .studies import (
+    Convergence,
+    ModeFrequencies,
+    ScatterBand,
+    SuggestedModes,
+    TruncationMap,
+    floating_band_error,
+    mode_frequencies,
+    scatter_band,
+    suggest_modes,
+    truncation_map,
+)
 from .tire import TireModel, reference_tire
 
 __version__ = "0.1.0"
@@ -58,6 +70,16 @@ __all__ = [
     "ChassisModel",
     "reference_chassis",
     "bushing_response",
+    "truncation_map",
+    "suggest_modes",
+    "mode_frequencies",
+    "scatter_band",
+    "floating_band_error",
+    "TruncationMap",
+    "SuggestedModes",
+    "ModeFrequencies",
+    "ScatterBand",
+    "Convergence",
     "node_labels",
     "parse_label",
     "load_frf",

@@ -43,6 +43,8 @@ def _numba_solve(A, b):
     args = [np.ascontiguousarray(x) for z in (A, b) for x in (z.real, z.imag)]
     args[4:4] = [zero, zero]
     args += [np.ascontiguousarray(eye), zero]
+    for x in args:
+        x.setflags(write=False)  # the signature the library compiles
     out = np.empty((1, m, n), complex)
     _kernels.noisy_block_run(*args, 0, m, _rng.seed_key(0), np.zeros(1, np.int64), 0.0, False,
                              False, False, np.empty((0, 0, 0)), out)
@@ -79,6 +81,8 @@ def test_numpy_factors_equal_kernel_factors():
     eye = np.ascontiguousarray(np.broadcast_to(np.eye(n), (m, n, n)))
     zero = np.zeros((m, n, n))
     args = [eye, zero, a.real.copy(), a.imag.copy(), zero, zero, eye, zero]
+    for x in args:
+        x.setflags(write=False)
     rids = np.array([0, 7, 33], np.int64)
     out = np.empty((3, m, n), complex)
     key = _rng.seed_key(9)
@@ -104,6 +108,8 @@ def test_lane_kernel_equals_numpy_on_random_systems():
     for fd in (False, True):
         out = np.empty((rids.size, nf, ne), complex)
         args = [x for z in (A, a, E, B) for x in (z.real.copy(), z.imag.copy())]
+        for x in args:
+            x.setflags(write=False)
         _kernels.noisy_block_run(*args, 0, nf, key, rids, 0.1, True, True, fd,
                                  np.empty((0, 0, 0)), out)
         lines = np.tile(np.arange(nf) if fd else np.zeros(nf, np.int64), rids.size)

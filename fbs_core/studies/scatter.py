@@ -217,7 +217,8 @@ def _flags(target: str) -> tuple[bool, bool]:
 
 
 def _split(z):
-    return np.ascontiguousarray(z.real, float), np.ascontiguousarray(z.imag, float)
+    # read-only, C-contiguous: one compiled signature for the band and single rounds
+    return _ro(np.ascontiguousarray(z.real, float)), _ro(np.ascontiguousarray(z.imag, float))
 
 
 def _run_complex(arrays, key, rids, p, tire, vehicle, freq_dep):
@@ -359,13 +360,12 @@ def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = 
                 f"{name} of the scatter band is not finite at {f[line]:g} Hz: the (noisy) "
                 "interface matrix Y_jj^A + Y_jj^E is singular there"
             )
-    frozen_arrays = tuple(_ro(a) for a in arrays)
     return ScatterBand(
         freq=_ro(f), dofs=dofs, reference=_ro(ref), lower=_ro(lo), upper=_ro(hi),
         argmin_round=_ro(alo), argmax_round=_ro(ahi), q=_ro(qs), percentiles=_ro(pct),
         convergence=Convergence(_ro(ck), _ro(clo), _ro(chi)), noise=float(noise),
         target=target, rounds=rounds, frequency_dependent=bool(frequency_dependent),
-        seed=seed, harmonic=harmonic, _inputs=(frozen_arrays, key),
+        seed=seed, harmonic=harmonic, _inputs=(arrays, key),
     )
 
 

@@ -268,9 +268,11 @@ def truncation_map(harmonic, n_modes=None, *, freq=None, df: float = 0.5, width:
             f"got {np.asarray(n_modes).tolist()}"
         )
     YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
-    YjjA, vj = _models.tire_arrays(tire, f, h, list(n) + [n_total], dirs)
+    has_all = n[-1] == n_total  # the reference is then the last truncation itself
+    YjjA, vj = _models.tire_arrays(tire, f, h, list(n) + ([] if has_all else [n_total]), dirs)
+    k = n.size
     return truncation_map_arrays(
-        f, YjjA[:-1], vj[:-1], YjjA[-1], vj[-1], YjjE, YejE, n, dofs=resp, harmonic=h.k,
+        f, YjjA[:k], vj[:k], YjjA[-1], vj[-1], YjjE, YejE, n, dofs=resp, harmonic=h.k,
         n_modes_total=n_total, width=width, step=step, edges=edges, centres=centres,
     )
 
