@@ -15,7 +15,7 @@ from functools import cache
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from fbs_core import FRF
@@ -143,3 +143,82 @@ def test_header_texts(text):
         frequency_from_units(np.ones(2), text, "t")
     except FrequencyGridError:
         pass
+
+
+# -- structure-aware fuzzing: well-formed files with hostile contents ---------------------
+LABELS = st.sampled_from(["spindle:z", "spindle:RX", "bushing:-x", "hub:tz", "patch", "1:z",
+                          "hub:w", "", "a b:x", "x:y:z", "hub:", ":z", "spindle:z"])
+FINITE = st.floats(-1e6, 1e6)
+NUMBERS = st.one_of(FINITE, FINITE, FINITE, st.integers(-3, 3).map(float),
+                    st.floats(allow_nan=True, allow_infinity=True, width=64))
+
+
+def grid(data, n):
+    """Mostly a valid grid, sometimes anything."""
+    if data.draw(st.integers(0, 3)):
+        return list(np.cumsum(data.draw(st.lists(st.floats(0.01, 100.0), min_size=n,
+                                                 max_size=n))))
+    return data.draw(st.lists(NUMBERS, min_size=n, max_size=n))
+HEADER_VALUES = st.sampled_from(["mobility", "receptance", "accelerance", "velocity", "",
+                                 "m/N", "m/(N s)", "mm/s/N", "N/m", "g/N", "kg", "V/V",
+                                 "re-im", "mag-phase", "deg", "rad", "Hz", "rad/s", "rpm"])
+
+
+@FUZZ
+@given(data=st.data())
+def test_structured_csv(data):
+    outs = data.draw(st.lists(LABELS, min_size=1, max_size=3))
+    ins = data.draw(st.lists(LABELS, min_size=1, max_size=2))
+    n = data.draw(st.integers(0, 5))
+    head = [f"# {k}: {data.draw(HEADER_VALUES)}"
+            for k in data.draw(st.lists(st.sampled_from(
+                ["quantity", "units", "layout", "phase_unit", "freq_unit", "other"]),
+                max_size=4))]
+    parts = data.draw(st.sampled_from([("Re", "Im"), ("Mag", "Phase"), ("Re", "Im"),
+                                       ("Re", "Phase")]))
+    cols = ["freq [Hz]"] + [f"{p}({o} / {i})" for o in outs for i in ins for p in parts]
+    f = grid(data, n)
+    num = data.draw(st.sampled_from([FINITE, FINITE, NUMBERS]))
+    rows = [",".join([repr(float(f[r]))] + [repr(data.draw(num)) for _ in cols[1:]])
+            for r in range(n)]
+    text = "\n".join(head + [",".join(cols)] + rows)
+    try:
+        load_frf(text.encode(), filename="s.csv", quantity=data.draw(
+            st.sampled_from([None, "mobility", "accelerance"])))
+        event("loaded")
+    except FBSError as e:
+        event(type(e).__name__)
+        assert str(e)
+
+
+@FUZZ
+@given(data=st.data())
+def test_structured_mat(data):
+    import io
+
+    import scipy.io
+
+    nf = data.draw(st.integers(1, 4))
+    shape = data.draw(st.one_of(st.lists(st.integers(1, 3), min_size=1, max_size=4),
+                                st.tuples(st.just(nf), st.integers(1, 3), st.just(1))))
+    v = {
+        "freq": np.array(grid(data, nf)),
+        data.draw(st.sampled_from(["H", "Y", "G"])):
+            np.array(data.draw(st.lists(data.draw(st.sampled_from([FINITE, FINITE, NUMBERS])),
+                                        min_size=int(np.prod(shape)),
+                                        max_size=int(np.prod(shape))))).reshape(shape)
+            * data.draw(st.sampled_from([1.0, 1.0 + 0.5j])),
+        "outputs": np.array(data.draw(st.lists(LABELS, min_size=1, max_size=3))),
+        "inputs": data.draw(LABELS),
+    }
+    for key in data.draw(st.lists(st.sampled_from(["quantity", "units", "freq_unit"]),
+                                  max_size=3)):
+        v[key] = data.draw(HEADER_VALUES)
+    b = io.BytesIO()
+    scipy.io.savemat(b, v)
+    try:
+        load_frf(b.getvalue(), filename="s.mat", timeout=TIMEOUT)
+        event("loaded")
+    except FBSError as e:
+        event(type(e).__name__)
+        assert str(e)
