@@ -22,11 +22,17 @@ import os
 import sys
 import time
 
-#: Digest of all plot data of the page: per ColumnDataSource, the number of values and a
-#: position-weighted sum of the finite numbers, sorted (model ids differ between sessions).
+#: Digest of the plot data shown (data sources reachable from the document roots; replaced
+#: ones may linger in all_models): per source, the number of values and a weighted sum of
+#: the finite numbers and their squares, sorted (model ids differ between sessions).
 DIGEST_JS = """() => {
+  const doc = Bokeh.documents[0], shown = new Set();
+  for (const root of doc.roots()) {
+    shown.add(root);
+    for (const m of root.references()) shown.add(m);
+  }
   const out = [];
-  for (const m of Bokeh.documents[0].all_models) {
+  for (const m of shown) {
     if (m.type !== 'ColumnDataSource') continue;
     const cols = m.data instanceof Map ? [...m.data.entries()] : Object.entries(m.data);
     let n = 0, s = 0;
@@ -35,7 +41,7 @@ DIGEST_JS = """() => {
       n += col.length;
       for (let i = 0; i < col.length; i++) {
         const v = col[i];
-        if (typeof v === 'number' && Number.isFinite(v)) s += v * ((i % 7) + 1);
+        if (typeof v === 'number' && Number.isFinite(v)) s += v * Math.sqrt(i + 2) + v * v;
       }
     }
     out.push(n + ':' + s.toPrecision(10));
