@@ -42,7 +42,7 @@ def _numba_solve(A, b):
     zero = np.zeros((m, n, n))
     args = [np.ascontiguousarray(x) for z in (A, b) for x in (z.real, z.imag)]
     args[4:4] = [zero, zero]
-    args += [np.ascontiguousarray(eye), zero]
+    args += [np.ascontiguousarray(eye), zero, _kernels.pivot_order(A, 0 * A)]
     for x in args:
         x.setflags(write=False)  # the signature the library compiles
     out = np.empty((1, m, n), complex)
@@ -80,7 +80,8 @@ def test_numpy_factors_equal_kernel_factors():
     a = np.ones((m, n), complex)
     eye = np.ascontiguousarray(np.broadcast_to(np.eye(n), (m, n, n)))
     zero = np.zeros((m, n, n))
-    args = [eye, zero, a.real.copy(), a.imag.copy(), zero, zero, eye, zero]
+    args = [eye, zero, a.real.copy(), a.imag.copy(), zero, zero, eye, zero,
+            np.tile(np.arange(n), (m, 1))]
     for x in args:
         x.setflags(write=False)
     rids = np.array([0, 7, 33], np.int64)
@@ -108,6 +109,7 @@ def test_lane_kernel_equals_numpy_on_random_systems():
     for fd in (False, True):
         out = np.empty((rids.size, nf, ne), complex)
         args = [x for z in (A, a, E, B) for x in (z.real.copy(), z.imag.copy())]
+        args.append(_kernels.pivot_order(A, E))
         for x in args:
             x.setflags(write=False)
         _kernels.noisy_block_run(*args, 0, nf, key, rids, 0.1, True, True, fd,
@@ -118,6 +120,36 @@ def test_lane_kernel_equals_numpy_on_random_systems():
         x = np.linalg.solve(S["Yjj_A"] * A + S["Yjj_E"] * E, (S["vj_A"] * a)[..., None])
         y = np.einsum("rfek,rfk->rfe", S["Yej_E"] * B, x[..., 0])
         np.testing.assert_allclose(out, y, rtol=1e-10, atol=1e-12 * np.abs(y).max())
+
+
+def test_pivot_order_is_lapack_partial_pivoting():
+    import scipy.linalg as sla
+
+    rng = np.random.default_rng(4)
+    A, E = _rand_c(rng, 30, 6, 6), _rand_c(rng, 30, 6, 6)
+    A[:10] *= np.logspace(-5, 5, 6)[:, None]  # rows of very different size
+    order = _kernels.pivot_order(A, E)
+    for line in range(30):
+        P = sla.lu(A[line] + E[line])[0]
+        np.testing.assert_array_equal(order[line], np.argmax(P, axis=0))
+
+
+def test_row_order_changes_no_result():
+    rng = np.random.default_rng(5)
+    m, n = 20, 6
+    A, b = _rand_c(rng, m, n, n), _rand_c(rng, m, n)
+    x = _numba_solve(A, b)
+    # the kernel pre-orders rows by pivoting; any other order gives the same solution
+    eye = np.ascontiguousarray(np.broadcast_to(np.eye(n), (m, n, n)))
+    zero = np.zeros((m, n, n))
+    args = [A.real.copy(), A.imag.copy(), b.real.copy(), b.imag.copy(), zero, zero, eye, zero,
+            np.tile(np.arange(n)[::-1].copy(), (m, 1))]
+    for y in args:
+        y.setflags(write=False)
+    out = np.empty((1, m, n), complex)
+    _kernels.noisy_block_run(*args, 0, m, _rng.seed_key(0), np.zeros(1, np.int64), 0.0, False,
+                             False, False, np.empty((0, 0, 0)), out)
+    np.testing.assert_allclose(out[0], x, rtol=1e-10)
 
 
 def test_rng_matches_python_reference():

@@ -146,15 +146,15 @@ def test_same_seed_same_band_other_seed_other_band(arrays):
 
 
 def test_chunking_gives_identical_results_and_bounds_memory(arrays):
-    whole = _band(arrays, rounds=1000, frequency_dependent=True)
+    whole = _band(arrays, rounds=4000, frequency_dependent=True)
     tracemalloc.start()
-    small = _band(arrays, rounds=1000, frequency_dependent=True, max_chunk_bytes=8 * 6 * 1000 * 3)
+    small = _band(arrays, rounds=4000, frequency_dependent=True, max_chunk_bytes=8 * 6 * 4000 * 3)
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     for name in ("lower", "upper", "percentiles", "argmin_round"):
         np.testing.assert_array_equal(getattr(whole, name), getattr(small, name))
     np.testing.assert_array_equal(whole.convergence.upper, small.convergence.upper)
-    all_rounds_bytes = 1000 * NF * NE * 8
+    all_rounds_bytes = 4000 * NF * NE * 8
     assert peak < all_rounds_bytes / 4  # chunks of 3 lines, never all rounds at once
 
 

@@ -37,7 +37,7 @@ from ._rng import GOLDEN, mix64, mix64_np, stream_base
 _JIT = dict(cache=True, fastmath=False, error_model="numpy")
 
 #: Rounds solved together in one vectorised block.
-LANES = 32
+LANES = 64
 
 _ONE = np.uint64(1)
 _S32 = np.uint64(32)
@@ -74,8 +74,14 @@ def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
 
 
 @njit(**_JIT)
-def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, piv, pm, yr, yi):
-    """Noisy eq. 4.1 at one line for ``nv`` lanes: ``y (n_e, nv)`` from factors ``s``."""
+def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, s, nv, Wr, Wi, xr, xi, Pr, Pi, piv, pm,
+                yr, yi):
+    """Noisy eq. 4.1 at one line for all lanes: ``y (n_e, LANES)`` from factors ``s``.
+
+    Rows enter in ``order`` (the partial-pivoting order of the noise-free matrix),
+    which changes no result but makes row exchanges in the noisy lanes rare; each
+    factor stays bound to its original matrix element.
+    """
     nj = Ar.shape[0]
     ne = Br.shape[0]
     oa = nj * nj
@@ -83,19 +89,20 @@ def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, s, nv, Wr, Wi, xr, xi, Pr, Pi, p
     oB = oE + nj * nj
     # interface matrix and right-hand side
     for i in range(nj):
+        o = order[i]
         for k in range(nj):
-            sa = s[i * nj + k]
-            se = s[oE + i * nj + k]
-            A_r = Ar[i, k]
-            A_i = Ai[i, k]
-            E_r = Er[i, k]
-            E_i = Ei[i, k]
+            sa = s[o * nj + k]
+            se = s[oE + o * nj + k]
+            A_r = Ar[o, k]
+            A_i = Ai[o, k]
+            E_r = Er[o, k]
+            E_i = Ei[o, k]
             for v in range(LANES):
                 Wr[i, k, v] = sa[v] * A_r + se[v] * E_r
                 Wi[i, k, v] = sa[v] * A_i + se[v] * E_i
-        sv = s[oa + i]
-        a_r = ar[i]
-        a_i = ai[i]
+        sv = s[oa + o]
+        a_r = ar[o]
+        a_i = ai[o]
         for v in range(LANES):
             xr[i, v] = sv[v] * a_r
             xi[i, v] = sv[v] * a_i
@@ -189,10 +196,11 @@ def _workspace(nj, ne, n_el):
 
 
 @njit(parallel=True, **_JIT)
-def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, l0, l1, key, rids, p, tire, vehicle,
+def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p, tire, vehicle,
                     freq_dep, mag, cplx):
     """Noisy responses of rounds ``rids`` at lines ``l0 .. l1-1``.
 
+    ``order (n_f, n_j)`` is the row order of each line (:func:`pivot_order`).
     Writes ``|v_e|`` into ``mag (l1-l0, n_e, n_rounds)`` if ``mag.size`` (band mode),
     else the complex response into ``cplx (n_rounds, n_f, n_e)`` (regeneration mode).
     Lines are global indices, so a chunk of lines gives the same numbers as the whole.
@@ -222,7 +230,8 @@ def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, l0, l1, key, rids, p, tire, 
                 if vehicle:
                     _lane_factors(key, lane_ids, nv, stream_line, p, k_tire, k_all, s, base)
             _lane_solve(Ar[line], Ai[line], ar[line], ai[line], Er[line], Ei[line], Br[line],
-                        Bi[line], s, nv, W[0], W[1], X[0], X[1], X[2], X[3], piv, pm, Y[0], Y[1])
+                        Bi[line], order[line], s, nv, W[0], W[1], X[0], X[1], X[2], X[3], piv,
+                        pm, Y[0], Y[1])
             if want_mag:
                 for e in range(ne):
                     for v in range(nv):
@@ -232,6 +241,29 @@ def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, l0, l1, key, rids, p, tire, 
                 for e in range(ne):
                     for v in range(nv):
                         cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
+
+
+def pivot_order(A, E):
+    """Row order of partial pivoting (pivot ``|Re| + |Im|``) of ``A + E`` at every line.
+
+    ``A, E`` complex ``(n_f, n, n)``; returns ``(n_f, n)`` int64: row ``i`` of the
+    reordered system is original row ``order[l, i]``.
+    """
+    W = np.array(A + E, dtype=np.complex128)
+    nf, n = W.shape[:2]
+    order = np.tile(np.arange(n, dtype=np.int64), (nf, 1))
+    lines = np.arange(nf)
+    for k in range(n):
+        col = W[:, k:, k]
+        p = k + np.argmax(np.abs(col.real) + np.abs(col.imag), axis=1)
+        W[lines, k], W[lines, p] = W[lines, p].copy(), W[lines, k].copy()
+        order[lines, k], order[lines, p] = order[lines, p].copy(), order[lines, k].copy()
+        piv = W[:, k, k]
+        ok = piv != 0
+        m = np.zeros((nf, n - k - 1), np.complex128)
+        m[ok] = W[ok, k + 1:, k] / piv[ok, None]
+        W[:, k + 1:, k:] -= m[:, :, None] * W[:, None, k, k:]
+    return order
 
 
 def noise_factors(key, rounds, lines, p, nj, ne, tire, vehicle):

@@ -254,7 +254,8 @@ def _check_inputs(YjjA, vj, YjjE, YejE):
     for name, x in (("YjjA", YjjA), ("vj", vj), ("YjjE", YjjE), ("YejE", YejE)):
         if not np.all(np.isfinite(x)):
             raise DataFormatError(f"{name} contains non-finite values")
-    return (*_split(YjjA), *_split(vj), *_split(YjjE), *_split(YejE))
+    order = _ro(_kernels.pivot_order(YjjA, YjjE))
+    return (*_split(YjjA), *_split(vj), *_split(YjjE), *_split(YejE), order)
 
 
 def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = "both",
