@@ -1,9 +1,14 @@
 """Cached calls into :mod:`fbs_core`, shaped for the views.
 
 This is the only module of the app that calls the core library. Results are cached per
-argument tuple (the core objects are immutable), so that a control change that only selects
-(e.g. another response DOF) costs a dictionary lookup. The only arithmetic done here is the
-conversion to dB for display (``20 log10 |v|``).
+argument tuple (the core result objects are immutable), so that a control change that only
+selects (another response DOF, another N of the truncation map) costs a lookup. The only
+arithmetic done here is the conversion to dB for display (``20 log10 |v|``).
+
+The coupled response for N retained modes is read from the harmonic's truncation map
+(:func:`fbs_core.studies.truncation_map` computes the eq. 4.1 response for every
+N = 10, 20, ... at once with the modal model's cumulative truncation), so moving the N slider
+costs no new coupling.
 """
 
 from __future__ import annotations
@@ -13,29 +18,36 @@ from functools import lru_cache
 import numpy as np
 
 import fbs_core
+from fbs_core import studies
 
 __all__ = [
     "DB_FLOOR",
-    "db",
-    "frequencies",
-    "coupled",
-    "mobility_data",
-    "uncoupled_data",
-    "error_map",
-    "error_map_data",
-    "suggested_table",
-    "eigen_curves",
+    "EIGEN_SPEEDS",
+    "PERCENTILE_BANDS",
+    "Q_LEVELS",
     "band",
     "band_data",
-    "single_round_data",
+    "coupled_response",
+    "db",
+    "eigen_curves",
+    "error_map",
+    "error_map_data",
+    "frequencies",
     "level_unit",
+    "mobility_data",
+    "single_round_data",
+    "suggested_table",
+    "uncoupled_data",
     "version",
 ]
 
-#: Magnitudes are floored at this value before the dB conversion (avoids -inf at exact zeros).
+#: Magnitudes are floored at this value before the dB conversion (no -inf at exact zeros).
 DB_FLOOR = 1e-30
 #: Operating speeds of the eigenfrequency plot (thesis fig. 5.8), km/h.
 EIGEN_SPEEDS = (20.0, 80.0, 120.0)
+#: Central percentile bands offered (width in %) and the percentile levels they need.
+PERCENTILE_BANDS = (50, 80, 90, 95, 99)
+Q_LEVELS = tuple(sorted({q for w in PERCENTILE_BANDS for q in ((100 - w) / 2, (100 + w) / 2)}))
 
 
 def version() -> str:
@@ -48,13 +60,17 @@ def db(x: np.ndarray) -> np.ndarray:
 
 
 def level_unit(dof: str) -> str:
-    """Display unit of the bushing velocity per unit patch load for a DOF direction."""
-    return "dB re 1 (rad/s)/N" if dof.startswith("r") else "dB re 1 (m/s)/N"
+    """Display unit of a velocity response to the patch input for a DOF direction.
+
+    The ``patch`` input of the reference tire is a unit road wave (1 m amplitude), so
+    responses are m/s (rad/s) per metre of road amplitude (``fbs_core.bushing_response``).
+    """
+    return "dB re 1 (rad/s)/m" if dof.startswith("r") else "dB re 1 (m/s)/m"
 
 
 @lru_cache(maxsize=8)
 def frequencies(harmonic: int) -> np.ndarray:
-    """The analysis grid of a harmonic case (Hz), read-only."""
+    """The analysis grid of a harmonic case in Hz (read-only)."""
     f = np.array(fbs_core.harmonic(harmonic).frequencies(), dtype=float)
     f.setflags(write=False)
     return f
@@ -70,20 +86,49 @@ def _chassis():
     return fbs_core.reference_chassis()
 
 
-@lru_cache(maxsize=256)
-def coupled(harmonic: int, n_modes: int | None, coupling: str):
-    """Bushing velocity v_e* (thesis eq. 4.1) as an FRF, all 6 bushing DOFs; cached."""
-    return fbs_core.bushing_response(
-        harmonic, n_modes=n_modes, freq=frequencies(harmonic), coupling=coupling
-    )
+# -- truncation study and coupled response ---------------------------------------------------
+@lru_cache(maxsize=16)
+def error_map(harmonic: int, coupling: str):
+    """Truncation error map of a harmonic (thesis figs. 5.3, 5.6, 5.7), cached.
+
+    Holds the coupled responses for every N of the map and the all-modes reference too.
+    The counts are 10, 20, ... below the tire's total (the total is the reference itself).
+    """
+    n_total = int(_tire().n_modes)
+    return studies.truncation_map(harmonic, n_modes=np.arange(10, n_total, 10),
+                                  coupling=coupling)
 
 
-def _column(frf, dof: str) -> np.ndarray:
-    return frf.sel(outputs=dof).data[:, 0, 0]
+@lru_cache(maxsize=64)
+def _bushing_response(harmonic: int, n_modes: int | None, coupling: str) -> np.ndarray:
+    frf = fbs_core.bushing_response(harmonic, n_modes=n_modes, freq=frequencies(harmonic),
+                                    coupling=coupling)
+    return np.stack([frf.sel(outputs=f"bushing:{d}").data[:, 0, 0]
+                     for d in ("x", "y", "z", "rx", "ry", "rz")], axis=1)
+
+
+def coupled_response(harmonic: int, n_modes: int | None, coupling: str) -> np.ndarray:
+    """Bushing velocity v_e* (eq. 4.1), shape ``(n_freq, 6)`` for ``bushing:x`` ... ``rz``.
+
+    ``n_modes=None`` is the all-modes reference. Read from the cached truncation map when it
+    holds that N, else computed with :func:`fbs_core.bushing_response`.
+    """
+    m = error_map(harmonic, coupling)
+    order = [m.dofs.index(f"bushing:{d}") for d in ("x", "y", "z", "rx", "ry", "rz")]
+    if n_modes is None or (m.n_modes_total is not None and n_modes >= m.n_modes_total):
+        return m.reference[:, order]
+    hit = np.flatnonzero(m.n_modes == int(n_modes))
+    if hit.size:
+        return m.response[hit[0]][:, order]
+    return _bushing_response(harmonic, int(n_modes), coupling)
+
+
+def _dof_index(dof: str) -> int:
+    return ("x", "y", "z", "rx", "ry", "rz").index(dof)
 
 
 def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str) -> dict:
-    """Columns of the coupled-mobility view: reference (all modes) and truncated (N modes).
+    """Columns of the coupled-response view: reference (all modes) and truncated (N modes).
 
     Returns
     -------
@@ -91,10 +136,11 @@ def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str) -> dict:
         ``freq`` (Hz), ``reference`` and ``truncated`` (complex v_e*), ``reference_db`` and
         ``truncated_db`` (dB), each of shape ``(n_freq,)``.
     """
-    ref = _column(coupled(harmonic, None, coupling), f"bushing:{dof}")
-    trunc = _column(coupled(harmonic, int(n_modes), coupling), f"bushing:{dof}")
+    j = _dof_index(dof)
+    ref = coupled_response(harmonic, None, coupling)[:, j]
+    trunc = coupled_response(harmonic, int(n_modes), coupling)[:, j]
     return {
-        "freq": frequencies(harmonic),
+        "freq": np.asarray(error_map(harmonic, coupling).freq, float),
         "reference": ref,
         "truncated": trunc,
         "reference_db": db(ref),
@@ -102,6 +148,56 @@ def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str) -> dict:
     }
 
 
+def error_map_data(harmonic: int, coupling: str, dof: str | None) -> dict:
+    """Error in percent over retained modes and centre frequency.
+
+    ``dof=None`` gives the maximum over the 6 bushing DOFs (fig. 5.6).
+
+    Returns
+    -------
+    dict
+        ``centre_freq`` (n_c,), ``n_modes`` (n_N,), ``error_pct`` (n_N, n_c).
+    """
+    m = error_map(harmonic, coupling)
+    err = m.max_error if dof is None else m.dof_error(f"bushing:{dof}")
+    return {
+        "centre_freq": np.asarray(m.centres, float),
+        "n_modes": np.asarray(m.n_modes, int),
+        "error_pct": 100.0 * np.asarray(err, float),
+    }
+
+
+@lru_cache(maxsize=64)
+def suggested_table(threshold_pct: float, f_max: float, coupling: str,
+                    dof: str | None = None) -> dict:
+    """Suggested number of modes for all seven harmonics (thesis table 5.1).
+
+    ``dof=None`` judges the maximum error over the 6 DOFs (as the thesis' table).
+    """
+    maps = [error_map(k, coupling) for k in range(1, 8)]
+    s = studies.suggest_modes(threshold=threshold_pct / 100.0, f_max=f_max, maps=maps,
+                              dof=None if dof is None else f"bushing:{dof}")
+    return {
+        "harmonic": np.asarray(s.harmonics, int),
+        "f_low": np.asarray(s.freq_range[:, 0], float),
+        "f_high": np.asarray(s.freq_range[:, 1], float),
+        "n_modes": np.asarray(s.n_modes, int),
+        "eigenfrequency": np.asarray(s.eigenfrequency, float),
+        "speed": float(s.speed),
+    }
+
+
+@lru_cache(maxsize=1)
+def eigen_curves() -> dict:
+    """Highest retained eigenfrequency versus N at 20, 80, 120 km/h (thesis fig. 5.8)."""
+    mf = studies.mode_frequencies(EIGEN_SPEEDS)
+    out = {"n_modes": np.asarray(mf.n_modes, int)}
+    for v, row in zip(mf.speeds, mf.frequency, strict=True):
+        out[f"f_{int(v)}"] = np.asarray(row, float)
+    return out
+
+
+# -- uncoupled subsystems --------------------------------------------------------------------
 @lru_cache(maxsize=64)
 def _tire_hub(harmonic: int, n_modes: int | None):
     return _tire().patch_response(frequencies(harmonic), fbs_core.harmonic(harmonic), n_modes)
@@ -113,18 +209,17 @@ def _chassis_frf(harmonic: int):
 
 
 def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str) -> dict:
-    """Uncoupled subsystems (thesis figs. 4.2-4.3 and 4.6-4.7).
+    """Uncoupled subsystems (thesis figs. 4.6-4.7 and 4.2-4.3).
 
     Returns
     -------
     dict
-        ``freq``; ``tire_reference_db`` / ``tire_truncated_db``: free hub velocity
-        ``Y_ja^A F_a`` at ``hub:<dof>`` with all / N modes; ``chassis_db``: chassis mobility
-        ``Y_ej^E`` from ``spindle:<spindle_input>`` to ``bushing:<dof>``; complex columns
-        ``tire_reference``, ``tire_truncated``, ``chassis``.
+        ``freq``; ``tire_reference`` / ``tire_truncated``: free hub velocity ``Y_ja^A F_a`` at
+        ``hub:<dof>`` with all / N modes; ``chassis``: chassis mobility ``Y_ej^E`` from
+        ``spindle:<spindle_input>`` to ``bushing:<dof>``; and their ``*_db`` columns.
     """
-    t_ref = _column(_tire_hub(harmonic, None), f"hub:{dof}")
-    t_tr = _column(_tire_hub(harmonic, int(n_modes)), f"hub:{dof}")
+    t_ref = _tire_hub(harmonic, None).sel(outputs=f"hub:{dof}").data[:, 0, 0]
+    t_tr = _tire_hub(harmonic, int(n_modes)).sel(outputs=f"hub:{dof}").data[:, 0, 0]
     ch = _chassis_frf(harmonic).sel(
         outputs=f"bushing:{dof}", inputs=f"spindle:{spindle_input}"
     ).data[:, 0, 0]
@@ -139,87 +234,35 @@ def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str) ->
     }
 
 
-@lru_cache(maxsize=16)
-def error_map(harmonic: int, coupling: str):
-    """The truncation error map of a harmonic (thesis figs. 5.3, 5.6, 5.7); cached."""
-    return fbs_core.truncation_map(harmonic, coupling=coupling)
-
-
-def error_map_data(harmonic: int, coupling: str, dof: str | None) -> dict:
-    """Error (in percent) over centre frequency and retained modes.
-
-    ``dof=None`` gives the maximum over the 6 bushing DOFs (fig. 5.6).
-
-    Returns
-    -------
-    dict
-        ``centre_freq`` (n_fc,), ``n_modes`` (n_N,), ``error_pct`` (n_N, n_fc).
-    """
-    m = error_map(harmonic, coupling)
-    if dof is None:
-        err = m.max_error
-    else:
-        err = m.error[..., list(m.dofs).index(f"bushing:{dof}")]
-    return {
-        "centre_freq": np.asarray(m.centre_freq, float),
-        "n_modes": np.asarray(m.n_modes, int),
-        "error_pct": 100.0 * np.asarray(err, float),
-    }
-
-
-@lru_cache(maxsize=64)
-def suggested_table(threshold_pct: float, f_max: float, coupling: str) -> dict:
-    """Suggested number of modes for all seven harmonics (thesis table 5.1)."""
-    s = fbs_core.suggest_modes(threshold=threshold_pct / 100.0, f_max=f_max, coupling=coupling)
-    ks = [int(k) for k in s.harmonics]
-    rng = [fbs_core.harmonic(k).freq_range for k in ks]
-    return {
-        "harmonic": np.array(ks),
-        "f_low": np.array([r[0] for r in rng], float),
-        "f_high": np.array([r[1] for r in rng], float),
-        "n_modes": np.asarray(s.n_modes, int),
-        "eigenfrequency": np.asarray(s.eigenfrequency, float),
-    }
-
-
-@lru_cache(maxsize=1)
-def eigen_curves() -> dict:
-    """Highest retained eigenfrequency versus N at 20, 80, 120 km/h (thesis fig. 5.8)."""
-    tire = _tire()
-    out = {}
-    for v in EIGEN_SPEEDS:
-        fn = np.asarray(tire.eigenfrequencies(v), float)
-        out[f"f_{int(v)}"] = fn
-    n = min(a.size for a in out.values())
-    out = {k: a[:n] for k, a in out.items()}
-    out["n_modes"] = 2 * np.arange(1, n + 1)
-    return out
-
-
+# -- noise study -----------------------------------------------------------------------------
 @lru_cache(maxsize=4)
 def band(harmonic: int, n_modes: int | None, coupling: str, noise_pct: float, target: str,
          frequency_dependent: bool, rounds: int, seed: int):
-    """The Monte-Carlo scatter band (thesis section 5.2); cached (a few results only)."""
-    return fbs_core.scatter_band(
+    """The Monte-Carlo scatter band (thesis 5.2), cached (a few results: they are large)."""
+    return studies.scatter_band(
         harmonic, noise=noise_pct / 100.0, target=target, rounds=rounds,
-        frequency_dependent=frequency_dependent, seed=seed, n_modes=n_modes, coupling=coupling,
+        frequency_dependent=frequency_dependent, seed=seed, n_modes=n_modes,
+        coupling=coupling, percentiles=Q_LEVELS,
     )
 
 
-def band_data(result, dof: str, percentile: float = 90.0) -> dict:
-    """Columns of the scatter-band view for one bushing DOF (dB and linear).
+def band_data(result, dof: str, percentile: float = 90) -> dict:
+    """Columns of the scatter-band view for one bushing DOF.
 
-    ``percentile`` is the width of the central band in percent (90 -> 5 % to 95 %).
+    ``percentile`` is the width of the central band in percent (one of
+    :data:`PERCENTILE_BANDS`; 90 -> the 5 % and 95 % percentiles).
     """
-    j = list(result.dofs).index(f"bushing:{dof}")
+    j = result.dofs.index(f"bushing:{dof}")
+    lo, hi = (100 - percentile) / 2, (100 + percentile) / 2
+    q = list(np.asarray(result.q, float))
     ref = result.reference[:, j]
     cols = {
         "freq": np.asarray(result.freq, float),
         "reference": ref,
-        "minimum": result.minimum[:, j],
-        "maximum": result.maximum[:, j],
-        "lower": result.lower[:, j],
-        "upper": result.upper[:, j],
+        "minimum": np.asarray(result.lower[:, j], float),
+        "maximum": np.asarray(result.upper[:, j], float),
+        "lower": np.asarray(result.percentiles[q.index(lo), :, j], float),
+        "upper": np.asarray(result.percentiles[q.index(hi), :, j], float),
     }
     for k in ("reference", "minimum", "maximum", "lower", "upper"):
         cols[f"{k}_db"] = db(cols[k])
@@ -227,7 +270,18 @@ def band_data(result, dof: str, percentile: float = 90.0) -> dict:
 
 
 def single_round_data(result, index: int, dof: str) -> dict:
-    """One regenerated polluted round (figs. 5.10-5.11) for one bushing DOF."""
-    j = list(result.dofs).index(f"bushing:{dof}")
+    """One regenerated polluted round (thesis figs. 5.10-5.11) for one bushing DOF."""
+    j = result.dofs.index(f"bushing:{dof}")
     v = result.round(int(index))[:, j]
     return {"freq": np.asarray(result.freq, float), "round": v, "round_db": db(v)}
+
+
+def peak_round(result, freq: float, dof: str, which: str = "max") -> int:
+    """The round with the highest (lowest) level at the line nearest ``freq``."""
+    return int(result.peak_round(float(freq), f"bushing:{dof}", which))
+
+
+def convergence_db(result) -> float:
+    """Largest change of either band edge (dB) between the last two checkpoints."""
+    step = np.asarray(result.convergence.step_change_db, float)
+    return float(step[-1]) if step.size else float("nan")

@@ -15,6 +15,7 @@ from app.views import (
     EigenView,
     MobilityView,
     ScatterBandView,
+    SuggestedModesView,
     TruncationView,
     UncoupledView,
 )
@@ -49,33 +50,37 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
     sync_url(state)
     scatter = ScatterBandView(case=case, noise=noise)
 
-    def card(title, view, **kw):
-        return pn.Card(view, title=title, collapsible=True, sizing_mode="stretch_both",
-                       header_background="#f1f3f5", margin=(5, 5), **kw)
+    def card(title, view, height, **kw):
+        return pn.Card(view, title=title, collapsible=True, height=height,
+                       sizing_mode="stretch_width", header_background="#e9ecef",
+                       margin=(4, 4), **kw)
 
     main = pn.Column(
         pn.Row(
-            card("Coupled response at the bushing", MobilityView(case=case), min_height=430),
-            card("Truncation error map and suggested modes",
-                 TruncationView(case=case, truncation=trunc), min_height=430),
+            card("Coupled response at the bushing (thesis eq. 4.1)", MobilityView(case=case),
+                 480),
+            card("Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
+                 TruncationView(case=case, truncation=trunc), 480),
         ),
         pn.Row(
-            card("Uncoupled subsystems (tire hub, chassis spindle to bushing)",
-                 UncoupledView(case=case), min_height=400),
-            visible=case.param.show_uncoupled,
+            card("Uncoupled subsystems: tire hub and chassis spindle-to-bushing",
+                 UncoupledView(case=case), 420),
+            visible=case.param.show_uncoupled, css_classes=["uncoupled-row"],
         ),
         pn.Row(
-            card("Noise scatter band", scatter, min_height=430),
-            card("Eigenfrequency versus number of modes", EigenView(case=case),
-                 min_height=430, max_width=560),
+            card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", scatter, 480),
+            card("Eigenfrequency versus number of modes (fig. 5.8)", EigenView(case=case),
+                 480),
         ),
+        pn.Row(card("Suggested number of modes (thesis table 5.1)",
+                    SuggestedModesView(case=case, truncation=trunc), 360)),
         sizing_mode="stretch_width",
     )
     template = pn.template.BootstrapTemplate(
         title="Tire-chassis FBS: bushing vibration dashboard",
         sidebar=[pn.pane.Markdown(INTRO, styles={"font-size": "0.85em"}),
                  Controls(state=state)],
-        main=[main], header_background=ACCENT, sidebar_width=330,
+        main=[main], header_background=ACCENT, sidebar_width=340,
     )
     template.state = state  # for tests and benchmarks
     if pn.state.curdoc is not None and pn.state.curdoc.session_context is not None:

@@ -77,7 +77,7 @@ class NoiseState(param.Parameterized):
         doc="New scaling matrix at every frequency line (else one per round).",
     )
     rounds = param.Integer(
-        default=10_000, bounds=(1, 200_000), softbounds=(100, 20_000),
+        default=10_000, bounds=(1, 200_000),
         doc="Number of Monte-Carlo rounds R.",
     )
     seed = param.Integer(default=0, bounds=(0, None), doc="Random seed of the study.")
@@ -85,8 +85,8 @@ class NoiseState(param.Parameterized):
         default=0, bounds=(0, 200_000 - 1),
         doc="Index of the single polluted round drawn inside the band (0-based).",
     )
-    percentile = param.Number(
-        default=90.0, bounds=(1.0, 99.9), step=1.0,
+    percentile = param.Selector(
+        default=90, objects=[50, 80, 90, 95, 99],
         doc="Width of the central percentile band in percent (90 -> 5-95 %).",
     )
 

@@ -85,7 +85,7 @@ def test_single_round_stays_inside_the_batch():
         ("noise.rounds", 500, "noise", "rounds"),
         ("noise.seed", 7, "noise", "seed"),
         ("noise.single_round", 42, "noise", "single_round"),
-        ("noise.percentile", 50.0, "noise", "percentile"),
+        ("noise.percentile", 50, "noise", "percentile"),
     ],
 )
 def test_widgets_drive_the_state(controls, key, value, group, name):

@@ -3,13 +3,14 @@
 from .controls import Controls
 from .mobility import MobilityView, UncoupledView
 from .scatter import ScatterBandView
-from .truncation import EigenView, TruncationView
+from .truncation import EigenView, SuggestedModesView, TruncationView
 
 __all__ = [
     "Controls",
     "EigenView",
     "MobilityView",
     "ScatterBandView",
+    "SuggestedModesView",
     "TruncationView",
     "UncoupledView",
 ]

@@ -33,10 +33,14 @@ CURVE_OPTS = dict(
 )
 
 
-def level_dim(dof: str, name: str = "level") -> hv.Dimension:
-    """Level axis (dB) of a bushing/hub velocity per patch load for a DOF direction."""
+def level_dim(dof: str, name: str = "level", label: str = "Level") -> hv.Dimension:
+    """Level axis (dB) of a bushing/hub velocity per patch load for a DOF direction.
+
+    Dimensions are matched by label too: give a second one on the same element (the upper
+    edge of an area) its own label.
+    """
     unit = compute.level_unit(dof).removeprefix("dB ")
-    return hv.Dimension(name, label="Level", unit=f"dB {unit}")
+    return hv.Dimension(name, label=label, unit=f"dB {unit}")
 
 
 def level_tooltips(extra: str = "level") -> list[tuple[str, str]]:

@@ -48,8 +48,8 @@ class Controls(Viewer):
                 "noise.seed": W.IntInput.from_param(n.param.seed, name="Seed"),
                 "noise.single_round": W.IntInput.from_param(
                     n.param.single_round, name="Single round #"),
-                "noise.percentile": W.EditableFloatSlider.from_param(
-                    n.param.percentile, name="Central percentile band (%)", format="0"),
+                "noise.percentile": W.Select.from_param(
+                    n.param.percentile, name="Central percentile band (%)"),
             }
             for key, w in self._widgets.items():
                 w.css_classes = [*w.css_classes, "ctl-" + key.replace(".", "-")]

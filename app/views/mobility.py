@@ -39,19 +39,17 @@ class MobilityView(Viewer):
 
     # -- plot layers (each a DynamicMap watching only what it needs) -------------------
     def _reference(self, harmonic, dof, coupling):
-        ref = compute.coupled(harmonic, None, coupling).sel(outputs=f"bushing:{dof}")
-        y = compute.db(ref.data[:, 0, 0])
+        d = compute.mobility_data(harmonic, 400, dof, coupling)
         return hv.Curve(
-            (compute.frequencies(harmonic), y), FREQ, level_dim(dof), label="all modes (reference)"
+            (d["freq"], d["reference_db"]), FREQ, level_dim(dof), label="all modes (reference)"
         ).opts(color=COLORS["reference"], hooks=[name_source("mobility.reference")],
-               hover_tooltips=[("", "reference"), ("Frequency", "@freq{0.0} Hz"),
+               hover_tooltips=[("", "all modes"), ("Frequency", "@freq{0.0} Hz"),
                                ("Level", "@level{0.0} dB")])
 
     def _truncated(self, harmonic, n_modes, dof, coupling):
-        tr = compute.coupled(harmonic, int(n_modes), coupling).sel(outputs=f"bushing:{dof}")
-        y = compute.db(tr.data[:, 0, 0])
+        d = compute.mobility_data(harmonic, n_modes, dof, coupling)
         return hv.Curve(
-            (compute.frequencies(harmonic), y), FREQ, level_dim(dof), label="N retained modes"
+            (d["freq"], d["truncated_db"]), FREQ, level_dim(dof), label="N retained modes"
         ).opts(color=COLORS["truncated"], line_dash="dashed",
                hooks=[name_source("mobility.truncated")],
                hover_tooltips=[("", f"N = {n_modes}"), ("Frequency", "@freq{0.0} Hz"),
@@ -65,7 +63,7 @@ class MobilityView(Viewer):
         tr = hv.DynamicMap(self._truncated, streams=[hv.streams.Params(c, CASE_KEYS)])
         return (ref * tr).opts(
             hv.opts.Curve(**CURVE_OPTS),
-            hv.opts.Overlay(legend_position="bottom_left", title="Coupled response at the bushing"),
+            hv.opts.Overlay(legend_position="bottom_left"),
         )
 
     def __panel__(self):
@@ -74,13 +72,12 @@ class MobilityView(Viewer):
             "mobility", self._csv_columns, self.meta,
             lambda: f"bushing_response_h{c.harmonic}_N{c.n_modes}_{c.dof}_{c.coupling}.csv",
         )
-        title = pn.pane.Markdown(
-            "**Coupled response at the bushing** v<sub>e</sub>* = Y<sub>ej</sub>"
-            "(Y<sub>jj</sub><sup>A</sup>+Y<sub>jj</sub><sup>E</sup>)<sup>-1</sup>"
-            "Y<sub>ja</sub>F<sub>a</sub>, thesis eq. 4.1", margin=(0, 10),
-        )
+        caption = pn.pane.Markdown(pn.bind(
+            lambda h, n, d, cp: f"**Harmonic {h}** &middot; bushing:{d} &middot; N = {n} "
+            f"&middot; {cp} coupling", c.param.harmonic, c.param.n_modes, c.param.dof,
+            c.param.coupling), margin=(0, 10))
         return pn.Column(
-            pn.Row(title, pn.layout.HSpacer(), dl),
+            pn.Row(caption, pn.layout.HSpacer(), dl),
             pn.pane.HoloViews(self.plot(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )
@@ -116,9 +113,8 @@ class UncoupledView(Viewer):
 
     def _chassis(self, harmonic, dof, spindle_input):
         d = compute.uncoupled_data(harmonic, 400, dof, spindle_input)
-        unit = "dB re 1 (rad/s)/N" if dof.startswith("r") else "dB re 1 (m/s)/N"
-        if spindle_input.startswith("r"):
-            unit = unit.replace("/N", "/(N m)")
+        unit = "dB re 1 (rad/s)/" if dof.startswith("r") else "dB re 1 (m/s)/"
+        unit += "(N m)" if spindle_input.startswith("r") else "N"
         lvl = hv.Dimension("chassis_level", label="Mobility", unit=unit)
         return hv.Curve((d["freq"], d["chassis_db"]), FREQ, lvl).opts(
             color=COLORS["chassis"], hooks=[name_source("uncoupled.chassis")],

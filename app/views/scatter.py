@@ -84,7 +84,8 @@ class ScatterBandView(Viewer):
 
     # -- plot layers -------------------------------------------------------------------
     def _bands(self, result, dof, percentile):
-        lvl, lvl2 = level_dim(dof), level_dim(dof, "level2")
+        # own level dimension: the band's y range is not linked to the coupled-response plot
+        lvl, lvl2 = level_dim(dof, "band_level"), level_dim(dof, "band_level2", "Upper level")
         if result is None:
             e = ([], [], [])
             return (hv.Area(e, FREQ, [lvl, lvl2], label="min-max corridor").opts(
@@ -94,27 +95,26 @@ class ScatterBandView(Viewer):
                     * hv.Curve(([], []), FREQ, lvl, label="unpolluted").opts(
                         hooks=[name_source("scatter.reference")]))
         d = compute.band_data(result, dof, percentile)
-        lo = (100 - percentile) / 2
         return (
             hv.Area((d["freq"], d["minimum_db"], d["maximum_db"]), FREQ, [lvl, lvl2],
                     label="min-max corridor").opts(
                 color=COLORS["band"], alpha=0.35, line_alpha=0,
                 hooks=[name_source("scatter.minmax")],
-                hover_tooltips=[("Frequency", "@freq{0.0} Hz"), ("min", "@level{0.0} dB"),
-                                ("max", "@level2{0.0} dB")])
+                hover_tooltips=[("min-max corridor", ""), ("Frequency", "$x{0.0} Hz"),
+                                ("Level", "$y{0.0} dB")])
             * hv.Area((d["freq"], d["lower_db"], d["upper_db"]), FREQ, [lvl, lvl2],
                       label="percentile band").opts(
                 color=COLORS["percentile"], alpha=0.45, line_alpha=0,
                 hooks=[name_source("scatter.percentile")],
-                hover_tooltips=[("Frequency", "@freq{0.0} Hz"), (f"p{lo:g}", "@level{0.0} dB"),
-                                (f"p{100 - lo:g}", "@level2{0.0} dB")])
+                hover_tooltips=[(f"central {percentile} % band", ""),
+                                ("Frequency", "$x{0.0} Hz"), ("Level", "$y{0.0} dB")])
             * hv.Curve((d["freq"], d["reference_db"]), FREQ, lvl, label="unpolluted").opts(
                 color=COLORS["reference"], hooks=[name_source("scatter.reference")],
-                hover_tooltips=[("Frequency", "@freq{0.0} Hz"), ("Level", "@level{0.0} dB")])
+                hover_tooltips=[("Frequency", "@freq{0.0} Hz"), ("Level", "@band_level{0.0} dB")])
         )
 
     def _round(self, result, dof, single_round):
-        lvl = level_dim(dof)
+        lvl = level_dim(dof, "band_level")
         if result is None:
             return hv.Curve(([], []), FREQ, lvl, label="single round").opts(
                 hooks=[name_source("scatter.round")])
@@ -123,7 +123,7 @@ class ScatterBandView(Viewer):
                         label="single round").opts(
             color=COLORS["round"], line_width=1.5, hooks=[name_source("scatter.round")],
             hover_tooltips=[("Round", str(single_round)), ("Frequency", "@freq{0.0} Hz"),
-                            ("Level", "@level{0.0} dB")])
+                            ("Level", "@band_level{0.0} dB")])
 
     @param.depends("busy", "seconds", "result")
     def _status(self):
@@ -133,8 +133,10 @@ class ScatterBandView(Viewer):
                 css_classes=["scatter-status"])
         if self.seconds is None:
             return pn.pane.Markdown("", margin=(0, 10), css_classes=["scatter-status"])
+        conv = compute.convergence_db(self.result)
         return pn.pane.Markdown(
-            f"{self.noise.rounds:,} rounds in {self.seconds:.2f} s", margin=(0, 10),
+            f"{self.result.rounds:,} rounds in {self.seconds:.2f} s &middot; largest edge change "
+            f"in the last half of the rounds: {conv:.1f} dB", margin=(0, 10),
             css_classes=["scatter-status"])
 
     def __panel__(self):
@@ -145,6 +147,9 @@ class ScatterBandView(Viewer):
         single = hv.DynamicMap(self._round, streams=[
             hv.streams.Params(self, ["result"]), hv.streams.Params(c, ["dof"]),
             hv.streams.Params(n, ["single_round"])])
+        # click on the plot: show the round with the highest level at that frequency
+        tap = hv.streams.Tap(source=single, x=None, y=None)
+        tap.add_subscriber(self._pick_peak_round)
         plot = (bands * single).opts(
             hv.opts.Curve(**CURVE_OPTS), hv.opts.Area(responsive=True, min_height=320,
                                                       framewise=True, tools=["hover"]),
@@ -155,12 +160,18 @@ class ScatterBandView(Viewer):
             visible=self.param.busy, css_classes=["scatter-progress"], margin=(12, 10))
         dl = download_button("scatter", self._csv_columns, self._meta, self._filename)
         return pn.Column(
-            pn.Row(pn.pane.Markdown("**Scatter band** (thesis 5.2, eqs. 5.2-5.4)",
-                                    margin=(0, 10)), progress, self._status,
+            pn.Row(pn.pane.Markdown("Click a frequency to draw the round with the highest "
+                                    "level there (figs. 5.10-5.11).", margin=(0, 10)),
+                   progress, self._status,
                    pn.layout.HSpacer(), dl),
             pn.pane.HoloViews(plot, sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )
+
+    def _pick_peak_round(self, x=None, y=None):
+        if x is None or self.result is None:
+            return
+        self.noise.single_round = compute.peak_round(self.result, x, self.case.dof, "max")
 
     def _filename(self) -> str:
         c, n = self.case, self.noise
@@ -178,6 +189,7 @@ class ScatterBandView(Viewer):
             "frequency dependent": n.frequency_dependent, "rounds": n.rounds,
             "seed": n.seed, "single round": n.single_round,
             "percentiles": f"{lo:g}-{100 - lo:g}", "unit": compute.level_unit(c.dof),
+            "lower/upper": "min/max of |v_e| over the rounds; percentiles numpy 'linear'",
         }
 
     def _csv_columns(self) -> dict:

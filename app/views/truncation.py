@@ -28,10 +28,6 @@ class TruncationView(Viewer):
         dof = c.dof if t.map_mode == "selected DOF" else None
         return compute.error_map_data(c.harmonic, c.coupling, dof)
 
-    def table(self) -> dict:
-        t = self.truncation
-        return compute.suggested_table(float(t.threshold), float(t.f_max), self.case.coupling)
-
     def _map(self, harmonic, coupling, dof, map_mode, threshold):
         d = compute.error_map_data(harmonic, coupling, dof if map_mode == "selected DOF" else None)
         what = f"bushing:{dof}" if map_mode == "selected DOF" else "max over 6 DOFs"
@@ -49,25 +45,12 @@ class TruncationView(Viewer):
         return hv.HLine(float(n_modes), label="chosen N").opts(
             color=COLORS["round"], line_width=2)
 
-    def _suggested(self, harmonic, coupling, threshold, f_max):
-        tab = compute.suggested_table(float(threshold), float(f_max), coupling)
+    def _suggested(self, harmonic, coupling, dof, threshold, f_max, map_mode):
+        tab = compute.suggested_table(float(threshold), float(f_max), coupling,
+                                      dof if map_mode == "selected DOF" else None)
         n = float(tab["n_modes"][list(tab["harmonic"]).index(harmonic)])
         return hv.HLine(n).opts(color="#0ca678", line_dash="dashed", line_width=2) * hv.VLine(
             float(f_max)).opts(color="#0ca678", line_dash="dotted", line_width=2)
-
-    def table_frame(self):
-        """The suggested-modes table as a DataFrame (what the Tabulator shows)."""
-        import pandas as pd
-
-        t = self.truncation
-        tab = self.table()
-        return pd.DataFrame({
-            "Harmonic": tab["harmonic"],
-            "f range (Hz)": [f"{a:.1f}-{b:.1f}" for a, b in zip(tab["f_low"], tab["f_high"],
-                                                                 strict=True)],
-            f"N (error < {t.threshold:g} % up to {t.f_max:g} Hz)": tab["n_modes"],
-            "Highest eigenfreq. at 80 km/h (Hz)": tab["eigenfrequency"].round(1),
-        })
 
     def __panel__(self):
         c, t = self.case, self.truncation
@@ -76,30 +59,17 @@ class TruncationView(Viewer):
             hv.streams.Params(t, ["map_mode", "threshold"])])
         chosen = hv.DynamicMap(self._chosen, streams=[hv.streams.Params(c, ["n_modes"])])
         sugg = hv.DynamicMap(self._suggested, streams=[
-            hv.streams.Params(c, ["harmonic", "coupling"]),
-            hv.streams.Params(t, ["threshold", "f_max"])])
-        table = pn.widgets.Tabulator(
-            self.table_frame(), disabled=True, show_index=False, selectable=False,
-            sizing_mode="stretch_width", height=250, css_classes=["suggested-table"],
-            layout="fit_columns")
-
-        def refresh(*_):
-            table.value = self.table_frame()
-
-        t.param.watch(refresh, ["threshold", "f_max"])
-        c.param.watch(refresh, ["coupling"])
+            hv.streams.Params(c, ["harmonic", "coupling", "dof"]),
+            hv.streams.Params(t, ["threshold", "f_max", "map_mode"])])
         dl = download_button("truncation", self._csv_columns, self._meta,
                              lambda: f"truncation_map_h{c.harmonic}_{self._what()}.csv")
-        dl_tab = download_button(
-            "suggested", self._csv_table, self._meta_table,
-            lambda: f"suggested_modes_thr{t.threshold:g}_fmax{t.f_max:g}.csv")
         return pn.Column(
-            pn.Row(pn.pane.Markdown("**Modal truncation error** (eq. 5.1, floating band)",
-                                    margin=(0, 10)), pn.layout.HSpacer(), dl),
+            pn.Row(pn.pane.Markdown(
+                "Eq. 5.1 error in a floating 12 Hz band against all modes; black: at or above "
+                "the threshold. Solid line: chosen N; dashed: suggested N up to the dotted "
+                "frequency.", margin=(0, 10), styles={"color": "#495057"}),
+                pn.layout.HSpacer(), dl),
             pn.pane.HoloViews(img * sugg * chosen, sizing_mode="stretch_both", min_height=340),
-            pn.Row(pn.pane.Markdown("**Suggested number of modes** (table 5.1)",
-                                    margin=(0, 10)), pn.layout.HSpacer(), dl_tab),
-            table,
             sizing_mode="stretch_both",
         )
 
@@ -120,10 +90,61 @@ class TruncationView(Viewer):
         return {"n_modes": nn.ravel(), "centre_freq_Hz": ff.ravel(),
                 "error_pct": d["error_pct"].ravel()}
 
+class SuggestedModesView(Viewer):
+    """Suggested number of modes for all seven harmonics (thesis table 5.1)."""
+
+    case = param.ClassSelector(class_=CaseState)
+    truncation = param.ClassSelector(class_=TruncationState)
+
+    def table(self) -> dict:
+        c, t = self.case, self.truncation
+        return compute.suggested_table(float(t.threshold), float(t.f_max), c.coupling,
+                                       c.dof if t.map_mode == "selected DOF" else None)
+
+    def table_frame(self):
+        """The suggested-modes table as a DataFrame (what the Tabulator shows)."""
+        import pandas as pd
+
+        tab = self.table()
+        return pd.DataFrame({
+            "Harmonic": tab["harmonic"],
+            "Band (Hz)": [f"{a:.1f}-{b:.1f}" for a, b in zip(tab["f_low"], tab["f_high"],
+                                                              strict=True)],
+            "Suggested N": tab["n_modes"],
+            "Highest eigenfreq. (Hz)": tab["eigenfrequency"].round(1),
+        })
+
+    def __panel__(self):
+        c, t = self.case, self.truncation
+        table = pn.widgets.Tabulator(
+            self.table_frame(), disabled=True, show_index=False, selectable=False,
+            sizing_mode="stretch_width", css_classes=["suggested-table"],
+            layout="fit_data_stretch", theme="bootstrap5")
+
+        def refresh(*_):
+            table.value = self.table_frame()
+
+        t.param.watch(refresh, ["threshold", "f_max", "map_mode"])
+        c.param.watch(refresh, ["coupling", "dof"])
+        dl = download_button(
+            "suggested", self._csv_table, self._meta_table,
+            lambda: f"suggested_modes_thr{t.threshold:g}_fmax{t.f_max:g}.csv")
+        caption = pn.pane.Markdown(pn.bind(
+            lambda thr, fm, mode, dof: f"Smallest N from which the error stays below "
+            f"**{thr:g} %** up to **{fm:g} Hz** "
+            f"({'bushing:' + dof if mode == 'selected DOF' else mode}), and the highest "
+            "eigenfrequency among those modes at 80 km/h.",
+            t.param.threshold, t.param.f_max, t.param.map_mode, c.param.dof),
+            margin=(0, 10), styles={"color": "#495057"})
+        return pn.Column(pn.Row(caption, pn.layout.HSpacer(), dl), table,
+                         sizing_mode="stretch_both")
+
     def _meta_table(self) -> dict:
         c, t = self.case, self.truncation
         return {"view": "suggested number of modes (thesis table 5.1)",
                 "threshold_pct": t.threshold, "f_max_Hz": t.f_max, "coupling": c.coupling,
+                "response DOF": f"bushing:{c.dof}" if t.map_mode == "selected DOF"
+                else "max over 6 DOFs",
                 "eigenfrequency": "highest retained eigenfrequency at 80 km/h"}
 
     def _csv_table(self) -> dict:
@@ -131,6 +152,7 @@ class TruncationView(Viewer):
         return {"harmonic": tab["harmonic"], "f_low_Hz": tab["f_low"],
                 "f_high_Hz": tab["f_high"], "n_modes": tab["n_modes"],
                 "eigenfrequency_Hz": tab["eigenfrequency"]}
+
 
 
 class EigenView(Viewer):
@@ -170,7 +192,9 @@ class EigenView(Viewer):
             lambda: {"view": "highest retained eigenfrequency vs N (thesis fig. 5.8)"},
             lambda: "eigenfrequency_vs_modes.csv")
         return pn.Column(
-            pn.Row(pn.pane.Markdown("**Eigenfrequencies** (fig. 5.8)", margin=(0, 10)),
+            pn.Row(pn.pane.Markdown("Highest eigenfrequency among N retained modes (N/2 "
+                                    "pairs), thesis fig. 5.8.", margin=(0, 10),
+                                    styles={"color": "#495057"}),
                    pn.layout.HSpacer(), dl),
             pn.pane.HoloViews(static * marker, sizing_mode="stretch_both", min_height=300),
             sizing_mode="stretch_both",

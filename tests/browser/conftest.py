@@ -1,0 +1,234 @@
+"""Real-browser harness: `panel serve app/main.py` in a subprocess, chromium via playwright.
+
+Chromium: Debian's /usr/bin/chromium when present (playwright cannot download its own browser
+on the CI machines), else the one `playwright install chromium` put in its cache.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import socket
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SYSTEM_CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = [
+    "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+    "--disable-component-update", "--no-first-run", "--disable-sync",
+]
+#: Script served; overridable for debugging the harness itself.
+APP_SCRIPT = os.environ.get("FBS_DASHBOARD_SCRIPT", str(ROOT / "app" / "main.py"))
+#: Names of the ColumnDataSources that every page shows (set by the views' hooks).
+SOURCES = [
+    "mobility.reference", "mobility.truncated", "truncation.map", "scatter.minmax",
+    "scatter.percentile", "scatter.reference", "scatter.round", "eigen.f_20", "eigen.f_80",
+    "eigen.f_120",
+]
+
+
+def chromium_launch_args() -> dict:
+    """Launch arguments for playwright's chromium (system browser first)."""
+    args = {"args": list(CHROMIUM_ARGS)}
+    if Path(SYSTEM_CHROMIUM).exists():
+        args["executable_path"] = SYSTEM_CHROMIUM
+    return args
+
+
+@pytest.fixture(scope="session")
+def browser_type_launch_args(browser_type_launch_args):
+    return {**browser_type_launch_args, **chromium_launch_args()}
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class DashboardServer:
+    """`panel serve` of the dashboard in a subprocess; ready when it logs its URL."""
+
+    def __init__(self, script: str = APP_SCRIPT, num_threads: int = 2, timeout: float = 120):
+        self.port = free_port()
+        name = Path(script).stem
+        self.url = f"http://127.0.0.1:{self.port}/{name}"
+        cmd = [sys.executable, "-m", "panel", "serve", script, "--port", str(self.port),
+               "--address", "127.0.0.1", "--num-threads", str(num_threads),
+               "--allow-websocket-origin", f"127.0.0.1:{self.port}"]
+        self.proc = subprocess.Popen(
+            cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+            env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        )
+        self.log: list[str] = []
+        ready: queue.Queue = queue.Queue()
+
+        def pump():
+            for line in self.proc.stdout:
+                self.log.append(line)
+                if "Bokeh app running at" in line:
+                    ready.put(True)
+            ready.put(False)
+
+        threading.Thread(target=pump, daemon=True).start()
+        try:
+            ok = ready.get(timeout=timeout)
+        except queue.Empty:
+            ok = False
+        if not ok:
+            self.stop()
+            raise RuntimeError("panel serve did not start:\n" + "".join(self.log[-40:]))
+
+    def errors(self) -> list[str]:
+        """Server log lines that report an exception."""
+        return [ln for ln in self.log if "Traceback" in ln or "ERROR" in ln]
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+
+
+@pytest.fixture(scope="session")
+def dashboard():
+    server = DashboardServer()
+    yield server
+    server.stop()
+
+
+# -- helpers reading the Bokeh document ----------------------------------------------------
+JS_SOURCE = """
+(name) => {
+  const doc = Bokeh.documents[0];
+  const ms = [...doc._all_models.values()].filter(
+      m => m.name === name && m.type === 'ColumnDataSource');
+  if (ms.length !== 1) return null;
+  const out = {};
+  for (const [k, v] of Object.entries(ms[0].data)) {
+    if (k === 'image') out[k] = Array.from(v[0]);
+    else out[k] = Array.from(v, x => (typeof x === 'number' ? x : Number(x)));
+  }
+  return out;
+}
+"""
+
+JS_FINGERPRINT = """
+(name) => {
+  const doc = Bokeh.documents[0];
+  const ms = [...doc._all_models.values()].filter(
+      m => m.name === name && m.type === 'ColumnDataSource');
+  if (ms.length !== 1) return null;
+  let s = '';
+  for (const [k, v] of Object.entries(ms[0].data)) {
+    const a = k === 'image' ? v[0] : v;
+    let t = 0, n = 0;
+    for (const x of a) { if (Number.isFinite(x)) { t += x * (1 + (n % 7)); } n++; }
+    s += k + ':' + n + ':' + t.toPrecision(12) + ';';
+  }
+  return s;
+}
+"""
+
+
+def source(page, name: str) -> dict | None:
+    """The data of the named ColumnDataSource as lists (None if absent or ambiguous)."""
+    return page.evaluate(JS_SOURCE, name)
+
+
+def fingerprint(page, name: str) -> str | None:
+    """A short summary of a source's data that changes when the data change."""
+    return page.evaluate(JS_FINGERPRINT, name)
+
+
+def wait_loaded(page, names=SOURCES, timeout=90_000):
+    """Wait until the Bokeh document exists and every named source holds data."""
+    page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0", timeout=timeout)
+    page.wait_for_function(
+        """(names) => names.every(n => {
+             const ms = [...Bokeh.documents[0]._all_models.values()].filter(
+                 m => m.name === n && m.type === 'ColumnDataSource');
+             if (ms.length !== 1) return false;
+             const d = ms[0].data; const k = Object.keys(d)[0];
+             return k !== undefined && d[k].length > 0;
+           })""",
+        arg=list(names), timeout=timeout,
+    )
+
+
+def wait_changed(page, name: str, before: str, timeout=30_000):
+    """Wait until the fingerprint of a source differs from ``before``."""
+    page.wait_for_function(
+        f"([name, before]) => ({JS_FINGERPRINT})(name) !== before",
+        arg=[name, before], timeout=timeout,
+    )
+
+
+def set_model_value(page, css_class: str, value, model_type: str | None = None):
+    """Set ``value`` of the widget model carrying ``css_class`` (as a user's drag would)."""
+    page.evaluate(
+        """([cls, value, type]) => {
+             const ms = [...Bokeh.documents[0]._all_models.values()].filter(
+                 m => m.css_classes && m.css_classes.includes(cls) && 'value' in m
+                      && (type === null || m.type === type));
+             if (ms.length !== 1) throw new Error(`${ms.length} widget models for ${cls}`);
+             ms[0].value = value;
+           }""",
+        [css_class, value, model_type],
+    )
+
+
+def model_value(page, css_class: str, model_type: str | None = None):
+    return page.evaluate(
+        """([cls, type]) => [...Bokeh.documents[0]._all_models.values()].filter(
+             m => m.css_classes && m.css_classes.includes(cls) && 'value' in m
+                  && (type === null || m.type === type))[0].value""",
+        [css_class, model_type],
+    )
+
+
+JS_TABLE = """
+(cls) => {
+  const ms = [...Bokeh.documents[0]._all_models.values()].filter(
+      m => m.css_classes && m.css_classes.includes(cls) && m.source);
+  if (ms.length !== 1) return null;
+  const out = {};
+  for (const [k, v] of Object.entries(ms[0].source.data)) out[k] = Array.from(v, String);
+  return JSON.stringify(out);
+}
+"""
+
+
+def table_json(page, css_class: str) -> str | None:
+    """The data of the table widget carrying ``css_class`` as a JSON string."""
+    return page.evaluate(JS_TABLE, css_class)
+
+
+def color_high(page) -> float:
+    """Upper colour limit of the (only) colour mapper on the page: the error map's cap."""
+    return page.evaluate(
+        """() => [...Bokeh.documents[0]._all_models.values()].filter(
+             m => m.type === 'LinearColorMapper').map(m => m.high)[0]"""
+    )
+
+
+@pytest.fixture(scope="module")
+def shared_page(browser, dashboard):
+    """One page for a sequence of control changes (a page load costs seconds)."""
+    context = browser.new_context(viewport={"width": 1600, "height": 1200},
+                                  accept_downloads=True)
+    page = context.new_page()
+    page.errors = []
+    page.on("console", lambda m: m.type == "error" and page.errors.append(m.text))
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    page.goto(dashboard.url + "?rounds=1000")
+    wait_loaded(page)
+    yield page
+    context.close()

@@ -1,0 +1,228 @@
+"""The dashboard in a real browser (chromium via playwright).
+
+Plot data are read from the Bokeh document (the named ColumnDataSources), not from
+screenshots. One server for the whole module; most tests share one page.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from app import compute
+from app.export import read_csv
+
+from .conftest import (
+    SOURCES,
+    color_high,
+    fingerprint,
+    model_value,
+    set_model_value,
+    source,
+    table_json,
+    wait_changed,
+    wait_loaded,
+)
+
+pytestmark = pytest.mark.browser
+
+MOBILITY = ["mobility.reference", "mobility.truncated"]
+MAP = ["truncation.map"]
+BAND = ["scatter.minmax", "scatter.percentile", "scatter.reference", "scatter.round"]
+EIGEN = ["eigen.f_20", "eigen.f_80", "eigen.f_120"]
+
+
+def _radio(page, cls, label):
+    page.locator(f".{cls}").get_by_role("button", name=label, exact=True).click()
+
+
+def _type(page, cls, value):
+    box = page.locator(f".{cls} input").first
+    box.fill(str(value))
+    box.press("Enter")
+
+
+# control -> (action, sources that must change, sources that must not change)
+STEPS = {
+    "harmonic": (lambda p: set_model_value(p, "ctl-case-harmonic", 2, "Slider"),
+                 MOBILITY + MAP + ["scatter.minmax", "scatter.reference"], EIGEN),
+    "n_modes": (lambda p: set_model_value(p, "ctl-case-n_modes", 9, "Slider"),  # N = 100
+                ["mobility.truncated", "scatter.minmax", "scatter.reference"],
+                ["mobility.reference"] + MAP + EIGEN),
+    "dof": (lambda p: _radio(p, "ctl-case-dof", "x"),
+            MOBILITY + MAP + BAND, EIGEN),
+    "coupling": (lambda p: _radio(p, "ctl-case-coupling", "5dof"),
+                 MOBILITY + MAP + ["scatter.minmax", "scatter.reference"], EIGEN),
+    "map_mode": (lambda p: _radio(p, "ctl-truncation-map_mode", "max over 6 DOFs"),
+                 MAP, MOBILITY + BAND + EIGEN),
+    "noise": (lambda p: _type(p, "ctl-noise-noise", 4.5),
+              ["scatter.minmax", "scatter.percentile", "scatter.round"],
+              MOBILITY + MAP + ["scatter.reference"] + EIGEN),
+    "target": (lambda p: _radio(p, "ctl-noise-target", "tire"),
+               ["scatter.minmax", "scatter.percentile", "scatter.round"],
+               MOBILITY + MAP + ["scatter.reference"] + EIGEN),
+    "frequency_dependent": (
+        lambda p: p.locator(".ctl-noise-frequency_dependent input").click(),
+        ["scatter.minmax", "scatter.percentile", "scatter.round"],
+        MOBILITY + MAP + ["scatter.reference"] + EIGEN),
+    "seed": (lambda p: _type(p, "ctl-noise-seed", 11),
+             ["scatter.minmax", "scatter.percentile", "scatter.round"],
+             MOBILITY + MAP + ["scatter.reference"] + EIGEN),
+    # the same round index is the same round whatever R: only the band edges move
+    "rounds": (lambda p: _type(p, "ctl-noise-rounds", 2000),
+               ["scatter.minmax", "scatter.percentile"],
+               MOBILITY + MAP + ["scatter.reference", "scatter.round"] + EIGEN),
+    "single_round": (lambda p: _type(p, "ctl-noise-single_round", 5),
+                     ["scatter.round"],
+                     MOBILITY + MAP + ["scatter.minmax", "scatter.percentile",
+                                       "scatter.reference"] + EIGEN),
+    "percentile": (lambda p: p.locator(".ctl-noise-percentile select").select_option("50"),
+                   ["scatter.percentile"],
+                   MOBILITY + MAP + ["scatter.minmax", "scatter.reference", "scatter.round"]
+                   + EIGEN),
+}
+
+
+def test_page_loads_without_console_errors(shared_page, dashboard):
+    page = shared_page
+    assert page.errors == []
+    assert dashboard.errors() == []
+    assert "Tire-chassis FBS" in page.title() or "tire-fbs" in page.title()
+    for name in SOURCES:
+        data = source(page, name)
+        assert data is not None, name
+        assert all(np.isfinite(np.asarray(v, float)).all() for k, v in data.items()
+                   if k != "image"), name
+
+
+@pytest.mark.parametrize("control", list(STEPS))
+def test_control_updates_exactly_the_views_that_depend_on_it(shared_page, control):
+    page = shared_page
+    action, changed, unchanged = STEPS[control]
+    before = {n: fingerprint(page, n) for n in SOURCES}
+    action(page)
+    for n in changed:
+        wait_changed(page, n, before[n])
+    for n in unchanged:
+        assert fingerprint(page, n) == before[n], f"{control} changed {n}"
+    assert page.errors == []
+
+
+def test_threshold_caps_the_colour_and_f_max_changes_the_table(shared_page):
+    page = shared_page
+    table = table_json(page, "suggested-table")
+    before = {n: fingerprint(page, n) for n in SOURCES}
+    _type(page, "ctl-truncation-threshold", 7)
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0]._all_models.values()].some("
+        "m => m.type === 'LinearColorMapper' && m.high === 7)")
+    assert color_high(page) == 7
+    page.wait_for_function(f"(t) => ({_js_table()})('suggested-table') !== t", arg=table)
+    table2 = table_json(page, "suggested-table")
+    _type(page, "ctl-truncation-f_max", 60)
+    page.wait_for_function(f"(t) => ({_js_table()})('suggested-table') !== t", arg=table2)
+    for n in SOURCES:  # threshold and f_max change colours and the table, not the data
+        assert fingerprint(page, n) == before[n], n
+
+
+def test_uncoupled_subsystems_on_request(shared_page):
+    page = shared_page
+    row = page.locator(".uncoupled-row")
+    assert not row.is_visible()
+    page.locator(".ctl-case-show_uncoupled input").click()
+    row.wait_for(state="visible")
+    wait_loaded(page, ["uncoupled.tire_reference", "uncoupled.tire_truncated",
+                       "uncoupled.chassis"])
+    before = {n: fingerprint(page, n) for n in ["uncoupled.chassis", "uncoupled.tire_reference"]}
+    page.locator(".uncoupled-row select").select_option("x")  # spindle input
+    wait_changed(page, "uncoupled.chassis", before["uncoupled.chassis"])
+    assert fingerprint(page, "uncoupled.tire_reference") == before["uncoupled.tire_reference"]
+
+
+def _js_table():
+    from .conftest import JS_TABLE
+
+    return JS_TABLE
+
+
+URL = ("?h=3&N=120&dof=rx&coupling=5dof&noise=5.5&target=tire&fdep=true&rounds=800&seed=3"
+       "&round=7&pct=50&thr=10&fmax=130&map=max+over+6+DOFs")
+
+
+def test_url_restores_the_state(browser, dashboard):
+    page = browser.new_page()
+    page.goto(dashboard.url + URL)
+    wait_loaded(page)
+    assert model_value(page, "ctl-case-harmonic", "Slider") == 3
+    assert model_value(page, "ctl-case-n_modes", "Slider") == 11  # index of N = 120
+    assert model_value(page, "ctl-noise-seed") == 3
+    assert model_value(page, "ctl-noise-rounds") == 800
+    assert model_value(page, "ctl-noise-single_round") == 7
+    # the plotted data are those of the state in the URL
+    mob = source(page, "mobility.truncated")
+    want = compute.mobility_data(3, 120, "rx", "5dof")
+    np.testing.assert_allclose(mob["freq"], want["freq"])
+    np.testing.assert_allclose(mob["level"], want["truncated_db"], rtol=1e-12)
+    err = compute.error_map_data(3, "5dof", None)["error_pct"]
+    np.testing.assert_allclose(source(page, "truncation.map")["image"], err.ravel(), rtol=1e-12)
+    band = compute.band(3, 120, "5dof", 5.5, "tire", True, 800, 3)
+    d = compute.band_data(band, "rx", 50)
+    # HoloViews draws the area as one polygon: upper edge, then the lower edge backwards
+    y = np.asarray(source(page, "scatter.percentile")["y"])
+    n = d["freq"].size
+    np.testing.assert_allclose(y[:n], d["upper_db"], rtol=1e-12)
+    np.testing.assert_allclose(y[n:][::-1], d["lower_db"], rtol=1e-12)
+    assert color_high(page) == 10
+    # a control change goes back into the URL
+    set_model_value(page, "ctl-case-n_modes", 12, "Slider")
+    page.wait_for_function("() => window.location.search.includes('N=130')")
+    page.close()
+
+
+def test_csv_downloads_match_the_plotted_data(shared_page):
+    page = shared_page
+    with page.expect_download() as info:
+        page.locator(".download-mobility").first.click()
+    meta, cols = read_csv(open(info.value.path()).read())
+    assert {"harmonic", "N (retained tire modes)", "response DOF", "coupling",
+            "fbs_core version"} <= set(meta)
+    ref, tr = source(page, "mobility.reference"), source(page, "mobility.truncated")
+    np.testing.assert_allclose(cols["freq_Hz"], ref["freq"])
+    np.testing.assert_allclose(cols["reference_dB"], ref["level"], rtol=1e-12)
+    np.testing.assert_allclose(cols["truncated_dB"], tr["level"], rtol=1e-12)
+
+    with page.expect_download() as info:
+        page.locator(".download-scatter").first.click()
+    meta, cols = read_csv(open(info.value.path()).read())
+    assert {"noise_pct", "noise target", "frequency dependent", "rounds", "seed"} <= set(meta)
+    mm = np.asarray(source(page, "scatter.minmax")["y"])
+    n = cols["freq_Hz"].size
+    np.testing.assert_allclose(cols["maximum_dB"], mm[:n], rtol=1e-12)  # upper edge first
+    np.testing.assert_allclose(cols["minimum_dB"], mm[n:][::-1], rtol=1e-12)
+    rnd = [k for k in cols if k.startswith("round_")]
+    np.testing.assert_allclose(cols[rnd[0]], source(page, "scatter.round")["band_level"],
+                               rtol=1e-12)
+
+    with page.expect_download() as info:
+        page.locator(".download-truncation").first.click()
+    meta, cols = read_csv(open(info.value.path()).read())
+    np.testing.assert_allclose(cols["error_pct"], source(page, "truncation.map")["image"],
+                               rtol=1e-12)
+
+
+def test_long_computation_in_one_session_does_not_block_another(browser, dashboard):
+    a, b = browser.new_page(), browser.new_page()
+    a.goto(dashboard.url + "?rounds=500")
+    b.goto(dashboard.url + "?rounds=500")
+    wait_loaded(a)
+    wait_loaded(b)
+    # session A starts a long scatter band ...
+    _type(a, "ctl-noise-rounds", 60_000)
+    a.locator(".scatter-status p", has_text="Computing").wait_for()
+    # ... session B changes N and sees its plot updated while A is still computing
+    before = fingerprint(b, "mobility.truncated")
+    set_model_value(b, "ctl-case-n_modes", 20, "Slider")
+    wait_changed(b, "mobility.truncated", before, timeout=10_000)
+    assert a.locator(".scatter-status p", has_text="Computing").count() == 1
+    a.close()
+    b.close()
