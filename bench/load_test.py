@@ -129,6 +129,8 @@ class SessionResult:
     final_value: float | None = None
     final_digest: str | None = None
     errors: list[str] = field(default_factory=list)
+    context: object = None
+    page: object = None
 
 
 def chromium_args() -> dict:
@@ -192,13 +194,20 @@ async def run_session(browser, url: str, index: int, changes: int, title: str,
                 continue
             res.first_ms.append(lat[0])
             res.settled_ms.append(lat[1])
-        res.final_digest = await page.evaluate(SETTLE_JS, [ms, 1500])
         res.final_value = (await page.evaluate(SLIDER_INFO_JS, title))["value"]
     except Exception as exc:  # a failed session is reported, the others go on
         res.errors.append(f"{type(exc).__name__}: {str(exc).splitlines()[0]}")
-    finally:
-        await context.close()
+    res.context, res.page = context, page  # kept open for the isolation check
     return res
+
+
+async def final_digest(res: SessionResult, timeout_s: float) -> None:
+    """Plot data of a session once nothing changes for 3 s any more; closes the session."""
+    try:
+        if not res.errors:
+            res.final_digest = await res.page.evaluate(SETTLE_JS, [timeout_s * 1000, 3000])
+    finally:
+        await res.context.close()
 
 
 async def reference_digest(browser, url: str, title: str, value: float,
@@ -213,7 +222,7 @@ async def reference_digest(browser, url: str, title: str, value: float,
         info = await page.evaluate(SLIDER_INFO_JS, title)
         if info["value"] != value:
             await page.evaluate(CHANGE_JS, [title, value, ms, 400])
-        return await page.evaluate(SETTLE_JS, [ms, 1500])
+        return await page.evaluate(SETTLE_JS, [ms, 3000])
     finally:
         await context.close()
 
@@ -253,6 +262,8 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
             if check_isolation:
                 for value in sorted({r.last_value for r in results if not r.errors}):
                     refs[value] = await reference_digest(browser, url, title, value, timeout_s)
+            await asyncio.gather(*(final_digest(r, timeout_s) for r in results))
+            if check_isolation:
                 for r in results:
                     if r.errors or r.final_digest is None:
                         continue
@@ -406,10 +417,12 @@ def main(argv: list[str] | None = None) -> int:
                 print("   no errors; every session saw only its own state")
         if server is not None:
             logs = server.logs()
-            bad = [ln for ln in logs.splitlines() if "Traceback" in ln or " ERROR " in ln]
+            lines = logs.splitlines()
+            bad = [i for i, ln in enumerate(lines) if "Traceback" in ln or " ERROR " in ln]
             if bad:
                 failed = True
-                print(f"\nserver log has {len(bad)} error lines, first: {bad[0]}")
+                print(f"\nserver log has {len(bad)} error lines; the first:")
+                print("\n".join(lines[bad[0]:bad[0] + 25]))
     finally:
         if server is not None:
             server.stop()
