@@ -297,9 +297,9 @@ def noise_factors(key, rounds, lines, p, nj, ne, tire, vehicle):
 
 
 @njit(**_JIT)
-def _select(buf, k):
-    """Partially sort ``buf`` in place so that ``buf[k]`` is its k-th smallest (Hoare)."""
-    lo = 0
+def _select(buf, k, lo):
+    """Partially sort ``buf[lo:]`` in place so that ``buf[k]`` is its k-th smallest (Hoare);
+    ``buf[:lo]`` must already hold the ``lo`` smallest values."""
     hi = buf.size - 1
     while lo < hi:
         pivot = buf[(lo + hi) // 2]
@@ -325,9 +325,10 @@ def _select(buf, k):
 
 
 @njit(**_JIT)
-def _order_stat_pair(buf, k):
-    """``(x_(k), x_(k+1))``, 0-based order statistics of ``buf`` (reordered in place)."""
-    _select(buf, k)
+def _order_stat_pair(buf, k, lo):
+    """``(x_(k), x_(k+1))``, 0-based order statistics of ``buf`` (reordered in place);
+    ``buf[:lo]`` already holds the ``lo`` smallest values (``lo <= k``)."""
+    _select(buf, k, lo)
     lo = buf[k]
     hi = lo
     if k + 1 < buf.size:
@@ -350,6 +351,7 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
     checkpoints ascending, each in ``1 .. R``).
     """
     nl, ne, R = mag.shape
+    qsort = np.argsort(qs)
     for c in prange(nl * ne):
         li = c // ne
         e = c - li * ne
@@ -376,15 +378,18 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
         hi[line, e] = mx
         arg_lo[line, e] = imn
         arg_hi[line, e] = imx
-        for iq in range(qs.size):
+        # percentiles in ascending order of level share one partially sorted copy
+        buf = col.copy()
+        done = 0
+        for iq in qsort:
             h = (R - 1) * qs[iq] / 100.0
             k = int(np.floor(h))
             if k >= R - 1:
                 pct[iq, line, e] = mx
                 continue
             t = h - k
-            buf = col.copy()
-            a0, b0 = _order_stat_pair(buf, k)
+            a0, b0 = _order_stat_pair(buf, k, done)
+            done = k + 1
             d = b0 - a0
             # numpy's _lerp: a + d t, evaluated from b for t >= 0.5
             pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t
