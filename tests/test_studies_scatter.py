@@ -238,3 +238,14 @@ def test_split_factors_layout():
     S = split_factors(s, 6, 6)
     assert S["Yjj_A"][0, 1] == 1 and S["vj_A"][0] == 36 and S["Yjj_E"][0, 0] == 42
     assert S["Yej_E"][5, 5] == 113
+
+
+def test_concurrent_bands_from_threads_agree(arrays):
+    """A dashboard may compute bands from several threads at once."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(3) as ex:
+        bands = list(ex.map(lambda s: _band(arrays, seed=s % 2, frequency_dependent=True),
+                            range(4)))
+    np.testing.assert_array_equal(bands[0].upper, bands[2].upper)
+    np.testing.assert_array_equal(bands[1].upper, bands[3].upper)

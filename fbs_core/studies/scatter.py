@@ -28,6 +28,7 @@ rounds are processed in chunks of lines whose size is bounded by ``max_chunk_byt
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +44,9 @@ __all__ = ["TARGETS", "ScatterBand", "Convergence", "scatter_band", "scatter_ban
 TARGETS = ("tire", "vehicle", "both")
 
 _EMPTY_MAG = np.empty((0, 0, 0))
+# one compiled parallel run at a time (some numba threading layers abort on concurrent
+# launches from several Python threads, e.g. a dashboard serving two sessions)
+_LOCK = threading.Lock()
 _EMPTY_CPLX = np.empty((0, 0, 0), np.complex128)
 
 
@@ -224,8 +228,9 @@ def _split(z):
 def _run_complex(arrays, key, rids, p, tire, vehicle, freq_dep):
     nf, ne = arrays[0].shape[0], arrays[6].shape[1]
     out = np.empty((rids.size, nf, ne), np.complex128)
-    _kernels.noisy_block_run(*arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep,
-                             _EMPTY_MAG, out)
+    with _LOCK:
+        _kernels.noisy_block_run(*arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep,
+                                 _EMPTY_MAG, out)
     return out
 
 
@@ -350,9 +355,10 @@ def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = 
     for l0 in range(0, nf, chunk):
         l1 = min(nf, l0 + chunk)
         m = mag[: l1 - l0]
-        _kernels.noisy_block_run(*arrays, l0, l1, key, rids, float(noise), tire, vehicle,
-                                 bool(frequency_dependent), m, _EMPTY_CPLX)
-        _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
+        with _LOCK:
+            _kernels.noisy_block_run(*arrays, l0, l1, key, rids, float(noise), tire, vehicle,
+                                     bool(frequency_dependent), m, _EMPTY_CPLX)
+            _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
     del mag
     for name, x in (("reference", np.abs(ref)), ("upper edge", hi), ("lower edge", lo)):
         if not np.all(np.isfinite(x)):
