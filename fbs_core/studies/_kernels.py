@@ -348,7 +348,7 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
     (``arg_lo``, ``arg_hi``); the percentiles ``qs`` in % (``pct (n_q, n_f, n_e)``,
     numpy's default "linear" method); the running minimum and maximum after the
     first ``checkpoints[k]`` rounds (``conv_lo``, ``conv_hi`` ``(n_k, n_f, n_e)``,
-    checkpoints ascending, each in ``1 .. R``).
+    checkpoints ascending, each in ``1 .. R``). ``mag`` is reordered along the rounds.
     """
     nl, ne, R = mag.shape
     qsort = np.argsort(qs)
@@ -378,8 +378,8 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
         hi[line, e] = mx
         arg_lo[line, e] = imn
         arg_hi[line, e] = imx
-        # percentiles in ascending order of level share one partially sorted copy
-        buf = col.copy()
+        # percentiles in ascending order of level, selected in place (mag is scratch)
+        buf = col
         done = 0
         for iq in qsort:
             h = (R - 1) * qs[iq] / 100.0
