@@ -27,7 +27,7 @@ N_A, N_E, BETA = 26, 18, 2e-4  # tire DOFs (6 hub first), chassis DOFs, damping 
 def _spring_net(rng, n, ground):
     kc = rng.uniform(0.3, 1.0, (n, n)) * 4e5 * (rng.uniform(size=(n, n)) < 0.5)
     kc = np.triu(kc, 1)
-    kc = kc + kc.T + np.diag(np.arange(1, n)) * 0 if False else kc + kc.T
+    kc = kc + kc.T  # symmetric spring network between the DOFs
     K = np.diag(kc.sum(1) + ground) - kc
     M = np.diag(rng.uniform(0.5, 2.0, n))
     return M, K

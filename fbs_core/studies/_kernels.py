@@ -24,7 +24,9 @@ both subsystems. ``n_j (n_j + 1)`` is even, so the tire part ends on a word boun
 
 Speed: the solves run on ``LANES`` rounds at once in structure-of-arrays layout
 (real and imaginary parts apart, rounds innermost), so that the compiler vectorises
-the elimination over rounds; partial pivoting is decided per round (lane).
+the elimination over rounds; partial pivoting is decided per round (lane). The rows
+of every line enter in the pivot order of the noise-free matrix (:func:`pivot_order`),
+so that row exchanges, which cannot be vectorised, are rare in the noisy lanes.
 """
 
 from __future__ import annotations
@@ -55,7 +57,8 @@ def n_elements(nj: int, ne: int) -> int:
 
 @njit(**_JIT)
 def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
-    """Factors of words ``k0 .. k1-1`` of rounds ``rids[:nv]`` at stream line ``line``."""
+    """Factors of words ``k0 .. k1-1`` of the ``LANES`` rounds ``rids`` at stream line ``line``
+    into ``s (n_el, LANES)``; ``nv`` (valid lanes) is unused: padded lanes cost nothing extra."""
     n_el = s.shape[0]
     for v in range(LANES):
         base[v] = stream_base(key, rids[v], line)
