@@ -78,9 +78,13 @@ READY_JS = """() => window.Bokeh && Bokeh.documents.length > 0 &&
       .some(c => c && c.length > 0)) &&
   [...Bokeh.documents[0].all_models].some(m => m.type.endsWith('Slider'))"""
 
-#: The slider to move: the first slider model whose title contains ``title`` (any if empty).
-SLIDER_JS = """(title) => [...Bokeh.documents[0].all_models].find(
-  m => m.type.endsWith('Slider') && (!title || String(m.title).includes(title)))"""
+#: The slider to move: ``#k`` is the k-th slider model (0-based, document order), else the
+#: first one whose title contains ``title`` (any if empty).
+SLIDER_JS = """(title) => {
+  const all = [...Bokeh.documents[0].all_models].filter(m => m.type.endsWith('Slider'));
+  if (title.startsWith('#')) return all[parseInt(title.slice(1))];
+  return all.find(m => !title || String(m.title).includes(title));
+}"""
 
 SLIDER_INFO_JS = f"""(title) => {{
   const m = ({SLIDER_JS})(title);
@@ -141,11 +145,15 @@ def chromium_args() -> dict:
     return {}
 
 
-def slider_values(info: dict) -> list[float]:
-    """All values of a slider (bounded to 50)."""
+def slider_values(info: dict, k: int = 7) -> list[float]:
+    """At most ``k`` evenly spaced values of a slider, its ends included.
+
+    Few values keep the number of distinct final states (and of reference sessions) small.
+    """
     start, end, step = info["start"], info["end"], info["step"] or 1
-    n = min(int(round((end - start) / step)) + 1, 50)
-    values = [start + k * step for k in range(n)]
+    n = int(round((end - start) / step)) + 1
+    picks = sorted({round(j * (n - 1) / (k - 1)) for j in range(k)}) if n > k else range(n)
+    values = [start + j * step for j in picks]
     return [int(v) if float(v).is_integer() else v for v in values]
 
 
@@ -153,7 +161,7 @@ def targets(values: list[float], index: int, changes: int, current: float) -> li
     """The session's own sequence of slider values: each differs from the one before."""
     seq, prev = [], current
     for k in range(changes):
-        j = (7 * index + 3 * k + 1) % len(values)
+        j = (index + 3 * k + 1) % len(values)
         while values[j] == prev:
             j = (j + 1) % len(values)
         seq.append(values[j])
@@ -172,6 +180,7 @@ async def run_session(browser, url: str, index: int, changes: int, title: str,
     res = SessionResult(index)
     await asyncio.sleep(start_delay)
     context, page = await open_page(browser, url, timeout_s)
+    res.context, res.page = context, page  # kept open for the isolation check
     page.on("pageerror", lambda exc: res.errors.append(f"page error: {exc}"))
     ms = timeout_s * 1000
     try:
@@ -197,7 +206,6 @@ async def run_session(browser, url: str, index: int, changes: int, title: str,
         res.final_value = (await page.evaluate(SLIDER_INFO_JS, title))["value"]
     except Exception as exc:  # a failed session is reported, the others go on
         res.errors.append(f"{type(exc).__name__}: {str(exc).splitlines()[0]}")
-    res.context, res.page = context, page  # kept open for the isolation check
     return res
 
 
@@ -260,8 +268,10 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
                                     f"but this session set {r.last_value} last")
             refs: dict = {}
             if check_isolation:
-                for value in sorted({r.last_value for r in results if not r.errors}):
-                    refs[value] = await reference_digest(browser, url, title, value, timeout_s)
+                values = sorted({r.last_value for r in results if not r.errors})
+                digests = await asyncio.gather(*(
+                    reference_digest(browser, url, title, v, timeout_s) for v in values))
+                refs = dict(zip(values, digests, strict=True))
             await asyncio.gather(*(final_digest(r, timeout_s) for r in results))
             if check_isolation:
                 for r in results:
@@ -375,7 +385,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sessions", default="20",
                     help="concurrent sessions; a comma list sweeps levels (20)")
     ap.add_argument("--changes", type=int, default=5, help="slider changes per session (5)")
-    ap.add_argument("--slider", default="", help="title (part) of the slider to move")
+    ap.add_argument("--slider", default="",
+                    help="slider to move: part of its title, or #k for the k-th (first)")
     ap.add_argument("--target", type=float, default=1000.0, help="p95 target in ms (1000)")
     ap.add_argument("--timeout", type=float, default=120.0, help="seconds per wait (120)")
     ap.add_argument("--max-sessions", type=int, default=60, help="safety bound (60)")
