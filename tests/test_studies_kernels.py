@@ -195,3 +195,43 @@ def test_seed_validation():
     for bad in (-1, 2**64, 1.5, "1", True):
         with pytest.raises(fc.FBSError, match="seed"):
             _rng.as_seed(bad)
+
+
+def _stats(mag, qs):
+    nl, ne, R = mag.shape
+    ck = np.array([R], np.int64)
+    out = [np.empty((nl, ne)) for _ in range(2)] + [np.empty((nl, ne), np.int64) for _ in range(2)]
+    pct = np.empty((len(qs), nl, ne))
+    conv = [np.empty((1, nl, ne)) for _ in range(2)]
+    _kernels.band_stats(mag, np.asarray(qs, float), ck, *out, pct, *conv, 0)
+    return out, pct
+
+
+@pytest.mark.parametrize("R", [7, 1000, 5000])
+def test_band_percentiles_equal_numpy(R):
+    """Both selection paths (plain quickselect, sample-bracketed) against np.percentile."""
+    rng = np.random.default_rng(R)
+    mag = rng.lognormal(size=(3, 4, R))
+    mag[0, 0] = 2.0  # all equal
+    mag[0, 1, : R // 2] = 1.0  # many ties
+    qs = (0.0, 0.1, 5.0, 50.0, 95.0, 99.9, 100.0)
+    (lo, hi, alo, ahi), pct = _stats(mag.copy(), qs)
+    np.testing.assert_allclose(pct, np.percentile(mag, qs, axis=-1), rtol=1e-14, atol=0)
+    np.testing.assert_array_equal(lo, mag.min(-1))
+    np.testing.assert_array_equal(hi, mag.max(-1))
+    np.testing.assert_array_equal(alo, mag.argmin(-1))
+    np.testing.assert_array_equal(ahi, mag.argmax(-1))
+
+
+def test_band_percentiles_when_the_sample_misleads():
+    """An adversarial column whose stride sample is unrepresentative: the bracket misses
+    and the exact fallback selection must still give numpy's percentiles."""
+    R = 5000
+    rng = np.random.default_rng(0)
+    col = rng.uniform(1.0, 2.0, R)
+    m = _kernels._SAMPLE
+    col[(np.arange(m) * R) // m] = 1e-3 * (1 + np.arange(m))  # sample: all tiny
+    mag = np.ascontiguousarray(np.broadcast_to(col, (1, 1, R)))
+    qs = (5.0, 50.0, 95.0)
+    _, pct = _stats(mag.copy(), qs)
+    np.testing.assert_allclose(pct[:, 0, 0], np.percentile(col, qs), rtol=1e-14)

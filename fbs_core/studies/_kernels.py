@@ -328,10 +328,9 @@ def _select(buf, k, lo):
 
 
 @njit(**_JIT)
-def _order_stat_pair(buf, k, lo):
-    """``(x_(k), x_(k+1))``, 0-based order statistics of ``buf`` (reordered in place);
-    ``buf[:lo]`` already holds the ``lo`` smallest values (``lo <= k``)."""
-    _select(buf, k, lo)
+def _order_stat_pair(buf, k):
+    """``(x_(k), x_(k+1))``, 0-based order statistics of ``buf`` (reordered in place)."""
+    _select(buf, k, 0)
     lo = buf[k]
     hi = lo
     if k + 1 < buf.size:
@@ -340,6 +339,40 @@ def _order_stat_pair(buf, k, lo):
             if buf[i] < hi:
                 hi = buf[i]
     return lo, hi
+
+
+_SAMPLE = 256
+_SLACK = 16  # sample ranks on either side of the target (about sqrt(_SAMPLE))
+
+
+@njit(**_JIT)
+def _order_stat_pair_sampled(col, k, sample, mid):
+    """``(x_(k), x_(k+1))`` of ``col`` (unchanged) by sample-bracketed selection.
+
+    A sorted stride sample of ``col`` gives bounds that bracket ranks ``k`` and
+    ``k + 1`` with high probability (Floyd & Rivest, CACM 18(3), 1975); one pass counts
+    the values below the bracket and collects those inside it into ``mid``, where
+    the exact selection runs. Falls back to a full selection when the bracket misses.
+    ``mid`` needs ``col.size + 1`` places.
+    """
+    n = col.size
+    m = sample.size
+    j = (k * m) // n
+    a = j - _SLACK
+    b = j + 1 + _SLACK
+    lo_v = -np.inf if a < 0 else sample[a]
+    hi_v = np.inf if b >= m else sample[b]
+    below = 0
+    nmid = 0
+    for i in range(n):  # branch-free: unconditional store, conditional advance
+        x = col[i]
+        below += x < lo_v
+        mid[nmid] = x
+        nmid += (x >= lo_v) & (x <= hi_v)
+    if below <= k and k + 1 < below + nmid:
+        return _order_stat_pair(mid[:nmid], k - below)
+    buf = col.copy()
+    return _order_stat_pair(buf, k)
 
 
 @njit(parallel=True, **_JIT)
@@ -351,10 +384,9 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
     (``arg_lo``, ``arg_hi``); the percentiles ``qs`` in % (``pct (n_q, n_f, n_e)``,
     numpy's default "linear" method); the running minimum and maximum after the
     first ``checkpoints[k]`` rounds (``conv_lo``, ``conv_hi`` ``(n_k, n_f, n_e)``,
-    checkpoints ascending, each in ``1 .. R``). ``mag`` is reordered along the rounds.
+    checkpoints ascending, each in ``1 .. R``).
     """
     nl, ne, R = mag.shape
-    qsort = np.argsort(qs)
     for c in prange(nl * ne):
         li = c // ne
         e = c - li * ne
@@ -381,18 +413,26 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
         hi[line, e] = mx
         arg_lo[line, e] = imn
         arg_hi[line, e] = imx
-        # percentiles in ascending order of level, selected in place (mag is scratch)
-        buf = col
-        done = 0
-        for iq in qsort:
+        if qs.size == 0:
+            continue
+        big = R > 4 * _SAMPLE
+        if big:
+            sample = np.empty(_SAMPLE)
+            for i in range(_SAMPLE):
+                sample[i] = col[(i * R) // _SAMPLE]
+            sample.sort()
+            mid = np.empty(R + 1)
+        for iq in range(qs.size):
             h = (R - 1) * qs[iq] / 100.0
             k = int(np.floor(h))
             if k >= R - 1:
                 pct[iq, line, e] = mx
                 continue
             t = h - k
-            a0, b0 = _order_stat_pair(buf, k, done)
-            done = k + 1
+            if big:
+                a0, b0 = _order_stat_pair_sampled(col, k, sample, mid)
+            else:
+                a0, b0 = _order_stat_pair(col.copy(), k)
             d = b0 - a0
             # numpy's _lerp: a + d t, evaluated from b for t >= 0.5
             pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t
