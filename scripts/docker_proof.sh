@@ -31,6 +31,7 @@ health_timeout=${FBS_PROOF_HEALTH_TIMEOUT:-180}
 standin=${FBS_PROOF_STANDIN:-auto}
 base_image=python:3.11-slim-bookworm
 export DOCKER_BUILDKIT=0   # the classic builder: no buildx plugin needed, same Dockerfile
+export PATH="$PATH:/usr/local/sbin:/usr/sbin:/sbin"   # dockerd, debootstrap
 if [[ -x .venv/bin/python ]]; then PY=$repo/.venv/bin/python; else PY=python3; fi
 
 work=$(mktemp -d /tmp/docker-proof.XXXXXX)
