@@ -55,22 +55,30 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
                        sizing_mode="stretch_width", header_background="#e9ecef",
                        margin=(4, 4), **kw)
 
+    # the uncoupled subsystems are built on first request (two plots less per page load)
+    uncoupled = pn.Row(visible=case.param.show_uncoupled, css_classes=["uncoupled-row"],
+                       sizing_mode="stretch_width")
+
+    def show_uncoupled(*_):
+        if case.show_uncoupled and not uncoupled.objects:
+            uncoupled.append(card("Uncoupled subsystems: tire hub and chassis "
+                                  "spindle-to-bushing", UncoupledView(case=case), 420))
+
+    case.param.watch(show_uncoupled, "show_uncoupled")
+    show_uncoupled()
+
     main = pn.Column(
         pn.Row(
             card("Coupled response at the bushing (thesis eq. 4.1)", MobilityView(case=case),
-                 480),
+                 500),
             card("Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
-                 TruncationView(case=case, truncation=trunc), 480),
+                 TruncationView(case=case, truncation=trunc), 500),
         ),
+        uncoupled,
         pn.Row(
-            card("Uncoupled subsystems: tire hub and chassis spindle-to-bushing",
-                 UncoupledView(case=case), 420),
-            visible=case.param.show_uncoupled, css_classes=["uncoupled-row"],
-        ),
-        pn.Row(
-            card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", scatter, 480),
+            card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", scatter, 500),
             card("Eigenfrequency versus number of modes (fig. 5.8)", EigenView(case=case),
-                 480),
+                 500),
         ),
         pn.Row(card("Suggested number of modes (thesis table 5.1)",
                     SuggestedModesView(case=case, truncation=trunc), 360)),

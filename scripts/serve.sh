@@ -35,5 +35,8 @@ SHOW_ARG=()
 if [ "${SHOW:-0}" = 1 ] && { [ -n "${DISPLAY:-}" ] || [ "$(uname)" = Darwin ]; }; then
   SHOW_ARG=(--show)
 fi
+# --warm runs the page once at start-up: the reference models are loaded, the compiled
+# kernels and the truncation maps cached, so the first visitor sees plots within seconds.
+echo "== warming up (reference models, truncation maps, default scatter band) ..."
 exec .venv/bin/panel serve app/main.py --port "$PORT" --address "$ADDRESS" \
-  --num-threads "$NUM_THREADS" "${SHOW_ARG[@]}" "$@"
+  --num-threads "$NUM_THREADS" --warm "${SHOW_ARG[@]}" "$@"

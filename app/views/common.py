@@ -69,7 +69,7 @@ def download_button(view: str, columns: Callable[[], dict], meta: Callable[[], d
 
     btn = pn.widgets.FileDownload(
         callback=callback, filename=filename(), label="CSV", button_type="light",
-        width=90, embed=False, name=f"download-{view}",
+        width=90, embed=False,
         css_classes=[f"download-{view}"],
     )
     return btn

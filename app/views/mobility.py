@@ -38,33 +38,30 @@ class MobilityView(Viewer):
         }
 
     # -- plot layers (each a DynamicMap watching only what it needs) -------------------
+    # each layer is a DynamicMap fed by the parameters it depends on; styles are set once on
+    # the DynamicMap (setting options inside a callback costs more than the data)
     def _reference(self, harmonic, dof, coupling):
         d = compute.mobility_data(harmonic, 400, dof, coupling)
-        return hv.Curve(
-            (d["freq"], d["reference_db"]), FREQ, level_dim(dof), label="all modes (reference)"
-        ).opts(color=COLORS["reference"], hooks=[name_source("mobility.reference")],
-               hover_tooltips=[("", "all modes"), ("Frequency", "@freq{0.0} Hz"),
-                               ("Level", "@level{0.0} dB")])
+        return hv.Curve((d["freq"], d["reference_db"]), FREQ, level_dim(dof),
+                        label="all modes (reference)")
 
     def _truncated(self, harmonic, n_modes, dof, coupling):
         d = compute.mobility_data(harmonic, n_modes, dof, coupling)
-        return hv.Curve(
-            (d["freq"], d["truncated_db"]), FREQ, level_dim(dof), label="N retained modes"
-        ).opts(color=COLORS["truncated"], line_dash="dashed",
-               hooks=[name_source("mobility.truncated")],
-               hover_tooltips=[("", f"N = {n_modes}"), ("Frequency", "@freq{0.0} Hz"),
-                               ("Level", "@level{0.0} dB")])
+        return hv.Curve((d["freq"], d["truncated_db"]), FREQ, level_dim(dof),
+                        label="N retained modes")
 
     def plot(self) -> hv.DynamicMap:
         c = self.case
+        tips = [("Frequency", "@freq{0.0} Hz"), ("Level", "@level{0.0} dB")]
         ref = hv.DynamicMap(
             self._reference, streams=[hv.streams.Params(c, ["harmonic", "dof", "coupling"])]
-        )
-        tr = hv.DynamicMap(self._truncated, streams=[hv.streams.Params(c, CASE_KEYS)])
-        return (ref * tr).opts(
-            hv.opts.Curve(**CURVE_OPTS),
-            hv.opts.Overlay(legend_position="bottom_left"),
-        )
+        ).opts(color=COLORS["reference"], hooks=[name_source("mobility.reference")],
+               hover_tooltips=[("", "all modes"), *tips], **CURVE_OPTS)
+        tr = hv.DynamicMap(self._truncated, streams=[hv.streams.Params(c, CASE_KEYS)]).opts(
+            color=COLORS["truncated"], line_dash="dashed",
+            hooks=[name_source("mobility.truncated")],
+            hover_tooltips=[("", "N retained modes"), *tips], **CURVE_OPTS)
+        return (ref * tr).opts(hv.opts.Overlay(legend_position="bottom_left"))
 
     def __panel__(self):
         c = self.case

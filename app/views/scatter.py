@@ -20,6 +20,8 @@ from ..state import CaseState, NoiseState
 from .common import COLORS, CURVE_OPTS, FREQ, download_button, level_dim, name_source
 
 CASE_KEYS = ["harmonic", "n_modes", "coupling"]
+#: Seconds between a control change and the start of the band computation.
+DEBOUNCE_S = 0.15
 NOISE_KEYS = ["noise", "target", "frequency_dependent", "rounds", "seed"]
 
 
@@ -63,7 +65,19 @@ class ScatterBandView(Viewer):
         self._pending = key
         self.busy = True
         t0 = time.perf_counter()
-        res = await asyncio.to_thread(compute.band, *key)
+        # debounce: let the quick plots of this change reach the browser first, and skip
+        # bands that a further change (a dragged slider) has already superseded
+        await asyncio.sleep(DEBOUNCE_S)
+        if self._pending != key:
+            return
+        try:
+            res = await asyncio.to_thread(compute.band, *key)
+        except Exception as exc:  # show the core's message instead of a silent spinner
+            if self._pending == key:
+                self.busy = False
+                if pn.state.notifications is not None:
+                    pn.state.notifications.error(f"Scatter band failed: {exc}", duration=8000)
+            raise
         if self._pending != key:  # settings changed while computing: a newer task is running
             return
         self.param.update(result=res, seconds=time.perf_counter() - t0, busy=False)
@@ -83,47 +97,35 @@ class ScatterBandView(Viewer):
         return compute.single_round_data(res, self.noise.single_round, self.case.dof)
 
     # -- plot layers -------------------------------------------------------------------
-    def _bands(self, result, dof, percentile):
-        # own level dimension: the band's y range is not linked to the coupled-response plot
-        lvl, lvl2 = level_dim(dof, "band_level"), level_dim(dof, "band_level2", "Upper level")
+    # own level dimension (ranges are linked by label and unit): the band's y range is not
+    # tied to the coupled-response plot. Styles are set once on the DynamicMaps.
+    @staticmethod
+    def _dims(dof):
+        return (level_dim(dof, "band_level", "Band level"),
+                level_dim(dof, "band_level2", "Upper level"))
+
+    def _area(self, result, dof, percentile, which):
+        lvl, lvl2 = self._dims(dof)
+        label = "min-max corridor" if which == "minmax" else "percentile band"
         if result is None:
-            e = ([], [], [])
-            return (hv.Area(e, FREQ, [lvl, lvl2], label="min-max corridor").opts(
-                        hooks=[name_source("scatter.minmax")])
-                    * hv.Area(e, FREQ, [lvl, lvl2], label="percentile band").opts(
-                        hooks=[name_source("scatter.percentile")])
-                    * hv.Curve(([], []), FREQ, lvl, label="unpolluted").opts(
-                        hooks=[name_source("scatter.reference")]))
+            return hv.Area(([], [], []), FREQ, [lvl, lvl2], label=label)
         d = compute.band_data(result, dof, percentile)
-        return (
-            hv.Area((d["freq"], d["minimum_db"], d["maximum_db"]), FREQ, [lvl, lvl2],
-                    label="min-max corridor").opts(
-                color=COLORS["band"], alpha=0.35, line_alpha=0,
-                hooks=[name_source("scatter.minmax")],
-                hover_tooltips=[("min-max corridor", ""), ("Frequency", "$x{0.0} Hz"),
-                                ("Level", "$y{0.0} dB")])
-            * hv.Area((d["freq"], d["lower_db"], d["upper_db"]), FREQ, [lvl, lvl2],
-                      label="percentile band").opts(
-                color=COLORS["percentile"], alpha=0.45, line_alpha=0,
-                hooks=[name_source("scatter.percentile")],
-                hover_tooltips=[(f"central {percentile} % band", ""),
-                                ("Frequency", "$x{0.0} Hz"), ("Level", "$y{0.0} dB")])
-            * hv.Curve((d["freq"], d["reference_db"]), FREQ, lvl, label="unpolluted").opts(
-                color=COLORS["reference"], hooks=[name_source("scatter.reference")],
-                hover_tooltips=[("Frequency", "@freq{0.0} Hz"), ("Level", "@band_level{0.0} dB")])
-        )
+        lo, hi = ("minimum_db", "maximum_db") if which == "minmax" else ("lower_db", "upper_db")
+        return hv.Area((d["freq"], d[lo], d[hi]), FREQ, [lvl, lvl2], label=label)
+
+    def _reference(self, result, dof):
+        lvl, _ = self._dims(dof)
+        if result is None:
+            return hv.Curve(([], []), FREQ, lvl, label="unpolluted")
+        d = compute.band_data(result, dof)
+        return hv.Curve((d["freq"], d["reference_db"]), FREQ, lvl, label="unpolluted")
 
     def _round(self, result, dof, single_round):
-        lvl = level_dim(dof, "band_level")
+        lvl, _ = self._dims(dof)
         if result is None:
-            return hv.Curve(([], []), FREQ, lvl, label="single round").opts(
-                hooks=[name_source("scatter.round")])
+            return hv.Curve(([], []), FREQ, lvl, label="single round")
         d = compute.single_round_data(result, single_round, dof)
-        return hv.Curve((d["freq"], d["round_db"]), FREQ, lvl,
-                        label="single round").opts(
-            color=COLORS["round"], line_width=1.5, hooks=[name_source("scatter.round")],
-            hover_tooltips=[("Round", str(single_round)), ("Frequency", "@freq{0.0} Hz"),
-                            ("Level", "@band_level{0.0} dB")])
+        return hv.Curve((d["freq"], d["round_db"]), FREQ, lvl, label="single round")
 
     @param.depends("busy", "seconds", "result")
     def _status(self):
@@ -141,28 +143,47 @@ class ScatterBandView(Viewer):
 
     def __panel__(self):
         c, n = self.case, self.noise
-        bands = hv.DynamicMap(self._bands, streams=[
-            hv.streams.Params(self, ["result"]), hv.streams.Params(c, ["dof"]),
-            hv.streams.Params(n, ["percentile"])])
+        def res():
+            return hv.streams.Params(self, ["result"])
+
+        def dof():
+            return hv.streams.Params(c, ["dof"])
+
+
+        area_tips = [("Frequency", "$x{0.0} Hz"), ("Level", "$y{0.0} dB")]
+        curve_tips = [("Frequency", "@freq{0.0} Hz"), ("Level", "@band_level{0.0} dB")]
+        area = dict(responsive=True, min_height=320, framewise=True, tools=["hover"],
+                    line_alpha=0)
+        minmax = hv.DynamicMap(
+            lambda result, dof, percentile: self._area(result, dof, percentile, "minmax"),
+            streams=[res(), dof(), hv.streams.Params(n, ["percentile"])]).opts(
+            color=COLORS["band"], alpha=0.35, hooks=[name_source("scatter.minmax")],
+            hover_tooltips=[("", "min-max corridor"), *area_tips], **area)
+        pct = hv.DynamicMap(
+            lambda result, dof, percentile: self._area(result, dof, percentile, "pct"),
+            streams=[res(), dof(), hv.streams.Params(n, ["percentile"])]).opts(
+            color=COLORS["percentile"], alpha=0.45, hooks=[name_source("scatter.percentile")],
+            hover_tooltips=[("", "central percentile band"), *area_tips], **area)
+        ref = hv.DynamicMap(self._reference, streams=[res(), dof()]).opts(
+            color=COLORS["reference"], hooks=[name_source("scatter.reference")],
+            hover_tooltips=[("", "unpolluted"), *curve_tips], **CURVE_OPTS)
         single = hv.DynamicMap(self._round, streams=[
-            hv.streams.Params(self, ["result"]), hv.streams.Params(c, ["dof"]),
-            hv.streams.Params(n, ["single_round"])])
+            res(), dof(), hv.streams.Params(n, ["single_round"])]).opts(
+            color=COLORS["round"], line_width=1.5, hooks=[name_source("scatter.round")],
+            hover_tooltips=[("", "single round"), *curve_tips],
+            **{k: v for k, v in CURVE_OPTS.items() if k != "line_width"})
         # click on the plot: show the round with the highest level at that frequency
         tap = hv.streams.Tap(source=single, x=None, y=None)
         tap.add_subscriber(self._pick_peak_round)
-        plot = (bands * single).opts(
-            hv.opts.Curve(**CURVE_OPTS), hv.opts.Area(responsive=True, min_height=320,
-                                                      framewise=True, tools=["hover"]),
+        plot = (minmax * pct * ref * single).opts(
             hv.opts.Overlay(legend_position="bottom_left",
-                            title="Scatter band: noise in the subsystem FRFs"))
+                            title="Click a frequency: the round with the highest level there"))
         progress = pn.indicators.Progress(
             active=True, bar_color="primary", width=160, height=12,
             visible=self.param.busy, css_classes=["scatter-progress"], margin=(12, 10))
         dl = download_button("scatter", self._csv_columns, self._meta, self._filename)
         return pn.Column(
-            pn.Row(pn.pane.Markdown("Click a frequency to draw the round with the highest "
-                                    "level there (figs. 5.10-5.11).", margin=(0, 10)),
-                   progress, self._status,
+            pn.Row(progress, self._status,
                    pn.layout.HSpacer(), dl),
             pn.pane.HoloViews(plot, sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",

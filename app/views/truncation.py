@@ -32,18 +32,11 @@ class TruncationView(Viewer):
         d = compute.error_map_data(harmonic, coupling, dof if map_mode == "selected DOF" else None)
         what = f"bushing:{dof}" if map_mode == "selected DOF" else "max over 6 DOFs"
         img = hv.Image((d["centre_freq"], d["n_modes"], d["error_pct"]), [FREQ, MODES], ERROR)
-        return img.opts(
-            cmap="inferno_r", clim=(0.0, float(threshold)), colorbar=True,
-            clabel=f"Error (%), capped at {threshold:g} %", responsive=True, min_height=320,
-            tools=["hover"], title=f"Truncation error, harmonic {harmonic}, {what}",
-            hover_tooltips=[("Centre frequency", "$x{0.0} Hz"), ("N", "$y{0}"),
-                            ("Error", "@image{0.0} %")],
-            hooks=[name_source("truncation.map")], framewise=True,
-        )
+        return img.opts(clim=(0.0, float(threshold)), title=f"Harmonic {harmonic}, {what}",
+                        clabel=f"Error (%), capped at {threshold:g} %")
 
     def _chosen(self, n_modes):
-        return hv.HLine(float(n_modes), label="chosen N").opts(
-            color=COLORS["round"], line_width=2)
+        return hv.HLine(float(n_modes), label="chosen N")
 
     def _suggested(self, harmonic, coupling, dof, threshold, f_max, map_mode):
         tab = compute.suggested_table(float(threshold), float(f_max), coupling,
@@ -56,8 +49,13 @@ class TruncationView(Viewer):
         c, t = self.case, self.truncation
         img = hv.DynamicMap(self._map, streams=[
             hv.streams.Params(c, ["harmonic", "coupling", "dof"]),
-            hv.streams.Params(t, ["map_mode", "threshold"])])
-        chosen = hv.DynamicMap(self._chosen, streams=[hv.streams.Params(c, ["n_modes"])])
+            hv.streams.Params(t, ["map_mode", "threshold"])]).opts(
+            cmap="inferno_r", colorbar=True, responsive=True, min_height=320, tools=["hover"],
+            hover_tooltips=[("Centre frequency", "$x{0.0} Hz"), ("N", "$y{0}"),
+                            ("Error", "@image{0.0} %")],
+            hooks=[name_source("truncation.map")], framewise=True)
+        chosen = hv.DynamicMap(self._chosen, streams=[hv.streams.Params(c, ["n_modes"])]).opts(
+            color=COLORS["round"], line_width=2)
         sugg = hv.DynamicMap(self._suggested, streams=[
             hv.streams.Params(c, ["harmonic", "coupling", "dof"]),
             hv.streams.Params(t, ["threshold", "f_max", "map_mode"])])
@@ -65,9 +63,9 @@ class TruncationView(Viewer):
                              lambda: f"truncation_map_h{c.harmonic}_{self._what()}.csv")
         return pn.Column(
             pn.Row(pn.pane.Markdown(
-                "Eq. 5.1 error in a floating 12 Hz band against all modes; black: at or above "
-                "the threshold. Solid line: chosen N; dashed: suggested N up to the dotted "
-                "frequency.", margin=(0, 10), styles={"color": "#495057"}),
+                "Error vs all modes, 12 Hz floating band; black: at or above the threshold. "
+                "Solid: chosen N; dashed: suggested N up to the dotted frequency.",
+                margin=(0, 10), styles={"color": "#495057", "font-size": "0.9em"}),
                 pn.layout.HSpacer(), dl),
             pn.pane.HoloViews(img * sugg * chosen, sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
@@ -121,7 +119,9 @@ class SuggestedModesView(Viewer):
             sizing_mode="stretch_width", css_classes=["suggested-table"],
             layout="fit_data_stretch", theme="bootstrap5")
 
-        def refresh(*_):
+        def refresh(*events):
+            if all(e.name == "dof" for e in events) and t.map_mode != "selected DOF":
+                return  # the table judges the maximum over DOFs: nothing to do
             table.value = self.table_frame()
 
         t.param.watch(refresh, ["threshold", "f_max", "map_mode"])
@@ -177,7 +177,7 @@ class EigenView(Viewer):
         return hv.Overlay(layers)
 
     def _marker(self, n_modes):
-        return hv.VLine(float(n_modes)).opts(color=COLORS["round"], line_width=2)
+        return hv.VLine(float(n_modes))
 
     def __panel__(self):
         d = self.data()
@@ -185,16 +185,17 @@ class EigenView(Viewer):
             hv.opts.Curve(**{**CURVE_OPTS, "framewise": False}),
             hv.opts.Overlay(legend_position="top_left", title="Eigenfrequency vs mode number",
                             logy=False))
-        marker = hv.DynamicMap(self._marker, streams=[hv.streams.Params(self.case, ["n_modes"])])
+        marker = hv.DynamicMap(self._marker, streams=[
+            hv.streams.Params(self.case, ["n_modes"])]).opts(color=COLORS["round"], line_width=2)
         dl = download_button(
             "eigen", lambda: {"n_modes": d["n_modes"], "f_20kmh_Hz": d["f_20"],
                               "f_80kmh_Hz": d["f_80"], "f_120kmh_Hz": d["f_120"]},
             lambda: {"view": "highest retained eigenfrequency vs N (thesis fig. 5.8)"},
             lambda: "eigenfrequency_vs_modes.csv")
         return pn.Column(
-            pn.Row(pn.pane.Markdown("Highest eigenfrequency among N retained modes (N/2 "
-                                    "pairs), thesis fig. 5.8.", margin=(0, 10),
-                                    styles={"color": "#495057"}),
+            pn.Row(pn.pane.Markdown("Highest eigenfrequency among N retained modes "
+                                    "(N/2 +/- pairs, lowest first).", margin=(0, 10),
+                                    styles={"color": "#495057", "font-size": "0.9em"}),
                    pn.layout.HSpacer(), dl),
             pn.pane.HoloViews(static * marker, sizing_mode="stretch_both", min_height=300),
             sizing_mode="stretch_both",

@@ -148,6 +148,13 @@ def fingerprint(page, name: str) -> str | None:
     return page.evaluate(JS_FINGERPRINT, name)
 
 
+def open_dashboard(page, url: str, timeout=180_000):
+    """Navigate and wait until every view holds data (the first page of a fresh server also
+    loads the reference models and builds the truncation maps: generous timeout)."""
+    page.goto(url, timeout=timeout, wait_until="commit")
+    wait_loaded(page, timeout=timeout)
+
+
 def wait_loaded(page, names=SOURCES, timeout=90_000):
     """Wait until the Bokeh document exists and every named source holds data."""
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0", timeout=timeout)
@@ -169,6 +176,14 @@ def wait_changed(page, name: str, before: str, timeout=30_000):
         f"([name, before]) => ({JS_FINGERPRINT})(name) !== before",
         arg=[name, before], timeout=timeout,
     )
+
+
+def wait_band_idle(page, timeout=120_000):
+    """Wait until no scatter band is being computed (its progress bar is hidden)."""
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
+        "m.css_classes.includes('scatter-progress')).every(m => m.visible === false)",
+        timeout=timeout, polling=50)
 
 
 def set_model_value(page, css_class: str, value, model_type: str | None = None):
@@ -228,7 +243,6 @@ def shared_page(browser, dashboard):
     page.errors = []
     page.on("console", lambda m: m.type == "error" and page.errors.append(m.text))
     page.on("pageerror", lambda e: page.errors.append(str(e)))
-    page.goto(dashboard.url + "?rounds=1000")
-    wait_loaded(page)
+    open_dashboard(page, dashboard.url + "?rounds=1000")
     yield page
     context.close()

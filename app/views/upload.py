@@ -1,0 +1,110 @@
+"""Bring your own data: upload a chassis FRF file or a modal tire model for this session.
+
+The files go to the session's :class:`~app.datasource.DataSource` (read with
+:mod:`fbs_core.io`, checked, never written anywhere); the page shows what was read
+(quantity, DOFs, frequency range, operating points) or why the file was refused. A refused
+file changes nothing; "Use reference data" goes back to the shipped models.
+"""
+
+from __future__ import annotations
+
+import panel as pn
+import param
+from panel.viewable import Viewer
+
+from ..datasource import CHASSIS_ACCEPT, TIRE_ACCEPT, DataSource
+
+HELP = (
+    "Chassis FRF: UFF 58 (.uff/.unv), MATLAB (.mat), CSV or HDF5 (.h5), layouts in "
+    "docs/file-formats.md; it must hold the six spindle DOFs (outputs and inputs) and the "
+    "six bushing outputs. Name the spindle and bushing nodes (a node name, or a UFF node "
+    "number). Modal tire model: the project's .h5 format or MATLAB .mat. Uploads stay in "
+    "this browser session."
+)
+
+
+class UploadView(Viewer):
+    """File inputs for a chassis FRF and a tire model, the import summary or the error."""
+
+    data = param.ClassSelector(class_=DataSource, doc="The session's data source.")
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        ds = self.data
+        W = pn.widgets
+        self.chassis_file = W.FileInput(accept=CHASSIS_ACCEPT, multiple=False,
+                                        css_classes=["upload-chassis"], sizing_mode="fixed",
+                                        width=260)
+        self.tire_file = W.FileInput(accept=TIRE_ACCEPT, multiple=False,
+                                     css_classes=["upload-tire"], sizing_mode="fixed",
+                                     width=260)
+        self.spindle = W.TextInput.from_param(ds.param.spindle, name="Spindle node",
+                                              width=120, css_classes=["upload-spindle"])
+        self.bushing = W.TextInput.from_param(ds.param.bushing, name="Bushing node",
+                                              width=120, css_classes=["upload-bushing"])
+        self.interpolate = W.Checkbox.from_param(
+            ds.param.interpolate, name="Interpolate onto the analysis grid (linear Re/Im)",
+            css_classes=["upload-interpolate"])
+        self.reread = W.Button(name="Read chassis again", button_type="light", width=150,
+                               css_classes=["upload-reread"])
+        self.reset = W.Button(name="Use reference data", button_type="warning", width=160,
+                              css_classes=["upload-reset"])
+        self.chassis_file.param.watch(self._on_chassis, "value")
+        self.tire_file.param.watch(self._on_tire, "value")
+        self.reread.on_click(lambda _: self._run(ds.load_chassis))
+        self.reset.on_click(lambda _: ds.reset())
+
+    # -- actions (each a call into the data source; errors land in ``data.error``) --------
+    def _run(self, fn, *args):
+        self._busy(True)
+        try:
+            fn(*args)
+        finally:
+            self._busy(False)
+
+    def _busy(self, on: bool):
+        for w in (self.chassis_file, self.tire_file, self.reread, self.reset):
+            w.disabled = on
+
+    def _on_chassis(self, event):
+        if event.new:
+            self._run(self.data.load_chassis, event.new, self.chassis_file.filename)
+
+    def _on_tire(self, event):
+        if event.new:
+            self._run(self.data.load_tire, event.new, self.tire_file.filename)
+
+    # -- display -----------------------------------------------------------------------
+    @param.depends("data.models", "data.tire_summary", "data.chassis_summary")
+    def _summary(self):
+        ds = self.data
+        parts = [f"**In use: {ds.describe()}**"]
+        for title, text in (("Chassis", ds.chassis_summary), ("Tire", ds.tire_summary)):
+            if text and ((title == "Chassis" and ds.models.chassis is not None)
+                         or (title == "Tire" and ds.models.tire is not None)):
+                parts.append(f"{title}:\n```\n{text}\n```")
+        kind = "success" if not ds.models.is_reference else "secondary"
+        return pn.pane.Alert("\n\n".join(parts), alert_type=kind, margin=(4, 5),
+                             css_classes=["upload-summary"], sizing_mode="stretch_width")
+
+    @param.depends("data.error")
+    def _error(self):
+        return pn.pane.Alert(
+            f"**File refused, nothing changed.** {self.data.error}", alert_type="danger",
+            visible=bool(self.data.error), margin=(4, 5), css_classes=["upload-error"],
+            sizing_mode="stretch_width")
+
+    def __panel__(self):
+        label = pn.pane.Markdown
+        return pn.Column(
+            label(HELP, margin=(0, 10), styles={"color": "#495057", "font-size": "0.9em"}),
+            pn.Row(
+                pn.Column(label("**Chassis FRF**", margin=(0, 5)), self.chassis_file,
+                          pn.Row(self.spindle, self.bushing), self.interpolate, self.reread),
+                pn.Column(label("**Modal tire model**", margin=(0, 5)), self.tire_file),
+                pn.Column(label("&nbsp;", margin=(0, 5)), self.reset),
+            ),
+            self._error,
+            self._summary,
+            sizing_mode="stretch_width",
+        )

@@ -1,0 +1,200 @@
+"""Browser-measured latency of the dashboard (issue 6), figures printed.
+
+Starts ``panel serve app/main.py`` (as ``scripts/serve.sh`` does: ``--num-threads``,
+``--warm``), opens it in chromium (playwright) and measures inside the page, with
+``performance.now()``, the time from a control change to the updated plot data in the Bokeh
+document (the named ColumnDataSource of the view):
+
+- retained modes N, harmonic and response DOF: median and 95th percentile;
+- the scatter band with R rounds (default 10,000): a new seed until the band's data change;
+- server start: process launch to "app running", and to the first rendered plot.
+
+Usage::
+
+    .venv/bin/python bench/bench_dashboard.py [--rounds 10000] [--samples 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import queue
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+from playwright.sync_api import sync_playwright
+
+ROOT = Path(__file__).resolve().parents[1]
+CHROMIUM = "/usr/bin/chromium"
+ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--no-first-run", "--disable-sync"]
+
+# Set a widget model's value (or click a radio button) and resolve with the milliseconds
+# until the named source's data differ (polled every 2 ms).
+JS_MEASURE = """
+async ([kind, cls, value, name, timeout]) => {
+  const models = () => [...Bokeh.documents[0]._all_models.values()];
+  const src = () => models().filter(m => m.name === name && m.type === 'ColumnDataSource')[0];
+  const fp = () => { const d = src().data; let s = '';
+    for (const [k, v] of Object.entries(d)) { const a = k === 'image' ? v[0] : v;
+      let t = 0, i = 0; for (const x of a) { if (Number.isFinite(x)) t += x * (1 + i % 7); i++; }
+      s += k + i + ':' + t + ';'; } return s; };
+  const before = fp();
+  const t0 = performance.now();
+  if (kind === 'value') {
+    const w = models().filter(m => m.css_classes && m.css_classes.includes(cls)
+                              && 'value' in m && m.type === 'Slider')[0];
+    w.value = value;
+  } else {
+    const w = models().filter(m => m.css_classes && m.css_classes.includes(cls)
+                              && 'active' in m)[0];
+    w.active = value;
+  }
+  return await new Promise((resolve, reject) => {
+    const check = () => {
+      const dt = performance.now() - t0;
+      if (fp() !== before) resolve(dt);
+      else if (dt > timeout) reject(new Error('no change of ' + name));
+      else setTimeout(check, 2);
+    };
+    check();
+  });
+}
+"""
+
+JS_READY = """(name) => { if (!(window.Bokeh && Bokeh.documents.length)) return false;
+  const m = [...Bokeh.documents[0]._all_models.values()].filter(
+      m => m.name === name && m.type === 'ColumnDataSource')[0];
+  if (!m) return false; const k = Object.keys(m.data)[0];
+  return k !== undefined && m.data[k].length > 0; }"""
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start_server(port: int, threads: int, warm: bool):
+    cmd = [sys.executable, "-m", "panel", "serve", "app/main.py", "--port", str(port),
+           "--address", "127.0.0.1", "--num-threads", str(threads)]
+    if warm:
+        cmd.append("--warm")
+    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    ready: queue.Queue = queue.Queue()
+
+    def pump():
+        for line in proc.stdout:
+            if "Bokeh app running at" in line:
+                ready.put(time.perf_counter())
+        ready.put(None)
+
+    threading.Thread(target=pump, daemon=True).start()
+    return proc, ready
+
+
+def stats(ms: list[float]) -> str:
+    a = np.asarray(ms)
+    return (f"median {np.median(a):7.0f} ms   p95 {np.percentile(a, 95):7.0f} ms   "
+            f"min {a.min():6.0f}   max {a.max():6.0f}   (n={a.size})")
+
+
+def wait_band_idle(page, timeout=300_000):
+    """Wait until no scatter band is being computed (its progress bar is hidden)."""
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
+        "m.css_classes.includes('scatter-progress')).every(m => m.visible === false)",
+        timeout=timeout, polling=50)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=10_000)
+    ap.add_argument("--samples", type=int, default=20)
+    ap.add_argument("--threads", type=int, default=4)
+    ap.add_argument("--no-warm", action="store_true")
+    args = ap.parse_args()
+
+    launch = {"args": ARGS}
+    if Path(CHROMIUM).exists():
+        launch["executable_path"] = CHROMIUM
+    print(f"cores: {os.cpu_count()}, load average: {os.getloadavg()[0]:.1f}; "
+          f"rounds R = {args.rounds:,}; --num-threads {args.threads}"
+          f"{'' if args.no_warm else ' --warm'}")
+    with sync_playwright() as p:
+        browser = p.chromium.launch(**launch)
+        page = browser.new_page(viewport={"width": 1600, "height": 1200})
+        port = free_port()
+        t0 = time.perf_counter()
+        proc, ready = start_server(port, args.threads, not args.no_warm)
+        try:
+            t_ready = ready.get(timeout=600)
+            if t_ready is None:
+                raise RuntimeError("server did not start")
+            page.goto(f"http://127.0.0.1:{port}/main?rounds={args.rounds}")
+            page.wait_for_function(JS_READY, arg="mobility.truncated", timeout=300_000)
+            t_plot = time.perf_counter()
+            page.wait_for_function(JS_READY, arg="scatter.minmax", timeout=600_000)
+            t_band = time.perf_counter()
+            print(f"server start -> app running:          {t_ready - t0:6.1f} s")
+            print(f"server start -> first rendered plot:  {t_plot - t0:6.1f} s "
+                  f"(page request -> plot {t_plot - t_ready:.1f} s)")
+            print(f"server start -> scatter band shown:   {t_band - t0:6.1f} s")
+            wait_band_idle(page)
+
+            def measure(kind, cls, values, name):
+                out = []
+                for v in values:
+                    out.append(page.evaluate(JS_MEASURE, [kind, cls, v, name, 120_000]))
+                    wait_band_idle(page)  # the next sample starts from a settled page
+                return out
+
+            n = args.samples
+            modes = [int(i) for i in np.resize(np.arange(1, 20), n)]  # index: N = 20 ... 200
+            res = {
+                "modes N (mobility.truncated)":
+                    measure("value", "ctl-case-n_modes", modes, "mobility.truncated"),
+                "harmonic (mobility.truncated)":
+                    measure("value", "ctl-case-harmonic",
+                            [int(h) for h in np.resize([2, 3, 4, 5, 6, 7, 1], n)],
+                            "mobility.truncated"),
+                "response DOF (mobility.truncated)":
+                    measure("active", "ctl-case-dof",
+                            [int(d) for d in np.resize([0, 1, 3, 4, 5, 2], n)],
+                            "mobility.truncated"),
+            }
+            for k, v in res.items():
+                print(f"{k:36s} {stats(v)}")
+            # scatter band: a new seed forces a new band of R rounds
+            band = []
+            for seed in range(1, 6):
+                t = page.evaluate(
+                    """async ([seed]) => {
+                      const ms = [...Bokeh.documents[0]._all_models.values()];
+                      const w = ms.filter(m => m.css_classes &&
+                          m.css_classes.includes('ctl-noise-seed') && 'value' in m)[0];
+                      const src = ms.filter(m => m.name === 'scatter.minmax')[0];
+                      const before = src.data.y[3];
+                      const t0 = performance.now(); w.value = seed;
+                      return await new Promise(r => { const c = () => {
+                        if (src.data.y[3] !== before) r(performance.now() - t0);
+                        else setTimeout(c, 5); }; c(); });
+                    }""", [seed])
+                band.append(t)
+                wait_band_idle(page)
+            print(f"{'scatter band R=' + format(args.rounds, ','):36s} {stats(band)}")
+        finally:
+            proc.terminate()
+            proc.wait(timeout=20)
+            browser.close()
+    print(f"load average at the end: {os.getloadavg()[0]:.1f}")
+
+
+if __name__ == "__main__":
+    main()
