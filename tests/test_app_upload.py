@@ -1,0 +1,195 @@
+"""Uploads without a browser: the session's data source, the upload view, the views' data.
+
+Truth: the uploaded chassis is the reference chassis' own mobility with changed numbers
+(scaled by 2, nodes renumbered), so what the views show must be the core's prediction with
+that FRF as chassis (a second path into ``fbs_core``), the uncoupled chassis curve must be
+exactly 6.02 dB above the reference one, and the same FRF unscaled must give back the
+reference views.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fbs_core
+from app.datasource import REFERENCE, DataSource
+from app.views.upload import UploadView
+from fbs_core.io import save_frf
+from fbs_core.tire.model import TireModel
+from fbs_core.tire.storage import save_tire_model
+
+ROOT = Path(__file__).resolve().parents[1]
+#: The union of the seven harmonics' analysis grids (0.5 Hz lattice, 13-422 Hz).
+GRID = np.arange(13.0, 422.01, 0.5)
+
+
+def _renumber(Y, scale=1.0, spindle="3", bushing="8"):
+    ren = {"spindle": spindle, "bushing": bushing}
+    lab = [ren[x.split(":")[0]] + ":" + x.split(":")[1] for x in Y.outputs]
+    inp = [ren[x.split(":")[0]] + ":" + x.split(":")[1] for x in Y.inputs]
+    return Y.replace(data=Y.data * scale, outputs=lab, inputs=inp)
+
+
+@pytest.fixture(scope="module")
+def chassis_frf():
+    """The reference chassis' mobility on every harmonic's lines."""
+    return fbs_core.reference_chassis().mobility(GRID)
+
+
+@pytest.fixture(scope="module")
+def doubled_mat(chassis_frf):
+    """A MATLAB file of the reference chassis mobility times 2, nodes numbered 3 and 8."""
+    return save_frf(_renumber(chassis_frf, 2.0), format="mat")
+
+
+def _data_hashes():
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted((ROOT / "data").iterdir()) if p.is_file()}
+
+
+def _tire_bytes(tmp_path, model, name="tire.h5"):
+    return save_tire_model(model, tmp_path / name).read_bytes()
+
+
+def _sub_tire(n_modes=None, speeds=slice(None)):
+    T = fbs_core.reference_tire()
+    m = slice(None) if n_modes is None else slice(0, n_modes)
+    return TireModel(T.speeds[speeds], T.poles[speeds, m], T.psi[speeds, m], T.chi[speeds, m],
+                     T.wavelengths, T.participation[speeds][:, :, m], meta={"source": "test"})
+
+
+# -- the chassis upload ----------------------------------------------------------------------
+def test_chassis_upload_with_node_numbers_replaces_the_chassis(chassis_frf, doubled_mat):
+    ds = DataSource()
+    assert ds.models is REFERENCE
+    # nodes numbered 3 and 8 in the file: the default names are refused with the file's nodes
+    assert not ds.load_chassis(doubled_mat, "chassis.mat")
+    assert "3, 8" in ds.error and ds.models is REFERENCE
+    assert ds.load_chassis(doubled_mat, "chassis.mat", spindle="3", bushing="8"), ds.error
+    assert ds.error == "" and ds.models.chassis is not None and ds.models.tire is None
+    # what was read is shown: quantity, DOFs, frequency range
+    s = ds.chassis_summary
+    assert "mobility" in s and "bushing:rz" in s and "spindle:x" in s
+    assert "13" in s and "422" in s
+    f = fbs_core.harmonic(3).frequencies()
+    got = ds.models.chassis.mobility(f)
+    want = fbs_core.reference_chassis().mobility(f)
+    assert got.outputs == want.outputs and got.inputs == want.inputs
+    np.testing.assert_allclose(got.data, 2.0 * want.data, rtol=1e-12)
+
+
+def test_bad_bytes_show_an_error_and_change_nothing(doubled_mat):
+    ds = DataSource()
+    assert ds.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    before = (ds.models, ds.chassis_summary, ds.tire_summary)
+    for raw, name, words in [
+        (b"\x00garbage" * 50, "chassis.uff", "chassis.uff"),
+        (b"PK\x03\x04" + bytes(200), "chassis.mat", "chassis.mat"),
+        (doubled_mat[: len(doubled_mat) // 2], "cut.mat", "cut.mat"),
+        (b"", "empty.csv", "empty"),
+    ]:
+        assert not ds.load_chassis(raw, name, spindle="3", bushing="8")
+        assert words in ds.error
+        assert (ds.models, ds.chassis_summary, ds.tire_summary) == before
+        assert not ds.load_tire(raw, name)
+        assert (ds.models, ds.chassis_summary, ds.tire_summary) == before
+
+
+def test_missing_bushing_dof_is_named(chassis_frf):
+    Y = _renumber(chassis_frf, 1.0, "spindle", "bushing")
+    Y = Y.sel(outputs=[o for o in Y.outputs if o != "bushing:rz"])
+    ds = DataSource()
+    assert not ds.load_chassis(save_frf(Y, format="mat"), "five.mat")
+    assert "bushing:rz" in ds.error and ds.models is REFERENCE
+
+
+def test_other_grid_needs_an_explicit_interpolation(chassis_frf):
+    coarse = chassis_frf.isel(freq=slice(0, None, 2)).crop(None, 422.0)  # 1 Hz lines
+    raw = save_frf(coarse, format="hdf5")
+    ds = DataSource()
+    assert not ds.load_chassis(raw, "coarse.h5")
+    assert "interpolate" in ds.error and ds.models is REFERENCE
+    assert ds.load_chassis(raw, "coarse.h5", interpolate=True), ds.error
+    assert "interpolated" in ds.chassis_summary
+    f = fbs_core.harmonic(1).frequencies()  # 13.0, 13.5, ... : every other line is new
+    got = ds.models.chassis.mobility(f).data
+    on = np.isin(f, coarse.freq)
+    np.testing.assert_allclose(got[on], chassis_frf.data[np.isin(GRID, f[on])], rtol=1e-12)
+    # linear in real and imaginary part between the neighbouring lines
+    k = np.flatnonzero(~on)[0]
+    lo = coarse.data[np.flatnonzero(coarse.freq == f[k] - 0.5)[0]]
+    hi = coarse.data[np.flatnonzero(coarse.freq == f[k] + 0.5)[0]]
+    np.testing.assert_allclose(got[k], 0.5 * (lo + hi), rtol=1e-12)
+
+
+# -- the tire upload -------------------------------------------------------------------------
+def test_tire_upload_shows_modes_and_operating_points(tmp_path):
+    ds = DataSource()
+    assert ds.load_tire(_tire_bytes(tmp_path, _sub_tire(n_modes=200)), "supplier.h5"), ds.error
+    assert ds.models.tire.n_modes == 200 and ds.models.chassis is None
+    s = ds.tire_summary
+    assert "200 complex modes" in s and "20, 40, 60, 80, 100, 120 km/h" in s
+    assert "0.646" in s  # wavelengths of the harmonic cases
+
+
+def test_tire_without_the_harmonics_operating_points_is_refused(tmp_path):
+    ds = DataSource()
+    # operating points from 60 km/h: the harmonics need 30 km/h
+    assert not ds.load_tire(_tire_bytes(tmp_path, _sub_tire(speeds=slice(2, None))), "t.h5")
+    assert "outside the operating points" in ds.error and "harmonic 1" in ds.error
+    assert ds.models is REFERENCE
+
+
+def test_reset_goes_back_to_the_reference(tmp_path, doubled_mat):
+    ds = DataSource()
+    assert ds.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    assert ds.load_tire(_tire_bytes(tmp_path, _sub_tire(n_modes=100)), "t.h5")
+    assert ds.models.tire is not None and ds.models.chassis is not None
+    ds.reset()
+    assert ds.models is REFERENCE and ds.chassis_summary == ds.tire_summary == ""
+
+
+# -- sessions and the shipped data -----------------------------------------------------------
+def test_two_sessions_are_independent(doubled_mat):
+    a, b = DataSource(), DataSource()
+    assert a.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    assert b.models is REFERENCE and b.chassis_summary == "" and b.spindle == "spindle"
+    assert not b.load_chassis(b"junk", "x.csv")
+    assert a.error == "" and a.models.chassis is not None
+
+
+def test_uploads_never_touch_the_shipped_data(tmp_path, chassis_frf):
+    before = _data_hashes()
+    ds = DataSource()
+    # files named like the shipped ones, good and bad
+    raw = save_frf(_renumber(chassis_frf, 3.0, "spindle", "bushing"), format="hdf5")
+    assert ds.load_chassis(raw, "reference_chassis.h5"), ds.error
+    assert not ds.load_chassis(b"\x89HDF\r\n\x1a\n" + bytes(100), "reference_chassis.h5")
+    assert ds.load_tire(_tire_bytes(tmp_path, _sub_tire(n_modes=60)), "reference_tire.h5")
+    assert not ds.load_tire(b"not a tire", "reference_tire.h5")
+    ds.reset()
+    assert _data_hashes() == before
+
+
+# -- the upload view -------------------------------------------------------------------------
+def test_upload_view_shows_the_summary_or_the_error(doubled_mat):
+    ds = DataSource()
+    view = UploadView(data=ds)
+    view.__panel__().get_root()  # renders
+    view.spindle.value, view.bushing.value = "3", "8"
+    view.chassis_file.param.update(value=doubled_mat, filename="mine.mat")
+    assert ds.error == "" and ds.models.chassis_name == "mine.mat"
+    summary = view._summary()
+    assert summary.alert_type == "success" and "bushing:z" in summary.object
+    assert "uploaded chassis 'mine.mat'" in summary.object
+    assert not view._error().visible
+    view.tire_file.param.update(value=b"no tire here", filename="t.mat")
+    err = view._error()
+    assert err.visible and "t.mat" in err.object and "refused" in err.object
+    assert ds.models.chassis_name == "mine.mat" and ds.models.tire is None
+    view.reset.clicks += 1
+    assert ds.models is REFERENCE and not view._error().visible
