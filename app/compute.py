@@ -9,6 +9,11 @@ The coupled response for N retained modes is read from the harmonic's truncation
 (:func:`fbs_core.studies.truncation_map` computes the eq. 4.1 response for every
 N = 10, 20, ... at once with the modal model's cumulative truncation), so moving the N slider
 costs no new coupling.
+
+Every function takes the session's ``models`` (an :class:`app.datasource.Models` token:
+the uploaded tire and chassis, or None / the reference); the token is part of the cache key
+(it is hashed by a digest of the uploaded bytes), so uploads never mix with the reference
+results nor with each other's.
 """
 
 from __future__ import annotations
@@ -76,58 +81,83 @@ def frequencies(harmonic: int) -> np.ndarray:
     return f
 
 
-@lru_cache(maxsize=1)
-def _tire():
-    return fbs_core.reference_tire()
+def _key(models):
+    """``None`` for the reference models, else the (hashable) session models token."""
+    return None if models is None or models.is_reference else models
 
 
-@lru_cache(maxsize=1)
-def _chassis():
-    return fbs_core.reference_chassis()
+def _tire(models=None):
+    t = None if models is None else models.tire
+    return fbs_core.reference_tire() if t is None else t
+
+
+def _chassis(models=None):
+    c = None if models is None else models.chassis
+    return fbs_core.reference_chassis() if c is None else c
+
+
+def _models_kw(models) -> dict:
+    """``tire=`` / ``chassis=`` for the core (None keeps the core's reference caches)."""
+    return {} if models is None else {"tire": models.tire, "chassis": models.chassis}
+
+
+def _n(models, n_modes):
+    """A retained-mode count the session's tire has (``None``: all of its modes)."""
+    if n_modes is None or int(n_modes) >= _tire(models).n_modes:
+        return None
+    return int(n_modes)
 
 
 # -- truncation study and coupled response ---------------------------------------------------
-@lru_cache(maxsize=16)
-def error_map(harmonic: int, coupling: str):
+def error_map(harmonic: int, coupling: str, models=None):
     """Truncation error map of a harmonic (thesis figs. 5.3, 5.6, 5.7), cached.
 
     Holds the coupled responses for every N of the map and the all-modes reference too.
     The counts are 10, 20, ... below the tire's total (the total is the reference itself).
     """
-    n_total = int(_tire().n_modes)
+    return _error_map(int(harmonic), coupling, _key(models))
+
+
+@lru_cache(maxsize=24)
+def _error_map(harmonic: int, coupling: str, models):
+    n_total = int(_tire(models).n_modes)
     return studies.truncation_map(harmonic, n_modes=np.arange(10, n_total, 10),
-                                  coupling=coupling)
+                                  coupling=coupling, **_models_kw(models))
 
 
 @lru_cache(maxsize=64)
-def _bushing_response(harmonic: int, n_modes: int | None, coupling: str) -> np.ndarray:
+def _bushing_response(harmonic: int, n_modes: int | None, coupling: str,
+                      models=None) -> np.ndarray:
     frf = fbs_core.bushing_response(harmonic, n_modes=n_modes, freq=frequencies(harmonic),
-                                    coupling=coupling)
+                                    coupling=coupling, **_models_kw(models))
     return np.stack([frf.sel(outputs=f"bushing:{d}").data[:, 0, 0]
                      for d in ("x", "y", "z", "rx", "ry", "rz")], axis=1)
 
 
-def coupled_response(harmonic: int, n_modes: int | None, coupling: str) -> np.ndarray:
+def coupled_response(harmonic: int, n_modes: int | None, coupling: str,
+                     models=None) -> np.ndarray:
     """Bushing velocity v_e* (eq. 4.1), shape ``(n_freq, 6)`` for ``bushing:x`` ... ``rz``.
 
     ``n_modes=None`` is the all-modes reference. Read from the cached truncation map when it
     holds that N, else computed with :func:`fbs_core.bushing_response`.
     """
-    m = error_map(harmonic, coupling)
+    models = _key(models)
+    m = error_map(harmonic, coupling, models)
     order = [m.dofs.index(f"bushing:{d}") for d in ("x", "y", "z", "rx", "ry", "rz")]
     if n_modes is None or (m.n_modes_total is not None and n_modes >= m.n_modes_total):
         return m.reference[:, order]
     hit = np.flatnonzero(m.n_modes == int(n_modes))
     if hit.size:
         return m.response[hit[0]][:, order]
-    return _bushing_response(harmonic, int(n_modes), coupling)
+    return _bushing_response(harmonic, int(n_modes), coupling, models)
 
 
 def _dof_index(dof: str) -> int:
     return ("x", "y", "z", "rx", "ry", "rz").index(dof)
 
 
-def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str) -> dict:
+def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str,
+                  models=None) -> dict:
     """Columns of the coupled-response view: reference (all modes) and truncated (N modes).
 
     Returns
@@ -137,10 +167,10 @@ def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str) -> dict:
         ``truncated_db`` (dB), each of shape ``(n_freq,)``.
     """
     j = _dof_index(dof)
-    ref = coupled_response(harmonic, None, coupling)[:, j]
-    trunc = coupled_response(harmonic, int(n_modes), coupling)[:, j]
+    ref = coupled_response(harmonic, None, coupling, models)[:, j]
+    trunc = coupled_response(harmonic, int(n_modes), coupling, models)[:, j]
     return {
-        "freq": np.asarray(error_map(harmonic, coupling).freq, float),
+        "freq": np.asarray(error_map(harmonic, coupling, models).freq, float),
         "reference": ref,
         "truncated": trunc,
         "reference_db": db(ref),
@@ -148,7 +178,7 @@ def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str) -> dict:
     }
 
 
-def error_map_data(harmonic: int, coupling: str, dof: str | None) -> dict:
+def error_map_data(harmonic: int, coupling: str, dof: str | None, models=None) -> dict:
     """Error in percent over retained modes and centre frequency.
 
     ``dof=None`` gives the maximum over the 6 bushing DOFs (fig. 5.6).
@@ -158,7 +188,7 @@ def error_map_data(harmonic: int, coupling: str, dof: str | None) -> dict:
     dict
         ``centre_freq`` (n_c,), ``n_modes`` (n_N,), ``error_pct`` (n_N, n_c).
     """
-    m = error_map(harmonic, coupling)
+    m = error_map(harmonic, coupling, models)
     err = m.max_error if dof is None else m.dof_error(f"bushing:{dof}")
     return {
         "centre_freq": np.asarray(m.centres, float),
@@ -167,16 +197,21 @@ def error_map_data(harmonic: int, coupling: str, dof: str | None) -> dict:
     }
 
 
-@lru_cache(maxsize=64)
 def suggested_table(threshold_pct: float, f_max: float, coupling: str,
-                    dof: str | None = None) -> dict:
+                    dof: str | None = None, models=None) -> dict:
     """Suggested number of modes for all seven harmonics (thesis table 5.1).
 
     ``dof=None`` judges the maximum error over the 6 DOFs (as the thesis' table).
     """
-    maps = [error_map(k, coupling) for k in range(1, 8)]
+    return _suggested_table(float(threshold_pct), float(f_max), coupling, dof, _key(models))
+
+
+@lru_cache(maxsize=64)
+def _suggested_table(threshold_pct, f_max, coupling, dof, models) -> dict:
+    maps = [error_map(k, coupling, models) for k in range(1, 8)]
     s = studies.suggest_modes(threshold=threshold_pct / 100.0, f_max=f_max, maps=maps,
-                              dof=None if dof is None else f"bushing:{dof}")
+                              dof=None if dof is None else f"bushing:{dof}",
+                              tire=None if models is None else models.tire)
     return {
         "harmonic": np.asarray(s.harmonics, int),
         "f_low": np.asarray(s.freq_range[:, 0], float),
@@ -187,10 +222,14 @@ def suggested_table(threshold_pct: float, f_max: float, coupling: str,
     }
 
 
-@lru_cache(maxsize=1)
-def eigen_curves() -> dict:
+def eigen_curves(models=None) -> dict:
     """Highest retained eigenfrequency versus N at 20, 80, 120 km/h (thesis fig. 5.8)."""
-    mf = studies.mode_frequencies(EIGEN_SPEEDS)
+    return _eigen_curves(_key(models))
+
+
+@lru_cache(maxsize=8)
+def _eigen_curves(models) -> dict:
+    mf = studies.mode_frequencies(EIGEN_SPEEDS, tire=None if models is None else models.tire)
     out = {"n_modes": np.asarray(mf.n_modes, int)}
     for v, row in zip(mf.speeds, mf.frequency, strict=True):
         out[f"f_{int(v)}"] = np.asarray(row, float)
@@ -199,16 +238,18 @@ def eigen_curves() -> dict:
 
 # -- uncoupled subsystems --------------------------------------------------------------------
 @lru_cache(maxsize=64)
-def _tire_hub(harmonic: int, n_modes: int | None):
-    return _tire().patch_response(frequencies(harmonic), fbs_core.harmonic(harmonic), n_modes)
+def _tire_hub(harmonic: int, n_modes: int | None, models=None):
+    return _tire(models).patch_response(frequencies(harmonic), fbs_core.harmonic(harmonic),
+                                        _n(models, n_modes))
 
 
 @lru_cache(maxsize=8)
-def _chassis_frf(harmonic: int):
-    return _chassis().mobility(frequencies(harmonic))
+def _chassis_frf(harmonic: int, models=None):
+    return _chassis(models).mobility(frequencies(harmonic))
 
 
-def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str) -> dict:
+def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str,
+                   models=None) -> dict:
     """Uncoupled subsystems (thesis figs. 4.6-4.7 and 4.2-4.3).
 
     Returns
@@ -218,9 +259,10 @@ def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str) ->
         ``hub:<dof>`` with all / N modes; ``chassis``: chassis mobility ``Y_ej^E`` from
         ``spindle:<spindle_input>`` to ``bushing:<dof>``; and their ``*_db`` columns.
     """
-    t_ref = _tire_hub(harmonic, None).sel(outputs=f"hub:{dof}").data[:, 0, 0]
-    t_tr = _tire_hub(harmonic, int(n_modes)).sel(outputs=f"hub:{dof}").data[:, 0, 0]
-    ch = _chassis_frf(harmonic).sel(
+    models = _key(models)
+    t_ref = _tire_hub(harmonic, None, models).sel(outputs=f"hub:{dof}").data[:, 0, 0]
+    t_tr = _tire_hub(harmonic, int(n_modes), models).sel(outputs=f"hub:{dof}").data[:, 0, 0]
+    ch = _chassis_frf(harmonic, models).sel(
         outputs=f"bushing:{dof}", inputs=f"spindle:{spindle_input}"
     ).data[:, 0, 0]
     return {
@@ -235,14 +277,21 @@ def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str) ->
 
 
 # -- noise study -----------------------------------------------------------------------------
-@lru_cache(maxsize=4)
 def band(harmonic: int, n_modes: int | None, coupling: str, noise_pct: float, target: str,
-         frequency_dependent: bool, rounds: int, seed: int):
+         frequency_dependent: bool, rounds: int, seed: int, models=None):
     """The Monte-Carlo scatter band (thesis 5.2), cached (a few results: they are large)."""
+    return _band(harmonic, n_modes, coupling, noise_pct, target, frequency_dependent, rounds,
+                 seed, _key(models))
+
+
+@lru_cache(maxsize=4)
+def _band(harmonic, n_modes, coupling, noise_pct, target, frequency_dependent, rounds, seed,
+          models):
     return studies.scatter_band(
         harmonic, noise=noise_pct / 100.0, target=target, rounds=rounds,
-        frequency_dependent=frequency_dependent, seed=seed, n_modes=n_modes,
-        coupling=coupling, percentiles=Q_LEVELS,
+        frequency_dependent=frequency_dependent, seed=seed,
+        n_modes=n_modes if models is None else _n(models, n_modes),
+        coupling=coupling, percentiles=Q_LEVELS, **_models_kw(models),
     )
 
 

@@ -18,6 +18,7 @@ from app.views import (
     SuggestedModesView,
     TruncationView,
     UncoupledView,
+    UploadView,
 )
 
 hv.extension("bokeh", logo=False)
@@ -67,7 +68,11 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
     case.param.watch(show_uncoupled, "show_uncoupled")
     show_uncoupled()
 
+    upload = card("Your data: chassis FRF and tire model for this session",
+                  UploadView(data=state.data), None, collapsed=False,
+                  css_classes=["upload-card"])
     main = pn.Column(
+        pn.Row(upload),
         pn.Row(
             card("Coupled response at the bushing (thesis eq. 4.1)", MobilityView(case=case),
                  500),

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import param
 
+from .datasource import REFERENCE, DataSource, Models
+
 __all__ = [
     "DIRECTIONS",
     "COUPLINGS",
@@ -59,6 +61,11 @@ class CaseState(param.Parameterized):
     spindle_input = param.Selector(
         default="z", objects=list(DIRECTIONS),
         doc="Spindle input DOF of the uncoupled chassis spindle-to-bushing mobility.",
+    )
+    models = param.ClassSelector(
+        class_=Models, default=REFERENCE, instantiate=False, precedence=-1,
+        doc="The session's tire and chassis (uploads or the reference), mirrored from "
+        "DashboardState.data; not a control and not in the URL.",
     )
 
 
@@ -121,12 +128,20 @@ class DashboardState(param.Parameterized):
     case = param.ClassSelector(class_=CaseState, instantiate=False)
     noise = param.ClassSelector(class_=NoiseState, instantiate=False)
     truncation = param.ClassSelector(class_=TruncationState, instantiate=False)
+    data = param.ClassSelector(class_=DataSource, instantiate=False,
+                               doc="This session's uploads (never shared between sessions).")
 
     def __init__(self, **params):
         params.setdefault("case", CaseState())
         params.setdefault("noise", NoiseState())
         params.setdefault("truncation", TruncationState())
+        params.setdefault("data", DataSource())
         super().__init__(**params)
+        self.case.models = self.data.models
+        self.data.param.watch(self._use_models, "models")
+
+    def _use_models(self, event):
+        self.case.models = event.new
 
 
 #: URL query keys of each state parameter (short, stable: links are shared in reviews).

@@ -193,3 +193,121 @@ def test_upload_view_shows_the_summary_or_the_error(doubled_mat):
     assert ds.models.chassis_name == "mine.mat" and ds.models.tire is None
     view.reset.clicks += 1
     assert ds.models is REFERENCE and not view._error().visible
+
+
+# -- the views on the session's models (app.compute keys its caches on them) -----------------
+NAMES = ["mobility.reference", "mobility.truncated", "truncation.map", "scatter.minmax",
+         "scatter.percentile", "scatter.reference", "scatter.round", "eigen.f_80"]
+
+
+def _plot_data(root):
+    from bokeh.models import ColumnDataSource
+
+    out = {}
+    for name in NAMES:
+        (src,) = [m for m in root.select({"name": name}) if isinstance(m, ColumnDataSource)]
+        out[name] = {k: np.array(v, copy=True) for k, v in src.data.items()}
+    return out
+
+
+def _moved(a, b):
+    return {n for n in a if not all(
+        np.shape(a[n][k]) == np.shape(b[n][k]) and np.array_equal(a[n][k], b[n][k],
+                                                                   equal_nan=True)
+        for k in a[n])}
+
+
+def test_the_page_runs_every_view_on_an_upload_of_this_session_only(doubled_mat):
+    from app.main import create_app
+    from app.state import DashboardState
+
+    state, other = DashboardState(), DashboardState()
+    for s in (state, other):
+        s.noise.rounds = 100
+    root = create_app(state).main[0].get_root()
+    before = _plot_data(root)
+    assert state.data.load_chassis(doubled_mat, "mine.mat", spindle="3", bushing="8")
+    assert state.case.models is state.data.models and other.case.models is REFERENCE
+    after = _plot_data(root)
+    # the tire did not change: the eigenfrequencies stay; every coupled view moves
+    assert _moved(before, after) == set(NAMES) - {"eigen.f_80"}
+    c = state.case
+    br = fbs_core.bushing_response(c.harmonic, n_modes=c.n_modes, coupling=c.coupling,
+                                   chassis=state.data.models.chassis)
+    want = 20 * np.log10(np.abs(br.sel(outputs=f"bushing:{c.dof}").data[:, 0, 0]))
+    np.testing.assert_allclose(after["mobility.truncated"]["level"], want, rtol=1e-9)
+    state.data.reset()
+    assert _moved(before, _plot_data(root)) == set()
+
+
+def test_views_on_the_unchanged_chassis_equal_the_reference(chassis_frf):
+    from app import compute
+    from app.state import DashboardState
+    from app.views import MobilityView, UncoupledView
+
+    state = DashboardState()
+    state.case.param.update(harmonic=2, n_modes=60, dof="y")
+    mob, unc = MobilityView(case=state.case), UncoupledView(case=state.case)
+    ref, ref_u = mob.data(), unc.data()
+    raw = save_frf(_renumber(chassis_frf, 1.0, "spindle", "bushing"), format="uff")
+    assert state.data.load_chassis(raw, "same.uff"), state.data.error
+    got, got_u = mob.data(), unc.data()
+    for k in ("reference", "truncated"):
+        np.testing.assert_allclose(got[k], ref[k], rtol=1e-5)  # UFF: single precision
+    np.testing.assert_allclose(got_u["chassis"], ref_u["chassis"], rtol=1e-5)
+    # the reference results are still the cached reference ones
+    again = compute.mobility_data(2, 60, "y", "6dof")
+    np.testing.assert_array_equal(again["truncated"], ref["truncated"])
+
+
+def test_doubled_chassis_shows_6_db_more_uncoupled_mobility(doubled_mat):
+    from app.state import DashboardState
+    from app.views import UncoupledView
+
+    state = DashboardState()
+    unc = UncoupledView(case=state.case)
+    ref = unc.data()
+    assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    got = unc.data()
+    np.testing.assert_allclose(got["chassis_db"], ref["chassis_db"] + 20 * np.log10(2.0),
+                               rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(got["tire_truncated"], ref["tire_truncated"])
+
+
+def test_truncated_tire_upload_is_the_reference_with_fewer_modes(tmp_path):
+    from app import compute
+    from app.state import DashboardState
+    from app.views import EigenView, MobilityView, TruncationView
+
+    state = DashboardState()
+    state.case.param.update(harmonic=1, n_modes=100, dof="z")
+    assert state.data.load_tire(_tire_bytes(tmp_path, _sub_tire(n_modes=200)), "t200.h5")
+    mob = MobilityView(case=state.case).data()
+    ref100 = compute.mobility_data(1, 100, "z", "6dof")
+    ref200 = compute.mobility_data(1, 200, "z", "6dof")
+    # the first 100 modes are the reference's; "all modes" of this tire are its 200
+    np.testing.assert_allclose(mob["truncated"], ref100["truncated"], rtol=1e-9)
+    np.testing.assert_allclose(mob["reference"], ref200["truncated"], rtol=1e-9)
+    m = TruncationView(case=state.case, truncation=state.truncation).data()
+    assert m["n_modes"].tolist() == list(range(10, 200, 10))
+    e = EigenView(case=state.case).data()
+    e_ref = compute.eigen_curves()
+    k = e["n_modes"].size
+    assert e["n_modes"][-1] == 200
+    np.testing.assert_allclose(e["f_80"], e_ref["f_80"][:k], rtol=1e-12)
+    state.case.n_modes = 300  # more than the tire has: all of its modes
+    mob = MobilityView(case=state.case).data()
+    np.testing.assert_array_equal(mob["truncated"], mob["reference"])
+
+
+def test_zero_noise_band_on_an_upload_is_its_coupled_response(doubled_mat):
+    from app.state import DashboardState
+    from app.views import MobilityView, ScatterBandView
+
+    state = DashboardState()
+    state.noise.param.update(noise=0.0, rounds=20)
+    assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    b = ScatterBandView(case=state.case, noise=state.noise).data()
+    mob = MobilityView(case=state.case).data()
+    np.testing.assert_allclose(b["reference"], mob["truncated"], rtol=1e-9)
+    np.testing.assert_allclose(b["maximum"], np.abs(mob["truncated"]), rtol=1e-9)

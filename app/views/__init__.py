@@ -4,6 +4,7 @@ from .controls import Controls
 from .mobility import MobilityView, UncoupledView
 from .scatter import ScatterBandView
 from .truncation import EigenView, SuggestedModesView, TruncationView
+from .upload import UploadView
 
 __all__ = [
     "Controls",
@@ -13,4 +14,5 @@ __all__ = [
     "SuggestedModesView",
     "TruncationView",
     "UncoupledView",
+    "UploadView",
 ]

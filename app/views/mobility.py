@@ -15,7 +15,7 @@ from .. import compute
 from ..state import CaseState
 from .common import COLORS, CURVE_OPTS, FREQ, download_button, level_dim, name_source
 
-CASE_KEYS = ["harmonic", "n_modes", "dof", "coupling"]
+CASE_KEYS = ["harmonic", "n_modes", "dof", "coupling", "models"]
 
 
 class MobilityView(Viewer):
@@ -26,7 +26,7 @@ class MobilityView(Viewer):
     def data(self) -> dict:
         """The columns behind the plot for the current state."""
         c = self.case
-        return compute.mobility_data(c.harmonic, c.n_modes, c.dof, c.coupling)
+        return compute.mobility_data(c.harmonic, c.n_modes, c.dof, c.coupling, c.models)
 
     def meta(self) -> dict:
         c = self.case
@@ -35,18 +35,19 @@ class MobilityView(Viewer):
             "harmonic": c.harmonic, "N (retained tire modes)": c.n_modes,
             "reference": "all tire modes", "response DOF": f"bushing:{c.dof}",
             "coupling": c.coupling, "unit": compute.level_unit(c.dof),
+            "models": c.models.describe(),
         }
 
     # -- plot layers (each a DynamicMap watching only what it needs) -------------------
     # each layer is a DynamicMap fed by the parameters it depends on; styles are set once on
     # the DynamicMap (setting options inside a callback costs more than the data)
-    def _reference(self, harmonic, dof, coupling):
-        d = compute.mobility_data(harmonic, 400, dof, coupling)
+    def _reference(self, harmonic, dof, coupling, models):
+        d = compute.mobility_data(harmonic, 400, dof, coupling, models)
         return hv.Curve((d["freq"], d["reference_db"]), FREQ, level_dim(dof),
                         label="all modes (reference)")
 
-    def _truncated(self, harmonic, n_modes, dof, coupling):
-        d = compute.mobility_data(harmonic, n_modes, dof, coupling)
+    def _truncated(self, harmonic, n_modes, dof, coupling, models):
+        d = compute.mobility_data(harmonic, n_modes, dof, coupling, models)
         return hv.Curve((d["freq"], d["truncated_db"]), FREQ, level_dim(dof),
                         label="N retained modes")
 
@@ -54,7 +55,8 @@ class MobilityView(Viewer):
         c = self.case
         tips = [("Frequency", "@freq{0.0} Hz"), ("Level", "@level{0.0} dB")]
         ref = hv.DynamicMap(
-            self._reference, streams=[hv.streams.Params(c, ["harmonic", "dof", "coupling"])]
+            self._reference,
+            streams=[hv.streams.Params(c, ["harmonic", "dof", "coupling", "models"])],
         ).opts(color=COLORS["reference"], hooks=[name_source("mobility.reference")],
                hover_tooltips=[("", "all modes"), *tips], **CURVE_OPTS)
         tr = hv.DynamicMap(self._truncated, streams=[hv.streams.Params(c, CASE_KEYS)]).opts(
@@ -95,10 +97,11 @@ class UncoupledView(Viewer):
 
     def data(self) -> dict:
         c = self.case
-        return compute.uncoupled_data(c.harmonic, c.n_modes, c.dof, c.spindle_input)
+        return compute.uncoupled_data(c.harmonic, c.n_modes, c.dof, c.spindle_input,
+                                      c.models)
 
-    def _tire(self, harmonic, n_modes, dof):
-        d = compute.uncoupled_data(harmonic, n_modes, dof, "z")
+    def _tire(self, harmonic, n_modes, dof, models):
+        d = compute.uncoupled_data(harmonic, n_modes, dof, "z", models)
         lvl = level_dim(dof, "tire_level")
         ref = hv.Curve((d["freq"], d["tire_reference_db"]), FREQ, lvl, label="all modes").opts(
             color=COLORS["reference"], hooks=[name_source("uncoupled.tire_reference")])
@@ -108,8 +111,8 @@ class UncoupledView(Viewer):
             hooks=[name_source("uncoupled.tire_truncated")])
         return (ref * tr).opts(title=f"Tire: free hub velocity hub:{dof} (figs. 4.6-4.7)")
 
-    def _chassis(self, harmonic, dof, spindle_input):
-        d = compute.uncoupled_data(harmonic, 400, dof, spindle_input)
+    def _chassis(self, harmonic, dof, spindle_input, models):
+        d = compute.uncoupled_data(harmonic, 400, dof, spindle_input, models)
         unit = "dB re 1 (rad/s)/" if dof.startswith("r") else "dB re 1 (m/s)/"
         unit += "(N m)" if spindle_input.startswith("r") else "N"
         lvl = hv.Dimension("chassis_level", label="Mobility", unit=unit)
@@ -120,10 +123,10 @@ class UncoupledView(Viewer):
     def __panel__(self):
         c = self.case
         tire = hv.DynamicMap(self._tire, streams=[
-            hv.streams.Params(c, ["harmonic", "n_modes", "dof"])]).opts(
+            hv.streams.Params(c, ["harmonic", "n_modes", "dof", "models"])]).opts(
             hv.opts.Curve(**CURVE_OPTS), hv.opts.Overlay(legend_position="bottom_left"))
         chassis = hv.DynamicMap(self._chassis, streams=[
-            hv.streams.Params(c, ["harmonic", "dof", "spindle_input"])]).opts(
+            hv.streams.Params(c, ["harmonic", "dof", "spindle_input", "models"])]).opts(
             hv.opts.Curve(**CURVE_OPTS))
         dl = download_button(
             "uncoupled", self._csv_columns, self._meta,

@@ -19,7 +19,7 @@ from .. import compute
 from ..state import CaseState, NoiseState
 from .common import COLORS, CURVE_OPTS, FREQ, download_button, level_dim, name_source
 
-CASE_KEYS = ["harmonic", "n_modes", "coupling"]
+CASE_KEYS = ["harmonic", "n_modes", "coupling", "models"]
 #: Seconds between a control change and the start of the band computation.
 DEBOUNCE_S = 0.15
 NOISE_KEYS = ["noise", "target", "frequency_dependent", "rounds", "seed"]
@@ -44,7 +44,7 @@ class ScatterBandView(Viewer):
     def key(self) -> tuple:
         c, n = self.case, self.noise
         return (c.harmonic, c.n_modes, c.coupling, float(n.noise), n.target,
-                bool(n.frequency_dependent), int(n.rounds), int(n.seed))
+                bool(n.frequency_dependent), int(n.rounds), int(n.seed), c.models)
 
     def compute_now(self):
         """Compute (or fetch from the cache) the band of the current state, blocking."""
@@ -211,6 +211,7 @@ class ScatterBandView(Viewer):
             "seed": n.seed, "single round": n.single_round,
             "percentiles": f"{lo:g}-{100 - lo:g}", "unit": compute.level_unit(c.dof),
             "lower/upper": "min/max of |v_e| over the rounds; percentiles numpy 'linear'",
+            "models": c.models.describe(),
         }
 
     def _csv_columns(self) -> dict:

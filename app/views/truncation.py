@@ -26,10 +26,11 @@ class TruncationView(Viewer):
     def data(self) -> dict:
         c, t = self.case, self.truncation
         dof = c.dof if t.map_mode == "selected DOF" else None
-        return compute.error_map_data(c.harmonic, c.coupling, dof)
+        return compute.error_map_data(c.harmonic, c.coupling, dof, c.models)
 
-    def _map(self, harmonic, coupling, dof, map_mode, threshold):
-        d = compute.error_map_data(harmonic, coupling, dof if map_mode == "selected DOF" else None)
+    def _map(self, harmonic, coupling, dof, map_mode, threshold, models):
+        d = compute.error_map_data(harmonic, coupling, dof if map_mode == "selected DOF" else None,
+                                   models)
         what = f"bushing:{dof}" if map_mode == "selected DOF" else "max over 6 DOFs"
         img = hv.Image((d["centre_freq"], d["n_modes"], d["error_pct"]), [FREQ, MODES], ERROR)
         return img.opts(clim=(0.0, float(threshold)), title=f"Harmonic {harmonic}, {what}",
@@ -38,9 +39,9 @@ class TruncationView(Viewer):
     def _chosen(self, n_modes):
         return hv.HLine(float(n_modes), label="chosen N")
 
-    def _suggested(self, harmonic, coupling, dof, threshold, f_max, map_mode):
+    def _suggested(self, harmonic, coupling, dof, threshold, f_max, map_mode, models):
         tab = compute.suggested_table(float(threshold), float(f_max), coupling,
-                                      dof if map_mode == "selected DOF" else None)
+                                      dof if map_mode == "selected DOF" else None, models)
         n = float(tab["n_modes"][list(tab["harmonic"]).index(harmonic)])
         return hv.HLine(n).opts(color="#0ca678", line_dash="dashed", line_width=2) * hv.VLine(
             float(f_max)).opts(color="#0ca678", line_dash="dotted", line_width=2)
@@ -48,7 +49,7 @@ class TruncationView(Viewer):
     def __panel__(self):
         c, t = self.case, self.truncation
         img = hv.DynamicMap(self._map, streams=[
-            hv.streams.Params(c, ["harmonic", "coupling", "dof"]),
+            hv.streams.Params(c, ["harmonic", "coupling", "dof", "models"]),
             hv.streams.Params(t, ["map_mode", "threshold"])]).opts(
             cmap="inferno_r", colorbar=True, responsive=True, min_height=320, tools=["hover"],
             hover_tooltips=[("Centre frequency", "$x{0.0} Hz"), ("N", "$y{0}"),
@@ -57,7 +58,7 @@ class TruncationView(Viewer):
         chosen = hv.DynamicMap(self._chosen, streams=[hv.streams.Params(c, ["n_modes"])]).opts(
             color=COLORS["round"], line_width=2)
         sugg = hv.DynamicMap(self._suggested, streams=[
-            hv.streams.Params(c, ["harmonic", "coupling", "dof"]),
+            hv.streams.Params(c, ["harmonic", "coupling", "dof", "models"]),
             hv.streams.Params(t, ["threshold", "f_max", "map_mode"])])
         dl = download_button("truncation", self._csv_columns, self._meta,
                              lambda: f"truncation_map_h{c.harmonic}_{self._what()}.csv")
@@ -97,7 +98,8 @@ class SuggestedModesView(Viewer):
     def table(self) -> dict:
         c, t = self.case, self.truncation
         return compute.suggested_table(float(t.threshold), float(t.f_max), c.coupling,
-                                       c.dof if t.map_mode == "selected DOF" else None)
+                                       c.dof if t.map_mode == "selected DOF" else None,
+                                       c.models)
 
     def table_frame(self):
         """The suggested-modes table as a DataFrame (what the Tabulator shows)."""
@@ -125,7 +127,7 @@ class SuggestedModesView(Viewer):
             table.value = self.table_frame()
 
         t.param.watch(refresh, ["threshold", "f_max", "map_mode"])
-        c.param.watch(refresh, ["coupling", "dof"])
+        c.param.watch(refresh, ["coupling", "dof", "models"])
         dl = download_button(
             "suggested", self._csv_table, self._meta_table,
             lambda: f"suggested_modes_thr{t.threshold:g}_fmax{t.f_max:g}.csv")
@@ -161,10 +163,10 @@ class EigenView(Viewer):
     case = param.ClassSelector(class_=CaseState)
 
     def data(self) -> dict:
-        return compute.eigen_curves()
+        return compute.eigen_curves(self.case.models)
 
-    def _curves(self):
-        d = compute.eigen_curves()
+    def _curves(self, models):
+        d = compute.eigen_curves(models)
         styles = {"f_20": ("20 km/h", "#74c0fc"), "f_80": ("80 km/h", "#1c7ed6"),
                   "f_120": ("120 km/h", "#0b3d91")}
         layers = [
@@ -180,23 +182,28 @@ class EigenView(Viewer):
         return hv.VLine(float(n_modes))
 
     def __panel__(self):
-        d = self.data()
-        static = self._curves().opts(
-            hv.opts.Curve(**{**CURVE_OPTS, "framewise": False}),
+        curves = hv.DynamicMap(self._curves, streams=[
+            hv.streams.Params(self.case, ["models"])]).opts(
+            hv.opts.Curve(**CURVE_OPTS),
             hv.opts.Overlay(legend_position="top_left", title="Eigenfrequency vs mode number",
                             logy=False))
         marker = hv.DynamicMap(self._marker, streams=[
             hv.streams.Params(self.case, ["n_modes"])]).opts(color=COLORS["round"], line_width=2)
         dl = download_button(
-            "eigen", lambda: {"n_modes": d["n_modes"], "f_20kmh_Hz": d["f_20"],
-                              "f_80kmh_Hz": d["f_80"], "f_120kmh_Hz": d["f_120"]},
-            lambda: {"view": "highest retained eigenfrequency vs N (thesis fig. 5.8)"},
+            "eigen", self._csv_columns,
+            lambda: {"view": "highest retained eigenfrequency vs N (thesis fig. 5.8)",
+                     "models": self.case.models.describe()},
             lambda: "eigenfrequency_vs_modes.csv")
         return pn.Column(
             pn.Row(pn.pane.Markdown("Highest eigenfrequency among N retained modes "
                                     "(N/2 +/- pairs, lowest first).", margin=(0, 10),
                                     styles={"color": "#495057", "font-size": "0.9em"}),
                    pn.layout.HSpacer(), dl),
-            pn.pane.HoloViews(static * marker, sizing_mode="stretch_both", min_height=300),
+            pn.pane.HoloViews(curves * marker, sizing_mode="stretch_both", min_height=300),
             sizing_mode="stretch_both",
         )
+
+    def _csv_columns(self) -> dict:
+        d = self.data()
+        return {"n_modes": d["n_modes"], "f_20kmh_Hz": d["f_20"], "f_80kmh_Hz": d["f_80"],
+                "f_120kmh_Hz": d["f_120"]}

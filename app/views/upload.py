@@ -33,11 +33,9 @@ class UploadView(Viewer):
         ds = self.data
         W = pn.widgets
         self.chassis_file = W.FileInput(accept=CHASSIS_ACCEPT, multiple=False,
-                                        css_classes=["upload-chassis"], sizing_mode="fixed",
-                                        width=260)
+                                        css_classes=["upload-chassis"], width=260)
         self.tire_file = W.FileInput(accept=TIRE_ACCEPT, multiple=False,
-                                     css_classes=["upload-tire"], sizing_mode="fixed",
-                                     width=260)
+                                     css_classes=["upload-tire"], width=260)
         self.spindle = W.TextInput.from_param(ds.param.spindle, name="Spindle node",
                                               width=120, css_classes=["upload-spindle"])
         self.bushing = W.TextInput.from_param(ds.param.bushing, name="Bushing node",
