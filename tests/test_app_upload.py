@@ -311,3 +311,30 @@ def test_zero_noise_band_on_an_upload_is_its_coupled_response(doubled_mat):
     mob = MobilityView(case=state.case).data()
     np.testing.assert_allclose(b["reference"], mob["truncated"], rtol=1e-9)
     np.testing.assert_allclose(b["maximum"], np.abs(mob["truncated"]), rtol=1e-9)
+
+
+def test_ill_conditioned_interface_is_refused(chassis_frf):
+    # a rigid-link-like spindle block: the same huge mobility in every entry (rank one)
+    Y = _renumber(chassis_frf, 1.0, "spindle", "bushing")
+    data = np.array(Y.data)
+    data[:, :6, :6] = 1e6 * np.abs(data[:, :1, :1]).max() * np.ones((6, 6))
+    ds = DataSource()
+    assert not ds.load_chassis(save_frf(Y.replace(data=data), format="mat"), "rigid.mat")
+    assert "ill-conditioned" in ds.error and "harmonic 1" in ds.error
+    assert ds.models is REFERENCE
+
+
+def test_free_rolling_coupling_runs_on_an_upload(doubled_mat):
+    from app.state import DashboardState
+    from app.views import MobilityView, SuggestedModesView
+
+    state = DashboardState()
+    assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    state.case.param.update(coupling="5dof", harmonic=4, n_modes=80)
+    mob = MobilityView(case=state.case).data()
+    br = fbs_core.bushing_response(4, n_modes=80, coupling="5dof",
+                                   chassis=state.data.models.chassis)
+    np.testing.assert_allclose(mob["truncated"], br.sel(outputs="bushing:z").data[:, 0, 0],
+                               rtol=1e-9)
+    tab = SuggestedModesView(case=state.case, truncation=state.truncation).table()
+    assert list(tab["harmonic"]) == list(range(1, 8)) and np.all(tab["n_modes"] > 0)
