@@ -132,6 +132,12 @@ class Models:
     def __setattr__(self, name, value):
         raise AttributeError("Models is immutable")
 
+    def __copy__(self) -> Models:
+        return self
+
+    def __deepcopy__(self, memo) -> Models:
+        return self  # immutable: copies (param, holoviews streams) share the models
+
     def __eq__(self, other) -> bool:
         return isinstance(other, Models) and other.key == self.key
 
