@@ -338,3 +338,26 @@ def test_free_rolling_coupling_runs_on_an_upload(doubled_mat):
                                rtol=1e-9)
     tab = SuggestedModesView(case=state.case, truncation=state.truncation).table()
     assert list(tab["harmonic"]) == list(range(1, 8)) and np.all(tab["n_modes"] > 0)
+
+
+def test_tire_from_matlab_in_the_documented_layout():
+    import io
+
+    from scipy.io import savemat
+
+    from app import compute
+    from app.state import DashboardState
+    from app.views import MobilityView
+
+    T = _sub_tire(n_modes=120)
+    buf = io.BytesIO()
+    savemat(buf, {"speeds": T.speeds, "poles": T.poles, "psi": T.psi, "chi": T.chi,
+                  "wavelengths": T.wavelengths, "participation": T.participation})
+    state = DashboardState()
+    assert state.data.load_tire(buf.getvalue(), "supplier_tire.mat"), state.data.error
+    assert "120 complex modes" in state.data.tire_summary
+    assert "MATLAB" in state.data.tire_summary
+    state.case.param.update(harmonic=5, n_modes=60)
+    mob = MobilityView(case=state.case).data()
+    np.testing.assert_allclose(mob["truncated"], compute.mobility_data(5, 60, "z", "6dof")
+                               ["truncated"], rtol=1e-9)
