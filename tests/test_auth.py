@@ -158,6 +158,18 @@ class _NoRedirect(urllib.request.HTTPRedirectHandler):
         return None
 
 
+def _run_async(coro):
+    """Run ``coro`` to completion on a fresh event loop in its own thread.
+
+    ``asyncio.run`` refuses to start inside a running loop, and pytest-playwright's sync API
+    leaves one running in a worker that has already run browser tests.
+    """
+    import concurrent.futures
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=1) as pool:
+        return pool.submit(asyncio.run, coro).result()
+
+
 def _get(opener, url):
     """(status, location header, body) without following redirects."""
     try:
@@ -253,7 +265,7 @@ def test_without_credentials_no_app_content_and_no_websocket(server):
     assert status == 200 and 'name="password"' in body
     assert "render_items" not in body and "confidential-model-marker" not in body
     with pytest.raises(Exception, match="403"):
-        asyncio.run(_websocket_session(port, cookie=None))
+        _run_async(_websocket_session(port, cookie=None))
     # the health endpoint stays open (Docker's HEALTHCHECK), and tells nothing of the app
     status, _, body = _get(opener, base + "/liveness")
     assert status == 200 and json.loads(body) == {"/liveness": True}
@@ -286,6 +298,6 @@ def test_with_credentials_the_app_and_its_websocket_work(server):
     assert status == 200 and "render_items" in body
     token = re.search(r'"token":\s*"([^"]+)"', body).group(1)
     cookie = "; ".join(f"{c.name}={c.value}" for c in jar)
-    first, document = asyncio.run(_websocket_session(port, cookie, token))
+    first, document = _run_async(_websocket_session(port, cookie, token))
     assert first == "ACK"
     assert "confidential-model-marker" in document and "ColumnDataSource" in document
