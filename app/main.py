@@ -6,7 +6,6 @@ URL query (``?h=5&N=150&dof=z...``), so that a link reproduces the view.
 
 from __future__ import annotations
 
-import holoviews as hv
 import panel as pn
 
 from app.state import URL_KEYS, DashboardState
@@ -20,8 +19,8 @@ from app.views import (
     UncoupledView,
     UploadView,
 )
+from app.views.plots import frequency_range
 
-hv.extension("bokeh", logo=False)
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
 
 ACCENT = "#1c7ed6"
@@ -49,7 +48,9 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
     state = state or DashboardState()
     case, noise, trunc = state.case, state.noise, state.truncation
     sync_url(state)
-    scatter = ScatterBandView(case=case, noise=noise)
+    # one frequency axis range for all spectra of the session: zoom and pan are linked
+    freq = frequency_range()
+    scatter = ScatterBandView(case=case, noise=noise, x_range=freq)
 
     def card(title, view, height, **kw):
         return pn.Card(view, title=title, collapsible=True, height=height,
@@ -63,7 +64,8 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
     def show_uncoupled(*_):
         if case.show_uncoupled and not uncoupled.objects:
             uncoupled.append(card("Uncoupled subsystems: tire hub and chassis "
-                                  "spindle-to-bushing", UncoupledView(case=case), 420))
+                                  "spindle-to-bushing",
+                                  UncoupledView(case=case, x_range=freq), 420))
 
     case.param.watch(show_uncoupled, "show_uncoupled")
     show_uncoupled()
@@ -74,10 +76,10 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
     main = pn.Column(
         pn.Row(upload),
         pn.Row(
-            card("Coupled response at the bushing (thesis eq. 4.1)", MobilityView(case=case),
-                 500),
+            card("Coupled response at the bushing (thesis eq. 4.1)",
+                 MobilityView(case=case, x_range=freq), 500),
             card("Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
-                 TruncationView(case=case, truncation=trunc), 500),
+                 TruncationView(case=case, truncation=trunc, x_range=freq), 500),
         ),
         uncoupled,
         pn.Row(

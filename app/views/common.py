@@ -1,20 +1,14 @@
-"""Shared dimensions, plot options and helpers of the views."""
+"""Shared colours, axis labels, hover lines and the CSV download button of the views."""
 
 from __future__ import annotations
 
 import io
 from collections.abc import Callable
 
-import holoviews as hv
 import panel as pn
 
 from .. import compute
 from ..export import to_csv
-
-#: Frequency axis shared by all spectra (same Dimension -> Panel links zoom and pan).
-FREQ = hv.Dimension("freq", label="Frequency", unit="Hz")
-#: Number of retained tire modes.
-MODES = hv.Dimension("n_modes", label="Retained modes N")
 
 #: Colours: reference (dark), truncated (accent), uncoupled subsystems.
 COLORS = {
@@ -25,37 +19,21 @@ COLORS = {
     "band": "#4dabf7",
     "percentile": "#1864ab",
     "round": "#e8590c",
+    "suggested": "#0ca678",
 }
 
-CURVE_OPTS = dict(
-    responsive=True, min_height=320, show_grid=True, tools=["hover"], line_width=2,
-    active_tools=["wheel_zoom"], framewise=True,
-)
+FREQ_LABEL = "Frequency (Hz)"
+MODES_LABEL = "Retained modes N"
 
 
-def level_dim(dof: str, name: str = "level", label: str = "Level") -> hv.Dimension:
-    """Level axis (dB) of a bushing/hub velocity per patch load for a DOF direction.
-
-    Dimensions are matched by label too: give a second one on the same element (the upper
-    edge of an area) its own label.
-    """
-    unit = compute.level_unit(dof).removeprefix("dB ")
-    return hv.Dimension(name, label=label, unit=f"dB {unit}")
+def level_label(dof: str, label: str = "Level") -> str:
+    """Axis label of a bushing/hub velocity level per road amplitude for a DOF direction."""
+    return f"{label} ({compute.level_unit(dof)})"
 
 
-def level_tooltips(extra: str = "level") -> list[tuple[str, str]]:
-    return [("Frequency", "@freq{0.0} Hz"), ("Level", "@{" + extra + "}{0.0} dB")]
-
-
-def name_source(name: str) -> Callable:
-    """HoloViews hook that names the plot's ColumnDataSource (found by the browser tests)."""
-
-    def hook(plot, element):
-        src = plot.handles.get("source")
-        if src is not None and src.name != name:
-            src.name = name
-
-    return hook
+def level_tooltips(what: str, column: str = "level") -> list[tuple[str, str]]:
+    """Hover lines of a level curve: what it is, frequency and level."""
+    return [("", what), ("Frequency", "@freq{0.0} Hz"), ("Level", "@" + column + "{0.0} dB")]
 
 
 def download_button(view: str, columns: Callable[[], dict], meta: Callable[[], dict],

@@ -6,14 +6,14 @@ chassis' spindle-to-bushing mobility (figs. 4.2-4.3).
 
 from __future__ import annotations
 
-import holoviews as hv
 import panel as pn
 import param
 from panel.viewable import Viewer
 
 from .. import compute
 from ..state import CaseState
-from .common import COLORS, CURVE_OPTS, FREQ, download_button, level_dim, name_source
+from .common import COLORS, FREQ_LABEL, download_button, level_label, level_tooltips
+from .plots import Pusher, add_line, fit_range, frequency_range, new_figure
 
 CASE_KEYS = ["harmonic", "n_modes", "dof", "coupling", "models"]
 
@@ -22,6 +22,13 @@ class MobilityView(Viewer):
     """Coupled bushing response v_e* in dB versus frequency (thesis eq. 4.1)."""
 
     case = param.ClassSelector(class_=CaseState)
+    x_range = param.Parameter(default=None, doc="Frequency range shared with other views "
+                              "(linked zoom and pan); a new one if None.")
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._layout = None
+        self._push = Pusher()
 
     def data(self) -> dict:
         """The columns behind the plot for the current state."""
@@ -38,34 +45,40 @@ class MobilityView(Viewer):
             "models": c.models.describe(),
         }
 
-    # -- plot layers (each a DynamicMap watching only what it needs) -------------------
-    # each layer is a DynamicMap fed by the parameters it depends on; styles are set once on
-    # the DynamicMap (setting options inside a callback costs more than the data)
-    def _reference(self, harmonic, dof, coupling, models):
-        d = compute.mobility_data(harmonic, 400, dof, coupling, models)
-        return hv.Curve((d["freq"], d["reference_db"]), FREQ, level_dim(dof),
-                        label="all modes (reference)")
+    # -- plot ----------------------------------------------------------------------------
+    def _build(self):
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        fig = new_figure(x_label=FREQ_LABEL, y_label=level_label(self.case.dof),
+                         x_range=self.x_range, name="mobility.figure")
+        self._fig = fig
+        self._ref = add_line(fig, "mobility.reference", color=COLORS["reference"],
+                             legend="all modes (reference)",
+                             tooltips=level_tooltips("all modes"))
+        self._tr = add_line(fig, "mobility.truncated", color=COLORS["truncated"],
+                            legend="N retained modes", dash="dashed",
+                            tooltips=level_tooltips("N retained modes"))
+        self._apply(self.data(), self.case.dof)()
+        self.case.param.watch(self._changed, CASE_KEYS)
+        return fig
 
-    def _truncated(self, harmonic, n_modes, dof, coupling, models):
-        d = compute.mobility_data(harmonic, n_modes, dof, coupling, models)
-        return hv.Curve((d["freq"], d["truncated_db"]), FREQ, level_dim(dof),
-                        label="N retained modes")
+    def _apply(self, d: dict, dof: str):
+        """The model changes that show data ``d`` of response DOF ``dof``."""
 
-    def plot(self) -> hv.DynamicMap:
-        c = self.case
-        tips = [("Frequency", "@freq{0.0} Hz"), ("Level", "@level{0.0} dB")]
-        ref = hv.DynamicMap(
-            self._reference,
-            streams=[hv.streams.Params(c, ["harmonic", "dof", "coupling", "models"])],
-        ).opts(color=COLORS["reference"], hooks=[name_source("mobility.reference")],
-               hover_tooltips=[("", "all modes"), *tips], **CURVE_OPTS)
-        tr = hv.DynamicMap(self._truncated, streams=[hv.streams.Params(c, CASE_KEYS)]).opts(
-            color=COLORS["truncated"], line_dash="dashed",
-            hooks=[name_source("mobility.truncated")],
-            hover_tooltips=[("", "N retained modes"), *tips], **CURVE_OPTS)
-        return (ref * tr).opts(hv.opts.Overlay(legend_position="bottom_left"))
+        def update():
+            fit_range(self.x_range, d["freq"])
+            self._ref.data = {"freq": d["freq"], "level": d["reference_db"]}
+            self._tr.data = {"freq": d["freq"], "level": d["truncated_db"]}
+            self._fig.yaxis[0].axis_label = level_label(dof)
+
+        return update
+
+    def _changed(self, *events):
+        self._push(self._apply(self.data(), self.case.dof))
 
     def __panel__(self):
+        if self._layout is not None:
+            return self._layout
         c = self.case
         dl = download_button(
             "mobility", self._csv_columns, self.meta,
@@ -75,11 +88,12 @@ class MobilityView(Viewer):
             lambda h, n, d, cp: f"**Harmonic {h}** &middot; bushing:{d} &middot; N = {n} "
             f"&middot; {cp} coupling", c.param.harmonic, c.param.n_modes, c.param.dof,
             c.param.coupling), margin=(0, 10))
-        return pn.Column(
+        self._layout = pn.Column(
             pn.Row(caption, pn.layout.HSpacer(), dl),
-            pn.pane.HoloViews(self.plot(), sizing_mode="stretch_both", min_height=340),
+            pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )
+        return self._layout
 
     def _csv_columns(self) -> dict:
         d = self.data()
@@ -94,53 +108,85 @@ class UncoupledView(Viewer):
     """Uncoupled tire hub response and chassis spindle-to-bushing mobility."""
 
     case = param.ClassSelector(class_=CaseState)
+    x_range = param.Parameter(default=None, doc="Shared frequency range; a new one if None.")
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._layout = None
+        self._push = Pusher()
 
     def data(self) -> dict:
         c = self.case
         return compute.uncoupled_data(c.harmonic, c.n_modes, c.dof, c.spindle_input,
                                       c.models)
 
-    def _tire(self, harmonic, n_modes, dof, models):
-        d = compute.uncoupled_data(harmonic, n_modes, dof, "z", models)
-        lvl = level_dim(dof, "tire_level")
-        ref = hv.Curve((d["freq"], d["tire_reference_db"]), FREQ, lvl, label="all modes").opts(
-            color=COLORS["reference"], hooks=[name_source("uncoupled.tire_reference")])
-        tr = hv.Curve((d["freq"], d["tire_truncated_db"]), FREQ, lvl,
-                      label="N retained modes").opts(
-            color=COLORS["tire"], line_dash="dashed",
-            hooks=[name_source("uncoupled.tire_truncated")])
-        return (ref * tr).opts(title=f"Tire: free hub velocity hub:{dof} (figs. 4.6-4.7)")
-
-    def _chassis(self, harmonic, dof, spindle_input, models):
-        d = compute.uncoupled_data(harmonic, 400, dof, spindle_input, models)
+    @staticmethod
+    def _chassis_label(dof: str, spindle_input: str) -> str:
         unit = "dB re 1 (rad/s)/" if dof.startswith("r") else "dB re 1 (m/s)/"
         unit += "(N m)" if spindle_input.startswith("r") else "N"
-        lvl = hv.Dimension("chassis_level", label="Mobility", unit=unit)
-        return hv.Curve((d["freq"], d["chassis_db"]), FREQ, lvl).opts(
-            color=COLORS["chassis"], hooks=[name_source("uncoupled.chassis")],
-            title=f"Chassis: spindle:{spindle_input} -> bushing:{dof} (figs. 4.2-4.3)")
+        return f"Mobility ({unit})"
+
+    def _build(self):
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        c = self.case
+        self._tire_fig = tire = new_figure(
+            x_label=FREQ_LABEL, y_label=level_label(c.dof), x_range=self.x_range,
+            min_height=300)
+        self._tire_ref = add_line(tire, "uncoupled.tire_reference", color=COLORS["reference"],
+                                  legend="all modes", tooltips=level_tooltips("all modes"))
+        self._tire_tr = add_line(tire, "uncoupled.tire_truncated", color=COLORS["tire"],
+                                 legend="N retained modes", dash="dashed",
+                                 tooltips=level_tooltips("N retained modes"))
+        self._chassis_fig = chassis = new_figure(
+            x_label=FREQ_LABEL, y_label=self._chassis_label(c.dof, c.spindle_input),
+            x_range=self.x_range, min_height=300)
+        self._chassis = add_line(chassis, "uncoupled.chassis", color=COLORS["chassis"],
+                                 legend=None, tooltips=level_tooltips("chassis mobility"))
+        self._apply(self.data())()
+        c.param.watch(self._changed,
+                      ["harmonic", "n_modes", "dof", "spindle_input", "models"])
+        return tire, chassis
+
+    def _apply(self, d: dict):
+        c = self.case
+        dof, inp = c.dof, c.spindle_input
+
+        def update():
+            fit_range(self.x_range, d["freq"])
+            self._tire_ref.data = {"freq": d["freq"], "level": d["tire_reference_db"]}
+            self._tire_tr.data = {"freq": d["freq"], "level": d["tire_truncated_db"]}
+            self._chassis.data = {"freq": d["freq"], "level": d["chassis_db"]}
+            self._tire_fig.title.text = f"Tire: free hub velocity hub:{dof} (figs. 4.6-4.7)"
+            self._tire_fig.yaxis[0].axis_label = level_label(dof)
+            self._chassis_fig.title.text = (f"Chassis: spindle:{inp} -> bushing:{dof} "
+                                            "(figs. 4.2-4.3)")
+            self._chassis_fig.yaxis[0].axis_label = self._chassis_label(dof, inp)
+
+        return update
+
+    def _changed(self, *events):
+        self._push(self._apply(self.data()))
 
     def __panel__(self):
+        if self._layout is not None:
+            return self._layout
         c = self.case
-        tire = hv.DynamicMap(self._tire, streams=[
-            hv.streams.Params(c, ["harmonic", "n_modes", "dof", "models"])]).opts(
-            hv.opts.Curve(**CURVE_OPTS), hv.opts.Overlay(legend_position="bottom_left"))
-        chassis = hv.DynamicMap(self._chassis, streams=[
-            hv.streams.Params(c, ["harmonic", "dof", "spindle_input", "models"])]).opts(
-            hv.opts.Curve(**CURVE_OPTS))
+        tire, chassis = self._build()
         dl = download_button(
             "uncoupled", self._csv_columns, self._meta,
             lambda: f"uncoupled_h{c.harmonic}_N{c.n_modes}_{c.dof}_in{c.spindle_input}.csv",
         )
         inp = pn.widgets.Select.from_param(c.param.spindle_input, name="Chassis spindle input",
                                            width=160)
-        return pn.Column(
+        self._layout = pn.Column(
             pn.Row(inp, pn.layout.HSpacer(), dl),
-            pn.Row(pn.pane.HoloViews(tire, sizing_mode="stretch_both", min_height=300),
-                   pn.pane.HoloViews(chassis, sizing_mode="stretch_both", min_height=300),
+            pn.Row(pn.pane.Bokeh(tire, sizing_mode="stretch_both", min_height=300),
+                   pn.pane.Bokeh(chassis, sizing_mode="stretch_both", min_height=300),
                    sizing_mode="stretch_both"),
             sizing_mode="stretch_both",
         )
+        return self._layout
 
     def _meta(self) -> dict:
         c = self.case

@@ -10,14 +10,16 @@ from __future__ import annotations
 import asyncio
 import time
 
-import holoviews as hv
+import numpy as np
 import panel as pn
 import param
+from bokeh.events import Tap
 from panel.viewable import Viewer
 
 from .. import compute
 from ..state import CaseState, NoiseState
-from .common import COLORS, CURVE_OPTS, FREQ, download_button, level_dim, name_source
+from .common import COLORS, FREQ_LABEL, download_button, level_label, level_tooltips
+from .plots import Pusher, add_band, add_line, fit_range, frequency_range, new_figure
 
 CASE_KEYS = ["harmonic", "n_modes", "coupling", "models"]
 #: Seconds between a control change and the start of the band computation.
@@ -33,10 +35,14 @@ class ScatterBandView(Viewer):
     result = param.Parameter(default=None, doc="The current scatter-band result object.")
     busy = param.Boolean(default=False, doc="True while a band is being computed.")
     seconds = param.Number(default=None, allow_None=True, doc="Wall time of the last band.")
+    x_range = param.Parameter(default=None, doc="Frequency range shared with other views "
+                              "(linked zoom and pan); a new one if None.")
 
     def __init__(self, **params):
         super().__init__(**params)
         self._pending = None
+        self._layout = None
+        self._push = Pusher()
         self.case.param.watch(self._schedule, CASE_KEYS)
         self.noise.param.watch(self._schedule, NOISE_KEYS)
 
@@ -96,37 +102,6 @@ class ScatterBandView(Viewer):
         res = self.result if self.result is not None else self.compute_now()
         return compute.single_round_data(res, self.noise.single_round, self.case.dof)
 
-    # -- plot layers -------------------------------------------------------------------
-    # own level dimension (ranges are linked by label and unit): the band's y range is not
-    # tied to the coupled-response plot. Styles are set once on the DynamicMaps.
-    @staticmethod
-    def _dims(dof):
-        return (level_dim(dof, "band_level", "Band level"),
-                level_dim(dof, "band_level2", "Upper level"))
-
-    def _area(self, result, dof, percentile, which):
-        lvl, lvl2 = self._dims(dof)
-        label = "min-max corridor" if which == "minmax" else "percentile band"
-        if result is None:
-            return hv.Area(([], [], []), FREQ, [lvl, lvl2], label=label)
-        d = compute.band_data(result, dof, percentile)
-        lo, hi = ("minimum_db", "maximum_db") if which == "minmax" else ("lower_db", "upper_db")
-        return hv.Area((d["freq"], d[lo], d[hi]), FREQ, [lvl, lvl2], label=label)
-
-    def _reference(self, result, dof):
-        lvl, _ = self._dims(dof)
-        if result is None:
-            return hv.Curve(([], []), FREQ, lvl, label="unpolluted")
-        d = compute.band_data(result, dof)
-        return hv.Curve((d["freq"], d["reference_db"]), FREQ, lvl, label="unpolluted")
-
-    def _round(self, result, dof, single_round):
-        lvl, _ = self._dims(dof)
-        if result is None:
-            return hv.Curve(([], []), FREQ, lvl, label="single round")
-        d = compute.single_round_data(result, single_round, dof)
-        return hv.Curve((d["freq"], d["round_db"]), FREQ, lvl, label="single round")
-
     @param.depends("busy", "seconds", "result")
     def _status(self):
         if self.busy:
@@ -141,53 +116,74 @@ class ScatterBandView(Viewer):
             f"in the last half of the rounds: {conv:.1f} dB", margin=(0, 10),
             css_classes=["scatter-status"])
 
-    def __panel__(self):
-        c, n = self.case, self.noise
-        def res():
-            return hv.streams.Params(self, ["result"])
-
-        def dof():
-            return hv.streams.Params(c, ["dof"])
-
-
-        area_tips = [("Frequency", "$x{0.0} Hz"), ("Level", "$y{0.0} dB")]
-        curve_tips = [("Frequency", "@freq{0.0} Hz"), ("Level", "@band_level{0.0} dB")]
-        area = dict(responsive=True, min_height=320, framewise=True, tools=["hover"],
-                    line_alpha=0)
-        minmax = hv.DynamicMap(
-            lambda result, dof, percentile: self._area(result, dof, percentile, "minmax"),
-            streams=[res(), dof(), hv.streams.Params(n, ["percentile"])]).opts(
-            color=COLORS["band"], alpha=0.35, hooks=[name_source("scatter.minmax")],
-            hover_tooltips=[("", "min-max corridor"), *area_tips], **area)
-        pct = hv.DynamicMap(
-            lambda result, dof, percentile: self._area(result, dof, percentile, "pct"),
-            streams=[res(), dof(), hv.streams.Params(n, ["percentile"])]).opts(
-            color=COLORS["percentile"], alpha=0.45, hooks=[name_source("scatter.percentile")],
-            hover_tooltips=[("", "central percentile band"), *area_tips], **area)
-        ref = hv.DynamicMap(self._reference, streams=[res(), dof()]).opts(
-            color=COLORS["reference"], hooks=[name_source("scatter.reference")],
-            hover_tooltips=[("", "unpolluted"), *curve_tips], **CURVE_OPTS)
-        single = hv.DynamicMap(self._round, streams=[
-            res(), dof(), hv.streams.Params(n, ["single_round"])]).opts(
-            color=COLORS["round"], line_width=1.5, hooks=[name_source("scatter.round")],
-            hover_tooltips=[("", "single round"), *curve_tips],
-            **{k: v for k, v in CURVE_OPTS.items() if k != "line_width"})
+    # -- plot ----------------------------------------------------------------------------
+    def _build(self):
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        fig = new_figure(x_label=FREQ_LABEL, y_label=level_label(self.case.dof, "Band level"),
+                         x_range=self.x_range, name="scatter.figure",
+                         title="Click a frequency: the round with the highest level there")
+        self._fig = fig
+        self._minmax = add_band(fig, "scatter.minmax", color=COLORS["band"], alpha=0.35,
+                                legend="min-max corridor")
+        self._pct = add_band(fig, "scatter.percentile", color=COLORS["percentile"],
+                             alpha=0.45, legend="central percentile band")
+        self._ref = add_line(fig, "scatter.reference", color=COLORS["reference"],
+                             legend="unpolluted", tooltips=level_tooltips("unpolluted"))
+        self._round = add_line(fig, "scatter.round", color=COLORS["round"], width=1.5,
+                               legend="single round", tooltips=level_tooltips("single round"))
         # click on the plot: show the round with the highest level at that frequency
-        tap = hv.streams.Tap(source=single, x=None, y=None)
-        tap.add_subscriber(self._pick_peak_round)
-        plot = (minmax * pct * ref * single).opts(
-            hv.opts.Overlay(legend_position="bottom_left",
-                            title="Click a frequency: the round with the highest level there"))
+        fig.on_event(Tap, lambda event: self._pick_peak_round(event.x, event.y))
+        self._apply(*self._plot_state())()
+        self.param.watch(self._changed, ["result"])
+        self.case.param.watch(self._changed, ["dof"])
+        self.noise.param.watch(self._changed, ["percentile", "single_round"])
+        return fig
+
+    def _plot_state(self) -> tuple:
+        res, dof, n = self.result, self.case.dof, self.noise
+        if res is None:
+            return None, None, dof
+        return (compute.band_data(res, dof, n.percentile),
+                compute.single_round_data(res, n.single_round, dof), dof)
+
+    def _apply(self, band, single, dof):
+        empty = np.zeros(0)
+
+        def update():
+            if band is None:
+                for src in (self._minmax, self._pct):
+                    src.data = {"freq": empty, "lower": empty, "upper": empty}
+                for src in (self._ref, self._round):
+                    src.data = {"freq": empty, "level": empty}
+                return
+            f = band["freq"]
+            fit_range(self.x_range, f)
+            self._minmax.data = {"freq": f, "lower": band["minimum_db"],
+                                 "upper": band["maximum_db"]}
+            self._pct.data = {"freq": f, "lower": band["lower_db"], "upper": band["upper_db"]}
+            self._ref.data = {"freq": f, "level": band["reference_db"]}
+            self._round.data = {"freq": f, "level": single["round_db"]}
+            self._fig.yaxis[0].axis_label = level_label(dof, "Band level")
+
+        return update
+
+    def _changed(self, *events):
+        self._push(self._apply(*self._plot_state()))
+
+    def __panel__(self):
+        if self._layout is not None:
+            return self._layout
         progress = pn.indicators.Progress(
             active=True, bar_color="primary", width=160, height=12,
             visible=self.param.busy, css_classes=["scatter-progress"], margin=(12, 10))
         dl = download_button("scatter", self._csv_columns, self._meta, self._filename)
-        return pn.Column(
-            pn.Row(progress, self._status,
-                   pn.layout.HSpacer(), dl),
-            pn.pane.HoloViews(plot, sizing_mode="stretch_both", min_height=340),
+        self._layout = pn.Column(
+            pn.Row(progress, self._status, pn.layout.HSpacer(), dl),
+            pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )
+        return self._layout
 
     def _pick_peak_round(self, x=None, y=None):
         if x is None or self.result is None:

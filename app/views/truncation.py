@@ -3,7 +3,6 @@ eigenfrequency versus mode number (fig. 5.8)."""
 
 from __future__ import annotations
 
-import holoviews as hv
 import numpy as np
 import panel as pn
 import param
@@ -11,10 +10,25 @@ from panel.viewable import Viewer
 
 from .. import compute
 from ..state import CaseState, TruncationState
-from .common import COLORS, CURVE_OPTS, FREQ, MODES, download_button, name_source
+from .common import COLORS, MODES_LABEL, download_button
+from .plots import Pusher, add_image, add_line, add_span, fit_range, frequency_range, new_figure
 
-ERROR = hv.Dimension("error", label="Truncation error", unit="%")
-EIGEN = hv.Dimension("eigenfrequency", label="Highest retained eigenfrequency", unit="Hz")
+#: Eigenfrequency curves of fig. 5.8: column -> (legend, colour).
+EIGEN_STYLES = {"f_20": ("20 km/h", "#74c0fc"), "f_80": ("80 km/h", "#1c7ed6"),
+                "f_120": ("120 km/h", "#0b3d91")}
+
+
+def _same_columns(old: dict, new: dict) -> bool:
+    """True when a source already holds ``new`` (skip a transfer that changes nothing)."""
+    if old.keys() != new.keys():
+        return False
+    for k, v in new.items():
+        a, b = old[k], v
+        if k == "image":
+            a, b = a[0], b[0]
+        if np.shape(a) != np.shape(b) or not np.array_equal(a, b, equal_nan=True):
+            return False
+    return True
 
 
 class TruncationView(Viewer):
@@ -22,55 +36,95 @@ class TruncationView(Viewer):
 
     case = param.ClassSelector(class_=CaseState)
     truncation = param.ClassSelector(class_=TruncationState)
+    x_range = param.Parameter(default=None, doc="Frequency range shared with other views "
+                              "(linked zoom and pan); a new one if None.")
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._layout = None
+        self._push = Pusher()
 
     def data(self) -> dict:
         c, t = self.case, self.truncation
         dof = c.dof if t.map_mode == "selected DOF" else None
         return compute.error_map_data(c.harmonic, c.coupling, dof, c.models)
 
-    def _map(self, harmonic, coupling, dof, map_mode, threshold, models):
-        d = compute.error_map_data(harmonic, coupling, dof if map_mode == "selected DOF" else None,
-                                   models)
-        what = f"bushing:{dof}" if map_mode == "selected DOF" else "max over 6 DOFs"
-        img = hv.Image((d["centre_freq"], d["n_modes"], d["error_pct"]), [FREQ, MODES], ERROR)
-        return img.opts(clim=(0.0, float(threshold)), title=f"Harmonic {harmonic}, {what}",
-                        clabel=f"Error (%), capped at {threshold:g} %")
+    def _suggested_n(self) -> int:
+        c, t = self.case, self.truncation
+        tab = compute.suggested_table(float(t.threshold), float(t.f_max), c.coupling,
+                                      c.dof if t.map_mode == "selected DOF" else None,
+                                      c.models)
+        return int(tab["n_modes"][list(tab["harmonic"]).index(c.harmonic)])
 
-    def _chosen(self, n_modes):
-        return hv.HLine(float(n_modes), label="chosen N")
+    def _build(self):
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        fig = new_figure(x_label="Centre frequency (Hz)", y_label=MODES_LABEL,
+                         x_range=self.x_range, name="truncation.figure")
+        fig.y_range.range_padding = 0.0
+        fig.grid.visible = False
+        self._fig = fig
+        self._src, self._mapper, self._bar = add_image(
+            fig, "truncation.map", colorbar_title="Error (%)",
+            tooltips=[("Centre frequency", "$x{0.0} Hz"), ("N", "$y{0}"),
+                      ("Error", "@image{0.0} %")])
+        self._suggested = add_span(fig, dimension="width", color=COLORS["suggested"],
+                                   dash="dashed", name="truncation.suggested_n")
+        self._f_max = add_span(fig, dimension="height", color=COLORS["suggested"],
+                               dash="dotted", name="truncation.f_max")
+        self._chosen = add_span(fig, dimension="width", color=COLORS["round"],
+                                name="truncation.chosen_n")
+        self._apply(*self._state())()
+        self.case.param.watch(self._changed, ["harmonic", "coupling", "dof", "models",
+                                              "n_modes"])
+        self.truncation.param.watch(self._changed, ["map_mode", "threshold", "f_max"])
+        return fig
 
-    def _suggested(self, harmonic, coupling, dof, threshold, f_max, map_mode, models):
-        tab = compute.suggested_table(float(threshold), float(f_max), coupling,
-                                      dof if map_mode == "selected DOF" else None, models)
-        n = float(tab["n_modes"][list(tab["harmonic"]).index(harmonic)])
-        return hv.HLine(n).opts(color="#0ca678", line_dash="dashed", line_width=2) * hv.VLine(
-            float(f_max)).opts(color="#0ca678", line_dash="dotted", line_width=2)
+    def _state(self) -> tuple:
+        c, t = self.case, self.truncation
+        what = f"bushing:{c.dof}" if t.map_mode == "selected DOF" else "max over 6 DOFs"
+        return (self.data(), self._suggested_n(), c.harmonic, c.n_modes, what,
+                float(t.threshold), float(t.f_max), compute.frequencies(c.harmonic))
+
+    def _apply(self, d, n_suggested, harmonic, n_modes, what, threshold, f_max, freq):
+        cf, nm = d["centre_freq"], d["n_modes"]
+        dc = float(cf[1] - cf[0]) if cf.size > 1 else 1.0
+        dn = float(nm[1] - nm[0]) if nm.size > 1 else 10.0
+        cols = {"image": [d["error_pct"]], "x": [float(cf[0]) - dc / 2],
+                "y": [float(nm[0]) - dn / 2], "dw": [dc * cf.size], "dh": [dn * nm.size]}
+
+        def update():
+            fit_range(self.x_range, freq)
+            if not _same_columns(self._src.data, cols):
+                self._src.data = cols
+            self._mapper.high = threshold
+            self._bar.title = f"Error (%), capped at {threshold:g} %"
+            self._fig.title.text = f"Harmonic {harmonic}, {what}"
+            self._suggested.location = float(n_suggested)
+            self._f_max.location = f_max
+            self._chosen.location = float(n_modes)
+
+        return update
+
+    def _changed(self, *events):
+        self._push(self._apply(*self._state()))
 
     def __panel__(self):
-        c, t = self.case, self.truncation
-        img = hv.DynamicMap(self._map, streams=[
-            hv.streams.Params(c, ["harmonic", "coupling", "dof", "models"]),
-            hv.streams.Params(t, ["map_mode", "threshold"])]).opts(
-            cmap="inferno_r", colorbar=True, responsive=True, min_height=320, tools=["hover"],
-            hover_tooltips=[("Centre frequency", "$x{0.0} Hz"), ("N", "$y{0}"),
-                            ("Error", "@image{0.0} %")],
-            hooks=[name_source("truncation.map")], framewise=True)
-        chosen = hv.DynamicMap(self._chosen, streams=[hv.streams.Params(c, ["n_modes"])]).opts(
-            color=COLORS["round"], line_width=2)
-        sugg = hv.DynamicMap(self._suggested, streams=[
-            hv.streams.Params(c, ["harmonic", "coupling", "dof", "models"]),
-            hv.streams.Params(t, ["threshold", "f_max", "map_mode"])])
+        if self._layout is not None:
+            return self._layout
+        c = self.case
         dl = download_button("truncation", self._csv_columns, self._meta,
                              lambda: f"truncation_map_h{c.harmonic}_{self._what()}.csv")
-        return pn.Column(
+        self._layout = pn.Column(
             pn.Row(pn.pane.Markdown(
                 "Error vs all modes, 12 Hz floating band; black: at or above the threshold. "
                 "Solid: chosen N; dashed: suggested N up to the dotted frequency.",
                 margin=(0, 10), styles={"color": "#495057", "font-size": "0.9em"}),
                 pn.layout.HSpacer(), dl),
-            pn.pane.HoloViews(img * sugg * chosen, sizing_mode="stretch_both", min_height=340),
+            pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )
+        return self._layout
 
     def _what(self) -> str:
         return self.case.dof if self.truncation.map_mode == "selected DOF" else "maxdof"
@@ -162,46 +216,61 @@ class EigenView(Viewer):
 
     case = param.ClassSelector(class_=CaseState)
 
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._layout = None
+        self._push = Pusher()
+
     def data(self) -> dict:
         return compute.eigen_curves(self.case.models)
 
-    def _curves(self, models):
-        d = compute.eigen_curves(models)
-        styles = {"f_20": ("20 km/h", "#74c0fc"), "f_80": ("80 km/h", "#1c7ed6"),
-                  "f_120": ("120 km/h", "#0b3d91")}
-        layers = [
-            hv.Curve((d["n_modes"], d[k]), MODES, EIGEN, label=lab).opts(
-                color=col, hooks=[name_source(f"eigen.{k}")],
-                hover_tooltips=[("Speed", lab), ("N", "@n_modes"),
-                                ("Eigenfrequency", "@eigenfrequency{0.0} Hz")])
-            for k, (lab, col) in styles.items()
-        ]
-        return hv.Overlay(layers)
+    def _build(self):
+        fig = new_figure(x_label=MODES_LABEL, y_label="Highest retained eigenfrequency (Hz)",
+                         title="Eigenfrequency vs mode number", min_height=300,
+                         name="eigen.figure")
+        self._srcs = {
+            k: add_line(fig, f"eigen.{k}", color=col, legend=lab, x="n_modes",
+                        y="eigenfrequency", legend_location="top_left",
+                        tooltips=[("Speed", lab), ("N", "@n_modes"),
+                                  ("Eigenfrequency", "@eigenfrequency{0.0} Hz")])
+            for k, (lab, col) in EIGEN_STYLES.items()
+        }
+        self._marker = add_span(fig, dimension="height", color=COLORS["round"],
+                                name="eigen.chosen_n")
+        self._apply(self.data(), self.case.n_modes)()
+        self.case.param.watch(self._changed, ["models", "n_modes"])
+        return fig
 
-    def _marker(self, n_modes):
-        return hv.VLine(float(n_modes))
+    def _apply(self, d: dict, n_modes: int):
+        def update():
+            for k, src in self._srcs.items():
+                if not _same_columns(src.data, {"n_modes": d["n_modes"],
+                                                "eigenfrequency": d[k]}):
+                    src.data = {"n_modes": d["n_modes"], "eigenfrequency": d[k]}
+            self._marker.location = float(n_modes)
+
+        return update
+
+    def _changed(self, *events):
+        self._push(self._apply(self.data(), self.case.n_modes))
 
     def __panel__(self):
-        curves = hv.DynamicMap(self._curves, streams=[
-            hv.streams.Params(self.case, ["models"])]).opts(
-            hv.opts.Curve(**CURVE_OPTS),
-            hv.opts.Overlay(legend_position="top_left", title="Eigenfrequency vs mode number",
-                            logy=False))
-        marker = hv.DynamicMap(self._marker, streams=[
-            hv.streams.Params(self.case, ["n_modes"])]).opts(color=COLORS["round"], line_width=2)
+        if self._layout is not None:
+            return self._layout
         dl = download_button(
             "eigen", self._csv_columns,
             lambda: {"view": "highest retained eigenfrequency vs N (thesis fig. 5.8)",
                      "models": self.case.models.describe()},
             lambda: "eigenfrequency_vs_modes.csv")
-        return pn.Column(
+        self._layout = pn.Column(
             pn.Row(pn.pane.Markdown("Highest eigenfrequency among N retained modes "
                                     "(N/2 +/- pairs, lowest first).", margin=(0, 10),
                                     styles={"color": "#495057", "font-size": "0.9em"}),
                    pn.layout.HSpacer(), dl),
-            pn.pane.HoloViews(curves * marker, sizing_mode="stretch_both", min_height=300),
+            pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=300),
             sizing_mode="stretch_both",
         )
+        return self._layout
 
     def _csv_columns(self) -> dict:
         d = self.data()

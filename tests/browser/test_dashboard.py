@@ -169,11 +169,10 @@ def test_url_restores_the_state(browser, dashboard):
     np.testing.assert_allclose(source(page, "truncation.map")["image"], err.ravel(), rtol=1e-12)
     band = compute.band(3, 120, "5dof", 5.5, "tire", True, 800, 3)
     d = compute.band_data(band, "rx", 50)
-    # HoloViews draws the area as one polygon: upper edge, then the lower edge backwards
-    y = np.asarray(source(page, "scatter.percentile")["y"])
-    n = d["freq"].size
-    np.testing.assert_allclose(y[:n], d["upper_db"], rtol=1e-12)
-    np.testing.assert_allclose(y[n:][::-1], d["lower_db"], rtol=1e-12)
+    pct = source(page, "scatter.percentile")
+    np.testing.assert_allclose(pct["freq"], d["freq"])
+    np.testing.assert_allclose(pct["upper"], d["upper_db"], rtol=1e-12)
+    np.testing.assert_allclose(pct["lower"], d["lower_db"], rtol=1e-12)
     assert color_high(page) == 10
     # a control change goes back into the URL
     set_model_value(page, "ctl-case-n_modes", 12, "Slider")
@@ -197,12 +196,12 @@ def test_csv_downloads_match_the_plotted_data(shared_page):
         page.locator(".download-scatter").first.click()
     meta, cols = read_csv(open(info.value.path()).read())
     assert {"noise_pct", "noise target", "frequency dependent", "rounds", "seed"} <= set(meta)
-    mm = np.asarray(source(page, "scatter.minmax")["y"])
-    n = cols["freq_Hz"].size
-    np.testing.assert_allclose(cols["maximum_dB"], mm[:n], rtol=1e-12)  # upper edge first
-    np.testing.assert_allclose(cols["minimum_dB"], mm[n:][::-1], rtol=1e-12)
+    mm = source(page, "scatter.minmax")
+    np.testing.assert_allclose(cols["freq_Hz"], mm["freq"])
+    np.testing.assert_allclose(cols["maximum_dB"], mm["upper"], rtol=1e-12)
+    np.testing.assert_allclose(cols["minimum_dB"], mm["lower"], rtol=1e-12)
     rnd = [k for k in cols if k.startswith("round_")]
-    np.testing.assert_allclose(cols[rnd[0]], source(page, "scatter.round")["band_level"],
+    np.testing.assert_allclose(cols[rnd[0]], source(page, "scatter.round")["level"],
                                rtol=1e-12)
 
     with page.expect_download() as info:
