@@ -19,7 +19,7 @@ from app.views import (
     UncoupledView,
     UploadView,
 )
-from app.views.plots import frequency_range
+from app.views.plots import frequency_range, modes_range
 
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
 
@@ -50,6 +50,7 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
     sync_url(state)
     # one frequency axis range for all spectra of the session: zoom and pan are linked
     freq = frequency_range()
+    modes = modes_range()  # the error map's N axis and the eigenfrequency plot's
     scatter = ScatterBandView(case=case, noise=noise, x_range=freq)
 
     def card(title, view, height, **kw):
@@ -79,13 +80,14 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
             card("Coupled response at the bushing (thesis eq. 4.1)",
                  MobilityView(case=case, x_range=freq), 500),
             card("Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
-                 TruncationView(case=case, truncation=trunc, x_range=freq), 500),
+                 TruncationView(case=case, truncation=trunc, x_range=freq,
+                                n_range=modes), 500),
         ),
         uncoupled,
         pn.Row(
             card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", scatter, 500),
-            card("Eigenfrequency versus number of modes (fig. 5.8)", EigenView(case=case),
-                 500),
+            card("Eigenfrequency versus number of modes (fig. 5.8)",
+                 EigenView(case=case, n_range=modes), 500),
         ),
         pn.Row(card("Suggested number of modes (thesis table 5.1)",
                     SuggestedModesView(case=case, truncation=trunc), 360)),

@@ -141,3 +141,22 @@ def test_suggested_table_follows_threshold_and_map_mode():
     strict = v.table()["n_modes"]
     assert np.all(strict >= loose)  # a stricter threshold never needs fewer modes
     assert list(v.table()["harmonic"]) == list(range(1, 8))
+
+
+def test_frequency_and_mode_axes_are_linked(page):
+    """One range object per shared axis: zooming one plot zooms the others (in the browser
+    the range is a single model), and it spans the harmonic's analysis grid."""
+    from bokeh.plotting import figure
+
+    state, _, root = page
+    figs = {f.name: f for f in root.select({"type": figure}) if f.name}
+    freq = figs["mobility.figure"].x_range
+    assert figs["scatter.figure"].x_range is freq
+    assert figs["truncation.figure"].x_range is freq
+    assert figs["eigen.figure"].x_range is figs["truncation.figure"].y_range
+    f = compute.frequencies(state.case.harmonic)
+    assert (freq.start, freq.end) == (f[0], f[-1])
+    state.case.harmonic = 6
+    f = compute.frequencies(6)
+    assert (freq.start, freq.end) == (f[0], f[-1])
+    assert (freq.reset_start, freq.reset_end) == (f[0], f[-1])

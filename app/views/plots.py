@@ -42,6 +42,7 @@ __all__ = [
     "add_span",
     "fit_range",
     "frequency_range",
+    "modes_range",
     "new_figure",
     "push",
     "Pusher",
@@ -55,6 +56,11 @@ ERROR_PALETTE = tuple(reversed(Inferno256))
 def frequency_range() -> Range1d:
     """A frequency axis range to share between the spectra of one session (linked zoom)."""
     return Range1d(start=0.0, end=1.0, name="frequency_range")
+
+
+def modes_range() -> Range1d:
+    """A retained-modes axis range to share (the error map's N axis and the eigen plot's)."""
+    return Range1d(start=0.0, end=400.0, name="modes_range")
 
 
 def fit_range(rng, values: np.ndarray) -> None:
@@ -71,12 +77,13 @@ def fit_range(rng, values: np.ndarray) -> None:
         rng.update(start=lo, end=hi, reset_start=lo, reset_end=hi)
 
 
-def new_figure(*, x_label: str, y_label: str, x_range=None, title: str | None = None,
-               min_height: int = 320, name: str | None = None):
+def new_figure(*, x_label: str, y_label: str, x_range=None, y_range=None,
+               title: str | None = None, min_height: int = 320, name: str | None = None):
     """A responsive figure with pan/zoom/box-zoom/reset/save, wheel zoom active."""
     fig = figure(
         x_range=x_range if x_range is not None else DataRange1d(range_padding=0.0),
-        y_range=DataRange1d(range_padding=0.05, only_visible=True),
+        y_range=y_range if y_range is not None else DataRange1d(range_padding=0.05,
+                                                                only_visible=True),
         tools=TOOLS, active_scroll="wheel_zoom", toolbar_location="above",
         sizing_mode="stretch_both", min_height=min_height, title=title or "", name=name,
     )

@@ -11,7 +11,16 @@ from panel.viewable import Viewer
 from .. import compute
 from ..state import CaseState, TruncationState
 from .common import COLORS, MODES_LABEL, download_button
-from .plots import Pusher, add_image, add_line, add_span, fit_range, frequency_range, new_figure
+from .plots import (
+    Pusher,
+    add_image,
+    add_line,
+    add_span,
+    fit_range,
+    frequency_range,
+    modes_range,
+    new_figure,
+)
 
 #: Eigenfrequency curves of fig. 5.8: column -> (legend, colour).
 EIGEN_STYLES = {"f_20": ("20 km/h", "#74c0fc"), "f_80": ("80 km/h", "#1c7ed6"),
@@ -38,6 +47,8 @@ class TruncationView(Viewer):
     truncation = param.ClassSelector(class_=TruncationState)
     x_range = param.Parameter(default=None, doc="Frequency range shared with other views "
                               "(linked zoom and pan); a new one if None.")
+    n_range = param.Parameter(default=None, doc="Retained-modes range shared with the "
+                              "eigenfrequency plot; a new one if None.")
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -59,9 +70,10 @@ class TruncationView(Viewer):
     def _build(self):
         if self.x_range is None:
             self.x_range = frequency_range()
+        if self.n_range is None:
+            self.n_range = modes_range()
         fig = new_figure(x_label="Centre frequency (Hz)", y_label=MODES_LABEL,
-                         x_range=self.x_range, name="truncation.figure")
-        fig.y_range.range_padding = 0.0
+                         x_range=self.x_range, y_range=self.n_range, name="truncation.figure")
         fig.grid.visible = False
         self._fig = fig
         self._src, self._mapper, self._bar = add_image(
@@ -95,6 +107,8 @@ class TruncationView(Viewer):
 
         def update():
             fit_range(self.x_range, freq)
+            # up to the all-modes count too (the reference: no error, not in the map)
+            fit_range(self.n_range, [cols["y"][0], cols["y"][0] + cols["dh"][0] + dn])
             if not _same_columns(self._src.data, cols):
                 self._src.data = cols
             self._mapper.high = threshold
@@ -215,6 +229,8 @@ class EigenView(Viewer):
     """Highest retained eigenfrequency versus number of modes at 20/80/120 km/h (fig. 5.8)."""
 
     case = param.ClassSelector(class_=CaseState)
+    n_range = param.Parameter(default=None, doc="Retained-modes range shared with the "
+                              "truncation map's N axis (linked zoom); own if None.")
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -227,7 +243,7 @@ class EigenView(Viewer):
     def _build(self):
         fig = new_figure(x_label=MODES_LABEL, y_label="Highest retained eigenfrequency (Hz)",
                          title="Eigenfrequency vs mode number", min_height=300,
-                         name="eigen.figure")
+                         name="eigen.figure", x_range=self.n_range)
         self._srcs = {
             k: add_line(fig, f"eigen.{k}", color=col, legend=lab, x="n_modes",
                         y="eigenfrequency", legend_location="top_left",

@@ -36,7 +36,9 @@ from numba import njit, prange
 
 from ._rng import GOLDEN, mix64, mix64_np, stream_base
 
-_JIT = dict(cache=True, fastmath=False, error_model="numpy")
+# nogil: a band computed for one dashboard session must not stall the event loop that
+# serves all the others
+_JIT = dict(cache=True, fastmath=False, error_model="numpy", nogil=True)
 
 #: Rounds solved together in one vectorised block.
 LANES = 64
