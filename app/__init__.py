@@ -1,4 +1,4 @@
-"""The tire-fbs dashboard (Panel + HoloViews + Bokeh + param).
+"""The tire-fbs dashboard (Panel + Bokeh + param).
 
 Serve it with ``panel serve app/main.py`` (or ``scripts/serve.sh``). State lives in
 :mod:`app.state`, the cached calls into :mod:`fbs_core` in :mod:`app.compute`, the views in

@@ -136,7 +136,7 @@ class Models:
         return self
 
     def __deepcopy__(self, memo) -> Models:
-        return self  # immutable: copies (param, holoviews streams) share the models
+        return self  # immutable: copies (param) share the models
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Models) and other.key == self.key

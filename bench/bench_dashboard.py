@@ -67,6 +67,21 @@ async ([kind, cls, value, name, timeout]) => {
 }
 """
 
+# A new seed; resolve with the milliseconds until the band's data change.
+JS_BAND = """
+async ([seed]) => {
+  const ms = [...Bokeh.documents[0]._all_models.values()];
+  const w = ms.filter(m => m.css_classes && m.css_classes.includes('ctl-noise-seed')
+                           && 'value' in m)[0];
+  const src = ms.filter(m => m.name === 'scatter.minmax')[0];
+  const before = src.data.upper[3];
+  const t0 = performance.now(); w.value = seed;
+  return await new Promise(r => { const c = () => {
+    if (src.data.upper[3] !== before) r(performance.now() - t0);
+    else setTimeout(c, 5); }; c(); });
+}
+"""
+
 JS_READY = """(name) => { if (!(window.Bokeh && Bokeh.documents.length)) return false;
   const m = [...Bokeh.documents[0]._all_models.values()].filter(
       m => m.name === name && m.type === 'ColumnDataSource')[0];
@@ -88,9 +103,11 @@ def start_server(port: int, threads: int, warm: bool):
     proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
     ready: queue.Queue = queue.Queue()
+    proc.log = []  # the server's output, printed if the benchmark fails
 
     def pump():
         for line in proc.stdout:
+            proc.log.append(line)
             if "Bokeh app running at" in line:
                 ready.put(time.perf_counter())
         ready.put(None)
@@ -109,7 +126,7 @@ def wait_band_idle(page, timeout=300_000):
     """Wait until no scatter band is being computed (its progress bar is hidden)."""
     page.wait_for_function(
         "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
-        "m.css_classes.includes('scatter-progress')).every(m => m.visible === false)",
+        "m.css_classes.includes('scatter-progress')).every(m => m.active === false)",
         timeout=timeout, polling=50)
 
 
@@ -171,24 +188,21 @@ def main():
             }
             for k, v in res.items():
                 print(f"{k:36s} {stats(v)}")
-            # scatter band: a new seed forces a new band of R rounds
-            band = []
-            for seed in range(1, 6):
-                t = page.evaluate(
-                    """async ([seed]) => {
-                      const ms = [...Bokeh.documents[0]._all_models.values()];
-                      const w = ms.filter(m => m.css_classes &&
-                          m.css_classes.includes('ctl-noise-seed') && 'value' in m)[0];
-                      const src = ms.filter(m => m.name === 'scatter.minmax')[0];
-                      const before = src.data.y[3];
-                      const t0 = performance.now(); w.value = seed;
-                      return await new Promise(r => { const c = () => {
-                        if (src.data.y[3] !== before) r(performance.now() - t0);
-                        else setTimeout(c, 5); }; c(); });
-                    }""", [seed])
-                band.append(t)
+            # scatter band: a new seed forces a new band of R rounds; at the default
+            # harmonic 1 (78 lines) and at harmonic 7 (633 lines, the largest)
+            for h in (1, 7):
+                page.evaluate(JS_MEASURE, ["value", "ctl-case-harmonic", h,
+                                           "mobility.truncated", 120_000])
                 wait_band_idle(page)
-            print(f"{'scatter band R=' + format(args.rounds, ','):36s} {stats(band)}")
+                band = []
+                for seed in range(1, 6):
+                    band.append(page.evaluate(JS_BAND, [seed]))
+                    wait_band_idle(page)
+                label = f"scatter band R={args.rounds:,}, harmonic {h}"
+                print(f"{label:36s} {stats(band)}")
+        except Exception:
+            print("server log (last lines):\n" + "".join(proc.log[-40:]), file=sys.stderr)
+            raise
         finally:
             proc.terminate()
             proc.wait(timeout=20)

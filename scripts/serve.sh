@@ -21,7 +21,7 @@ if [ ! -x .venv/bin/python ]; then
   echo "== creating .venv"
   "$PY" -m venv .venv
 fi
-if ! .venv/bin/python -c "import fbs_core, panel, holoviews" >/dev/null 2>&1; then
+if ! .venv/bin/python -c "import fbs_core, panel, bokeh, pyuff" >/dev/null 2>&1; then
   echo "== installing the project into .venv"
   .venv/bin/python -m pip install -q --upgrade pip
   .venv/bin/python -m pip install -q -e .

@@ -8,6 +8,17 @@ from panel.viewable import Viewer
 
 from ..state import DashboardState
 
+#: Milliseconds Panel waits after a browser-side widget change before handling it (Panel's
+#: default, 50 ms, merges bursts of changes; the views here update in a few milliseconds
+#: and drop superseded updates, so the wait would only add to every control's latency).
+DEBOUNCE_MS = 5
+
+
+def _respond_at_once(widget: pn.widgets.Widget) -> None:
+    # composite widgets (DiscreteSlider, Editable*Slider) receive the change on a sub-widget
+    for w in widget.select(pn.widgets.Widget):
+        w._debounce = DEBOUNCE_MS
+
 
 class Controls(Viewer):
     """All controls of the dashboard, grouped by concern."""
@@ -53,6 +64,7 @@ class Controls(Viewer):
             }
             for key, w in self._widgets.items():
                 w.css_classes = [*w.css_classes, "ctl-" + key.replace(".", "-")]
+                _respond_at_once(w)
         return self._widgets
 
     def __panel__(self):

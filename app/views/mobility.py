@@ -84,16 +84,23 @@ class MobilityView(Viewer):
             "mobility", self._csv_columns, self.meta,
             lambda: f"bushing_response_h{c.harmonic}_N{c.n_modes}_{c.dof}_{c.coupling}.csv",
         )
-        caption = pn.pane.Markdown(pn.bind(
-            lambda h, n, d, cp: f"**Harmonic {h}** &middot; bushing:{d} &middot; N = {n} "
-            f"&middot; {cp} coupling", c.param.harmonic, c.param.n_modes, c.param.dof,
-            c.param.coupling), margin=(0, 10))
+        caption = pn.pane.Markdown(self._caption(), margin=(0, 10))
+
+        def recaption(*_):  # a plain text update (a bound function re-renders the pane)
+            caption.object = self._caption()
+
+        c.param.watch(recaption, ["harmonic", "n_modes", "dof", "coupling"])
         self._layout = pn.Column(
             pn.Row(caption, pn.layout.HSpacer(), dl),
             pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )
         return self._layout
+
+    def _caption(self) -> str:
+        c = self.case
+        return (f"**Harmonic {c.harmonic}** &middot; bushing:{c.dof} &middot; N = {c.n_modes} "
+                f"&middot; {c.coupling} coupling")
 
     def _csv_columns(self) -> dict:
         d = self.data()

@@ -23,7 +23,7 @@ from .plots import Pusher, add_band, add_line, fit_range, frequency_range, new_f
 
 CASE_KEYS = ["harmonic", "n_modes", "coupling", "models"]
 #: Seconds between a control change and the start of the band computation.
-DEBOUNCE_S = 0.15
+DEBOUNCE_S = 0.05
 NOISE_KEYS = ["noise", "target", "frequency_dependent", "rounds", "seed"]
 
 
@@ -67,9 +67,13 @@ class ScatterBandView(Viewer):
         pn.state.execute(self._compute_async, schedule=True)
 
     async def _compute_async(self):
+        # Panel runs this coroutine on the event loop *without* the document lock (so the
+        # session stays responsive while the band computes); every change of state that
+        # reaches the Bokeh document is therefore handed back as a locked next-tick
+        # callback (``_locked``) instead of being made here directly.
         key = self.key()
         self._pending = key
-        self.busy = True
+        self._locked(self.param.update, busy=True)
         t0 = time.perf_counter()
         # debounce: let the quick plots of this change reach the browser first, and skip
         # bands that a further change (a dragged slider) has already superseded
@@ -80,13 +84,25 @@ class ScatterBandView(Viewer):
             res = await asyncio.to_thread(compute.band, *key)
         except Exception as exc:  # show the core's message instead of a silent spinner
             if self._pending == key:
-                self.busy = False
-                if pn.state.notifications is not None:
-                    pn.state.notifications.error(f"Scatter band failed: {exc}", duration=8000)
+                self._locked(self._failed, f"Scatter band failed: {exc}")
             raise
         if self._pending != key:  # settings changed while computing: a newer task is running
             return
-        self.param.update(result=res, seconds=time.perf_counter() - t0, busy=False)
+        self._locked(self._finish, key, res, time.perf_counter() - t0)
+
+    @staticmethod
+    def _locked(fn, *args, **kwargs):
+        """Run ``fn`` on the event loop under the session's document lock."""
+        pn.state.execute(lambda: fn(*args, **kwargs), schedule=True)
+
+    def _finish(self, key, res, seconds):
+        if self._pending == key:  # not overtaken while waiting for the lock
+            self.param.update(result=res, seconds=seconds, busy=False)
+
+    def _failed(self, message):
+        self.busy = False
+        if pn.state.notifications is not None:
+            pn.state.notifications.error(message, duration=8000)
 
     def start(self):
         """Compute the first band after the page has loaded."""
@@ -102,19 +118,14 @@ class ScatterBandView(Viewer):
         res = self.result if self.result is not None else self.compute_now()
         return compute.single_round_data(res, self.noise.single_round, self.case.dof)
 
-    @param.depends("busy", "seconds", "result")
-    def _status(self):
+    def _status_text(self) -> str:
         if self.busy:
-            return pn.pane.Markdown(
-                f"Computing {self.noise.rounds:,} rounds ...", margin=(0, 10),
-                css_classes=["scatter-status"])
-        if self.seconds is None:
-            return pn.pane.Markdown("", margin=(0, 10), css_classes=["scatter-status"])
+            return f"Computing {self.noise.rounds:,} rounds ..."
+        if self.seconds is None or self.result is None:
+            return ""
         conv = compute.convergence_db(self.result)
-        return pn.pane.Markdown(
-            f"{self.result.rounds:,} rounds in {self.seconds:.2f} s &middot; largest edge change "
-            f"in the last half of the rounds: {conv:.1f} dB", margin=(0, 10),
-            css_classes=["scatter-status"])
+        return (f"{self.result.rounds:,} rounds in {self.seconds:.2f} s &middot; largest edge "
+                f"change in the last half of the rounds: {conv:.1f} dB")
 
     # -- plot ----------------------------------------------------------------------------
     def _build(self):
@@ -174,12 +185,25 @@ class ScatterBandView(Viewer):
     def __panel__(self):
         if self._layout is not None:
             return self._layout
+        # The indicator and the status line keep their place and size: changing their
+        # content does not make the browser lay out the page again (toggling visibility
+        # did, and delayed every plot update sent with it by 100-200 ms).
         progress = pn.indicators.Progress(
-            active=True, bar_color="primary", width=160, height=12,
-            visible=self.param.busy, css_classes=["scatter-progress"], margin=(12, 10))
+            active=self.busy, value=-1 if self.busy else 0, max=100, bar_color="primary",
+            width=160, height=12, css_classes=["scatter-progress"], margin=(12, 10))
+        status = pn.pane.Markdown(self._status_text(), margin=(0, 10), height=28,
+                                  css_classes=["scatter-status"])
+
+        def show_status(*_):
+            progress.param.update(active=self.busy, value=-1 if self.busy else 0)
+            text = self._status_text()
+            if status.object != text:
+                status.object = text
+
+        self.param.watch(show_status, ["busy", "seconds", "result"])
         dl = download_button("scatter", self._csv_columns, self._meta, self._filename)
         self._layout = pn.Column(
-            pn.Row(progress, self._status, pn.layout.HSpacer(), dl),
+            pn.Row(progress, status, pn.layout.HSpacer(), dl),
             pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )

@@ -192,20 +192,30 @@ class SuggestedModesView(Viewer):
         def refresh(*events):
             if all(e.name == "dof" for e in events) and t.map_mode != "selected DOF":
                 return  # the table judges the maximum over DOFs: nothing to do
-            table.value = self.table_frame()
+            frame = self.table_frame()
+            if not frame.equals(table.value):  # a re-sent table costs the browser a redraw
+                table.value = frame
 
         t.param.watch(refresh, ["threshold", "f_max", "map_mode"])
         c.param.watch(refresh, ["coupling", "dof", "models"])
         dl = download_button(
             "suggested", self._csv_table, self._meta_table,
             lambda: f"suggested_modes_thr{t.threshold:g}_fmax{t.f_max:g}.csv")
-        caption = pn.pane.Markdown(pn.bind(
-            lambda thr, fm, mode, dof: f"Smallest N from which the error stays below "
-            f"**{thr:g} %** up to **{fm:g} Hz** "
-            f"({'bushing:' + dof if mode == 'selected DOF' else mode}), and the highest "
-            "eigenfrequency among those modes at 80 km/h.",
-            t.param.threshold, t.param.f_max, t.param.map_mode, c.param.dof),
-            margin=(0, 10), styles={"color": "#495057"})
+        def caption_text() -> str:
+            where = ("bushing:" + c.dof if t.map_mode == "selected DOF" else t.map_mode)
+            return (f"Smallest N from which the error stays below **{t.threshold:g} %** up "
+                    f"to **{t.f_max:g} Hz** ({where}), and the highest eigenfrequency among "
+                    "those modes at 80 km/h.")
+
+        caption = pn.pane.Markdown(caption_text(), margin=(0, 10), styles={"color": "#495057"})
+
+        def recaption(*_):  # only when the text changes (a DOF change often leaves it)
+            text = caption_text()
+            if caption.object != text:
+                caption.object = text
+
+        t.param.watch(recaption, ["threshold", "f_max", "map_mode"])
+        c.param.watch(recaption, ["dof"])
         return pn.Column(pn.Row(caption, pn.layout.HSpacer(), dl), table,
                          sizing_mode="stretch_both")
 

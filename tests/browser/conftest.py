@@ -182,7 +182,7 @@ def wait_band_idle(page, timeout=120_000):
     """Wait until no scatter band is being computed (its progress bar is hidden)."""
     page.wait_for_function(
         "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
-        "m.css_classes.includes('scatter-progress')).every(m => m.visible === false)",
+        "m.css_classes.includes('scatter-progress')).every(m => m.active === false)",
         timeout=timeout, polling=50)
 
 
