@@ -231,7 +231,38 @@ def test_band_percentiles_when_the_sample_misleads():
     col = rng.uniform(1.0, 2.0, R)
     m = _kernels._SAMPLE
     col[(np.arange(m) * R) // m] = 1e-3 * (1 + np.arange(m))  # sample: all tiny
+    col[1] = 1e9  # an outlier: the histogram's bins are too coarse, it declines too
+    assert not _kernels._order_stats_histogram(col, col.min(), col.max(),
+                                               np.array([R // 2]), np.empty(1))
     mag = np.ascontiguousarray(np.broadcast_to(col, (1, 1, R)))
     qs = (5.0, 50.0, 95.0)
     _, pct = _stats(mag.copy(), qs)
     np.testing.assert_allclose(pct[:, 0, 0], np.percentile(col, qs), rtol=1e-14)
+
+
+@pytest.mark.parametrize("shape", ["lognormal", "ties", "outliers"])
+def test_histogram_order_statistics_are_exact(shape):
+    """The one-histogram selection of many ranks gives the exact order statistics
+    (against a full sort), or declines (heavy outliers) and leaves the work to the
+    sampled selection, whose percentiles still equal numpy's."""
+    R = 10_000
+    rng = np.random.default_rng(1)
+    col = rng.lognormal(size=R)
+    if shape == "ties":
+        col[::50] = np.median(col)  # 200 equal values, in one bin
+    if shape == "outliers":
+        col[:5] = 1e12  # all others fall into the first bin
+    ranks = np.array([0, 1, 499, 500, 4999, 5000, 9498, 9499, 9998, 9999], np.int64)
+    out = np.full(ranks.size, np.nan)
+    before = col.copy()
+    ok = _kernels._order_stats_histogram(col, col.min(), col.max(), ranks, out)
+    np.testing.assert_array_equal(col, before)  # the column is left as it was
+    assert ok == (shape != "outliers")
+    if ok:
+        np.testing.assert_array_equal(out, np.sort(col)[ranks])
+    else:
+        assert np.all(np.isnan(out))
+    mag = np.ascontiguousarray(np.broadcast_to(col, (1, 1, R)))
+    qs = (1.0, 5.0, 50.0, 95.0, 99.0)
+    _, pct = _stats(mag.copy(), qs)
+    np.testing.assert_allclose(pct[:, 0, 0], np.percentile(col, qs), rtol=1e-14, atol=0)

@@ -377,6 +377,65 @@ def _order_stat_pair_sampled(col, k, sample, mid):
     return _order_stat_pair(buf, k)
 
 
+_BINS = 4096
+
+
+@njit(**_JIT)
+def _order_stats_histogram(col, mn, mx, ranks, out):
+    """Order statistics ``x_(ranks[i])`` (0-based) of ``col`` (unchanged) into ``out``.
+
+    One pass sorts the values into ``_BINS`` equal bins over ``[mn, mx]`` (the bin index
+    ``floor((x - mn) * scale)`` is monotone in ``x``: every floating-point step is), the
+    bin prefix counts locate each rank's bin, a second pass gathers the values of those
+    few bins, and an exact selection runs inside each. Two passes serve all ranks (the
+    sampled bracket needs one pass per percentile). Returns False, with nothing written,
+    when a rank's bin is too full (heavy outliers stretch the bins) or the data are not
+    finite; the caller then falls back to :func:`_order_stat_pair_sampled`.
+    """
+    n = col.size
+    if not (np.isfinite(mn) and np.isfinite(mx)) or mx <= mn:
+        return False
+    scale = _BINS / (mx - mn)
+    if not np.isfinite(scale):
+        return False
+    top = _BINS - 1
+    counts = np.zeros(_BINS, np.int64)
+    for i in range(n):
+        counts[min(int((col[i] - mn) * scale), top)] += 1
+    starts = np.empty(_BINS + 1, np.int64)
+    starts[0] = 0
+    for b in range(_BINS):
+        starts[b + 1] = starts[b] + counts[b]
+    cap = max(256, n // 16)
+    fill = np.full(_BINS, -1, np.int64)
+    rank_bin = np.empty(ranks.size, np.int64)
+    total = 0
+    for i in range(ranks.size):
+        b = np.searchsorted(starts, ranks[i], side="right") - 1
+        rank_bin[i] = b
+        if fill[b] < 0:
+            if counts[b] > cap:
+                return False
+            fill[b] = total
+            total += counts[b]
+    buf = np.empty(total + 1)
+    for i in range(n):
+        x = col[i]
+        b = min(int((x - mn) * scale), top)
+        o = fill[b]
+        if o >= 0:
+            buf[o] = x
+            fill[b] = o + 1
+    for i in range(ranks.size):
+        b = rank_bin[i]
+        end = fill[b]  # one past the bin's segment after the gather
+        seg = buf[end - counts[b]:end]
+        k = ranks[i] - starts[b]
+        _select(seg, k, 0)
+        out[i] = seg[k]
+    return True
+
+
 @njit(parallel=True, **_JIT)
 def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_hi, l0):
     """Band statistics over the rounds of ``mag (n_l, n_e, R)`` (rounds last).
@@ -419,6 +478,26 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
             continue
         big = R > 4 * _SAMPLE
         if big:
+            # all percentiles of the column from one histogram (two passes in all)
+            ranks = np.empty(2 * qs.size, np.int64)
+            for iq in range(qs.size):
+                k = min(int(np.floor((R - 1) * qs[iq] / 100.0)), R - 2)
+                ranks[2 * iq] = k
+                ranks[2 * iq + 1] = k + 1
+            stats = np.empty(2 * qs.size)
+            if _order_stats_histogram(col, mn, mx, ranks, stats):
+                for iq in range(qs.size):
+                    h = (R - 1) * qs[iq] / 100.0
+                    k = int(np.floor(h))
+                    if k >= R - 1:
+                        pct[iq, line, e] = mx
+                        continue
+                    a0 = stats[2 * iq]
+                    b0 = stats[2 * iq + 1]
+                    t = h - k
+                    d = b0 - a0
+                    pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t
+                continue
             sample = np.empty(_SAMPLE)
             for i in range(_SAMPLE):
                 sample[i] = col[(i * R) // _SAMPLE]
