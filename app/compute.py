@@ -18,7 +18,8 @@ results nor with each other's.
 
 from __future__ import annotations
 
-from functools import lru_cache
+import threading
+from functools import lru_cache, wraps
 
 import numpy as np
 
@@ -55,6 +56,44 @@ PERCENTILE_BANDS = (50, 80, 90, 95, 99)
 Q_LEVELS = tuple(sorted({q for w in PERCENTILE_BANDS for q in ((100 - w) / 2, (100 + w) / 2)}))
 
 
+def shared_cache(maxsize: int):
+    """``functools.lru_cache`` that computes a missing entry once for all threads.
+
+    Sessions run their callbacks on a thread pool; when several of them ask for the same
+    missing result at once (a review meeting opening the same link, many tabs loading the
+    default view), the first computes it and the others wait for it instead of computing
+    it again beside it on the same cores.
+    """
+
+    def decorate(fn):
+        cached = lru_cache(maxsize=maxsize)(fn)
+        guard = threading.Lock()
+        running: dict = {}
+
+        @wraps(fn)
+        def wrapper(*args):
+            with guard:
+                done = running.get(args)
+                mine = done is None
+                if mine:
+                    done = running[args] = threading.Event()
+            if not mine:
+                done.wait()
+                return cached(*args)  # a hit (recomputed only if the first call failed)
+            try:
+                return cached(*args)
+            finally:
+                with guard:
+                    del running[args]
+                done.set()
+
+        wrapper.cache_clear = cached.cache_clear
+        wrapper.cache_info = cached.cache_info
+        return wrapper
+
+    return decorate
+
+
 def version() -> str:
     return str(getattr(fbs_core, "__version__", "unknown"))
 
@@ -73,7 +112,7 @@ def level_unit(dof: str) -> str:
     return "dB re 1 (rad/s)/m" if dof.startswith("r") else "dB re 1 (m/s)/m"
 
 
-@lru_cache(maxsize=8)
+@shared_cache(maxsize=8)
 def frequencies(harmonic: int) -> np.ndarray:
     """The analysis grid of a harmonic case in Hz (read-only)."""
     f = np.array(fbs_core.harmonic(harmonic).frequencies(), dtype=float)
@@ -118,14 +157,14 @@ def error_map(harmonic: int, coupling: str, models=None):
     return _error_map(int(harmonic), coupling, _key(models))
 
 
-@lru_cache(maxsize=24)
+@shared_cache(maxsize=24)
 def _error_map(harmonic: int, coupling: str, models):
     n_total = int(_tire(models).n_modes)
     return studies.truncation_map(harmonic, n_modes=np.arange(10, n_total, 10),
                                   coupling=coupling, **_models_kw(models))
 
 
-@lru_cache(maxsize=64)
+@shared_cache(maxsize=64)
 def _bushing_response(harmonic: int, n_modes: int | None, coupling: str,
                       models=None) -> np.ndarray:
     frf = fbs_core.bushing_response(harmonic, n_modes=n_modes, freq=frequencies(harmonic),
@@ -206,7 +245,7 @@ def suggested_table(threshold_pct: float, f_max: float, coupling: str,
     return _suggested_table(float(threshold_pct), float(f_max), coupling, dof, _key(models))
 
 
-@lru_cache(maxsize=64)
+@shared_cache(maxsize=64)
 def _suggested_table(threshold_pct, f_max, coupling, dof, models) -> dict:
     maps = [error_map(k, coupling, models) for k in range(1, 8)]
     s = studies.suggest_modes(threshold=threshold_pct / 100.0, f_max=f_max, maps=maps,
@@ -227,7 +266,7 @@ def eigen_curves(models=None) -> dict:
     return _eigen_curves(_key(models))
 
 
-@lru_cache(maxsize=8)
+@shared_cache(maxsize=8)
 def _eigen_curves(models) -> dict:
     mf = studies.mode_frequencies(EIGEN_SPEEDS, tire=None if models is None else models.tire)
     out = {"n_modes": np.asarray(mf.n_modes, int)}
@@ -237,13 +276,13 @@ def _eigen_curves(models) -> dict:
 
 
 # -- uncoupled subsystems --------------------------------------------------------------------
-@lru_cache(maxsize=64)
+@shared_cache(maxsize=64)
 def _tire_hub(harmonic: int, n_modes: int | None, models=None):
     return _tire(models).patch_response(frequencies(harmonic), fbs_core.harmonic(harmonic),
                                         _n(models, n_modes))
 
 
-@lru_cache(maxsize=8)
+@shared_cache(maxsize=8)
 def _chassis_frf(harmonic: int, models=None):
     return _chassis(models).mobility(frequencies(harmonic))
 
@@ -284,7 +323,7 @@ def band(harmonic: int, n_modes: int | None, coupling: str, noise_pct: float, ta
                  seed, _key(models))
 
 
-@lru_cache(maxsize=4)
+@shared_cache(maxsize=4)
 def _band(harmonic, n_modes, coupling, noise_pct, target, frequency_dependent, rounds, seed,
           models):
     return studies.scatter_band(

@@ -138,3 +138,42 @@ def test_csv_rejects_bad_columns_and_headers():
         to_csv({"a": np.zeros((3, 2))}, {}, "x")
     with pytest.raises(ValueError, match="single line"):
         to_csv({"a": np.zeros(3)}, {"note": "two\nlines"}, "x")
+
+
+def test_shared_cache_computes_a_missing_entry_once_for_all_threads():
+    """Concurrent sessions asking for the same missing result: one computation, and every
+    caller gets that same (immutable) object; a failure is not cached."""
+    import threading
+    import time
+
+    from app.compute import shared_cache
+
+    calls = []
+
+    @shared_cache(maxsize=4)
+    def slow(x):
+        calls.append(x)
+        time.sleep(0.2)
+        if x < 0:
+            raise ValueError("negative")
+        return object()
+
+    results = [None] * 8
+    start = threading.Barrier(8)
+
+    def ask(i):
+        start.wait()
+        results[i] = slow(1)
+
+    threads = [threading.Thread(target=ask, args=(i,)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert calls == [1]
+    assert all(r is results[0] for r in results)
+    assert slow(2) is not results[0] and calls == [1, 2]
+    for _ in range(2):
+        with pytest.raises(ValueError, match="negative"):
+            slow(-1)
+    assert calls.count(-1) == 2
