@@ -246,3 +246,15 @@ def shared_page(browser, dashboard):
     open_dashboard(page, dashboard.url + "?rounds=1000")
     yield page
     context.close()
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """A failed browser test reports the server's log: a timeout in the page is often
+    explained there (an exception in a callback, a computation that never ended)."""
+    outcome = yield
+    report = outcome.get_result()
+    server = item.funcargs.get("dashboard") if hasattr(item, "funcargs") else None
+    if report.failed and isinstance(server, DashboardServer):
+        report.sections.append(("dashboard server log (last 80 lines)",
+                                "".join(server.log[-80:])))

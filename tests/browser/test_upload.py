@@ -54,7 +54,11 @@ def test_upload_changes_the_views_of_this_session_only(browser, dashboard, tmp_p
     a.locator(".upload-interpolate input").check()
     a.locator(".upload-reread button").click()
     for n in VIEWS:
-        wait_changed(a, n, before[n], timeout=120_000)
+        try:
+            wait_changed(a, n, before[n], timeout=120_000)
+        except Exception as exc:  # say which view, with the server's side of the story
+            raise AssertionError(f"{n} did not change after the upload; server log:\n"
+                                 + "".join(dashboard.log[-60:])) from exc
     for words in ("uploaded chassis 'reference_chassis.mat'", "bushing:rz", "1 to 600 Hz",
                   "interpolated onto the analysis grids"):
         _shows(a, "upload-summary", words)
