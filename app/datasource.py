@@ -29,6 +29,7 @@ A refused upload leaves the state as it was and says why in :attr:`DataSource.er
 from __future__ import annotations
 
 import hashlib
+import threading
 
 import numpy as np
 import param
@@ -265,6 +266,10 @@ class DataSource(param.Parameterized):
         super().__init__(**params)
         self._tire_key = self._chassis_key = ""
         self._last_chassis: tuple[bytes, str] | None = None
+        self._last_settings: tuple[str, str, bool] | None = None
+        # uploads of one session are read one at a time (a click and a settings change
+        # arrive on different worker threads: the last read must see the last settings)
+        self._lock = threading.RLock()
 
     # -- uploads -------------------------------------------------------------------------
     def load_chassis(self, data: bytes | None = None, filename: str | None = None, *,
@@ -275,6 +280,21 @@ class DataSource(param.Parameterized):
         Returns True when it is now the session's chassis; else ``error`` says why and
         nothing else changed.
         """
+        with self._lock:
+            return self._load_chassis(data, filename, spindle, bushing, interpolate)
+
+    def reread_if_changed(self) -> bool | None:
+        """Re-read the last chassis upload if the node names or the interpolation choice
+        differ from those of its last reading (None: nothing to do)."""
+        with self._lock:
+            if self._last_chassis is None or self._settings() == self._last_settings:
+                return None
+            return self._load_chassis(None, None, None, None, None)
+
+    def _settings(self) -> tuple[str, str, bool]:
+        return (self.spindle, self.bushing, bool(self.interpolate))
+
+    def _load_chassis(self, data, filename, spindle, bushing, interpolate) -> bool:
         if data is None:
             if self._last_chassis is None:
                 self.error = "no chassis file uploaded yet"
@@ -285,6 +305,7 @@ class DataSource(param.Parameterized):
         interp = self.interpolate if interpolate is None else bool(interpolate)
         name = filename or "upload"
         self._last_chassis = (bytes(data), name)  # settings can be changed and re-read
+        self._last_settings = (sp, bu, interp)
         try:
             chassis, summary, key = self._read_chassis(bytes(data), name, sp, bu, interp)
             check_pair(self.models.tire, chassis)
@@ -341,6 +362,10 @@ class DataSource(param.Parameterized):
         Returns True when it is now the session's tire; else ``error`` says why and
         nothing else changed.
         """
+        with self._lock:
+            return self._load_tire(data, filename)
+
+    def _load_tire(self, data: bytes, filename: str | None) -> bool:
         from fbs_core.io import load_tire_model
 
         name = filename or "upload"
@@ -363,11 +388,12 @@ class DataSource(param.Parameterized):
 
     def reset(self) -> None:
         """Back to the shipped reference tire and chassis."""
-        self._last_chassis = None
-        self._tire_key = self._chassis_key = ""
-        with param.parameterized.batch_call_watchers(self):
-            self.param.update(error="", tire_summary="", chassis_summary="")
-            self.models = REFERENCE
+        with self._lock:
+            self._last_chassis = self._last_settings = None
+            self._tire_key = self._chassis_key = ""
+            with param.parameterized.batch_call_watchers(self):
+                self.param.update(error="", tire_summary="", chassis_summary="")
+                self.models = REFERENCE
 
     def describe(self) -> str:
         """One line: which models the views use."""

@@ -361,3 +361,27 @@ def test_tire_from_matlab_in_the_documented_layout():
     mob = MobilityView(case=state.case).data()
     np.testing.assert_allclose(mob["truncated"], compute.mobility_data(5, 60, "z", "6dof")
                                ["truncated"], rtol=1e-9)
+
+
+def test_changed_settings_re_read_the_chassis_even_after_a_stale_click(chassis_frf):
+    """Ticking 'interpolate' re-reads the uploaded file at once. A click on 'Read chassis
+    again' that the server handles before the tick (Panel runs both on worker threads, in
+    either order) reads the old settings and fails, but the tick still wins: the last
+    reading always has the last settings."""
+    coarse = chassis_frf.isel(freq=slice(0, None, 2)).crop(None, 422.0)  # 1 Hz lines
+    raw = save_frf(coarse, format="hdf5")
+    ds = DataSource()
+    view = UploadView(data=ds)
+    view.__panel__().get_root()
+    view.chassis_file.param.update(value=raw, filename="coarse.h5")
+    assert "interpolate" in ds.error and ds.models is REFERENCE
+    view.reread.clicks += 1  # the stale click: still without interpolation
+    assert "interpolate" in ds.error and ds.models is REFERENCE
+    view.interpolate.value = True  # the tick arrives: read again with the new setting
+    assert ds.error == "" and ds.models.chassis_name == "coarse.h5"
+    assert "interpolated" in ds.chassis_summary
+    before = ds.models
+    view.reread.clicks += 1  # same settings: an explicit re-read gives the same models
+    assert ds.models == before
+    view.bushing.value = "nowhere"  # a wrong node name is reported, nothing else changes
+    assert "no bushing node 'nowhere'" in ds.error and ds.models == before

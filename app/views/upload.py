@@ -50,6 +50,11 @@ class UploadView(Viewer):
         self.chassis_file.param.watch(self._on_chassis, "value")
         self.tire_file.param.watch(self._on_tire, "value")
         self.reread.on_click(lambda _: self._run(ds.load_chassis))
+        # a new node name or the interpolation choice re-reads the chassis file at once;
+        # this also settles a click on "Read chassis again" that overtook the change
+        # (Panel hands both to its worker threads, in either order)
+        ds.param.watch(lambda *_: self._run(ds.reread_if_changed),
+                       ["spindle", "bushing", "interpolate"])
         self.reset.on_click(lambda _: ds.reset())
 
     # -- actions (each a call into the data source; errors land in ``data.error``) --------
