@@ -109,14 +109,20 @@ CHANGE_JS = f"""async ([title, value, timeout, quiet]) => {{
   return first === null ? null : [first - t0, last - t0];
 }}"""
 
+#: True while the page reports a computation in progress (the scatter band's progress bar):
+#: under load a band can take longer than any fixed quiet time.
+BUSY_JS = """() => [...Bokeh.documents[0].all_models].some(
+  m => m.css_classes && m.css_classes.includes('scatter-progress') && m.active === true)"""
+
 SETTLE_JS = f"""async ([timeout, quiet]) => {{
   const digest = {DIGEST_JS};
+  const busy = {BUSY_JS};
   const t0 = performance.now();
   let current = digest(), last = t0;
   while (performance.now() - t0 < timeout) {{
     await new Promise(r => setTimeout(r, 50));
     const d = digest();
-    if (d !== current) {{ current = d; last = performance.now(); }}
+    if (d !== current || busy()) {{ current = d; last = performance.now(); }}
     if (performance.now() - last > quiet) return current;
   }}
   return null;
