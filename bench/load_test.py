@@ -300,6 +300,37 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
 # ---- servers -------------------------------------------------------------------------------
 
 
+def host_busy_s() -> float:
+    """CPU seconds the whole host has been busy (all cores), from /proc/stat."""
+    with open("/proc/stat") as f:
+        fields = [int(x) for x in f.readline().split()[1:]]
+    busy = sum(fields) - fields[3] - (fields[4] if len(fields) > 4 else 0)  # minus idle, iowait
+    return busy / os.sysconf("SC_CLK_TCK")
+
+
+def proc_tree_cpu_s(pid: int) -> float:
+    """CPU seconds of a process and its live descendants (utime + stime, /proc)."""
+    tick = os.sysconf("SC_CLK_TCK")
+    children: dict[int, list[int]] = {}
+    times: dict[int, float] = {}
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open(f"/proc/{d}/stat") as f:
+                st = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        children.setdefault(int(st[1]), []).append(int(d))
+        times[int(d)] = (int(st[11]) + int(st[12])) / tick
+    total, todo = 0.0, [pid]
+    while todo:
+        p = todo.pop()
+        total += times.get(p, 0.0)
+        todo.extend(children.get(p, []))
+    return total
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -339,6 +370,9 @@ class LocalServer:
         self.log.seek(0)
         return self.log.read()
 
+    def cpu_s(self) -> float | None:
+        return proc_tree_cpu_s(self.proc.pid)
+
     def stop(self) -> None:
         self.proc.terminate()
         try:
@@ -375,6 +409,24 @@ class DockerServer:
     def logs(self) -> str:
         return subprocess.run(["docker", "logs", self.cid], capture_output=True,
                               text=True).stdout
+
+    def cpu_s(self) -> float | None:
+        """CPU seconds of the container (cgroup v2 or v1 accounting), None if unknown."""
+        for path, scale, key in (
+                (f"/sys/fs/cgroup/system.slice/docker-{self.cid}.scope/cpu.stat", 1e-6,
+                 "usage_usec"),
+                (f"/sys/fs/cgroup/docker/{self.cid}/cpu.stat", 1e-6, "usage_usec"),
+                (f"/sys/fs/cgroup/cpuacct/docker/{self.cid}/cpuacct.usage", 1e-9, None)):
+            try:
+                text = Path(path).read_text()
+            except OSError:
+                continue
+            if key is None:
+                return int(text) * scale
+            for line in text.splitlines():
+                if line.startswith(key):
+                    return int(line.split()[1]) * scale
+        return None
 
     def stop(self) -> None:
         subprocess.run(["docker", "rm", "-f", self.cid], capture_output=True)
@@ -416,8 +468,14 @@ def main(argv: list[str] | None = None) -> int:
     rows, failed = [], False
     try:
         for n in levels:
+            cpu0 = server.cpu_s() if server is not None else None
+            host0, t0 = host_busy_s(), time.monotonic()
             row = asyncio.run(run_level(url, n, args.changes, args.slider, args.timeout,
                                         not args.no_isolation_check))
+            cpu1 = server.cpu_s() if server is not None else None
+            row["host_cpu_s"] = host_busy_s() - host0
+            row["accounted_s"] = time.monotonic() - t0  # incl. the isolation check
+            row["server_cpu_s"] = None if cpu0 is None or cpu1 is None else cpu1 - cpu0
             rows.append(row)
             print(f"\n== {n} concurrent sessions, {row['changes']} changes, "
                   f"{row['wall_s']:.1f} s wall, {row['distinct_final_states']} distinct "
@@ -425,6 +483,12 @@ def main(argv: list[str] | None = None) -> int:
             print(f"   page load to plots (ms)  {summary(row['load_ms'])}")
             print(f"   change -> first update   {summary(row['first_ms'])}")
             print(f"   change -> settled        {summary(row['settled_ms'])}")
+            if row["server_cpu_s"] is not None:
+                # where the cores went: on one machine the browsers compete with the server
+                print(f"   CPU over {row['accounted_s']:.0f} s (sessions and isolation check): "
+                      f"server {row['server_cpu_s']:.1f} s, everything else on the host "
+                      f"(browsers, this script) {row['host_cpu_s'] - row['server_cpu_s']:.1f} s, "
+                      f"of {os.cpu_count() * row['accounted_s']:.0f} core-seconds")
             if row["problems"]:
                 failed = True
                 print(f"   PROBLEMS ({len(row['problems'])}):")

@@ -160,3 +160,35 @@ def test_frequency_and_mode_axes_are_linked(page):
     f = compute.frequencies(6)
     assert (freq.start, freq.end) == (f[0], f[-1])
     assert (freq.reset_start, freq.reset_end) == (f[0], f[-1])
+
+
+def test_a_slow_update_of_an_older_state_never_lands_last():
+    """Two control changes of one session handled by two worker threads: the thread that
+    read the older state finishes last. Its update must be dropped, so the plot shows the
+    latest state (the ticket is drawn before the state is read)."""
+    import threading
+
+    from app.views.plots import Pusher
+
+    state, shown = {"harmonic": 3}, []
+    push = Pusher()
+    a_has_read, b_is_done = threading.Event(), threading.Event()
+
+    def make_a():  # reads harmonic 3, then computes slowly
+        h = state["harmonic"]
+        a_has_read.set()
+        assert b_is_done.wait(5)
+        return lambda: shown.append(h)
+
+    def make_b():  # the next change: harmonic 1, computed quickly
+        h = state["harmonic"]
+        return lambda: shown.append(h)
+
+    slow = threading.Thread(target=push, args=(make_a,))
+    slow.start()
+    assert a_has_read.wait(5)
+    state["harmonic"] = 1
+    push(make_b)
+    b_is_done.set()
+    slow.join(5)
+    assert shown == [1]

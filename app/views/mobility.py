@@ -74,7 +74,7 @@ class MobilityView(Viewer):
         return update
 
     def _changed(self, *events):
-        self._push(self._apply(self.data(), self.case.dof))
+        self._push(lambda: self._apply(self.data(), self.case.dof))
 
     def __panel__(self):
         if self._layout is not None:
@@ -173,7 +173,7 @@ class UncoupledView(Viewer):
         return update
 
     def _changed(self, *events):
-        self._push(self._apply(self.data()))
+        self._push(lambda: self._apply(self.data()))
 
     def __panel__(self):
         if self._layout is not None:

@@ -174,9 +174,12 @@ def push(update: Callable[[], None]) -> None:
 class Pusher:
     """Pushes the model updates of one view in order, dropping any a newer one overtook.
 
-    Updates are computed on the thread that handled the control change; with several
-    threads an older, slower update could otherwise land after a newer one. Each update
-    must therefore set the view's complete state (not a difference to the previous one).
+    Control changes of one session may be handled by several worker threads at once. A
+    ticket is drawn *before* the view reads its state and computes the update, so the
+    update with the highest ticket is one computed from the latest state; an update whose
+    ticket is lower than one already applied is dropped (it may hold an older state, and a
+    slower thread could otherwise land it last). Each update must therefore set the view's
+    complete state (not a difference to the previous one).
     """
 
     def __init__(self):
@@ -184,10 +187,12 @@ class Pusher:
         self._issued = 0
         self._applied = 0
 
-    def __call__(self, update: Callable[[], None]) -> None:
+    def __call__(self, make: Callable[[], Callable[[], None]]) -> None:
+        """Draw a ticket, then ``make()`` the update from the current state and push it."""
         with self._lock:
             self._issued += 1
             seq = self._issued
+        update = make()
 
         def latest():
             with self._lock:

@@ -180,7 +180,7 @@ class ScatterBandView(Viewer):
         return update
 
     def _changed(self, *events):
-        self._push(self._apply(*self._plot_state()))
+        self._push(lambda: self._apply(*self._plot_state()))
 
     def __panel__(self):
         if self._layout is not None:

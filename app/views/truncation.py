@@ -121,7 +121,7 @@ class TruncationView(Viewer):
         return update
 
     def _changed(self, *events):
-        self._push(self._apply(*self._state()))
+        self._push(lambda: self._apply(*self._state()))
 
     def __panel__(self):
         if self._layout is not None:
@@ -278,7 +278,7 @@ class EigenView(Viewer):
         return update
 
     def _changed(self, *events):
-        self._push(self._apply(self.data(), self.case.n_modes))
+        self._push(lambda: self._apply(self.data(), self.case.n_modes))
 
     def __panel__(self):
         if self._layout is not None:
