@@ -161,14 +161,26 @@ def push(update: Callable[[], None]) -> None:
     if doc is None or doc.session_context is None:
         update()  # no server: tests, notebooks, exports
     elif pn.state._unblocked(doc):
-        # on the session's own thread with its websocket open (as Panel's own models do):
-        # dispatch the change events straight away
-        with pn.io.unlocked():
+        if _holds_document_lock(doc):
+            # a locked callback (a control change, a band result): Bokeh's own ordered
+            # path sends the patches once the callback returns
             update()
+        else:
+            # on the session's thread but outside the lock (Panel runs some event
+            # coroutines unlocked): Panel's way of dispatching the events straight away
+            with pn.io.unlocked():
+                update()
     else:
         # another thread, or before the page has loaded: on the event loop, under the
         # document lock
         pn.state.execute(update, schedule=True)
+
+
+def _holds_document_lock(doc) -> bool:
+    """True inside a callback that holds the session's document lock (Bokeh keeps the
+    list of pending writes only then)."""
+    session = getattr(doc.session_context, "_session", None)
+    return session is not None and getattr(session, "_pending_writes", None) is not None
 
 
 class Pusher:
