@@ -139,7 +139,9 @@ build_image() {
     log "docker build -t $image --build-arg WHEELHOUSE=wheelhouse ."
     docker build --force-rm --build-arg WHEELHOUSE=wheelhouse -t "$image" . \
         >"$work/build.log" 2>&1 || { tail -40 "$work/build.log"; fail "docker build failed"; }
-    grep -E "^(offline install|online install|reference|warm-up)" "$work/build.log" | sed "s/^/    /"
+    # (a build served from the layer cache prints none of these lines: not an error)
+    { grep -E "^(offline install|online install|reference|warm-up)" "$work/build.log" || true; } \
+        | sed "s/^/    /"
     log "image size: $(docker image inspect -f '{{.Size}}' "$image" | awk '{printf "%.0f MB", $1/1e6}')"
 }
 
