@@ -187,7 +187,8 @@ async def run_session(browser, url: str, index: int, changes: int, title: str,
     await asyncio.sleep(start_delay)
     context, page = await open_page(browser, url, timeout_s)
     res.context, res.page = context, page  # kept open for the isolation check
-    page.on("pageerror", lambda exc: res.errors.append(f"page error: {exc}"))
+    page.on("pageerror", lambda exc: res.errors.append(
+        f"page error: {exc}; stack: {' | '.join((exc.stack or '').splitlines()[:6])}"))
     ms = timeout_s * 1000
     try:
         t0 = time.monotonic()
