@@ -225,9 +225,8 @@ async def final_digest(res: SessionResult, timeout_s: float) -> None:
         await res.context.close()
 
 
-async def reference_digest(browser, url: str, title: str, value: float,
-                           timeout_s: float) -> str | None:
-    """Plot data of a lone fresh session that sets the slider to ``value``."""
+async def reference_page(browser, url: str, title: str, value: float, timeout_s: float):
+    """A lone fresh session that sets the slider to ``value`` (left open for its digest)."""
     context, page = await open_page(browser, url, timeout_s)
     ms = timeout_s * 1000
     try:
@@ -237,7 +236,16 @@ async def reference_digest(browser, url: str, title: str, value: float,
         info = await page.evaluate(SLIDER_INFO_JS, title)
         if info["value"] != value:
             await page.evaluate(CHANGE_JS, [title, value, ms, 400])
-        return await page.evaluate(SETTLE_JS, [ms, 3000])
+    except Exception:
+        await context.close()
+        raise
+    return context, page
+
+
+async def page_digest(context, page, timeout_s: float) -> str | None:
+    """Plot data of a page once nothing changes for 3 s any more; closes it."""
+    try:
+        return await page.evaluate(SETTLE_JS, [timeout_s * 1000, 3000])
     finally:
         await context.close()
 
@@ -256,8 +264,27 @@ def summary(values: list[float]) -> str:
             f"max {max(values):7.0f}")
 
 
+async def wait_server_idle(cpu_s, timeout_s: float, quiet_s: float = 3.0,
+                           busy_share: float = 0.1) -> bool:
+    """Wait until the server has used under ``busy_share`` of a core for ``quiet_s``
+    seconds (so no update is still queued behind a backlog); False if it never is, or
+    if the server's CPU time cannot be read."""
+    if cpu_s is None or cpu_s() is None:
+        return False
+    t_end = time.monotonic() + timeout_s
+    last, quiet = cpu_s(), 0.0
+    while time.monotonic() < t_end:
+        await asyncio.sleep(1.0)
+        now = cpu_s()
+        quiet = quiet + 1.0 if now - last < busy_share else 0.0
+        last = now
+        if quiet >= quiet_s:
+            return True
+    return False
+
+
 async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float,
-                    check_isolation: bool) -> dict:
+                    check_isolation: bool, cpu_s=None) -> dict:
     from playwright.async_api import async_playwright
 
     async with async_playwright() as p:
@@ -276,8 +303,14 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
             refs: dict = {}
             if check_isolation:
                 values = sorted({r.last_value for r in results if not r.errors})
+                ref_pages = await asyncio.gather(*(
+                    reference_page(browser, url, title, v, timeout_s) for v in values))
+            # under a backlog a page can be quiet for seconds with updates still queued on
+            # the server: take every digest once the server itself is idle
+            idle = await wait_server_idle(cpu_s, timeout_s)
+            if check_isolation:
                 digests = await asyncio.gather(*(
-                    reference_digest(browser, url, title, v, timeout_s) for v in values))
+                    page_digest(c, pg, timeout_s) for c, pg in ref_pages))
                 refs = dict(zip(values, digests, strict=True))
             await asyncio.gather(*(final_digest(r, timeout_s) for r in results))
             if check_isolation:
@@ -287,7 +320,8 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
                     if r.final_digest != refs.get(r.last_value):
                         problems.append(
                             f"session {r.index}: plot data differ from a lone session's "
-                            f"at slider value {r.last_value}")
+                            f"at slider value {r.last_value}"
+                            + ("" if idle else " (server never idle before the check)"))
         finally:
             await browser.close()
     first = [x for r in results for x in r.first_ms]
@@ -472,7 +506,8 @@ def main(argv: list[str] | None = None) -> int:
             cpu0 = server.cpu_s() if server is not None else None
             host0, t0 = host_busy_s(), time.monotonic()
             row = asyncio.run(run_level(url, n, args.changes, args.slider, args.timeout,
-                                        not args.no_isolation_check))
+                                        not args.no_isolation_check,
+                                        server.cpu_s if server is not None else None))
             cpu1 = server.cpu_s() if server is not None else None
             row["host_cpu_s"] = host_busy_s() - host0
             row["accounted_s"] = time.monotonic() - t0  # incl. the isolation check
