@@ -32,7 +32,7 @@ Variables (all optional; the table with examples is in docs/deployment.md):
 ``FBS_USE_XHEADERS``
     ``true`` behind a TLS-terminating reverse proxy (``--use-xheaders``).
 ``FBS_WEBSOCKET_MAX_MESSAGE_MB``
-    Largest websocket message (file uploads travel in one), default Bokeh's 20.
+    Largest websocket message (file uploads travel in one, base64-encoded), default 200.
 ``FBS_LOG_LEVEL``
     ``debug``, ``info`` (default), ``warning``, ``error`` or ``critical``.
 ``FBS_APP``
@@ -71,6 +71,10 @@ def _flag(env: dict[str, str], name: str) -> bool:
     if value in FALSE:
         return False
     raise SettingError(f"{name}={env[name]!r}: allowed values are {', '.join(TRUE + FALSE[1:])}")
+
+
+#: Default largest websocket message in MB (see build_command).
+WEBSOCKET_MAX_MESSAGE_MB = 200
 
 
 def _positive_int(env: dict[str, str], name: str, default: int | None) -> int | None:
@@ -211,9 +215,11 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
         cmd += ["--prefix", prefix]
     if _flag(env, "FBS_USE_XHEADERS"):
         cmd += ["--use-xheaders"]
-    size = _positive_int(env, "FBS_WEBSOCKET_MAX_MESSAGE_MB", None)
-    if size is not None:
-        cmd += ["--websocket-max-message-size", str(size * 1024 * 1024)]
+    # an uploaded file travels base64-encoded in one message: 200 MB carries files up to
+    # 150 MB, so a file above fbs_core's 100 MiB limit gets its clear refusal instead of a
+    # closed websocket (Bokeh's default of 20 MB would cut files above 15 MB)
+    size = _positive_int(env, "FBS_WEBSOCKET_MAX_MESSAGE_MB", WEBSOCKET_MAX_MESSAGE_MB)
+    cmd += ["--websocket-max-message-size", str(size * 1024 * 1024)]
     level = env.get("FBS_LOG_LEVEL", "info").strip().lower()
     if level not in LOG_LEVELS:
         raise SettingError(f"FBS_LOG_LEVEL={level!r}: allowed values are {', '.join(LOG_LEVELS)}")

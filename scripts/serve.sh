@@ -5,7 +5,8 @@
 #
 # Environment: PORT (5006), ADDRESS (localhost; 0.0.0.0 to listen on all interfaces),
 # NUM_THREADS (4: one session's long computation does not block the others),
-# PYTHON (python3), SHOW=1 to open a browser (only where there is a display).
+# PYTHON (python3), SHOW=1 to open a browser (only where there is a display), WS_MAX_MB
+# (200: largest websocket message, i.e. upload, in MB).
 # Serving to other machines: ADDRESS=0.0.0.0 and BOKEH_ALLOW_WS_ORIGIN=<host>:<port> (the
 # address the browsers use), or pass --allow-websocket-origin <host>:<port>.
 # Extra arguments are passed to `panel serve`.
@@ -38,5 +39,10 @@ fi
 # --warm runs the page once at start-up: the reference models are loaded, the compiled
 # kernels and the truncation maps cached, so the first visitor sees plots within seconds.
 echo "== warming up (reference models, truncation maps, default scatter band) ..."
+# uploads travel base64-encoded in one websocket message: 200 MB carries files up to
+# 150 MB, so a file above fbs_core's 100 MiB limit is refused with a message (Bokeh's
+# default of 20 MB would close the connection on files above 15 MB)
+WS_MAX_MB=${WS_MAX_MB:-200}
 exec .venv/bin/panel serve app/main.py --port "$PORT" --address "$ADDRESS" \
-  --num-threads "$NUM_THREADS" --warm "${SHOW_ARG[@]}" "$@"
+  --num-threads "$NUM_THREADS" --websocket-max-message-size $((WS_MAX_MB * 1024 * 1024)) \
+  --warm "${SHOW_ARG[@]}" "$@"

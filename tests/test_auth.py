@@ -87,6 +87,8 @@ def test_default_command(app_file):
     joined = " ".join(cmd)
     assert "--address 0.0.0.0 --port 5006 --liveness --num-threads 4" in joined
     assert "--basic-auth" not in cmd and "--cookie-secret" not in cmd
+    # uploads up to 150 MB fit one message (base64), beyond fbs_core's 100 MiB limit
+    assert f"--websocket-max-message-size {200 * 1024 * 1024}" in joined
     assert cmd[-1] == "--dev-flag" and warnings == []
 
 
