@@ -60,7 +60,9 @@ class DashboardServer:
         self.url = f"http://127.0.0.1:{self.port}/{name}"
         cmd = [sys.executable, "-m", "panel", "serve", script, "--port", str(self.port),
                "--address", "127.0.0.1", "--num-threads", str(num_threads),
-               "--allow-websocket-origin", f"127.0.0.1:{self.port}"]
+               "--allow-websocket-origin", f"127.0.0.1:{self.port}",
+               # as scripts/serve.sh and the image: uploads up to 150 MB fit one message
+               "--websocket-max-message-size", str(200 * 1024 * 1024)]
         self.proc = subprocess.Popen(
             cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
             env={**os.environ, "PYTHONUNBUFFERED": "1"},

@@ -6,6 +6,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from fbs_core.io import load_frf, save_frf
@@ -78,3 +79,24 @@ def test_upload_changes_the_views_of_this_session_only(browser, dashboard, tmp_p
     assert hashlib.sha256(shipped.read_bytes()).hexdigest() == digest
     for p in pages:
         p.context.close()
+
+
+def test_a_file_above_bokehs_default_message_limit_gets_a_clear_answer(browser, dashboard,
+                                                                        tmp_path):
+    """22 MB of bytes that are no MAT-file: base64-encoded, the upload is a 29 MB websocket
+    message, above Bokeh's default limit (20 MB), which would close the connection and
+    leave the page without an answer. With the served limit it reaches the server and is
+    refused with the reason; the page keeps working."""
+    path = tmp_path / "huge.mat"
+    path.write_bytes(np.random.default_rng(0).bytes(22 * 1024 * 1024))
+    ctx = browser.new_context(viewport={"width": 1600, "height": 1400})
+    page = ctx.new_page()
+    page.errors = []
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    open_dashboard(page, dashboard.url)
+    before = fingerprint(page, "mobility.reference")
+    page.locator(".upload-chassis input[type=file]").set_input_files(str(path))
+    _shows(page, "upload-error", "huge.mat", timeout=120_000)
+    assert fingerprint(page, "mobility.reference") == before  # nothing changed
+    assert page.errors == []
+    ctx.close()
