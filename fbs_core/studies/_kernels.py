@@ -477,6 +477,7 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
         if qs.size == 0:
             continue
         big = R > 4 * _SAMPLE
+        from_hist = False
         if big:
             # all percentiles of the column from one histogram (two passes in all)
             ranks = np.empty(2 * qs.size, np.int64)
@@ -485,24 +486,13 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
                 ranks[2 * iq] = k
                 ranks[2 * iq + 1] = k + 1
             stats = np.empty(2 * qs.size)
-            if _order_stats_histogram(col, mn, mx, ranks, stats):
-                for iq in range(qs.size):
-                    h = (R - 1) * qs[iq] / 100.0
-                    k = int(np.floor(h))
-                    if k >= R - 1:
-                        pct[iq, line, e] = mx
-                        continue
-                    a0 = stats[2 * iq]
-                    b0 = stats[2 * iq + 1]
-                    t = h - k
-                    d = b0 - a0
-                    pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t
-                continue
-            sample = np.empty(_SAMPLE)
-            for i in range(_SAMPLE):
-                sample[i] = col[(i * R) // _SAMPLE]
-            sample.sort()
-            mid = np.empty(R + 1)
+            from_hist = _order_stats_histogram(col, mn, mx, ranks, stats)
+            if not from_hist:  # declined: sample-bracketed selection, one pass per level
+                sample = np.empty(_SAMPLE)
+                for i in range(_SAMPLE):
+                    sample[i] = col[(i * R) // _SAMPLE]
+                sample.sort()
+                mid = np.empty(R + 1)
         for iq in range(qs.size):
             h = (R - 1) * qs[iq] / 100.0
             k = int(np.floor(h))
@@ -510,7 +500,10 @@ def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_
                 pct[iq, line, e] = mx
                 continue
             t = h - k
-            if big:
+            if from_hist:
+                a0 = stats[2 * iq]
+                b0 = stats[2 * iq + 1]
+            elif big:
                 a0, b0 = _order_stat_pair_sampled(col, k, sample, mid)
             else:
                 a0, b0 = _order_stat_pair(col.copy(), k)
