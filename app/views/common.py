@@ -36,6 +36,23 @@ def level_tooltips(what: str, column: str = "level") -> list[tuple[str, str]]:
     return [("", what), ("Frequency", "@freq{0.0} Hz"), ("Level", "@" + column + "{0.0} dB")]
 
 
+def live_text(text: Callable[[], str], watch: list[tuple], **pane_kw) -> pn.pane.Markdown:
+    """A Markdown pane showing ``text()``, rewritten when a watched parameter changes.
+
+    ``watch`` holds ``(parameterized, [parameter names])`` pairs. Only the pane's text
+    changes (a bound function would re-render the pane and make the browser lay out the
+    page again); an unchanged text sends nothing.
+    """
+    pane = pn.pane.Markdown(text(), **pane_kw)
+
+    def rewrite(*_):
+        pane.object = text()  # param sends no event for an equal value
+
+    for obj, names in watch:
+        obj.param.watch(rewrite, names)
+    return pane
+
+
 def download_button(view: str, columns: Callable[[], dict], meta: Callable[[], dict],
                     filename: Callable[[], str]) -> pn.widgets.FileDownload:
     """A CSV download of the data behind a view, built when clicked."""

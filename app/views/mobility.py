@@ -12,7 +12,14 @@ from panel.viewable import Viewer
 
 from .. import compute
 from ..state import CaseState
-from .common import COLORS, FREQ_LABEL, download_button, level_label, level_tooltips
+from .common import (
+    COLORS,
+    FREQ_LABEL,
+    download_button,
+    level_label,
+    level_tooltips,
+    live_text,
+)
 from .plots import Pusher, add_line, fit_range, frequency_range, new_figure
 
 CASE_KEYS = ["harmonic", "n_modes", "dof", "coupling", "models"]
@@ -84,12 +91,8 @@ class MobilityView(Viewer):
             "mobility", self._csv_columns, self.meta,
             lambda: f"bushing_response_h{c.harmonic}_N{c.n_modes}_{c.dof}_{c.coupling}.csv",
         )
-        caption = pn.pane.Markdown(self._caption(), margin=(0, 10))
-
-        def recaption(*_):  # a plain text update (a bound function re-renders the pane)
-            caption.object = self._caption()
-
-        c.param.watch(recaption, ["harmonic", "n_modes", "dof", "coupling"])
+        caption = live_text(self._caption, [(c, ["harmonic", "n_modes", "dof", "coupling"])],
+                            margin=(0, 10))
         self._layout = pn.Column(
             pn.Row(caption, pn.layout.HSpacer(), dl),
             pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),

@@ -18,7 +18,14 @@ from panel.viewable import Viewer
 
 from .. import compute
 from ..state import CaseState, NoiseState
-from .common import COLORS, FREQ_LABEL, download_button, level_label, level_tooltips
+from .common import (
+    COLORS,
+    FREQ_LABEL,
+    download_button,
+    level_label,
+    level_tooltips,
+    live_text,
+)
 from .plots import Pusher, add_band, add_line, fit_range, frequency_range, new_figure
 
 CASE_KEYS = ["harmonic", "n_modes", "coupling", "models"]
@@ -191,16 +198,11 @@ class ScatterBandView(Viewer):
         progress = pn.indicators.Progress(
             active=self.busy, value=-1 if self.busy else 0, max=100, bar_color="primary",
             width=160, height=12, css_classes=["scatter-progress"], margin=(12, 10))
-        status = pn.pane.Markdown(self._status_text(), margin=(0, 10), height=28,
-                                  css_classes=["scatter-status"])
-
-        def show_status(*_):
-            progress.param.update(active=self.busy, value=-1 if self.busy else 0)
-            text = self._status_text()
-            if status.object != text:
-                status.object = text
-
-        self.param.watch(show_status, ["busy", "seconds", "result"])
+        status = live_text(self._status_text, [(self, ["busy", "seconds", "result"])],
+                           margin=(0, 10), height=28, css_classes=["scatter-status"])
+        self.param.watch(
+            lambda _: progress.param.update(active=self.busy, value=-1 if self.busy else 0),
+            "busy")
         dl = download_button("scatter", self._csv_columns, self._meta, self._filename)
         self._layout = pn.Column(
             pn.Row(progress, status, pn.layout.HSpacer(), dl),

@@ -10,7 +10,7 @@ from panel.viewable import Viewer
 
 from .. import compute
 from ..state import CaseState, TruncationState
-from .common import COLORS, MODES_LABEL, download_button
+from .common import COLORS, MODES_LABEL, download_button, live_text
 from .plots import (
     Pusher,
     add_image,
@@ -207,15 +207,9 @@ class SuggestedModesView(Viewer):
                     f"to **{t.f_max:g} Hz** ({where}), and the highest eigenfrequency among "
                     "those modes at 80 km/h.")
 
-        caption = pn.pane.Markdown(caption_text(), margin=(0, 10), styles={"color": "#495057"})
-
-        def recaption(*_):  # only when the text changes (a DOF change often leaves it)
-            text = caption_text()
-            if caption.object != text:
-                caption.object = text
-
-        t.param.watch(recaption, ["threshold", "f_max", "map_mode"])
-        c.param.watch(recaption, ["dof"])
+        caption = live_text(caption_text, [(t, ["threshold", "f_max", "map_mode"]),
+                                           (c, ["dof"])],
+                            margin=(0, 10), styles={"color": "#495057"})
         return pn.Column(pn.Row(caption, pn.layout.HSpacer(), dl), table,
                          sizing_mode="stretch_both")
 
