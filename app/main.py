@@ -108,4 +108,8 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
 
 
 if pn.state.served:
-    create_app().servable(title="tire-fbs dashboard")
+    # One recomputation of the document's model graph instead of one per added root
+    # (Bokeh recomputes it on every change of the graph): about a fifth of the server's
+    # CPU time for a new session (bench/load_test.py)
+    with pn.state.curdoc.models.freeze():
+        create_app().servable(title="tire-fbs dashboard")

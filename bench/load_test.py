@@ -1,12 +1,20 @@
-"""Many users at once: concurrent browser sessions against one dashboard server.
+"""Many users at once: concurrent sessions against one dashboard server.
 
-Every session is a separate playwright browser context (its own cookies, its own Bokeh
-session on the server), like a meeting participant's browser. All sessions open the page
-at once, wait for the plots, then each moves a slider through its own sequence of values
-(``--changes`` times). Per change the latency is measured inside the page: from setting the
-slider's model value (what bokehjs does when a user drags it) to the first change of the
-plot data in ``Bokeh.documents[0]`` ("first update") and to the last one before the data
-stay quiet ("settled").
+Every session is a separate Bokeh session on the server, like a meeting participant's
+browser tab. Two kinds of client (``bench/load_clients.py``):
+
+- ``--client browser`` (default): a playwright chromium context with one page; latencies
+  are measured inside the page with ``performance.now()``;
+- ``--client bokeh``: a Bokeh websocket protocol client holding a replica of the document
+  (what the page holds, without rendering); a small fraction of a browser's CPU, so on one
+  machine the figures are the server's rather than the browsers'.
+
+All sessions open at once and wait for their plots to settle ("open to settled plots");
+once every session is open, each moves a slider through its own sequence of values
+(``--changes`` times), all sessions at the same time. Per change: the time from setting
+the slider's model value (what BokehJS does when a user releases it) to the first change
+of the plot data ("first update") and to the last one before the data stay quiet
+("settled").
 
 Checks (any failure -> exit status 1):
 
@@ -27,6 +35,7 @@ Servers (loopback only, stopped at the end by PID or container ID):
 
 Examples:
   python bench/load_test.py --serve --sessions 20
+  python bench/load_test.py --docker tire-fbs:proof --cpus 2 --client bokeh --sessions 1,2,5,10,20
   python bench/load_test.py --docker tire-fbs:proof --cpus 2 --sessions 5,10,20,30
 """
 
@@ -34,6 +43,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import json
 import os
 import socket
@@ -47,86 +57,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-
-DIGEST_JS = """() => {
-  const doc = Bokeh.documents[0], shown = new Set();
-  for (const root of doc.roots()) {
-    shown.add(root);
-    for (const m of root.references()) shown.add(m);
-  }
-  const out = [];
-  for (const m of shown) {
-    if (m.type !== 'ColumnDataSource') continue;
-    const cols = m.data instanceof Map ? [...m.data.entries()] : Object.entries(m.data);
-    let n = 0, s = 0;
-    for (const [name, col] of cols) {
-      if (col == null || col.length === undefined || typeof col === 'string') continue;
-      n += col.length;
-      for (let i = 0; i < col.length; i++) {
-        const v = col[i];
-        if (typeof v === 'number' && Number.isFinite(v)) s += v * Math.sqrt(i + 2) + v * v;
-      }
-    }
-    out.push(n + ':' + s.toPrecision(10));
-  }
-  return out.sort().join('|');
-}"""
-
-READY_JS = """() => window.Bokeh && Bokeh.documents.length > 0 &&
-  [...Bokeh.documents[0].all_models].some(m => m.type === 'ColumnDataSource' &&
-    Object.values(m.data instanceof Map ? Object.fromEntries(m.data) : m.data)
-      .some(c => c && c.length > 0)) &&
-  [...Bokeh.documents[0].all_models].some(m => m.type.endsWith('Slider'))"""
-
-#: The slider to move: ``#k`` is the k-th slider model (0-based, document order), else the
-#: first one whose title contains ``title`` (any if empty).
-SLIDER_JS = """(title) => {
-  const all = [...Bokeh.documents[0].all_models].filter(m => m.type.endsWith('Slider'));
-  if (title.startsWith('#')) return all[parseInt(title.slice(1))];
-  return all.find(m => !title || String(m.title).includes(title));
-}"""
-
-SLIDER_INFO_JS = f"""(title) => {{
-  const m = ({SLIDER_JS})(title);
-  return m ? {{title: m.title, value: m.value, start: m.start, end: m.end, step: m.step}} : null;
-}}"""
-
-#: Set the slider value and time the plot-data changes; returns [first, settled] in ms.
-CHANGE_JS = f"""async ([title, value, timeout, quiet]) => {{
-  const digest = {DIGEST_JS};
-  const m = ({SLIDER_JS})(title);
-  const before = digest();
-  const t0 = performance.now();
-  m.setv({{value: value, value_throttled: value}});
-  let first = null, last = null, current = before;
-  while (performance.now() - t0 < timeout) {{
-    await new Promise(r => setTimeout(r, 25));
-    const now = performance.now();
-    const d = digest();
-    if (d !== current) {{ current = d; last = now; if (first === null) first = now; }}
-    if (last !== null && now - last > quiet) break;
-  }}
-  return first === null ? null : [first - t0, last - t0];
-}}"""
-
-#: True while the page reports a computation in progress (the scatter band's progress bar):
-#: under load a band can take longer than any fixed quiet time.
-BUSY_JS = """() => [...Bokeh.documents[0].all_models].some(
-  m => m.css_classes && m.css_classes.includes('scatter-progress') && m.active === true)"""
-
-SETTLE_JS = f"""async ([timeout, quiet]) => {{
-  const digest = {DIGEST_JS};
-  const busy = {BUSY_JS};
-  const t0 = performance.now();
-  let current = digest(), last = t0;
-  while (performance.now() - t0 < timeout) {{
-    await new Promise(r => setTimeout(r, 50));
-    const d = digest();
-    if (d !== current || busy()) {{ current = d; last = performance.now(); }}
-    if (performance.now() - last > quiet) return current;
-  }}
-  return null;
-}}"""
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from load_clients import BokehSession, BrowserSession, chromium_args  # noqa: E402
 
 
 @dataclass
@@ -139,16 +71,7 @@ class SessionResult:
     final_value: float | None = None
     final_digest: str | None = None
     errors: list[str] = field(default_factory=list)
-    context: object = None
-    page: object = None
-
-
-def chromium_args() -> dict:
-    for path in ("/usr/bin/chromium", "/usr/bin/chromium-browser"):
-        if os.path.exists(path):
-            return {"executable_path": path,
-                    "args": ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"]}
-    return {}
+    session: object = None
 
 
 def slider_values(info: dict, k: int = 7) -> list[float]:
@@ -175,44 +98,58 @@ def targets(values: list[float], index: int, changes: int, current: float) -> li
     return seq
 
 
-async def open_page(browser, url: str, timeout_s: float):
-    context = await browser.new_context(viewport={"width": 1400, "height": 1000})
-    page = await context.new_page()
-    return context, page
+class AllOpen:
+    """Lets the sessions start changing only once every session has opened (or failed)."""
+
+    def __init__(self, n: int):
+        self._left, self._event = n, asyncio.Event()
+
+    def arrive(self) -> None:
+        self._left -= 1
+        if self._left <= 0 and not self._event.is_set():
+            # the change phase starts: where this script's CPU time goes from here on
+            self.at = (time.monotonic(), time.process_time())
+            self._event.set()
+
+    async def wait(self) -> None:
+        await self._event.wait()
 
 
-async def run_session(browser, url: str, index: int, changes: int, title: str,
-                      timeout_s: float, start_delay: float) -> SessionResult:
+async def run_session(new_session, url: str, index: int, changes: int, title: str,
+                      timeout_s: float, start_delay: float, all_open: AllOpen) -> SessionResult:
     res = SessionResult(index)
     await asyncio.sleep(start_delay)
-    context, page = await open_page(browser, url, timeout_s)
-    res.context, res.page = context, page  # kept open for the isolation check
-    page.on("pageerror", lambda exc: res.errors.append(
-        f"page error: {exc}; stack: {' | '.join((exc.stack or '').splitlines()[:6])}"))
-    ms = timeout_s * 1000
+    res.session = sess = new_session()  # kept open for the isolation check
+    res.errors = sess.errors  # page or protocol errors and the runner's own, in one list
+    arrived = False
     try:
         t0 = time.monotonic()
-        await page.goto(url, timeout=ms)
-        await page.wait_for_function(READY_JS, timeout=ms, polling=100)
-        res.load_s = time.monotonic() - t0
-        if await page.evaluate(SETTLE_JS, [ms, 1000]) is None:
+        await sess.open(url, timeout_s)
+        if await sess.settle(timeout_s, 1.0) is None:
             res.errors.append("plot data never settled after load")
             return res
-        info = await page.evaluate(SLIDER_INFO_JS, title)
+        res.load_s = time.monotonic() - t0 - 1.0  # minus the quiet second of settle
+        info = await sess.slider_info(title)
         if info is None:
             res.errors.append(f"no slider with title containing {title!r}")
             return res
+        all_open.arrive()
+        arrived = True
+        await all_open.wait()
         for value in targets(slider_values(info), index, changes, info["value"]):
-            lat = await page.evaluate(CHANGE_JS, [title, value, ms, 400])
+            lat = await sess.change(title, value, timeout_s, 0.4)
             res.last_value = value
             if lat is None:
                 res.errors.append(f"setting the slider to {value} changed no plot data")
                 continue
             res.first_ms.append(lat[0])
             res.settled_ms.append(lat[1])
-        res.final_value = (await page.evaluate(SLIDER_INFO_JS, title))["value"]
+        res.final_value = (await sess.slider_info(title))["value"]
     except Exception as exc:  # a failed session is reported, the others go on
-        res.errors.append(f"{type(exc).__name__}: {str(exc).splitlines()[0]}")
+        res.errors.append(f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}")
+    finally:
+        if not arrived:
+            all_open.arrive()
     return res
 
 
@@ -220,34 +157,71 @@ async def final_digest(res: SessionResult, timeout_s: float) -> None:
     """Plot data of a session once nothing changes for 3 s any more; closes the session."""
     try:
         if not res.errors:
-            res.final_digest = await res.page.evaluate(SETTLE_JS, [timeout_s * 1000, 3000])
+            res.final_digest = await res.session.settle(timeout_s, 3.0)
     finally:
-        await res.context.close()
+        await res.session.close()
 
 
-async def reference_page(browser, url: str, title: str, value: float, timeout_s: float):
+async def reference_session(new_session, url: str, title: str, value: float,
+                            timeout_s: float):
     """A lone fresh session that sets the slider to ``value`` (left open for its digest)."""
-    context, page = await open_page(browser, url, timeout_s)
-    ms = timeout_s * 1000
+    sess = new_session()
     try:
-        await page.goto(url, timeout=ms)
-        await page.wait_for_function(READY_JS, timeout=ms, polling=100)
-        await page.evaluate(SETTLE_JS, [ms, 1000])
-        info = await page.evaluate(SLIDER_INFO_JS, title)
+        await sess.open(url, timeout_s)
+        await sess.settle(timeout_s, 1.0)
+        info = await sess.slider_info(title)
         if info["value"] != value:
-            await page.evaluate(CHANGE_JS, [title, value, ms, 400])
+            await sess.change(title, value, timeout_s, 0.4)
     except Exception:
-        await context.close()
+        await sess.close()
         raise
-    return context, page
+    return sess
 
 
-async def page_digest(context, page, timeout_s: float) -> str | None:
-    """Plot data of a page once nothing changes for 3 s any more; closes it."""
+async def warm_up(new_session, url: str, title: str, timeout_s: float) -> float:
+    """One session visits every value the sessions will set (the server's shared result
+    cache then holds them, as after a while of use); returns the seconds it took."""
+    t0 = time.monotonic()
+    sess = new_session()
     try:
-        return await page.evaluate(SETTLE_JS, [timeout_s * 1000, 3000])
+        await sess.open(url, timeout_s)
+        await sess.settle(timeout_s, 1.0)
+        info = await sess.slider_info(title)
+        for value in slider_values(info):
+            if value == info["value"]:
+                continue  # what the page opened with is computed already
+            await sess.change(title, value, timeout_s, 0.4)
+            await sess.settle(timeout_s, 0.5)
     finally:
-        await context.close()
+        await sess.close()
+    return time.monotonic() - t0
+
+
+def session_factory(client: str, stack: contextlib.AsyncExitStack):
+    """A coroutine giving a function that makes a new (unopened) session of this kind."""
+    async def make():
+        if client == "bokeh":
+            return BokehSession
+        from playwright.async_api import async_playwright
+
+        p = await stack.enter_async_context(async_playwright())
+        browser = await p.chromium.launch(**chromium_args())
+        stack.push_async_callback(browser.close)
+        return lambda: BrowserSession(browser)
+    return make()
+
+
+async def run_warm_up(url: str, title: str, timeout_s: float, client: str) -> float:
+    async with contextlib.AsyncExitStack() as stack:
+        return await warm_up(await session_factory(client, stack), url, title, timeout_s)
+
+
+async def session_digest(sess, timeout_s: float) -> str | None:
+    """Plot data of a session once nothing changes for 3 s any more; closes it."""
+    try:
+        return await sess.settle(timeout_s, 3.0)
+    finally:
+        await sess.close()
 
 
 def pct(values: list[float], q: float) -> float:
@@ -284,52 +258,61 @@ async def wait_server_idle(cpu_s, timeout_s: float, quiet_s: float = 3.0,
 
 
 async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float,
-                    check_isolation: bool, cpu_s=None) -> dict:
-    from playwright.async_api import async_playwright
+                    check_isolation: bool, cpu_s=None, client: str = "browser") -> dict:
+    async with contextlib.AsyncExitStack() as stack:
+        new_session = await session_factory(client, stack)
 
-    async with async_playwright() as p:
-        browser = await p.chromium.launch(**chromium_args())
-        try:
-            t0 = time.monotonic()
-            results = await asyncio.gather(*(
-                run_session(browser, url, i, changes, title, timeout_s, 0.1 * i)
-                for i in range(n)))
-            wall = time.monotonic() - t0
-            problems = [f"session {r.index}: {e}" for r in results for e in r.errors]
+        t0 = time.monotonic()
+        all_open = AllOpen(n)
+        results = await asyncio.gather(*(
+            run_session(new_session, url, i, changes, title, timeout_s, 0.1 * i, all_open)
+            for i in range(n)))
+        wall = time.monotonic() - t0
+        # this script's (and its Bokeh clients') share of a core while the sessions changed:
+        # near 1 would mean the clients themselves delayed what they measured
+        change_wall = time.monotonic() - all_open.at[0]
+        script_share = (time.process_time() - all_open.at[1]) / change_wall
+        problems = [f"session {r.index}: {e}" for r in results for e in r.errors]
+        for r in results:
+            if not r.errors and r.final_value != r.last_value:
+                problems.append(f"session {r.index}: slider shows {r.final_value}, "
+                                f"but this session set {r.last_value} last")
+        refs: dict = {}
+        if check_isolation:
+            values = sorted({r.last_value for r in results if not r.errors})
+            ref_sessions = await asyncio.gather(*(
+                reference_session(new_session, url, title, v, timeout_s) for v in values))
+        # under a backlog a session can be quiet for seconds with updates still queued on
+        # the server: take every digest once the server itself is idle
+        idle = await wait_server_idle(cpu_s, timeout_s)
+        if check_isolation:
+            digests = await asyncio.gather(*(
+                session_digest(sess, timeout_s) for sess in ref_sessions))
+            refs = dict(zip(values, digests, strict=True))
+            problems += [f"reference session at {v}: {e}"
+                         for v, sess in zip(values, ref_sessions, strict=True)
+                         for e in sess.errors]
+        n_early = [len(r.errors) for r in results]
+        await asyncio.gather(*(final_digest(r, timeout_s) for r in results))
+        # errors reported after the changes (a late page error, a patch that failed)
+        problems += [f"session {r.index}: {e}" for r, k in zip(results, n_early, strict=True)
+                     for e in r.errors[k:]]
+        if check_isolation:
             for r in results:
-                if not r.errors and r.final_value != r.last_value:
-                    problems.append(f"session {r.index}: slider shows {r.final_value}, "
-                                    f"but this session set {r.last_value} last")
-            refs: dict = {}
-            if check_isolation:
-                values = sorted({r.last_value for r in results if not r.errors})
-                ref_pages = await asyncio.gather(*(
-                    reference_page(browser, url, title, v, timeout_s) for v in values))
-            # under a backlog a page can be quiet for seconds with updates still queued on
-            # the server: take every digest once the server itself is idle
-            idle = await wait_server_idle(cpu_s, timeout_s)
-            if check_isolation:
-                digests = await asyncio.gather(*(
-                    page_digest(c, pg, timeout_s) for c, pg in ref_pages))
-                refs = dict(zip(values, digests, strict=True))
-            await asyncio.gather(*(final_digest(r, timeout_s) for r in results))
-            if check_isolation:
-                for r in results:
-                    if r.errors or r.final_digest is None:
-                        continue
-                    if r.final_digest != refs.get(r.last_value):
-                        problems.append(
-                            f"session {r.index}: plot data differ from a lone session's "
-                            f"at slider value {r.last_value}"
-                            + ("" if idle else " (server never idle before the check)"))
-        finally:
-            await browser.close()
+                if r.errors or r.final_digest is None:
+                    continue
+                if r.final_digest != refs.get(r.last_value):
+                    problems.append(
+                        f"session {r.index}: plot data differ from a lone session's "
+                        f"at slider value {r.last_value}"
+                        + ("" if idle else " (server never idle before the check)"))
     first = [x for r in results for x in r.first_ms]
     settled = [x for r in results for x in r.settled_ms]
     loads = [r.load_s * 1000 for r in results if r.load_s is not None]
-    return {"sessions": n, "changes": len(first), "wall_s": wall, "load_ms": loads,
-            "first_ms": first, "settled_ms": settled, "problems": problems,
-            "distinct_final_states": len(refs)}
+    return {"sessions": n, "client": client, "changes": len(first), "wall_s": wall,
+            "load_ms": loads, "first_ms": first, "settled_ms": settled,
+            "problems": problems, "distinct_final_states": len(refs),
+            "change_phase_s": change_wall, "script_core_share": script_share}
 
 
 # ---- servers -------------------------------------------------------------------------------
@@ -390,14 +373,16 @@ def wait_http(url: str, timeout_s: float, alive=lambda: True) -> None:
 class LocalServer:
     """``panel serve`` through the container's entrypoint, on a loopback port."""
 
-    def __init__(self, threads: int):
+    def __init__(self, threads: int, cpuset: set[int] | None = None):
         self.port = free_port()
         self.log = tempfile.NamedTemporaryFile("w+", suffix=".log", delete=False)
         env = {**os.environ, "FBS_PORT": str(self.port), "FBS_ADDRESS": "127.0.0.1",
                "FBS_NUM_THREADS": str(threads),
                "BOKEH_ALLOW_WS_ORIGIN": f"127.0.0.1:{self.port}"}
+        pin = None if cpuset is None else (lambda: os.sched_setaffinity(0, cpuset))
         self.proc = subprocess.Popen([sys.executable, str(ROOT / "docker" / "entrypoint.py")],
-                                     env=env, stdout=self.log, stderr=subprocess.STDOUT)
+                                     env=env, stdout=self.log, stderr=subprocess.STDOUT,
+                                     preexec_fn=pin)
         self.url = f"http://127.0.0.1:{self.port}/"
         wait_http(self.url + "liveness", 60, lambda: self.proc.poll() is None)
 
@@ -422,10 +407,12 @@ class LocalServer:
 class DockerServer:
     """``docker run --cpus`` of the image on a loopback port, removed at the end."""
 
-    def __init__(self, image: str, cpus: float, threads: int):
+    def __init__(self, image: str, cpus: float, threads: int, cpuset: set[int] | None = None):
         self.port = free_port()
+        pin = [] if cpuset is None else ["--cpuset-cpus", ",".join(map(str, sorted(cpuset)))]
         self.cid = subprocess.run(
-            ["docker", "run", "-d", "--cpus", str(cpus), "-p", f"127.0.0.1:{self.port}:5006",
+            ["docker", "run", "-d", "--cpus", str(cpus), *pin,
+             "-p", f"127.0.0.1:{self.port}:5006",
              "-e", f"BOKEH_ALLOW_WS_ORIGIN=127.0.0.1:{self.port}",
              "-e", f"FBS_NUM_THREADS={threads}", image],
             check=True, capture_output=True, text=True).stdout.strip()
@@ -478,11 +465,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sessions", default="20",
                     help="concurrent sessions; a comma list sweeps levels (20)")
     ap.add_argument("--changes", type=int, default=5, help="slider changes per session (5)")
-    ap.add_argument("--slider", default="",
-                    help="slider to move: part of its title, or #k for the k-th (first)")
+    ap.add_argument("--slider", default="Harmonic",
+                    help="slider to move: part of its title, or #k for the k-th (Harmonic)")
+    ap.add_argument("--client", choices=("browser", "bokeh"), default="browser",
+                    help="sessions as chromium pages (browser) or as Bokeh protocol clients "
+                         "(bokeh: no rendering, a small fraction of a browser's CPU)")
     ap.add_argument("--target", type=float, default=1000.0, help="p95 target in ms (1000)")
     ap.add_argument("--timeout", type=float, default=120.0, help="seconds per wait (120)")
     ap.add_argument("--max-sessions", type=int, default=60, help="safety bound (60)")
+    ap.add_argument("--server-cpus", metavar="LIST",
+                    help="pin the server to these host CPUs (e.g. '1'; docker --cpuset-cpus) "
+                         "and this script with its clients to the others, so the two never "
+                         "compete for a core")
+    ap.add_argument("--cold", action="store_true",
+                    help="no warm-up: the first level also pays for computing the results "
+                         "that the server then shares between sessions")
     ap.add_argument("--no-isolation-check", action="store_true")
     ap.add_argument("--json", help="write the figures to this file")
     args = ap.parse_args(argv)
@@ -490,41 +487,67 @@ def main(argv: list[str] | None = None) -> int:
     if any(n < 1 or n > args.max_sessions for n in levels):
         ap.error(f"--sessions must be within 1..{args.max_sessions}")
 
+    server_cpus = None
+    if args.server_cpus:
+        if args.url:
+            ap.error("--server-cpus needs --serve or --docker")
+        server_cpus = {int(x) for x in args.server_cpus.split(",")}
+        rest = set(os.sched_getaffinity(0)) - server_cpus
+        if not rest or not server_cpus <= set(range(os.cpu_count())):
+            ap.error(f"--server-cpus {args.server_cpus}: needs host CPUs that exist and "
+                     f"leaves none for the clients")
+        os.sched_setaffinity(0, rest)  # browsers and threads started later inherit it
+        args.cpus = min(args.cpus, float(len(server_cpus)))
     server = None
     if args.serve:
-        server = LocalServer(args.threads)
+        server = LocalServer(args.threads, server_cpus)
     elif args.docker:
-        server = DockerServer(args.docker, args.cpus, args.threads)
+        server = DockerServer(args.docker, args.cpus, args.threads, server_cpus)
     url = server.url if server else args.url
     where = (f"docker {args.docker} --cpus {args.cpus}" if args.docker
              else "local panel serve" if args.serve else url)
-    print(f"load test: {where}, {args.threads} threads, {os.cpu_count()} host cores, "
+    if server_cpus is not None:
+        where += (f", server on CPU {args.server_cpus}, clients on CPU "
+                  f"{','.join(map(str, sorted(os.sched_getaffinity(0))))}")
+    print(f"load test: {where}, {args.threads} threads, sessions as {args.client} clients, "
+          f"{os.cpu_count()} host cores, "
           f"load average {os.getloadavg()[0]:.1f}")
     rows, failed = [], False
     try:
+        if not args.cold:
+            took = asyncio.run(run_warm_up(url, args.slider, args.timeout, args.client))
+            print(f"warm-up: one session visited every slider value in {took:.1f} s")
         for n in levels:
             cpu0 = server.cpu_s() if server is not None else None
-            host0, t0 = host_busy_s(), time.monotonic()
+            host0, t0, self0 = host_busy_s(), time.monotonic(), time.process_time()
             row = asyncio.run(run_level(url, n, args.changes, args.slider, args.timeout,
                                         not args.no_isolation_check,
-                                        server.cpu_s if server is not None else None))
+                                        server.cpu_s if server is not None else None,
+                                        args.client))
             cpu1 = server.cpu_s() if server is not None else None
             row["host_cpu_s"] = host_busy_s() - host0
+            row["script_cpu_s"] = time.process_time() - self0  # incl. Bokeh clients
             row["accounted_s"] = time.monotonic() - t0  # incl. the isolation check
             row["server_cpu_s"] = None if cpu0 is None or cpu1 is None else cpu1 - cpu0
             rows.append(row)
             print(f"\n== {n} concurrent sessions, {row['changes']} changes, "
                   f"{row['wall_s']:.1f} s wall, {row['distinct_final_states']} distinct "
                   f"final states checked against lone sessions")
-            print(f"   page load to plots (ms)  {summary(row['load_ms'])}")
-            print(f"   change -> first update   {summary(row['first_ms'])}")
+            print(f"   open to settled plots    {summary(row['load_ms'])}   (all opening at once)")
+            print(f"   change -> first update   {summary(row['first_ms'])}   (all changing, "
+                  "once all are open)")
             print(f"   change -> settled        {summary(row['settled_ms'])}")
+            print(f"   change phase {row['change_phase_s']:.1f} s; this script"
+                  f"{' and its Bokeh clients' if args.client == 'bokeh' else ''} busy "
+                  f"{100 * row['script_core_share']:.0f}% of one core meanwhile")
             if row["server_cpu_s"] is not None:
                 # where the cores went: on one machine the browsers compete with the server
                 print(f"   CPU over {row['accounted_s']:.0f} s (sessions and isolation check): "
                       f"server {row['server_cpu_s']:.1f} s, everything else on the host "
-                      f"(browsers, this script) {row['host_cpu_s'] - row['server_cpu_s']:.1f} s, "
-                      f"of {os.cpu_count() * row['accounted_s']:.0f} core-seconds")
+                      f"{row['host_cpu_s'] - row['server_cpu_s']:.1f} s (of which this "
+                      f"script{' and its Bokeh clients' if args.client == 'bokeh' else ''} "
+                      f"{row['script_cpu_s']:.1f} s), of {os.cpu_count() * row['accounted_s']:.0f}"
+                      " core-seconds")
             if row["problems"]:
                 failed = True
                 print(f"   PROBLEMS ({len(row['problems'])}):")

@@ -1,0 +1,395 @@
+"""The two kinds of load-test session: a real browser page, and a Bokeh protocol client.
+
+Both give the load test (``bench/load_test.py``) one interface:
+
+- ``await open(url)``: start a fresh session (its own Bokeh session on the server) and wait
+  until the document with its plots and sliders is there;
+- ``await settle(timeout_s, quiet_s)``: wait until the plot data have not changed, and no
+  computation has been reported in progress, for ``quiet_s``; the plot-data digest, or
+  None on timeout;
+- ``await slider_info(title)``: title, value, start, end, step of a slider (``#k``: the
+  k-th slider in document order; else the first whose title contains ``title``);
+- ``await change(title, value, timeout_s, quiet_s)``: set the slider the way a dragged
+  slider does and return ``(first, settled)`` in ms: the time to the first change of the
+  plot data and to the last one before they stay quiet for ``quiet_s`` (None if the plot
+  data never changed);
+- ``errors``: what went wrong in the session (page errors, protocol errors);
+- ``await close()``.
+
+``BrowserSession`` is a playwright browser context with one page (the JavaScript that runs
+in the page times its changes with ``performance.now()``). ``BokehSession`` speaks Bokeh's
+websocket protocol directly (``ACK``, ``PULL-DOC``, ``PATCH-DOC``): it holds a replica of
+the session's document, applies the server's patches to it and sends model changes like
+BokehJS does, including the ``document_ready`` event after the document has arrived (which
+starts the app's on-load work). It costs a fraction of a browser's CPU, so a load test on
+one machine measures the server rather than the browsers; rendering is what it leaves out.
+
+Digests (a count and a weighted sum of the numbers in every ``ColumnDataSource``) are
+compared only between sessions of the same kind.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import importlib
+import pkgutil
+import time
+import urllib.parse
+import urllib.request
+
+import numpy as np
+
+# ---- browser -----------------------------------------------------------------------------
+
+DIGEST_JS = """() => {
+  const doc = Bokeh.documents[0], shown = new Set();
+  for (const root of doc.roots()) {
+    shown.add(root);
+    for (const m of root.references()) shown.add(m);
+  }
+  const out = [];
+  for (const m of shown) {
+    if (m.type !== 'ColumnDataSource') continue;
+    const cols = m.data instanceof Map ? [...m.data.entries()] : Object.entries(m.data);
+    let n = 0, s = 0;
+    for (const [name, col] of cols) {
+      if (col == null || col.length === undefined || typeof col === 'string') continue;
+      n += col.length;
+      for (let i = 0; i < col.length; i++) {
+        const v = col[i];
+        if (typeof v === 'number' && Number.isFinite(v)) s += v * Math.sqrt(i + 2) + v * v;
+      }
+    }
+    out.push(n + ':' + s.toPrecision(10));
+  }
+  return out.sort().join('|');
+}"""
+
+READY_JS = """() => window.Bokeh && Bokeh.documents.length > 0 &&
+  [...Bokeh.documents[0].all_models].some(m => m.type === 'ColumnDataSource' &&
+    Object.values(m.data instanceof Map ? Object.fromEntries(m.data) : m.data)
+      .some(c => c && c.length > 0)) &&
+  [...Bokeh.documents[0].all_models].some(m => m.type.endsWith('Slider'))"""
+
+SLIDER_JS = """(title) => {
+  const all = [...Bokeh.documents[0].all_models].filter(m => m.type.endsWith('Slider'));
+  if (title.startsWith('#')) return all[parseInt(title.slice(1))];
+  return all.find(m => !title || String(m.title).includes(title));
+}"""
+
+SLIDER_INFO_JS = f"""(title) => {{
+  const m = ({SLIDER_JS})(title);
+  return m ? {{title: m.title, value: m.value, start: m.start, end: m.end, step: m.step}} : null;
+}}"""
+
+#: Set the slider value and time the plot-data changes; returns [first, settled] in ms.
+CHANGE_JS = f"""async ([title, value, timeout, quiet]) => {{
+  const digest = {DIGEST_JS};
+  const m = ({SLIDER_JS})(title);
+  const before = digest();
+  const t0 = performance.now();
+  m.setv({{value: value, value_throttled: value}});
+  let first = null, last = null, current = before;
+  while (performance.now() - t0 < timeout) {{
+    await new Promise(r => setTimeout(r, 25));
+    const now = performance.now();
+    const d = digest();
+    if (d !== current) {{ current = d; last = now; if (first === null) first = now; }}
+    if (last !== null && now - last > quiet) break;
+  }}
+  return first === null ? null : [first - t0, last - t0];
+}}"""
+
+#: True while the page reports a computation in progress (the scatter band's progress bar):
+#: under load a band can take longer than any fixed quiet time.
+BUSY_JS = """() => [...Bokeh.documents[0].all_models].some(
+  m => m.css_classes && m.css_classes.includes('scatter-progress') && m.active === true)"""
+
+SETTLE_JS = f"""async ([timeout, quiet]) => {{
+  const digest = {DIGEST_JS};
+  const busy = {BUSY_JS};
+  const t0 = performance.now();
+  let current = digest(), last = t0;
+  while (performance.now() - t0 < timeout) {{
+    await new Promise(r => setTimeout(r, 50));
+    const d = digest();
+    if (d !== current || busy()) {{ current = d; last = performance.now(); }}
+    if (performance.now() - last > quiet) return current;
+  }}
+  return null;
+}}"""
+
+
+def chromium_args() -> dict:
+    """Launch arguments for the system chromium where there is one (else playwright's)."""
+    import os
+
+    for path in ("/usr/bin/chromium", "/usr/bin/chromium-browser"):
+        if os.path.exists(path):
+            return {"executable_path": path,
+                    "args": ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"]}
+    return {}
+
+
+class BrowserSession:
+    """One browser context with one page (its own cookies and Bokeh session)."""
+
+    def __init__(self, browser):
+        self._browser = browser
+        self.context = self.page = None
+        self.errors: list[str] = []
+
+    async def open(self, url: str, timeout_s: float) -> None:
+        self.context = await self._browser.new_context(viewport={"width": 1400, "height": 1000})
+        self.page = await self.context.new_page()
+        self.page.on("pageerror", lambda exc: self.errors.append(
+            f"page error: {exc}; stack: {' | '.join((exc.stack or '').splitlines()[:6])}"))
+        ms = timeout_s * 1000
+        await self.page.goto(url, timeout=ms)
+        await self.page.wait_for_function(READY_JS, timeout=ms, polling=100)
+
+    async def settle(self, timeout_s: float, quiet_s: float) -> str | None:
+        return await self.page.evaluate(SETTLE_JS, [timeout_s * 1000, quiet_s * 1000])
+
+    async def slider_info(self, title: str) -> dict | None:
+        return await self.page.evaluate(SLIDER_INFO_JS, title)
+
+    async def change(self, title: str, value, timeout_s: float, quiet_s: float):
+        return await self.page.evaluate(CHANGE_JS, [title, value, timeout_s * 1000,
+                                                    quiet_s * 1000])
+
+    async def close(self) -> None:
+        if self.context is not None:
+            await self.context.close()
+
+
+# ---- Bokeh protocol client ---------------------------------------------------------------
+
+_MODELS_LOADED = False
+
+
+def _load_model_classes() -> None:
+    """Import every Panel model module, so the document's custom models deserialize."""
+    global _MODELS_LOADED
+    if _MODELS_LOADED:
+        return
+    import panel  # noqa: F401  (registers Panel's models with Bokeh)
+    import panel.models
+
+    for info in pkgutil.iter_modules(panel.models.__path__):
+        try:
+            importlib.import_module(f"panel.models.{info.name}")
+        except ImportError:  # optional extras (e.g. a model needing an absent package)
+            pass
+    _MODELS_LOADED = True
+
+
+_APP_URLS: dict[str, str] = {}
+
+
+def websocket_url(url: str) -> str:
+    """The Bokeh websocket endpoint of an app URL (``http://h:p/app`` -> ``ws://h:p/app/ws``).
+
+    A server root that redirects to its app (``panel serve`` of one script: ``/`` ->
+    ``/main``) is followed first, as a browser would.
+    """
+    if url not in _APP_URLS:
+        with urllib.request.urlopen(url, timeout=60) as r:
+            _APP_URLS[url] = r.geturl()
+    parts = urllib.parse.urlsplit(_APP_URLS[url])
+    scheme = {"http": "ws", "https": "wss"}.get(parts.scheme, parts.scheme)
+    path = parts.path.rstrip("/") + "/ws"
+    return urllib.parse.urlunsplit((scheme, parts.netloc, path, "", ""))
+
+
+def column_digest(doc) -> str:
+    """Count and weighted sum of the finite numbers of every ColumnDataSource of ``doc``."""
+    from bokeh.models import ColumnDataSource
+
+    out = []
+    for m in doc.models:
+        if not isinstance(m, ColumnDataSource):
+            continue
+        n, s = 0, 0.0
+        for col in m.data.values():
+            if isinstance(col, str) or not hasattr(col, "__len__"):
+                continue
+            n += len(col)
+            try:
+                v = np.asarray(col, dtype=float).ravel()
+            except (TypeError, ValueError):  # lists of arrays of different shapes, strings
+                v = np.concatenate([np.asarray(c, dtype=float).ravel() for c in col
+                                    if not isinstance(c, str)] or [np.zeros(0)])
+            v = v[np.isfinite(v)]
+            s += float(np.sum(v * np.sqrt(np.arange(v.size) + 2.0) + v * v))
+        out.append(f"{n}:{s:.9e}")
+    return "|".join(sorted(out))
+
+
+class BokehSession:
+    """A Bokeh websocket client with a replica of its session's document.
+
+    The server's ``PATCH-DOC`` messages are applied to the replica as they arrive; every
+    patch that touches a ColumnDataSource is followed by a digest of the plot data, and the
+    time of each change of that digest is kept (for ``change`` and ``settle``).
+    """
+
+    def __init__(self, *, max_message_mb: int = 200):
+        _load_model_classes()
+        self._max_bytes = max_message_mb * 2**20
+        self.errors: list[str] = []
+        self.doc = None
+        self._ws = self._sock = self._reader = None
+        self._digest = ""
+        self._change_times: list[float] = []  # perf_counter of each change of the digest
+        self._progress: list = []  # the progress bars of long computations (class name)
+
+    async def open(self, url: str, timeout_s: float) -> None:
+        from bokeh.client.websocket import WebSocketClientConnectionWrapper
+        from bokeh.document import Document
+        from bokeh.document.events import MessageSentEvent
+        from bokeh.events import DocumentReady
+        from bokeh.protocol import Protocol
+        from bokeh.protocol.receiver import Receiver
+        from bokeh.util.token import generate_jwt_token, generate_session_id
+        from tornado.websocket import websocket_connect
+
+        self._protocol = Protocol()
+        self._receiver = Receiver(self._protocol)
+        token = generate_jwt_token(generate_session_id())
+        self._ws = await asyncio.wait_for(
+            websocket_connect(websocket_url(url), subprotocols=["bokeh", token],
+                              max_message_size=self._max_bytes), timeout_s)
+        self._sock = WebSocketClientConnectionWrapper(self._ws)
+        ack = await asyncio.wait_for(self._pop(), timeout_s)
+        if ack is None or ack.msgtype != "ACK":
+            raise RuntimeError(f"expected ACK from the server, got {ack and ack.msgtype}")
+        await self._protocol.create("PULL-DOC-REQ").send(self._sock)
+        reply = await asyncio.wait_for(self._pop(), timeout_s)
+        if reply is None or reply.msgtype != "PULL-DOC-REPLY":
+            raise RuntimeError(f"expected PULL-DOC-REPLY, got {reply and reply.msgtype}: "
+                               f"{reply and reply.content}")
+        self.doc = Document()
+        reply.push_to_document(self.doc)
+        self._digest = column_digest(self.doc)
+        self._reader = asyncio.ensure_future(self._read())
+        # what BokehJS sends once the page has rendered: starts the app's on-load work
+        await self._send([MessageSentEvent(self.doc, "bokeh_event", DocumentReady())])
+
+    async def _pop(self):
+        while True:
+            frag = await self._ws.read_message()
+            if frag is None:
+                return None
+            msg = await self._receiver.consume(frag)
+            if msg is not None:
+                return msg
+
+    async def _send(self, events) -> None:
+        await self._protocol.create("PATCH-DOC", events).send(self._sock)
+
+    async def _read(self) -> None:
+        from bokeh.models import ColumnDataSource
+
+        sources = None
+        try:
+            while True:
+                msg = await self._pop()
+                if msg is None:
+                    return
+                if msg.msgtype == "ERROR":
+                    self.errors.append(f"server error: {msg.content.get('text')}")
+                    continue
+                if msg.msgtype != "PATCH-DOC":
+                    continue
+                msg.apply_to_document(self.doc, self)
+                events = msg.content["events"]
+                if sources is None or any(e.get("kind") == "ModelChanged" for e in events):
+                    # models may have come or gone
+                    sources = {m.id for m in self.doc.models
+                               if isinstance(m, ColumnDataSource)}
+                    self._progress = [m for m in self.doc.models
+                                      if "css_classes" in m.properties()
+                                      and "scatter-progress" in m.css_classes]
+                if any(_event_model_id(e) in sources for e in events):
+                    d = column_digest(self.doc)
+                    if d != self._digest:
+                        self._digest = d
+                        self._change_times.append(time.perf_counter())
+        except asyncio.CancelledError:
+            raise
+        except Exception as exc:  # a patch the replica cannot apply is a finding
+            self.errors.append(f"{type(exc).__name__} applying a server patch: {exc}")
+
+    @property
+    def _changed_at(self) -> float:
+        return self._change_times[-1] if self._change_times else 0.0
+
+    def _busy(self) -> bool:
+        return any(getattr(m, "active", False) for m in self._progress)
+
+    def _slider(self, title: str):
+        sliders = [m for m in self.doc.models if type(m).__name__.endswith("Slider")]
+        if title.startswith("#"):
+            k = int(title[1:])
+            return sliders[k] if k < len(sliders) else None
+        return next((m for m in sliders if not title or title in str(m.title)), None)
+
+    async def settle(self, timeout_s: float, quiet_s: float) -> str | None:
+        t0 = time.perf_counter()
+        last = max(t0, self._changed_at)
+        while time.perf_counter() - t0 < timeout_s:
+            await asyncio.sleep(0.05)
+            now = time.perf_counter()
+            if self._busy():
+                last = now
+            last = max(last, self._changed_at)
+            if now - last > quiet_s:
+                return self._digest
+        return None
+
+    async def slider_info(self, title: str) -> dict | None:
+        m = self._slider(title)
+        if m is None:
+            return None
+        return {"title": m.title, "value": m.value, "start": m.start, "end": m.end,
+                "step": m.step}
+
+    async def change(self, title: str, value, timeout_s: float, quiet_s: float):
+        from bokeh.document.events import ModelChangedEvent
+
+        m = self._slider(title)
+        n0 = len(self._change_times)
+        t0 = time.perf_counter()
+        # the replica changes without an echo (setter=self); the server gets both
+        # properties a released slider sets, in one patch, as BokehJS sends them
+        events = []
+        for attr in ("value", "value_throttled"):
+            m.set_from_json(attr, value, setter=self)
+            events.append(ModelChangedEvent(self.doc, m, attr, value))
+        await self._send(events)
+        while time.perf_counter() - t0 < timeout_s:
+            await asyncio.sleep(0.01)
+            if len(self._change_times) > n0 and time.perf_counter() - self._changed_at > quiet_s:
+                break
+        if len(self._change_times) == n0:
+            return None
+        return [(self._change_times[n0] - t0) * 1000, (self._changed_at - t0) * 1000]
+
+    async def close(self) -> None:
+        if self._reader is not None:
+            self._reader.cancel()
+            try:
+                await self._reader
+            except (asyncio.CancelledError, Exception):
+                pass
+        if self._ws is not None:
+            self._ws.close()
+
+
+def _event_model_id(event: dict) -> str | None:
+    model = event.get("model")
+    if isinstance(model, dict):
+        return model.get("id")
+    return None
+
