@@ -1,0 +1,65 @@
+"""Sessions of one server stay apart, seen through Bokeh's own websocket protocol.
+
+Each session here is a Bokeh protocol client (``bench/load_clients.py``, the load test's
+light client): it pulls its session's document, applies the server's patches to it and
+sends slider changes as BokehJS does. The check is between independent sessions: a change
+in one session never reaches another, and two sessions in the same state show the same
+plot data (results shared between sessions by the server's cache are neither altered by
+one session nor mixed up with another's).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+from load_clients import BokehSession, column_digest  # noqa: E402
+
+TIMEOUT_S = 90.0
+
+
+async def _opened(url: str) -> BokehSession:
+    sess = BokehSession()
+    await sess.open(url, TIMEOUT_S)
+    assert await sess.settle(TIMEOUT_S, 1.0) is not None, "plot data never settled"
+    return sess
+
+
+async def _scenario(url: str) -> None:
+    a, b = await asyncio.gather(_opened(url), _opened(url))
+    try:
+        assert (await a.slider_info("Harmonic"))["value"] == 1
+        before_b = b._digest
+        assert before_b == a._digest  # same state, same data
+
+        assert await a.change("Harmonic", 5, TIMEOUT_S, 0.4) is not None
+        after_a = await a.settle(TIMEOUT_S, 1.0)
+        assert after_a != before_b, "harmonic 5 shows the data of harmonic 1"
+        # b was left alone: its slider and its plot data are those it opened with
+        assert await b.settle(TIMEOUT_S, 1.0) == before_b
+        assert (await b.slider_info("Harmonic"))["value"] == 1
+
+        # a fresh session moved to the same state shows exactly a's data
+        c = await _opened(url)
+        try:
+            assert await c.change("Harmonic", 5, TIMEOUT_S, 0.4) is not None
+            assert await c.settle(TIMEOUT_S, 1.0) == after_a
+        finally:
+            await c.close()
+        # and b, moved there last, too; a is untouched by b's and c's changes
+        assert await b.change("Harmonic", 5, TIMEOUT_S, 0.4) is not None
+        assert await b.settle(TIMEOUT_S, 1.0) == after_a
+        assert await a.settle(TIMEOUT_S, 1.0) == after_a
+        assert column_digest(a.doc) == after_a  # the kept digest is the replica's
+        for s in (a, b, c):
+            assert s.errors == []
+    finally:
+        await a.close()
+        await b.close()
+
+
+def test_a_change_in_one_session_never_reaches_another(dashboard):
+    asyncio.run(_scenario(dashboard.url))
+    assert dashboard.errors() == []
