@@ -91,10 +91,9 @@ class MobilityView(Viewer):
             "mobility", self._csv_columns, self.meta,
             lambda: f"bushing_response_h{c.harmonic}_N{c.n_modes}_{c.dof}_{c.coupling}.csv",
         )
-        caption = live_text(self._caption, [(c, ["harmonic", "n_modes", "dof", "coupling"])],
-                            margin=(0, 10))
+        caption = live_text(self._caption, [(c, ["harmonic", "n_modes", "dof", "coupling"])])
         self._layout = pn.Column(
-            pn.Row(caption, pn.layout.HSpacer(), dl),
+            pn.Row(caption, dl),
             pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )

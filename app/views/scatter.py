@@ -198,14 +198,17 @@ class ScatterBandView(Viewer):
         progress = pn.indicators.Progress(
             active=self.busy, value=-1 if self.busy else 0, max=100, bar_color="primary",
             width=160, height=12, css_classes=["scatter-progress"], margin=(12, 10))
+        # its own line, two lines high: the text's length changes, its box does not
         status = live_text(self._status_text, [(self, ["busy", "seconds", "result"])],
-                           margin=(0, 10), height=28, css_classes=["scatter-status"])
+                           height=40, css_classes=["scatter-status"],
+                           styles={"font-size": "0.85em", "line-height": "1.3"})
         self.param.watch(
             lambda _: progress.param.update(active=self.busy, value=-1 if self.busy else 0),
             "busy")
         dl = download_button("scatter", self._csv_columns, self._meta, self._filename)
         self._layout = pn.Column(
-            pn.Row(progress, status, pn.layout.HSpacer(), dl),
+            pn.Row(progress, dl),
+            status,
             pn.pane.Bokeh(self._build(), sizing_mode="stretch_both", min_height=340),
             sizing_mode="stretch_both",
         )

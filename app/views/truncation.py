@@ -209,8 +209,8 @@ class SuggestedModesView(Viewer):
 
         caption = live_text(caption_text, [(t, ["threshold", "f_max", "map_mode"]),
                                            (c, ["dof"])],
-                            margin=(0, 10), styles={"color": "#495057"})
-        return pn.Column(pn.Row(caption, pn.layout.HSpacer(), dl), table,
+                            styles={"color": "#495057"})
+        return pn.Column(pn.Row(caption, dl), table,
                          sizing_mode="stretch_both")
 
     def _meta_table(self) -> dict:
