@@ -229,9 +229,11 @@ def column_digest(doc) -> str:
 class BokehSession:
     """A Bokeh websocket client with a replica of its session's document.
 
-    The server's ``PATCH-DOC`` messages are applied to the replica as they arrive; every
-    patch that touches a ColumnDataSource is followed by a digest of the plot data, and the
-    time of each change of that digest is kept (for ``change`` and ``settle``).
+    Two tasks share the work. The reader takes each message off the socket as soon as it
+    arrives and notes the arrival time of every patch that touches a ColumnDataSource (the
+    plot data); the applier applies the patches to the replica in order and keeps a digest
+    of the plot data. Latencies are arrival times, so a client that is busy applying other
+    sessions' patches does not count its own backlog as the server's.
     """
 
     def __init__(self, *, max_message_mb: int = 200):
@@ -239,9 +241,12 @@ class BokehSession:
         self._max_bytes = max_message_mb * 2**20
         self.errors: list[str] = []
         self.doc = None
-        self._ws = self._sock = self._reader = None
+        self._ws = self._sock = None
+        self._tasks: list[asyncio.Task] = []
+        self._queue: asyncio.Queue = asyncio.Queue()
         self._digest = ""
-        self._change_times: list[float] = []  # perf_counter of each change of the digest
+        self._change_times: list[float] = []  # arrival of each patch of plot data
+        self._sources: set[str] = set()  # ids of the ColumnDataSources
         self._progress: list = []  # the progress bars of long computations (class name)
 
     async def open(self, url: str, timeout_s: float) -> None:
@@ -271,10 +276,19 @@ class BokehSession:
                                f"{reply and reply.content}")
         self.doc = Document()
         reply.push_to_document(self.doc)
+        self._index_models()
         self._digest = column_digest(self.doc)
-        self._reader = asyncio.ensure_future(self._read())
+        self._tasks = [asyncio.ensure_future(self._read()),
+                       asyncio.ensure_future(self._apply())]
         # what BokehJS sends once the page has rendered: starts the app's on-load work
         await self._send([MessageSentEvent(self.doc, "bokeh_event", DocumentReady())])
+
+    def _index_models(self) -> None:
+        from bokeh.models import ColumnDataSource
+
+        self._sources = {m.id for m in self.doc.models if isinstance(m, ColumnDataSource)}
+        self._progress = [m for m in self.doc.models if "css_classes" in m.properties()
+                          and "scatter-progress" in m.css_classes]
 
     async def _pop(self):
         while True:
@@ -289,37 +303,32 @@ class BokehSession:
         await self._protocol.create("PATCH-DOC", events).send(self._sock)
 
     async def _read(self) -> None:
-        from bokeh.models import ColumnDataSource
+        while True:
+            msg = await self._pop()
+            if msg is None:
+                return
+            if msg.msgtype == "ERROR":
+                self.errors.append(f"server error: {msg.content.get('text')}")
+            elif msg.msgtype == "PATCH-DOC":
+                if any(_event_model_id(e) in self._sources for e in msg.content["events"]):
+                    self._change_times.append(time.perf_counter())
+                self._queue.put_nowait(msg)
 
-        sources = None
-        try:
-            while True:
-                msg = await self._pop()
-                if msg is None:
-                    return
-                if msg.msgtype == "ERROR":
-                    self.errors.append(f"server error: {msg.content.get('text')}")
-                    continue
-                if msg.msgtype != "PATCH-DOC":
-                    continue
+    async def _apply(self) -> None:
+        while True:
+            msg = await self._queue.get()
+            try:
                 msg.apply_to_document(self.doc, self)
                 events = msg.content["events"]
-                if sources is None or any(e.get("kind") == "ModelChanged" for e in events):
-                    # models may have come or gone
-                    sources = {m.id for m in self.doc.models
-                               if isinstance(m, ColumnDataSource)}
-                    self._progress = [m for m in self.doc.models
-                                      if "css_classes" in m.properties()
-                                      and "scatter-progress" in m.css_classes]
-                if any(_event_model_id(e) in sources for e in events):
-                    d = column_digest(self.doc)
-                    if d != self._digest:
-                        self._digest = d
-                        self._change_times.append(time.perf_counter())
-        except asyncio.CancelledError:
-            raise
-        except Exception as exc:  # a patch the replica cannot apply is a finding
-            self.errors.append(f"{type(exc).__name__} applying a server patch: {exc}")
+                if any(e.get("kind") == "ModelChanged" for e in events):
+                    self._index_models()  # models may have come or gone
+                if any(_event_model_id(e) in self._sources for e in events):
+                    self._digest = column_digest(self.doc)
+            except Exception as exc:  # a patch the replica cannot apply is a finding
+                self.errors.append(f"{type(exc).__name__} applying a server patch: {exc}")
+            finally:
+                self._queue.task_done()
+            await asyncio.sleep(0)  # let the readers of other sessions in
 
     @property
     def _changed_at(self) -> float:
@@ -341,7 +350,7 @@ class BokehSession:
         while time.perf_counter() - t0 < timeout_s:
             await asyncio.sleep(0.05)
             now = time.perf_counter()
-            if self._busy():
+            if self._busy() or not self._queue.empty():
                 last = now
             last = max(last, self._changed_at)
             if now - last > quiet_s:
@@ -359,7 +368,7 @@ class BokehSession:
         from bokeh.document.events import ModelChangedEvent
 
         m = self._slider(title)
-        n0 = len(self._change_times)
+        n0, before = len(self._change_times), self._digest
         t0 = time.perf_counter()
         # the replica changes without an echo (setter=self); the server gets both
         # properties a released slider sets, in one patch, as BokehJS sends them
@@ -372,15 +381,16 @@ class BokehSession:
             await asyncio.sleep(0.01)
             if len(self._change_times) > n0 and time.perf_counter() - self._changed_at > quiet_s:
                 break
-        if len(self._change_times) == n0:
+        await self._queue.join()  # applied: the digest is that of the new state
+        if len(self._change_times) == n0 or self._digest == before:
             return None
         return [(self._change_times[n0] - t0) * 1000, (self._changed_at - t0) * 1000]
 
     async def close(self) -> None:
-        if self._reader is not None:
-            self._reader.cancel()
+        for task in self._tasks:
+            task.cancel()
             try:
-                await self._reader
+                await task
             except (asyncio.CancelledError, Exception):
                 pass
         if self._ws is not None:

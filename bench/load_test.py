@@ -101,14 +101,15 @@ def targets(values: list[float], index: int, changes: int, current: float) -> li
 class AllOpen:
     """Lets the sessions start changing only once every session has opened (or failed)."""
 
-    def __init__(self, n: int):
+    def __init__(self, n: int, server_cpu_s=None):
         self._left, self._event = n, asyncio.Event()
+        self._server_cpu_s = server_cpu_s or (lambda: None)
 
     def arrive(self) -> None:
         self._left -= 1
         if self._left <= 0 and not self._event.is_set():
             # the change phase starts: where this script's CPU time goes from here on
-            self.at = (time.monotonic(), time.process_time())
+            self.at = (time.monotonic(), time.process_time(), self._server_cpu_s())
             self._event.set()
 
     async def wait(self) -> None:
@@ -263,7 +264,7 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
         new_session = await session_factory(client, stack)
 
         t0 = time.monotonic()
-        all_open = AllOpen(n)
+        all_open = AllOpen(n, cpu_s)
         results = await asyncio.gather(*(
             run_session(new_session, url, i, changes, title, timeout_s, 0.1 * i, all_open)
             for i in range(n)))
@@ -272,6 +273,9 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
         # near 1 would mean the clients themselves delayed what they measured
         change_wall = time.monotonic() - all_open.at[0]
         script_share = (time.process_time() - all_open.at[1]) / change_wall
+        n_changes = sum(len(r.first_ms) for r in results)
+        server_per_change = (None if all_open.at[2] is None or not n_changes
+                             else (cpu_s() - all_open.at[2]) / n_changes)
         problems = [f"session {r.index}: {e}" for r in results for e in r.errors]
         for r in results:
             if not r.errors and r.final_value != r.last_value:
@@ -312,7 +316,8 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
     return {"sessions": n, "client": client, "changes": len(first), "wall_s": wall,
             "load_ms": loads, "first_ms": first, "settled_ms": settled,
             "problems": problems, "distinct_final_states": len(refs),
-            "change_phase_s": change_wall, "script_core_share": script_share}
+            "change_phase_s": change_wall, "script_core_share": script_share,
+            "server_cpu_per_change_s": server_per_change}
 
 
 # ---- servers -------------------------------------------------------------------------------
@@ -539,7 +544,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"   change -> settled        {summary(row['settled_ms'])}")
             print(f"   change phase {row['change_phase_s']:.1f} s; this script"
                   f"{' and its Bokeh clients' if args.client == 'bokeh' else ''} busy "
-                  f"{100 * row['script_core_share']:.0f}% of one core meanwhile")
+                  f"{100 * row['script_core_share']:.0f}% of one core meanwhile"
+                  + ("" if row["server_cpu_per_change_s"] is None else
+                     f"; server CPU {1000 * row['server_cpu_per_change_s']:.0f} ms per change"))
             if row["server_cpu_s"] is not None:
                 # where the cores went: on one machine the browsers compete with the server
                 print(f"   CPU over {row['accounted_s']:.0f} s (sessions and isolation check): "

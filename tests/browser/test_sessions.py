@@ -11,18 +11,35 @@ one session nor mixed up with another's).
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 from load_clients import BokehSession, column_digest  # noqa: E402
 
+from .conftest import SOURCES  # noqa: E402
+
 TIMEOUT_S = 90.0
+
+
+def _all_plotted(sess: BokehSession) -> bool:
+    """Every view's data are there (the scatter band arrives after the page has loaded)."""
+    for name in SOURCES:
+        src = sess.doc.get_model_by_name(name)
+        if src is None or not any(len(col) for col in src.data.values()):
+            return False
+    return True
 
 
 async def _opened(url: str) -> BokehSession:
     sess = BokehSession()
     await sess.open(url, TIMEOUT_S)
+    for _ in range(int(TIMEOUT_S / 0.1)):
+        if _all_plotted(sess):
+            break
+        await asyncio.sleep(0.1)
+    assert _all_plotted(sess), f"not every view got its data: {sess.errors}"
     assert await sess.settle(TIMEOUT_S, 1.0) is not None, "plot data never settled"
     return sess
 
@@ -61,5 +78,7 @@ async def _scenario(url: str) -> None:
 
 
 def test_a_change_in_one_session_never_reaches_another(dashboard):
-    asyncio.run(_scenario(dashboard.url))
+    # its own event loop in its own thread: pytest-playwright's loop may be running here
+    with concurrent.futures.ThreadPoolExecutor(max_workers=1) as pool:
+        pool.submit(asyncio.run, _scenario(dashboard.url)).result()
     assert dashboard.errors() == []
