@@ -12,7 +12,8 @@ checks that
 With ``--expect-login`` it first checks that the page without credentials shows the login
 form and no Bokeh document. Exit status 0 on success, 1 on failure (with the reason).
 
-Usage: python docker/smoke_test.py URL [--user U --password P] [--expect-login]
+Usage: python docker/smoke_test.py URL [--user U --password=P] [--expect-login]
+(``--password=P``: a password may begin with "-")
 """
 
 from __future__ import annotations

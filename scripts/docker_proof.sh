@@ -203,7 +203,7 @@ proof_auth() {
     log "container ${cid:0:12} with basic auth on 127.0.0.1:$port"
     timed "start -> healthy (basic auth)" wait_healthy "$cid"
     timed "browser smoke test (login first)" "$PY" docker/smoke_test.py \
-        "http://127.0.0.1:$port/" --expect-login --user reviewer --password "$password"
+        "http://127.0.0.1:$port/" --expect-login --user reviewer "--password=$password"
     docker stop -t 20 "$cid" >/dev/null
     log "stopped container ${cid:0:12}"
 }
