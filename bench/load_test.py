@@ -98,6 +98,12 @@ def targets(values: list[float], index: int, changes: int, current: float) -> li
     return seq
 
 
+#: Above this share of a core the single-threaded Bokeh clients throttle themselves (they
+#: send a session's next change only once its last one is applied): such a level does not
+#: count for the capacity figure.
+CLIENT_LIMIT = 0.75
+
+
 class AllOpen:
     """Lets the sessions start changing only once every session has opened (or failed)."""
 
@@ -522,7 +528,13 @@ def main(argv: list[str] | None = None) -> int:
         if not args.cold:
             took = asyncio.run(run_warm_up(url, args.slider, args.timeout, args.client))
             print(f"warm-up: one session visited every slider value in {took:.1f} s")
-        for n in levels:
+        for k, n in enumerate(levels):
+            if k and server is not None:
+                # Bokeh destroys the closed sessions of the last level within about 32 s
+                # (unused-session lifetime 15 s, checked every 17 s): let that happen
+                # before this level rather than during its changes
+                time.sleep(35)
+                asyncio.run(wait_server_idle(server.cpu_s, 60))
             cpu0 = server.cpu_s() if server is not None else None
             host0, t0, self0 = host_busy_s(), time.monotonic(), time.process_time()
             row = asyncio.run(run_level(url, n, args.changes, args.slider, args.timeout,
@@ -547,6 +559,9 @@ def main(argv: list[str] | None = None) -> int:
                   f"{100 * row['script_core_share']:.0f}% of one core meanwhile"
                   + ("" if row["server_cpu_per_change_s"] is None else
                      f"; server CPU {1000 * row['server_cpu_per_change_s']:.0f} ms per change"))
+            if args.client == "bokeh" and row["script_core_share"] > CLIENT_LIMIT:
+                print("   CLIENT-LIMITED: the clients' core was nearly saturated; they sent their"
+                      " changes late and this level loaded the server less than it says")
             if row["server_cpu_s"] is not None:
                 # where the cores went: on one machine the browsers compete with the server
                 print(f"   CPU over {row['accounted_s']:.0f} s (sessions and isolation check): "
@@ -574,8 +589,10 @@ def main(argv: list[str] | None = None) -> int:
         if server is not None:
             server.stop()
     ok = [r["sessions"] for r in rows
-          if not r["problems"] and r["first_ms"] and pct(r["first_ms"], 95) < args.target]
-    print(f"\nlargest tested number of sessions with p95 first update < {args.target:.0f} ms: "
+          if not r["problems"] and r["first_ms"] and pct(r["first_ms"], 95) < args.target
+          and r["script_core_share"] <= CLIENT_LIMIT]
+    print(f"\nlargest tested number of sessions with p95 first update < {args.target:.0f} ms"
+          f"{' (clients below saturation)' if args.client == 'bokeh' else ''}: "
           f"{max(ok) if ok else 'none'}")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
