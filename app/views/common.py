@@ -8,7 +8,7 @@ import re
 from collections.abc import Callable
 
 import panel as pn
-from bokeh.models import Div
+from panel.models.markup import HTML as PanelHTML
 
 from .. import compute
 from ..export import to_csv
@@ -49,24 +49,31 @@ def inline_html(text: str) -> str:
     return re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", out)
 
 
+def _encoded(text: str) -> str:
+    # Panel's HTML model takes its markup escaped once more (its view decodes it)
+    return html.escape(f"<p>{inline_html(text)}</p>")
+
+
 def live_text(text: Callable[[], str], watch: list[tuple], *, css_classes=(), styles=None,
               margin=(0, 10), height=None) -> pn.pane.Bokeh:
     """A line of text showing ``text()``, rewritten when a watched parameter changes.
 
     ``watch`` holds ``(parameterized, [parameter names])`` pairs; ``text`` may use
-    ``**bold**`` and ``&middot;``. The line is a Bokeh ``Div`` whose ``text`` is assigned
-    like the plots' data (``Pusher``: one property change, in order across threads): a
-    Panel Markdown pane costs the server several times as much per rewrite (markdown
-    rendering, Panel's per-property bookkeeping), three rewrites per control change.
+    ``**bold**`` and ``&middot;``. The line is Panel's HTML Bokeh model (its browser view
+    swaps the text without laying out the page again, which Bokeh's ``Div`` does) whose
+    ``text`` is assigned like the plots' data (``Pusher``: one property change, in order
+    across threads): a Markdown pane rewritten in the watcher chain costs the server
+    several times as much per rewrite (markdown rendering, Panel's per-property
+    bookkeeping), three rewrites per control change.
     """
-    div = Div(text=f"<p>{inline_html(text())}</p>", css_classes=list(css_classes),
-              styles=dict(styles or {}), margin=margin, height=height,
-              sizing_mode="stretch_width")
+    div = PanelHTML(text=_encoded(text()), css_classes=list(css_classes),
+                    styles=dict(styles or {}), margin=margin, height=height,
+                    sizing_mode="stretch_width")
     pusher = Pusher()
 
     def rewrite(*_):
         def make():
-            new = f"<p>{inline_html(text())}</p>"
+            new = _encoded(text())
             return lambda: None if div.text == new else setattr(div, "text", new)
         pusher(make)
 
