@@ -194,7 +194,7 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
         raise SettingError("basic authentication (FBS_BASIC_AUTH*) and PANEL_OAUTH_PROVIDER "
                            "exclude each other: choose one")
     if users_file:
-        cmd += ["--basic-auth", users_file]
+        cmd += [f"--basic-auth={users_file}"]
 
     secret = env.get("FBS_COOKIE_SECRET", "")
     if secret and env.get("PANEL_COOKIE_SECRET"):
@@ -208,11 +208,13 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
         secret = secrets.token_urlsafe(32)
         warnings.append("no FBS_COOKIE_SECRET: made a random one, logins end at restart")
     if secret and not env.get("PANEL_COOKIE_SECRET"):
-        cmd += ["--cookie-secret", secret]
+        # one argument "--opt=value": a value beginning with "-" (token_urlsafe makes one in
+        # 64) would otherwise be taken by panel serve's parser for an option
+        cmd += [f"--cookie-secret={secret}"]
 
     prefix = env.get("FBS_PREFIX", "").strip("/")
     if prefix:
-        cmd += ["--prefix", prefix]
+        cmd += [f"--prefix={prefix}"]
     if _flag(env, "FBS_USE_XHEADERS"):
         cmd += ["--use-xheaders"]
     # an uploaded file travels base64-encoded in one message: 200 MB carries files up to
@@ -229,9 +231,7 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
 
 def masked(cmd: list[str]) -> list[str]:
     """The command line with the value of ``--cookie-secret`` hidden."""
-    return [
-        "***" if i > 0 and cmd[i - 1] == "--cookie-secret" else arg for i, arg in enumerate(cmd)
-    ]
+    return ["--cookie-secret=***" if arg.startswith("--cookie-secret=") else arg for arg in cmd]
 
 
 def healthcheck(env: dict[str, str]) -> int:

@@ -35,7 +35,7 @@ SPEC.loader.exec_module(entrypoint)
 SettingError = entrypoint.SettingError
 
 USER, PASSWORD = "reviewer", "Tyre:Chassis-2026"  # a ':' inside the password on purpose
-SECRET = "s" * 40
+SECRET = "-" + "s" * 39  # a leading "-" on purpose (token_urlsafe makes one in 64)
 
 APP = """
 import numpy as np
@@ -86,10 +86,17 @@ def test_default_command(app_file):
     assert cmd[1:3] == ["serve", str(app_file)]
     joined = " ".join(cmd)
     assert "--address 0.0.0.0 --port 5006 --liveness --num-threads 4" in joined
-    assert "--basic-auth" not in cmd and "--cookie-secret" not in cmd
+    assert not any(a.startswith(("--basic-auth", "--cookie-secret")) for a in cmd)
     # uploads up to 150 MB fit one message (base64), beyond fbs_core's 100 MiB limit
     assert f"--websocket-max-message-size {200 * 1024 * 1024}" in joined
     assert cmd[-1] == "--dev-flag" and warnings == []
+
+
+def _option(cmd: list[str], name: str) -> str:
+    """The value of ``name=value`` on a command line (exactly one such argument)."""
+    values = [a.split("=", 1)[1] for a in cmd if a.startswith(name + "=")]
+    assert len(values) == 1 and name not in cmd, cmd
+    return values[0]
 
 
 def test_basic_auth_users_go_to_a_private_file_not_the_command_line(app_file):
@@ -97,10 +104,10 @@ def test_basic_auth_users_go_to_a_private_file_not_the_command_line(app_file):
            "FBS_COOKIE_SECRET": SECRET}
     cmd, _ = entrypoint.build_command(env, [])
     assert PASSWORD not in " ".join(cmd)
-    users_file = Path(cmd[cmd.index("--basic-auth") + 1])
+    users_file = Path(_option(cmd, "--basic-auth"))
     assert json.loads(users_file.read_text()) == {USER: PASSWORD}
     assert stat.S_IMODE(users_file.stat().st_mode) == 0o600
-    assert cmd[cmd.index("--cookie-secret") + 1] == SECRET
+    assert _option(cmd, "--cookie-secret") == SECRET
     assert SECRET not in entrypoint.masked(cmd)
 
 
@@ -108,7 +115,7 @@ def test_auth_without_secret_makes_a_random_one(app_file):
     env = {"FBS_APP": str(app_file), "FBS_BASIC_AUTH": "a:b"}
     cmd1, warnings = entrypoint.build_command(env, [])
     cmd2, _ = entrypoint.build_command(env, [])
-    s1, s2 = (c[c.index("--cookie-secret") + 1] for c in (cmd1, cmd2))
+    s1, s2 = (_option(c, "--cookie-secret") for c in (cmd1, cmd2))
     assert len(s1) >= entrypoint.MIN_SECRET_LEN and s1 != s2
     assert any("FBS_COOKIE_SECRET" in w for w in warnings)
 
