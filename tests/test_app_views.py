@@ -192,3 +192,29 @@ def test_a_slow_update_of_an_older_state_never_lands_last():
     b_is_done.set()
     slow.join(5)
     assert shown == [1]
+
+
+def test_caption_text_is_escaped_html_with_bold_and_middots():
+    from app.views.common import inline_html
+
+    # a DOF label from a user's file is text, never markup
+    assert (inline_html("**Harmonic 2** &middot; bushing:<img src=x onerror=1> & co")
+            == "<b>Harmonic 2</b> &middot; bushing:&lt;img src=x onerror=1&gt; &amp; co")
+
+
+def test_live_text_follows_its_parameters():
+    import html
+
+    import param
+
+    from app.views.common import live_text
+
+    class P(param.Parameterized):
+        h = param.Integer(1)
+
+    p = P()
+    pane = live_text(lambda: f"**Harmonic {p.h}**", [(p, ["h"])])
+    model = pane.object
+    assert html.unescape(model.text) == "<p><b>Harmonic 1</b></p>"
+    p.h = 7  # no server: the update is applied at once
+    assert html.unescape(model.text) == "<p><b>Harmonic 7</b></p>"
