@@ -33,37 +33,19 @@ from __future__ import annotations
 import asyncio
 import importlib
 import pkgutil
+import sys
 import time
 import urllib.parse
 import urllib.request
+from pathlib import Path
 
 import numpy as np
 
-# ---- browser -----------------------------------------------------------------------------
+# the page digest and the browser launch arguments are the Docker smoke test's
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docker"))
+from smoke_test import DIGEST_JS, chromium_args  # noqa: E402, F401
 
-DIGEST_JS = """() => {
-  const doc = Bokeh.documents[0], shown = new Set();
-  for (const root of doc.roots()) {
-    shown.add(root);
-    for (const m of root.references()) shown.add(m);
-  }
-  const out = [];
-  for (const m of shown) {
-    if (m.type !== 'ColumnDataSource') continue;
-    const cols = m.data instanceof Map ? [...m.data.entries()] : Object.entries(m.data);
-    let n = 0, s = 0;
-    for (const [name, col] of cols) {
-      if (col == null || col.length === undefined || typeof col === 'string') continue;
-      n += col.length;
-      for (let i = 0; i < col.length; i++) {
-        const v = col[i];
-        if (typeof v === 'number' && Number.isFinite(v)) s += v * Math.sqrt(i + 2) + v * v;
-      }
-    }
-    out.push(n + ':' + s.toPrecision(10));
-  }
-  return out.sort().join('|');
-}"""
+# ---- browser -----------------------------------------------------------------------------
 
 READY_JS = """() => window.Bokeh && Bokeh.documents.length > 0 &&
   [...Bokeh.documents[0].all_models].some(m => m.type === 'ColumnDataSource' &&
@@ -118,17 +100,6 @@ SETTLE_JS = f"""async ([timeout, quiet]) => {{
   }}
   return null;
 }}"""
-
-
-def chromium_args() -> dict:
-    """Launch arguments for the system chromium where there is one (else playwright's)."""
-    import os
-
-    for path in ("/usr/bin/chromium", "/usr/bin/chromium-browser"):
-        if os.path.exists(path):
-            return {"executable_path": path,
-                    "args": ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"]}
-    return {}
 
 
 class BrowserSession:
@@ -248,6 +219,7 @@ class BokehSession:
         self._change_times: list[float] = []  # arrival of each patch of plot data
         self._sources: set[str] = set()  # ids of the ColumnDataSources
         self._progress: list = []  # the progress bars of long computations (class name)
+        self._n_models = 0
 
     async def open(self, url: str, timeout_s: float) -> None:
         from bokeh.client.websocket import WebSocketClientConnectionWrapper
@@ -286,6 +258,7 @@ class BokehSession:
     def _index_models(self) -> None:
         from bokeh.models import ColumnDataSource
 
+        self._n_models = len(self.doc.models)
         self._sources = {m.id for m in self.doc.models if isinstance(m, ColumnDataSource)}
         self._progress = [m for m in self.doc.models if "css_classes" in m.properties()
                           and "scatter-progress" in m.css_classes]
@@ -320,8 +293,8 @@ class BokehSession:
             try:
                 msg.apply_to_document(self.doc, self)
                 events = msg.content["events"]
-                if any(e.get("kind") == "ModelChanged" for e in events):
-                    self._index_models()  # models may have come or gone
+                if len(self.doc.models) != self._n_models:
+                    self._index_models()  # models came or went
                 if any(_event_model_id(e) in self._sources for e in events):
                     self._digest = column_digest(self.doc)
             except Exception as exc:  # a patch the replica cannot apply is a finding

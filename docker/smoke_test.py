@@ -64,7 +64,8 @@ def chromium_args() -> dict:
     """Launch arguments: the system chromium when present, else playwright's own."""
     for path in ("/usr/bin/chromium", "/usr/bin/chromium-browser"):
         if os.path.exists(path):
-            return {"executable_path": path, "args": ["--no-sandbox", "--disable-gpu"]}
+            return {"executable_path": path,
+                    "args": ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"]}
     return {}
 
 
