@@ -160,21 +160,27 @@ def error_map(harmonic: int, coupling: str, models=None):
 @shared_cache(maxsize=24)
 def _error_map(harmonic: int, coupling: str, models):
     n_total = int(_tire(models).n_modes)
-    return studies.truncation_map(harmonic, n_modes=np.arange(10, n_total, 10),
-                                  coupling=coupling, **_models_kw(models))
+    return studies.truncation_map(
+        harmonic, n_modes=np.arange(10, n_total, 10), coupling=coupling, **_models_kw(models)
+    )
 
 
 @shared_cache(maxsize=64)
-def _bushing_response(harmonic: int, n_modes: int | None, coupling: str,
-                      models=None) -> np.ndarray:
-    frf = fbs_core.bushing_response(harmonic, n_modes=n_modes, freq=frequencies(harmonic),
-                                    coupling=coupling, **_models_kw(models))
-    return np.stack([frf.sel(outputs=f"bushing:{d}").data[:, 0, 0]
-                     for d in ("x", "y", "z", "rx", "ry", "rz")], axis=1)
+def _bushing_response(harmonic: int, n_modes: int | None, coupling: str, models=None) -> np.ndarray:
+    frf = fbs_core.bushing_response(
+        harmonic,
+        n_modes=n_modes,
+        freq=frequencies(harmonic),
+        coupling=coupling,
+        **_models_kw(models),
+    )
+    return np.stack(
+        [frf.sel(outputs=f"bushing:{d}").data[:, 0, 0] for d in ("x", "y", "z", "rx", "ry", "rz")],
+        axis=1,
+    )
 
 
-def coupled_response(harmonic: int, n_modes: int | None, coupling: str,
-                     models=None) -> np.ndarray:
+def coupled_response(harmonic: int, n_modes: int | None, coupling: str, models=None) -> np.ndarray:
     """Bushing velocity v_e* (eq. 4.1), shape ``(n_freq, 6)`` for ``bushing:x`` ... ``rz``.
 
     ``n_modes=None`` is the all-modes reference. Read from the cached truncation map when it
@@ -195,8 +201,7 @@ def _dof_index(dof: str) -> int:
     return ("x", "y", "z", "rx", "ry", "rz").index(dof)
 
 
-def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str,
-                  models=None) -> dict:
+def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str, models=None) -> dict:
     """Columns of the coupled-response view: reference (all modes) and truncated (N modes).
 
     Returns
@@ -236,8 +241,9 @@ def error_map_data(harmonic: int, coupling: str, dof: str | None, models=None) -
     }
 
 
-def suggested_table(threshold_pct: float, f_max: float, coupling: str,
-                    dof: str | None = None, models=None) -> dict:
+def suggested_table(
+    threshold_pct: float, f_max: float, coupling: str, dof: str | None = None, models=None
+) -> dict:
     """Suggested number of modes for all seven harmonics (thesis table 5.1).
 
     ``dof=None`` judges the maximum error over the 6 DOFs (as the thesis' table).
@@ -248,9 +254,13 @@ def suggested_table(threshold_pct: float, f_max: float, coupling: str,
 @shared_cache(maxsize=64)
 def _suggested_table(threshold_pct, f_max, coupling, dof, models) -> dict:
     maps = [error_map(k, coupling, models) for k in range(1, 8)]
-    s = studies.suggest_modes(threshold=threshold_pct / 100.0, f_max=f_max, maps=maps,
-                              dof=None if dof is None else f"bushing:{dof}",
-                              tire=None if models is None else models.tire)
+    s = studies.suggest_modes(
+        threshold=threshold_pct / 100.0,
+        f_max=f_max,
+        maps=maps,
+        dof=None if dof is None else f"bushing:{dof}",
+        tire=None if models is None else models.tire,
+    )
     return {
         "harmonic": np.asarray(s.harmonics, int),
         "f_low": np.asarray(s.freq_range[:, 0], float),
@@ -278,8 +288,9 @@ def _eigen_curves(models) -> dict:
 # -- uncoupled subsystems --------------------------------------------------------------------
 @shared_cache(maxsize=64)
 def _tire_hub(harmonic: int, n_modes: int | None, models=None):
-    return _tire(models).patch_response(frequencies(harmonic), fbs_core.harmonic(harmonic),
-                                        _n(models, n_modes))
+    return _tire(models).patch_response(
+        frequencies(harmonic), fbs_core.harmonic(harmonic), _n(models, n_modes)
+    )
 
 
 @shared_cache(maxsize=8)
@@ -287,8 +298,7 @@ def _chassis_frf(harmonic: int, models=None):
     return _chassis(models).mobility(frequencies(harmonic))
 
 
-def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str,
-                   models=None) -> dict:
+def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str, models=None) -> dict:
     """Uncoupled subsystems (thesis figs. 4.6-4.7 and 4.2-4.3).
 
     Returns
@@ -301,9 +311,11 @@ def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str,
     models = _key(models)
     t_ref = _tire_hub(harmonic, None, models).sel(outputs=f"hub:{dof}").data[:, 0, 0]
     t_tr = _tire_hub(harmonic, int(n_modes), models).sel(outputs=f"hub:{dof}").data[:, 0, 0]
-    ch = _chassis_frf(harmonic, models).sel(
-        outputs=f"bushing:{dof}", inputs=f"spindle:{spindle_input}"
-    ).data[:, 0, 0]
+    ch = (
+        _chassis_frf(harmonic, models)
+        .sel(outputs=f"bushing:{dof}", inputs=f"spindle:{spindle_input}")
+        .data[:, 0, 0]
+    )
     return {
         "freq": frequencies(harmonic),
         "tire_reference": t_ref,
@@ -316,21 +328,46 @@ def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str,
 
 
 # -- noise study -----------------------------------------------------------------------------
-def band(harmonic: int, n_modes: int | None, coupling: str, noise_pct: float, target: str,
-         frequency_dependent: bool, rounds: int, seed: int, models=None):
+def band(
+    harmonic: int,
+    n_modes: int | None,
+    coupling: str,
+    noise_pct: float,
+    target: str,
+    frequency_dependent: bool,
+    rounds: int,
+    seed: int,
+    models=None,
+):
     """The Monte-Carlo scatter band (thesis 5.2), cached (32 results, about 2.3 MB each)."""
-    return _band(harmonic, n_modes, coupling, noise_pct, target, frequency_dependent, rounds,
-                 seed, _key(models))
+    return _band(
+        harmonic,
+        n_modes,
+        coupling,
+        noise_pct,
+        target,
+        frequency_dependent,
+        rounds,
+        seed,
+        _key(models),
+    )
 
 
 @shared_cache(maxsize=32)
-def _band(harmonic, n_modes, coupling, noise_pct, target, frequency_dependent, rounds, seed,
-          models):
+def _band(
+    harmonic, n_modes, coupling, noise_pct, target, frequency_dependent, rounds, seed, models
+):
     return studies.scatter_band(
-        harmonic, noise=noise_pct / 100.0, target=target, rounds=rounds,
-        frequency_dependent=frequency_dependent, seed=seed,
+        harmonic,
+        noise=noise_pct / 100.0,
+        target=target,
+        rounds=rounds,
+        frequency_dependent=frequency_dependent,
+        seed=seed,
         n_modes=n_modes if models is None else _n(models, n_modes),
-        coupling=coupling, percentiles=Q_LEVELS, **_models_kw(models),
+        coupling=coupling,
+        percentiles=Q_LEVELS,
+        **_models_kw(models),
     )
 
 

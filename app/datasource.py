@@ -110,8 +110,10 @@ class FRFChassis:
     def mobility(self, freq, outputs=None, inputs=None, quantity: str = "mobility") -> FRF:
         """The FRF on ``freq`` (Hz), same signature as ``ChassisModel.mobility``."""
         Y = self._on(freq)
-        Y = Y.sel(outputs=SPINDLE + BUSHING if outputs is None else list(outputs),
-                  inputs=SPINDLE if inputs is None else list(inputs))
+        Y = Y.sel(
+            outputs=SPINDLE + BUSHING if outputs is None else list(outputs),
+            inputs=SPINDLE if inputs is None else list(inputs),
+        )
         return Y if quantity == Y.quantity else Y.to(quantity)
 
 
@@ -124,10 +126,21 @@ class Models:
 
     __slots__ = ("tire", "chassis", "key", "tire_name", "chassis_name")
 
-    def __init__(self, tire=None, chassis=None, key: str = "reference",
-                 tire_name: str = "", chassis_name: str = "") -> None:
-        for name, val in (("tire", tire), ("chassis", chassis), ("key", key),
-                          ("tire_name", tire_name), ("chassis_name", chassis_name)):
+    def __init__(
+        self,
+        tire=None,
+        chassis=None,
+        key: str = "reference",
+        tire_name: str = "",
+        chassis_name: str = "",
+    ) -> None:
+        for name, val in (
+            ("tire", tire),
+            ("chassis", chassis),
+            ("key", key),
+            ("tire_name", tire_name),
+            ("chassis_name", chassis_name),
+        ):
             object.__setattr__(self, name, val)
 
     def __setattr__(self, name, value):
@@ -154,8 +167,11 @@ class Models:
 
     def describe(self) -> str:
         t = f"uploaded tire {self.tire_name!r}" if self.tire is not None else "reference tire"
-        c = (f"uploaded chassis {self.chassis_name!r}" if self.chassis is not None
-             else "reference chassis")
+        c = (
+            f"uploaded chassis {self.chassis_name!r}"
+            if self.chassis is not None
+            else "reference chassis"
+        )
         return f"{t} + {c}"
 
 
@@ -166,10 +182,17 @@ REFERENCE = Models()
 def _models(tire, tire_key, tire_name, chassis, chassis_key, chassis_name) -> Models:
     if tire is None and chassis is None:
         return REFERENCE
-    key = f"tire={tire_key if tire is not None else 'reference'};" \
-          f"chassis={chassis_key if chassis is not None else 'reference'}"
-    return Models(tire, chassis, key, tire_name if tire is not None else "",
-                  chassis_name if chassis is not None else "")
+    key = (
+        f"tire={tire_key if tire is not None else 'reference'};"
+        f"chassis={chassis_key if chassis is not None else 'reference'}"
+    )
+    return Models(
+        tire,
+        chassis,
+        key,
+        tire_name if tire is not None else "",
+        chassis_name if chassis is not None else "",
+    )
 
 
 def _digest(data: bytes, **settings) -> str:
@@ -189,8 +212,9 @@ def parse_node(text: str, role: str) -> tuple[str, int | None]:
     if t.isdigit():
         return t, int(t)
     if ":" in t or any(c.isspace() for c in t):
-        raise FBSError(f"the {role} node must be one node name or number without a direction, "
-                       f"got {t!r}")
+        raise FBSError(
+            f"the {role} node must be one node name or number without a direction, got {t!r}"
+        )
     return t, None
 
 
@@ -203,11 +227,14 @@ def check_tire(tire) -> list[str]:
         Naming the missing hub DOFs, modes, wavelengths or operating points.
     """
     if tuple(tire.hub_dofs) != HUB:
-        raise FBSError(f"the tire's hub DOFs must be {', '.join(HUB)}, got "
-                       f"{', '.join(tire.hub_dofs)}")
+        raise FBSError(
+            f"the tire's hub DOFs must be {', '.join(HUB)}, got {', '.join(tire.hub_dofs)}"
+        )
     if tire.n_modes < MIN_TIRE_MODES:
-        raise FBSError(f"the tire model has {tire.n_modes} complex modes; the truncation study "
-                       f"needs at least {MIN_TIRE_MODES}")
+        raise FBSError(
+            f"the tire model has {tire.n_modes} complex modes; the truncation study "
+            f"needs at least {MIN_TIRE_MODES}"
+        )
     for k in HARMONICS:
         f = _grid(k)
         try:
@@ -250,17 +277,26 @@ class DataSource(param.Parameterized):
     ``error`` holds the message of the last refused upload ("" after a success).
     """
 
-    models = param.ClassSelector(class_=Models, default=REFERENCE, instantiate=False,
-                                 doc="The current tire and chassis (a hashable token).")
+    models = param.ClassSelector(
+        class_=Models,
+        default=REFERENCE,
+        instantiate=False,
+        doc="The current tire and chassis (a hashable token).",
+    )
     tire_summary = param.String(default="", doc="What was read from the tire upload.")
     chassis_summary = param.String(default="", doc="What was read from the chassis upload.")
     error = param.String(default="", doc="Why the last upload was refused ('' if it was not).")
-    spindle = param.String(default="spindle", doc="Spindle node of the chassis file "
-                           "(name, or node number).")
-    bushing = param.String(default="bushing", doc="Bushing node of the chassis file "
-                           "(name, or node number).")
-    interpolate = param.Boolean(default=False, doc="Interpolate the chassis FRF onto the "
-                                "analysis grids when the file lacks their lines (explicit).")
+    spindle = param.String(
+        default="spindle", doc="Spindle node of the chassis file (name, or node number)."
+    )
+    bushing = param.String(
+        default="bushing", doc="Bushing node of the chassis file (name, or node number)."
+    )
+    interpolate = param.Boolean(
+        default=False,
+        doc="Interpolate the chassis FRF onto the "
+        "analysis grids when the file lacks their lines (explicit).",
+    )
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -272,9 +308,15 @@ class DataSource(param.Parameterized):
         self._lock = threading.RLock()
 
     # -- uploads -------------------------------------------------------------------------
-    def load_chassis(self, data: bytes | None = None, filename: str | None = None, *,
-                     spindle: str | None = None, bushing: str | None = None,
-                     interpolate: bool | None = None) -> bool:
+    def load_chassis(
+        self,
+        data: bytes | None = None,
+        filename: str | None = None,
+        *,
+        spindle: str | None = None,
+        bushing: str | None = None,
+        interpolate: bool | None = None,
+    ) -> bool:
         """Read a chassis FRF upload; ``data=None`` re-reads the last one (new settings).
 
         Returns True when it is now the session's chassis; else ``error`` says why and
@@ -315,8 +357,9 @@ class DataSource(param.Parameterized):
         self._chassis_key = key
         m = self.models
         with param.parameterized.batch_call_watchers(self):
-            self.param.update(spindle=sp, bushing=bu, interpolate=interp, error="",
-                              chassis_summary=summary)
+            self.param.update(
+                spindle=sp, bushing=bu, interpolate=interp, error="", chassis_summary=summary
+            )
             self.models = _models(m.tire, self._tire_key, m.tire_name, chassis, key, name)
         return True
 
@@ -341,17 +384,20 @@ class DataSource(param.Parameterized):
                     f"{', '.join(present)}; give the {role} node by name or number"
                 )
         frf, notes = prepare_chassis(res.frf, spindle=sp_name, bushing=bu_name)
-        require_dofs(frf, outputs=BUSHING, what="the chassis FRF (every view offers the six "
-                     "bushing DOFs)")
+        require_dofs(
+            frf, outputs=BUSHING, what="the chassis FRF (every view offers the six bushing DOFs)"
+        )
         chassis = FRFChassis(frf, interpolate=interpolate)
         used = []
         for k in HARMONICS:
             Y = chassis._on(_grid(k))  # FrequencyGridError unless present / interpolated
             used.append(not np.isin(Y.freq, frf.freq).all())
         if any(used):
-            notes.append("interpolated onto the analysis grids of harmonics "
-                         + ", ".join(str(k) for k, u in zip(HARMONICS, used, strict=True) if u)
-                         + " (linear in real and imaginary part)")
+            notes.append(
+                "interpolated onto the analysis grids of harmonics "
+                + ", ".join(str(k) for k, u in zip(HARMONICS, used, strict=True) if u)
+                + " (linear in real and imaginary part)"
+            )
         summary = res.summary + ("\nchassis: " + "; ".join(notes) if notes else "")
         key = _digest(data, spindle=spindle, bushing=bushing, interpolate=interpolate)
         return chassis, summary, key
@@ -382,8 +428,9 @@ class DataSource(param.Parameterized):
         summary = res.summary + ("\nnotes: " + "; ".join(notes) if notes else "")
         with param.parameterized.batch_call_watchers(self):
             self.param.update(error="", tire_summary=summary)
-            self.models = _models(res.model, key, name, m.chassis, self._chassis_key,
-                                  m.chassis_name)
+            self.models = _models(
+                res.model, key, name, m.chassis, self._chassis_key, m.chassis_name
+            )
         return True
 
     def reset(self) -> None:
@@ -398,4 +445,3 @@ class DataSource(param.Parameterized):
     def describe(self) -> str:
         """One line: which models the views use."""
         return self.models.describe()
-

@@ -72,6 +72,6 @@ def read_csv(text: str) -> tuple[dict[str, str], dict[str, np.ndarray]]:
             meta[k] = v
         i += 1
     names = lines[i].split(",")
-    rows = [list(map(float, ln.split(","))) for ln in lines[i + 1:] if ln.strip()]
+    rows = [list(map(float, ln.split(","))) for ln in lines[i + 1 :] if ln.strip()]
     data = np.array(rows, float).reshape(len(rows), len(names))
     return meta, {n: data[:, k] for k, n in enumerate(names)}

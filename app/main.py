@@ -54,50 +54,82 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
     scatter = ScatterBandView(case=case, noise=noise, x_range=freq)
 
     def card(title, view, height, **kw):
-        return pn.Card(view, title=title, collapsible=True, height=height,
-                       sizing_mode="stretch_width", header_background="#e9ecef",
-                       margin=(4, 4), **kw)
+        return pn.Card(
+            view,
+            title=title,
+            collapsible=True,
+            height=height,
+            sizing_mode="stretch_width",
+            header_background="#e9ecef",
+            margin=(4, 4),
+            **kw,
+        )
 
     # the uncoupled subsystems are built on first request (two plots less per page load)
-    uncoupled = pn.Row(visible=case.param.show_uncoupled, css_classes=["uncoupled-row"],
-                       sizing_mode="stretch_width")
+    uncoupled = pn.Row(
+        visible=case.param.show_uncoupled,
+        css_classes=["uncoupled-row"],
+        sizing_mode="stretch_width",
+    )
 
     def show_uncoupled(*_):
         if case.show_uncoupled and not uncoupled.objects:
-            uncoupled.append(card("Uncoupled subsystems: tire hub and chassis "
-                                  "spindle-to-bushing",
-                                  UncoupledView(case=case, x_range=freq), 420))
+            uncoupled.append(
+                card(
+                    "Uncoupled subsystems: tire hub and chassis spindle-to-bushing",
+                    UncoupledView(case=case, x_range=freq),
+                    420,
+                )
+            )
 
     case.param.watch(show_uncoupled, "show_uncoupled")
     show_uncoupled()
 
-    upload = card("Your data: chassis FRF and tire model for this session",
-                  UploadView(data=state.data), None, collapsed=False,
-                  css_classes=["upload-card"])
+    upload = card(
+        "Your data: chassis FRF and tire model for this session",
+        UploadView(data=state.data),
+        None,
+        collapsed=False,
+        css_classes=["upload-card"],
+    )
     main = pn.Column(
         pn.Row(upload),
         pn.Row(
-            card("Coupled response at the bushing (thesis eq. 4.1)",
-                 MobilityView(case=case, x_range=freq), 500),
-            card("Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
-                 TruncationView(case=case, truncation=trunc, x_range=freq,
-                                n_range=modes), 500),
+            card(
+                "Coupled response at the bushing (thesis eq. 4.1)",
+                MobilityView(case=case, x_range=freq),
+                500,
+            ),
+            card(
+                "Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
+                TruncationView(case=case, truncation=trunc, x_range=freq, n_range=modes),
+                500,
+            ),
         ),
         uncoupled,
         pn.Row(
             card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", scatter, 500),
-            card("Eigenfrequency versus number of modes (fig. 5.8)",
-                 EigenView(case=case, n_range=modes), 500),
+            card(
+                "Eigenfrequency versus number of modes (fig. 5.8)",
+                EigenView(case=case, n_range=modes),
+                500,
+            ),
         ),
-        pn.Row(card("Suggested number of modes (thesis table 5.1)",
-                    SuggestedModesView(case=case, truncation=trunc), 360)),
+        pn.Row(
+            card(
+                "Suggested number of modes (thesis table 5.1)",
+                SuggestedModesView(case=case, truncation=trunc),
+                360,
+            )
+        ),
         sizing_mode="stretch_width",
     )
     template = pn.template.BootstrapTemplate(
         title="Tire-chassis FBS: bushing vibration dashboard",
-        sidebar=[pn.pane.Markdown(INTRO, styles={"font-size": "0.85em"}),
-                 Controls(state=state)],
-        main=[main], header_background=ACCENT, sidebar_width=340,
+        sidebar=[pn.pane.Markdown(INTRO, styles={"font-size": "0.85em"}), Controls(state=state)],
+        main=[main],
+        header_background=ACCENT,
+        sidebar_width=340,
     )
     template.state = state  # for tests and benchmarks
     if pn.state.curdoc is not None and pn.state.curdoc.session_context is not None:

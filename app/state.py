@@ -44,26 +44,30 @@ class CaseState(param.Parameterized):
         default=1, bounds=(1, 7), doc="Harmonic excitation case (thesis fig. 4.4)."
     )
     n_modes = param.Selector(
-        default=50, objects=list(MODE_COUNTS),
+        default=50,
+        objects=list(MODE_COUNTS),
         doc="Retained complex tire modes N, 10-400 in steps of 10 (in +/- pairs: N/2 "
         "physical modes, lowest first; thesis 5.1).",
     )
-    dof = param.Selector(
-        default="z", objects=list(DIRECTIONS), doc="Response DOF at the bushing."
-    )
+    dof = param.Selector(default="z", objects=list(DIRECTIONS), doc="Response DOF at the bushing.")
     coupling = param.Selector(
-        default="6dof", objects=list(COUPLINGS),
+        default="6dof",
+        objects=list(COUPLINGS),
         doc="Couple all 6 hub DOFs (braked wheel) or 5 with the spin (ry) released.",
     )
     show_uncoupled = param.Boolean(
         default=False, doc="Also show the uncoupled tire (hub) and chassis FRFs."
     )
     spindle_input = param.Selector(
-        default="z", objects=list(DIRECTIONS),
+        default="z",
+        objects=list(DIRECTIONS),
         doc="Spindle input DOF of the uncoupled chassis spindle-to-bushing mobility.",
     )
     models = param.ClassSelector(
-        class_=Models, default=REFERENCE, instantiate=False, precedence=-1,
+        class_=Models,
+        default=REFERENCE,
+        instantiate=False,
+        precedence=-1,
         doc="The session's tire and chassis (uploads or the reference), mirrored from "
         "DashboardState.data; not a control and not in the URL.",
     )
@@ -73,7 +77,10 @@ class NoiseState(param.Parameterized):
     """Monte-Carlo noise study settings (thesis section 5.2)."""
 
     noise = param.Number(
-        default=10.0, bounds=(0.0, 100.0), softbounds=(0.0, 10.0), step=0.1,
+        default=10.0,
+        bounds=(0.0, 100.0),
+        softbounds=(0.0, 10.0),
+        step=0.1,
         doc="Noise level p in percent: scaling factors uniform in [1-p, 1+p].",
     )
     target = param.Selector(
@@ -84,16 +91,19 @@ class NoiseState(param.Parameterized):
         doc="New scaling matrix at every frequency line (else one per round).",
     )
     rounds = param.Integer(
-        default=10_000, bounds=(1, 200_000),
+        default=10_000,
+        bounds=(1, 200_000),
         doc="Number of Monte-Carlo rounds R.",
     )
     seed = param.Integer(default=0, bounds=(0, None), doc="Random seed of the study.")
     single_round = param.Integer(
-        default=0, bounds=(0, 200_000 - 1),
+        default=0,
+        bounds=(0, 200_000 - 1),
         doc="Index of the single polluted round drawn inside the band (0-based).",
     )
     percentile = param.Selector(
-        default=90, objects=[50, 80, 90, 95, 99],
+        default=90,
+        objects=[50, 80, 90, 95, 99],
         doc="Width of the central percentile band in percent (90 -> 5-95 %).",
     )
 
@@ -109,15 +119,22 @@ class TruncationState(param.Parameterized):
     """Truncation study settings (thesis section 5.1)."""
 
     threshold = param.Number(
-        default=20.0, bounds=(0.1, 1000.0), softbounds=(1.0, 50.0), step=1.0,
+        default=20.0,
+        bounds=(0.1, 1000.0),
+        softbounds=(1.0, 50.0),
+        step=1.0,
         doc="Error threshold in percent: colour cap of the map and criterion of the table.",
     )
     f_max = param.Number(
-        default=160.0, bounds=(1.0, 1000.0), softbounds=(50.0, 450.0), step=10.0,
+        default=160.0,
+        bounds=(1.0, 1000.0),
+        softbounds=(50.0, 450.0),
+        step=10.0,
         doc="Upper frequency in Hz for the suggested number of modes (table 5.1).",
     )
     map_mode = param.Selector(
-        default=MAP_MODES[0], objects=list(MAP_MODES),
+        default=MAP_MODES[0],
+        objects=list(MAP_MODES),
         doc="Error map of the selected DOF (fig. 5.3/5.7) or the maximum over 6 DOFs (fig. 5.6).",
     )
 
@@ -128,8 +145,11 @@ class DashboardState(param.Parameterized):
     case = param.ClassSelector(class_=CaseState, instantiate=False)
     noise = param.ClassSelector(class_=NoiseState, instantiate=False)
     truncation = param.ClassSelector(class_=TruncationState, instantiate=False)
-    data = param.ClassSelector(class_=DataSource, instantiate=False,
-                               doc="This session's uploads (never shared between sessions).")
+    data = param.ClassSelector(
+        class_=DataSource,
+        instantiate=False,
+        doc="This session's uploads (never shared between sessions).",
+    )
 
     def __init__(self, **params):
         params.setdefault("case", CaseState())
@@ -147,12 +167,21 @@ class DashboardState(param.Parameterized):
 #: URL query keys of each state parameter (short, stable: links are shared in reviews).
 URL_KEYS: dict[str, dict[str, str]] = {
     "case": {
-        "harmonic": "h", "n_modes": "N", "dof": "dof", "coupling": "coupling",
-        "show_uncoupled": "uncoupled", "spindle_input": "input",
+        "harmonic": "h",
+        "n_modes": "N",
+        "dof": "dof",
+        "coupling": "coupling",
+        "show_uncoupled": "uncoupled",
+        "spindle_input": "input",
     },
     "noise": {
-        "noise": "noise", "target": "target", "frequency_dependent": "fdep",
-        "rounds": "rounds", "seed": "seed", "single_round": "round", "percentile": "pct",
+        "noise": "noise",
+        "target": "target",
+        "frequency_dependent": "fdep",
+        "rounds": "rounds",
+        "seed": "seed",
+        "single_round": "round",
+        "percentile": "pct",
     },
     "truncation": {"threshold": "thr", "f_max": "fmax", "map_mode": "map"},
 }

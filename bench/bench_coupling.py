@@ -66,10 +66,14 @@ def main():
     e = list(B.outputs[6:12])
     Yej, YjjA, YjjE = B.sel(outputs=e, inputs=ib), A.sel(ia, ia), B.sel(ib, ib)
     vj = A.sel(outputs=ia, inputs=[A.outputs[0]])
-    t_fast, v = best(lambda: fc.couple_response(Yej, YjjA, YjjE, vj,
-                                                interface=list(zip(ia, ib, strict=True))))
-    t_fast_nocheck, _ = best(lambda: fc.couple_response(
-        Yej, YjjA, YjjE, vj, interface=list(zip(ia, ib, strict=True)), max_cond=None))
+    t_fast, v = best(
+        lambda: fc.couple_response(Yej, YjjA, YjjE, vj, interface=list(zip(ia, ib, strict=True)))
+    )
+    t_fast_nocheck, _ = best(
+        lambda: fc.couple_response(
+            Yej, YjjA, YjjE, vj, interface=list(zip(ia, ib, strict=True)), max_cond=None
+        )
+    )
 
     # same numbers three ways
     ref = Y_recipe[:, N_DOF + 6 : N_DOF + 12, 0]
@@ -77,13 +81,19 @@ def main():
     err_fast = np.max(np.abs(v.data[:, :, 0] - ref)) / np.max(np.abs(ref))
     print(f"subsystems: 2 x {N_DOF} DOFs, {N_J} interface DOFs, {N_FREQ} lines")
     print(f"LM-FBS recipe (pinv, dense B)      : {t_recipe * 1e3:9.1f} ms")
-    print(f"fbs_core.couple_lm                 : {t_lm * 1e3:9.1f} ms   "
-          f"ratio recipe/couple_lm = {t_recipe / t_lm:6.1f}x   max rel diff {err_lm:.1e}")
-    print(f"fbs_core.couple_response (eq. 4.1) : {t_fast * 1e3:9.1f} ms   "
-          f"ratio recipe/fast = {t_recipe / t_fast:6.0f}x   "
-          f"couple_lm/fast = {t_lm / t_fast:5.0f}x   max rel diff {err_fast:.1e}")
-    print(f"  (without the per-line condition check: {t_fast_nocheck * 1e3:.1f} ms, "
-          f"recipe/fast = {t_recipe / t_fast_nocheck:.0f}x)")
+    print(
+        f"fbs_core.couple_lm                 : {t_lm * 1e3:9.1f} ms   "
+        f"ratio recipe/couple_lm = {t_recipe / t_lm:6.1f}x   max rel diff {err_lm:.1e}"
+    )
+    print(
+        f"fbs_core.couple_response (eq. 4.1) : {t_fast * 1e3:9.1f} ms   "
+        f"ratio recipe/fast = {t_recipe / t_fast:6.0f}x   "
+        f"couple_lm/fast = {t_lm / t_fast:5.0f}x   max rel diff {err_fast:.1e}"
+    )
+    print(
+        f"  (without the per-line condition check: {t_fast_nocheck * 1e3:.1f} ms, "
+        f"recipe/fast = {t_recipe / t_fast_nocheck:.0f}x)"
+    )
     print("targets: fast path >= 20x faster than the recipe; couple_lm no slower than it")
 
 

@@ -31,8 +31,14 @@ from playwright.sync_api import sync_playwright
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--no-first-run", "--disable-sync"]
+ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+    "--disable-sync",
+]
 
 # Set a widget model's value (or click a radio button) and resolve with the milliseconds
 # until the named source's data differ (polled every 2 ms).
@@ -96,12 +102,29 @@ def free_port() -> int:
 
 
 def start_server(port: int, threads: int, warm: bool):
-    cmd = [sys.executable, "-m", "panel", "serve", "app/main.py", "--port", str(port),
-           "--address", "127.0.0.1", "--num-threads", str(threads)]
+    cmd = [
+        sys.executable,
+        "-m",
+        "panel",
+        "serve",
+        "app/main.py",
+        "--port",
+        str(port),
+        "--address",
+        "127.0.0.1",
+        "--num-threads",
+        str(threads),
+    ]
     if warm:
         cmd.append("--warm")
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    proc = subprocess.Popen(
+        cmd,
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
     ready: queue.Queue = queue.Queue()
     proc.log = []  # the server's output, printed if the benchmark fails
 
@@ -118,8 +141,10 @@ def start_server(port: int, threads: int, warm: bool):
 
 def stats(ms: list[float]) -> str:
     a = np.asarray(ms)
-    return (f"median {np.median(a):7.0f} ms   p95 {np.percentile(a, 95):7.0f} ms   "
-            f"min {a.min():6.0f}   max {a.max():6.0f}   (n={a.size})")
+    return (
+        f"median {np.median(a):7.0f} ms   p95 {np.percentile(a, 95):7.0f} ms   "
+        f"min {a.min():6.0f}   max {a.max():6.0f}   (n={a.size})"
+    )
 
 
 def wait_band_idle(page, timeout=300_000):
@@ -127,7 +152,9 @@ def wait_band_idle(page, timeout=300_000):
     page.wait_for_function(
         "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
         "m.css_classes.includes('scatter-progress')).every(m => m.active === false)",
-        timeout=timeout, polling=50)
+        timeout=timeout,
+        polling=50,
+    )
 
 
 def main():
@@ -141,9 +168,11 @@ def main():
     launch = {"args": ARGS}
     if Path(CHROMIUM).exists():
         launch["executable_path"] = CHROMIUM
-    print(f"cores: {os.cpu_count()}, load average: {os.getloadavg()[0]:.1f}; "
-          f"rounds R = {args.rounds:,}; --num-threads {args.threads}"
-          f"{'' if args.no_warm else ' --warm'}")
+    print(
+        f"cores: {os.cpu_count()}, load average: {os.getloadavg()[0]:.1f}; "
+        f"rounds R = {args.rounds:,}; --num-threads {args.threads}"
+        f"{'' if args.no_warm else ' --warm'}"
+    )
     with sync_playwright() as p:
         browser = p.chromium.launch(**launch)
         page = browser.new_page(viewport={"width": 1600, "height": 1200})
@@ -160,8 +189,10 @@ def main():
             page.wait_for_function(JS_READY, arg="scatter.minmax", timeout=600_000)
             t_band = time.perf_counter()
             print(f"server start -> app running:          {t_ready - t0:6.1f} s")
-            print(f"server start -> first rendered plot:  {t_plot - t0:6.1f} s "
-                  f"(page request -> plot {t_plot - t_ready:.1f} s)")
+            print(
+                f"server start -> first rendered plot:  {t_plot - t0:6.1f} s "
+                f"(page request -> plot {t_plot - t_ready:.1f} s)"
+            )
             print(f"server start -> scatter band shown:   {t_band - t0:6.1f} s")
             wait_band_idle(page)
 
@@ -175,24 +206,30 @@ def main():
             n = args.samples
             modes = [int(i) for i in np.resize(np.arange(1, 20), n)]  # index: N = 20 ... 200
             res = {
-                "modes N (mobility.truncated)":
-                    measure("value", "ctl-case-n_modes", modes, "mobility.truncated"),
-                "harmonic (mobility.truncated)":
-                    measure("value", "ctl-case-harmonic",
-                            [int(h) for h in np.resize([2, 3, 4, 5, 6, 7, 1], n)],
-                            "mobility.truncated"),
-                "response DOF (mobility.truncated)":
-                    measure("active", "ctl-case-dof",
-                            [int(d) for d in np.resize([0, 1, 3, 4, 5, 2], n)],
-                            "mobility.truncated"),
+                "modes N (mobility.truncated)": measure(
+                    "value", "ctl-case-n_modes", modes, "mobility.truncated"
+                ),
+                "harmonic (mobility.truncated)": measure(
+                    "value",
+                    "ctl-case-harmonic",
+                    [int(h) for h in np.resize([2, 3, 4, 5, 6, 7, 1], n)],
+                    "mobility.truncated",
+                ),
+                "response DOF (mobility.truncated)": measure(
+                    "active",
+                    "ctl-case-dof",
+                    [int(d) for d in np.resize([0, 1, 3, 4, 5, 2], n)],
+                    "mobility.truncated",
+                ),
             }
             for k, v in res.items():
                 print(f"{k:36s} {stats(v)}")
             # scatter band: a new seed forces a new band of R rounds; at the default
             # harmonic 1 (78 lines) and at harmonic 7 (633 lines, the largest)
             for h in (1, 7):
-                page.evaluate(JS_MEASURE, ["value", "ctl-case-harmonic", h,
-                                           "mobility.truncated", 120_000])
+                page.evaluate(
+                    JS_MEASURE, ["value", "ctl-case-harmonic", h, "mobility.truncated", 120_000]
+                )
                 band = []
                 for seed in range(100 * h + 1, 100 * h + 6):  # never computed before
                     # the band of the previous change starts after a short debounce: let it

@@ -42,9 +42,14 @@ def main() -> None:
     load_frf(save_frf(Y, format="mat"), filename="warm.mat")  # start the sandbox worker
     print(f"FRF {Y.shape[1]} x {Y.shape[2]} x {N_FREQ} lines")
     print(f"{'format':<14}{'size MiB':>10}{'write s':>10}{'read s':>10}  same")
-    cases = [("uff", {}, "uff"), ("uff 58b", {"binary": True}, "uff"), ("mat v5", {}, "mat"),
-             ("mat v7.3", {"mat_version": "7.3"}, "mat"), ("csv", {}, "csv"),
-             ("hdf5", {}, "h5")]
+    cases = [
+        ("uff", {}, "uff"),
+        ("uff 58b", {"binary": True}, "uff"),
+        ("mat v5", {}, "mat"),
+        ("mat v7.3", {"mat_version": "7.3"}, "mat"),
+        ("csv", {}, "csv"),
+        ("hdf5", {}, "h5"),
+    ]
     for name, kw, end in cases:
         fmt = {"uff": "uff", "mat": "mat", "csv": "csv", "h5": "hdf5"}[end]
         tw, raw = best(lambda fmt=fmt, kw=kw: save_frf(Y, format=fmt, **kw))

@@ -108,9 +108,11 @@ def scatter_inputs(nf=400, k=4):
 
 
 def main():
-    print(f"{os.cpu_count()} cores, numba {numba.__version__} with {numba.get_num_threads()} "
-          f"threads, load average {os.getloadavg()[0]:.1f} (other jobs slow every figure), "
-          f"numba cache: {'warm (on disk)' if '--warm' in sys.argv else 'cold (fresh dir)'}")
+    print(
+        f"{os.cpu_count()} cores, numba {numba.__version__} with {numba.get_num_threads()} "
+        f"threads, load average {os.getloadavg()[0]:.1f} (other jobs slow every figure), "
+        f"numba cache: {'warm (on disk)' if '--warm' in sys.argv else 'cold (fresh dir)'}"
+    )
 
     # -- JIT ----------------------------------------------------------------------------
     A, a, E, B, src = scatter_inputs(400)
@@ -120,25 +122,33 @@ def main():
 
     # -- scatter band -------------------------------------------------------------------
     R = 10_000
-    print(f"\nscatter band, R = {R}, {A.shape[0]} lines, 6 DOFs, frequency-dependent noise in "
-          f"both subsystems ({src}):")
+    print(
+        f"\nscatter band, R = {R}, {A.shape[0]} lines, 6 DOFs, frequency-dependent noise in "
+        f"both subsystems ({src}):"
+    )
     t_nb, c_nb, band = _t(lambda: scatter_band_arrays(A, a, E, B, 0.1, "both", R, True, seed=0))
     t_np, c_np, (lo, hi, pct) = _t(lambda: numpy_baseline(A, a, E, B, 0.1, R), repeat=1)
     t_nb2, c_nb2, _ = _t(lambda: scatter_band_arrays(A, a, E, B, 0.1, "both", R, True, seed=0))
     if t_nb2 < t_nb:
         t_nb, c_nb = t_nb2, c_nb2
     nth = numba.get_num_threads()
-    print(f"  numba kernel (min/max, 5/95 %, convergence): {t_nb:7.3f} s wall, {c_nb:7.3f} s CPU "
-          f"({c_nb / nth:.3f} s per thread)   target < 1.5 s")
+    print(
+        f"  numba kernel (min/max, 5/95 %, convergence): {t_nb:7.3f} s wall, {c_nb:7.3f} s CPU "
+        f"({c_nb / nth:.3f} s per thread)   target < 1.5 s"
+    )
     print(f"  numpy baseline (batched np.linalg.solve):    {t_np:7.3f} s wall, {c_np:7.3f} s CPU")
     print(f"  speed-up: {t_np / t_nb:6.1f}x wall, {c_np / c_nb:6.1f}x CPU   target >= 10x")
     d = np.abs(20 * np.log10(band.upper / hi))
-    print(f"  (independent random streams: upper edges differ by median {np.median(d):.2f} dB, "
-          f"95 % of lines within {np.percentile(d, 95):.2f} dB)")
+    print(
+        f"  (independent random streams: upper edges differ by median {np.median(d):.2f} dB, "
+        f"95 % of lines within {np.percentile(d, 95):.2f} dB)"
+    )
     t_fi, c_fi, _ = _t(lambda: scatter_band_arrays(A, a, E, B, 0.1, "both", R, False, seed=0))
     t_ti, c_ti, _ = _t(lambda: scatter_band_arrays(A, a, E, B, 0.1, "tire", R, True, seed=0))
-    print(f"  frequency-independent noise, both: {t_fi:7.3f} s wall ({c_fi:.3f} s CPU); "
-          f"frequency-dependent, tire only: {t_ti:7.3f} s wall ({c_ti:.3f} s CPU)")
+    print(
+        f"  frequency-independent noise, both: {t_fi:7.3f} s wall ({c_fi:.3f} s CPU); "
+        f"frequency-dependent, tire only: {t_ti:7.3f} s wall ({c_ti:.3f} s CPU)"
+    )
     t_r, _, _ = _t(lambda: band.round(int(band.argmax_round[200, 2])), repeat=5)
     print(f"  regenerate one round: {1e3 * t_r:7.2f} ms")
 
@@ -146,11 +156,14 @@ def main():
     A2, a2, E2, B2, _ = scatter_inputs(2000)
     t2 = time.perf_counter()
     peak, delta = _peak_rss_mb(
-        lambda: scatter_band_arrays(A2, a2, E2, B2, 0.1, "both", R, True, seed=0))
+        lambda: scatter_band_arrays(A2, a2, E2, B2, 0.1, "both", R, True, seed=0)
+    )
     t2 = time.perf_counter() - t2
-    print(f"\nscatter band R = {R} x 2,000 lines x 6 DOFs: {t2:6.2f} s; peak RSS {peak:.0f} MB "
-          f"(+{delta:.0f} MB over the process before; all rounds at once would be "
-          f"{R * 2000 * 6 * 8 / 1e6:.0f} MB)")
+    print(
+        f"\nscatter band R = {R} x 2,000 lines x 6 DOFs: {t2:6.2f} s; peak RSS {peak:.0f} MB "
+        f"(+{delta:.0f} MB over the process before; all rounds at once would be "
+        f"{R * 2000 * 6 * 8 / 1e6:.0f} MB)"
+    )
 
     # -- truncation study ---------------------------------------------------------------
     try:
@@ -165,10 +178,14 @@ def main():
     t_first = time.perf_counter() - t
     t_tr, c_tr, s = _t(lambda: suggest_modes(0.2, 160.0, tire=tire, chassis=chassis))
     nl = sum(m.freq.size for m in s.maps)
-    print(f"\ntruncation study, 7 harmonics x {n.size} N x 6 DOFs x floating band "
-          f"({nl} lines): {t_tr:6.3f} s wall, {c_tr:6.3f} s CPU   target < 1 s")
-    print(f"  (first call {t_first:.3f} s: includes the chassis' one-off modal decomposition "
-          "and its synthesis cache)")
+    print(
+        f"\ntruncation study, 7 harmonics x {n.size} N x 6 DOFs x floating band "
+        f"({nl} lines): {t_tr:6.3f} s wall, {c_tr:6.3f} s CPU   target < 1 s"
+    )
+    print(
+        f"  (first call {t_first:.3f} s: includes the chassis' one-off modal decomposition "
+        "and its synthesis cache)"
+    )
     t_130, _, s130 = _t(lambda: suggest_modes(0.2, 130.0, maps=s.maps, tire=tire))
     print(f"  re-reading the table for another f_max from the maps: {1e3 * t_130:6.2f} ms")
     print(s130.table())

@@ -113,8 +113,12 @@ class BrowserSession:
     async def open(self, url: str, timeout_s: float) -> None:
         self.context = await self._browser.new_context(viewport={"width": 1400, "height": 1000})
         self.page = await self.context.new_page()
-        self.page.on("pageerror", lambda exc: self.errors.append(
-            f"page error: {exc}; stack: {' | '.join((exc.stack or '').splitlines()[:6])}"))
+        self.page.on(
+            "pageerror",
+            lambda exc: self.errors.append(
+                f"page error: {exc}; stack: {' | '.join((exc.stack or '').splitlines()[:6])}"
+            ),
+        )
         ms = timeout_s * 1000
         await self.page.goto(url, timeout=ms)
         await self.page.wait_for_function(READY_JS, timeout=ms, polling=100)
@@ -126,8 +130,7 @@ class BrowserSession:
         return await self.page.evaluate(SLIDER_INFO_JS, title)
 
     async def change(self, title: str, value, timeout_s: float, quiet_s: float):
-        return await self.page.evaluate(CHANGE_JS, [title, value, timeout_s * 1000,
-                                                    quiet_s * 1000])
+        return await self.page.evaluate(CHANGE_JS, [title, value, timeout_s * 1000, quiet_s * 1000])
 
     async def close(self) -> None:
         if self.context is not None:
@@ -189,8 +192,10 @@ def column_digest(doc) -> str:
             try:
                 v = np.asarray(col, dtype=float).ravel()
             except (TypeError, ValueError):  # lists of arrays of different shapes, strings
-                v = np.concatenate([np.asarray(c, dtype=float).ravel() for c in col
-                                    if not isinstance(c, str)] or [np.zeros(0)])
+                v = np.concatenate(
+                    [np.asarray(c, dtype=float).ravel() for c in col if not isinstance(c, str)]
+                    or [np.zeros(0)]
+                )
             v = v[np.isfinite(v)]
             s += float(np.sum(v * np.sqrt(np.arange(v.size) + 2.0) + v * v))
         out.append(f"{n}:{s:.9e}")
@@ -235,8 +240,11 @@ class BokehSession:
         self._receiver = Receiver(self._protocol)
         token = generate_jwt_token(generate_session_id())
         self._ws = await asyncio.wait_for(
-            websocket_connect(websocket_url(url), subprotocols=["bokeh", token],
-                              max_message_size=self._max_bytes), timeout_s)
+            websocket_connect(
+                websocket_url(url), subprotocols=["bokeh", token], max_message_size=self._max_bytes
+            ),
+            timeout_s,
+        )
         self._sock = WebSocketClientConnectionWrapper(self._ws)
         ack = await asyncio.wait_for(self._pop(), timeout_s)
         if ack is None or ack.msgtype != "ACK":
@@ -244,14 +252,14 @@ class BokehSession:
         await self._protocol.create("PULL-DOC-REQ").send(self._sock)
         reply = await asyncio.wait_for(self._pop(), timeout_s)
         if reply is None or reply.msgtype != "PULL-DOC-REPLY":
-            raise RuntimeError(f"expected PULL-DOC-REPLY, got {reply and reply.msgtype}: "
-                               f"{reply and reply.content}")
+            raise RuntimeError(
+                f"expected PULL-DOC-REPLY, got {reply and reply.msgtype}: {reply and reply.content}"
+            )
         self.doc = Document()
         reply.push_to_document(self.doc)
         self._index_models()
         self._digest = column_digest(self.doc)
-        self._tasks = [asyncio.ensure_future(self._read()),
-                       asyncio.ensure_future(self._apply())]
+        self._tasks = [asyncio.ensure_future(self._read()), asyncio.ensure_future(self._apply())]
         # what BokehJS sends once the page has rendered: starts the app's on-load work
         await self._send([MessageSentEvent(self.doc, "bokeh_event", DocumentReady())])
 
@@ -260,8 +268,11 @@ class BokehSession:
 
         self._n_models = len(self.doc.models)
         self._sources = {m.id for m in self.doc.models if isinstance(m, ColumnDataSource)}
-        self._progress = [m for m in self.doc.models if "css_classes" in m.properties()
-                          and "scatter-progress" in m.css_classes]
+        self._progress = [
+            m
+            for m in self.doc.models
+            if "css_classes" in m.properties() and "scatter-progress" in m.css_classes
+        ]
 
     async def _pop(self):
         while True:
@@ -334,8 +345,7 @@ class BokehSession:
         m = self._slider(title)
         if m is None:
             return None
-        return {"title": m.title, "value": m.value, "start": m.start, "end": m.end,
-                "step": m.step}
+        return {"title": m.title, "value": m.value, "start": m.start, "end": m.end, "step": m.step}
 
     async def change(self, title: str, value, timeout_s: float, quiet_s: float):
         from bokeh.document.events import ModelChangedEvent
@@ -375,4 +385,3 @@ def _event_model_id(event: dict) -> str | None:
     if isinstance(model, dict):
         return model.get("id")
     return None
-

@@ -122,8 +122,16 @@ class AllOpen:
         await self._event.wait()
 
 
-async def run_session(new_session, url: str, index: int, changes: int, title: str,
-                      timeout_s: float, start_delay: float, all_open: AllOpen) -> SessionResult:
+async def run_session(
+    new_session,
+    url: str,
+    index: int,
+    changes: int,
+    title: str,
+    timeout_s: float,
+    start_delay: float,
+    all_open: AllOpen,
+) -> SessionResult:
     res = SessionResult(index)
     await asyncio.sleep(start_delay)
     res.session = sess = new_session()  # kept open for the isolation check
@@ -169,8 +177,7 @@ async def final_digest(res: SessionResult, timeout_s: float) -> None:
         await res.session.close()
 
 
-async def reference_session(new_session, url: str, title: str, value: float,
-                            timeout_s: float):
+async def reference_session(new_session, url: str, title: str, value: float, timeout_s: float):
     """A lone fresh session that sets the slider to ``value`` (left open for its digest)."""
     sess = new_session()
     try:
@@ -206,6 +213,7 @@ async def warm_up(new_session, url: str, title: str, timeout_s: float) -> float:
 
 def session_factory(client: str, stack: contextlib.AsyncExitStack):
     """A coroutine giving a function that makes a new (unopened) session of this kind."""
+
     async def make():
         if client == "bokeh":
             return BokehSession
@@ -215,6 +223,7 @@ def session_factory(client: str, stack: contextlib.AsyncExitStack):
         browser = await p.chromium.launch(**chromium_args())
         stack.push_async_callback(browser.close)
         return lambda: BrowserSession(browser)
+
     return make()
 
 
@@ -241,12 +250,15 @@ def pct(values: list[float], q: float) -> float:
 def summary(values: list[float]) -> str:
     if not values:
         return "n/a"
-    return (f"median {statistics.median(values):7.0f}  p95 {pct(values, 95):7.0f}  "
-            f"max {max(values):7.0f}")
+    return (
+        f"median {statistics.median(values):7.0f}  p95 {pct(values, 95):7.0f}  "
+        f"max {max(values):7.0f}"
+    )
 
 
-async def wait_server_idle(cpu_s, timeout_s: float, quiet_s: float = 3.0,
-                           busy_share: float = 0.1) -> bool:
+async def wait_server_idle(
+    cpu_s, timeout_s: float, quiet_s: float = 3.0, busy_share: float = 0.1
+) -> bool:
     """Wait until the server has used under ``busy_share`` of a core for ``quiet_s``
     seconds (so no update is still queued behind a backlog); False if it never is, or
     if the server's CPU time cannot be read."""
@@ -264,49 +276,72 @@ async def wait_server_idle(cpu_s, timeout_s: float, quiet_s: float = 3.0,
     return False
 
 
-async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float,
-                    check_isolation: bool, cpu_s=None, client: str = "browser") -> dict:
+async def run_level(
+    url: str,
+    n: int,
+    changes: int,
+    title: str,
+    timeout_s: float,
+    check_isolation: bool,
+    cpu_s=None,
+    client: str = "browser",
+) -> dict:
     async with contextlib.AsyncExitStack() as stack:
         new_session = await session_factory(client, stack)
 
         t0 = time.monotonic()
         all_open = AllOpen(n, cpu_s)
-        results = await asyncio.gather(*(
-            run_session(new_session, url, i, changes, title, timeout_s, 0.1 * i, all_open)
-            for i in range(n)))
+        results = await asyncio.gather(
+            *(
+                run_session(new_session, url, i, changes, title, timeout_s, 0.1 * i, all_open)
+                for i in range(n)
+            )
+        )
         wall = time.monotonic() - t0
         # this script's (and its Bokeh clients') share of a core while the sessions changed:
         # near 1 would mean the clients themselves delayed what they measured
         change_wall = time.monotonic() - all_open.at[0]
         script_share = (time.process_time() - all_open.at[1]) / change_wall
         n_changes = sum(len(r.first_ms) for r in results)
-        server_per_change = (None if all_open.at[2] is None or not n_changes
-                             else (cpu_s() - all_open.at[2]) / n_changes)
+        server_per_change = (
+            None
+            if all_open.at[2] is None or not n_changes
+            else (cpu_s() - all_open.at[2]) / n_changes
+        )
         problems = [f"session {r.index}: {e}" for r in results for e in r.errors]
         for r in results:
             if not r.errors and r.final_value != r.last_value:
-                problems.append(f"session {r.index}: slider shows {r.final_value}, "
-                                f"but this session set {r.last_value} last")
+                problems.append(
+                    f"session {r.index}: slider shows {r.final_value}, "
+                    f"but this session set {r.last_value} last"
+                )
         refs: dict = {}
         if check_isolation:
             values = sorted({r.last_value for r in results if not r.errors})
-            ref_sessions = await asyncio.gather(*(
-                reference_session(new_session, url, title, v, timeout_s) for v in values))
+            ref_sessions = await asyncio.gather(
+                *(reference_session(new_session, url, title, v, timeout_s) for v in values)
+            )
         # under a backlog a session can be quiet for seconds with updates still queued on
         # the server: take every digest once the server itself is idle
         idle = await wait_server_idle(cpu_s, timeout_s)
         if check_isolation:
-            digests = await asyncio.gather(*(
-                session_digest(sess, timeout_s) for sess in ref_sessions))
+            digests = await asyncio.gather(
+                *(session_digest(sess, timeout_s) for sess in ref_sessions)
+            )
             refs = dict(zip(values, digests, strict=True))
-            problems += [f"reference session at {v}: {e}"
-                         for v, sess in zip(values, ref_sessions, strict=True)
-                         for e in sess.errors]
+            problems += [
+                f"reference session at {v}: {e}"
+                for v, sess in zip(values, ref_sessions, strict=True)
+                for e in sess.errors
+            ]
         n_early = [len(r.errors) for r in results]
         await asyncio.gather(*(final_digest(r, timeout_s) for r in results))
         # errors reported after the changes (a late page error, a patch that failed)
-        problems += [f"session {r.index}: {e}" for r, k in zip(results, n_early, strict=True)
-                     for e in r.errors[k:]]
+        problems += [
+            f"session {r.index}: {e}"
+            for r, k in zip(results, n_early, strict=True)
+            for e in r.errors[k:]
+        ]
         if check_isolation:
             for r in results:
                 if r.errors or r.final_digest is None:
@@ -315,15 +350,25 @@ async def run_level(url: str, n: int, changes: int, title: str, timeout_s: float
                     problems.append(
                         f"session {r.index}: plot data differ from a lone session's "
                         f"at slider value {r.last_value}"
-                        + ("" if idle else " (server never idle before the check)"))
+                        + ("" if idle else " (server never idle before the check)")
+                    )
     first = [x for r in results for x in r.first_ms]
     settled = [x for r in results for x in r.settled_ms]
     loads = [r.load_s * 1000 for r in results if r.load_s is not None]
-    return {"sessions": n, "client": client, "changes": len(first), "wall_s": wall,
-            "load_ms": loads, "first_ms": first, "settled_ms": settled,
-            "problems": problems, "distinct_final_states": len(refs),
-            "change_phase_s": change_wall, "script_core_share": script_share,
-            "server_cpu_per_change_s": server_per_change}
+    return {
+        "sessions": n,
+        "client": client,
+        "changes": len(first),
+        "wall_s": wall,
+        "load_ms": loads,
+        "first_ms": first,
+        "settled_ms": settled,
+        "problems": problems,
+        "distinct_final_states": len(refs),
+        "change_phase_s": change_wall,
+        "script_core_share": script_share,
+        "server_cpu_per_change_s": server_per_change,
+    }
 
 
 # ---- servers -------------------------------------------------------------------------------
@@ -387,13 +432,21 @@ class LocalServer:
     def __init__(self, threads: int, cpuset: set[int] | None = None):
         self.port = free_port()
         self.log = tempfile.NamedTemporaryFile("w+", suffix=".log", delete=False)
-        env = {**os.environ, "FBS_PORT": str(self.port), "FBS_ADDRESS": "127.0.0.1",
-               "FBS_NUM_THREADS": str(threads),
-               "BOKEH_ALLOW_WS_ORIGIN": f"127.0.0.1:{self.port}"}
+        env = {
+            **os.environ,
+            "FBS_PORT": str(self.port),
+            "FBS_ADDRESS": "127.0.0.1",
+            "FBS_NUM_THREADS": str(threads),
+            "BOKEH_ALLOW_WS_ORIGIN": f"127.0.0.1:{self.port}",
+        }
         pin = None if cpuset is None else (lambda: os.sched_setaffinity(0, cpuset))
-        self.proc = subprocess.Popen([sys.executable, str(ROOT / "docker" / "entrypoint.py")],
-                                     env=env, stdout=self.log, stderr=subprocess.STDOUT,
-                                     preexec_fn=pin)
+        self.proc = subprocess.Popen(
+            [sys.executable, str(ROOT / "docker" / "entrypoint.py")],
+            env=env,
+            stdout=self.log,
+            stderr=subprocess.STDOUT,
+            preexec_fn=pin,
+        )
         self.url = f"http://127.0.0.1:{self.port}/"
         wait_http(self.url + "liveness", 60, lambda: self.proc.poll() is None)
 
@@ -422,11 +475,25 @@ class DockerServer:
         self.port = free_port()
         pin = [] if cpuset is None else ["--cpuset-cpus", ",".join(map(str, sorted(cpuset)))]
         self.cid = subprocess.run(
-            ["docker", "run", "-d", "--cpus", str(cpus), *pin,
-             "-p", f"127.0.0.1:{self.port}:5006",
-             "-e", f"BOKEH_ALLOW_WS_ORIGIN=127.0.0.1:{self.port}",
-             "-e", f"FBS_NUM_THREADS={threads}", image],
-            check=True, capture_output=True, text=True).stdout.strip()
+            [
+                "docker",
+                "run",
+                "-d",
+                "--cpus",
+                str(cpus),
+                *pin,
+                "-p",
+                f"127.0.0.1:{self.port}:5006",
+                "-e",
+                f"BOKEH_ALLOW_WS_ORIGIN=127.0.0.1:{self.port}",
+                "-e",
+                f"FBS_NUM_THREADS={threads}",
+                image,
+            ],
+            check=True,
+            capture_output=True,
+            text=True,
+        ).stdout.strip()
         self.url = f"http://127.0.0.1:{self.port}/"
         try:
             wait_http(self.url + "liveness", 120, self._running)
@@ -435,21 +502,23 @@ class DockerServer:
             raise
 
     def _running(self) -> bool:
-        out = subprocess.run(["docker", "inspect", "-f", "{{.State.Running}}", self.cid],
-                             capture_output=True, text=True).stdout.strip()
+        out = subprocess.run(
+            ["docker", "inspect", "-f", "{{.State.Running}}", self.cid],
+            capture_output=True,
+            text=True,
+        ).stdout.strip()
         return out == "true"
 
     def logs(self) -> str:
-        return subprocess.run(["docker", "logs", self.cid], capture_output=True,
-                              text=True).stdout
+        return subprocess.run(["docker", "logs", self.cid], capture_output=True, text=True).stdout
 
     def cpu_s(self) -> float | None:
         """CPU seconds of the container (cgroup v2 or v1 accounting), None if unknown."""
         for path, scale, key in (
-                (f"/sys/fs/cgroup/system.slice/docker-{self.cid}.scope/cpu.stat", 1e-6,
-                 "usage_usec"),
-                (f"/sys/fs/cgroup/docker/{self.cid}/cpu.stat", 1e-6, "usage_usec"),
-                (f"/sys/fs/cgroup/cpuacct/docker/{self.cid}/cpuacct.usage", 1e-9, None)):
+            (f"/sys/fs/cgroup/system.slice/docker-{self.cid}.scope/cpu.stat", 1e-6, "usage_usec"),
+            (f"/sys/fs/cgroup/docker/{self.cid}/cpu.stat", 1e-6, "usage_usec"),
+            (f"/sys/fs/cgroup/cpuacct/docker/{self.cid}/cpuacct.usage", 1e-9, None),
+        ):
             try:
                 text = Path(path).read_text()
             except OSError:
@@ -473,24 +542,38 @@ def main(argv: list[str] | None = None) -> int:
     src.add_argument("--docker", metavar="IMAGE", help="run this image with docker")
     ap.add_argument("--cpus", type=float, default=2.0, help="docker run --cpus (2)")
     ap.add_argument("--threads", type=int, default=4, help="server worker threads (4)")
-    ap.add_argument("--sessions", default="20",
-                    help="concurrent sessions; a comma list sweeps levels (20)")
+    ap.add_argument(
+        "--sessions", default="20", help="concurrent sessions; a comma list sweeps levels (20)"
+    )
     ap.add_argument("--changes", type=int, default=5, help="slider changes per session (5)")
-    ap.add_argument("--slider", default="Harmonic",
-                    help="slider to move: part of its title, or #k for the k-th (Harmonic)")
-    ap.add_argument("--client", choices=("browser", "bokeh"), default="browser",
-                    help="sessions as chromium pages (browser) or as Bokeh protocol clients "
-                         "(bokeh: no rendering, a small fraction of a browser's CPU)")
+    ap.add_argument(
+        "--slider",
+        default="Harmonic",
+        help="slider to move: part of its title, or #k for the k-th (Harmonic)",
+    )
+    ap.add_argument(
+        "--client",
+        choices=("browser", "bokeh"),
+        default="browser",
+        help="sessions as chromium pages (browser) or as Bokeh protocol clients "
+        "(bokeh: no rendering, a small fraction of a browser's CPU)",
+    )
     ap.add_argument("--target", type=float, default=1000.0, help="p95 target in ms (1000)")
     ap.add_argument("--timeout", type=float, default=120.0, help="seconds per wait (120)")
     ap.add_argument("--max-sessions", type=int, default=60, help="safety bound (60)")
-    ap.add_argument("--server-cpus", metavar="LIST",
-                    help="pin the server to these host CPUs (e.g. '1'; docker --cpuset-cpus) "
-                         "and this script with its clients to the others, so the two never "
-                         "compete for a core")
-    ap.add_argument("--cold", action="store_true",
-                    help="no warm-up: the first level also pays for computing the results "
-                         "that the server then shares between sessions")
+    ap.add_argument(
+        "--server-cpus",
+        metavar="LIST",
+        help="pin the server to these host CPUs (e.g. '1'; docker --cpuset-cpus) "
+        "and this script with its clients to the others, so the two never "
+        "compete for a core",
+    )
+    ap.add_argument(
+        "--cold",
+        action="store_true",
+        help="no warm-up: the first level also pays for computing the results "
+        "that the server then shares between sessions",
+    )
     ap.add_argument("--no-isolation-check", action="store_true")
     ap.add_argument("--json", help="write the figures to this file")
     args = ap.parse_args(argv)
@@ -505,8 +588,10 @@ def main(argv: list[str] | None = None) -> int:
         server_cpus = {int(x) for x in args.server_cpus.split(",")}
         rest = set(os.sched_getaffinity(0)) - server_cpus
         if not rest or not server_cpus <= set(range(os.cpu_count())):
-            ap.error(f"--server-cpus {args.server_cpus}: needs host CPUs that exist and "
-                     f"leaves none for the clients")
+            ap.error(
+                f"--server-cpus {args.server_cpus}: needs host CPUs that exist and "
+                f"leaves none for the clients"
+            )
         os.sched_setaffinity(0, rest)  # browsers and threads started later inherit it
         args.cpus = min(args.cpus, float(len(server_cpus)))
     server = None
@@ -515,14 +600,23 @@ def main(argv: list[str] | None = None) -> int:
     elif args.docker:
         server = DockerServer(args.docker, args.cpus, args.threads, server_cpus)
     url = server.url if server else args.url
-    where = (f"docker {args.docker} --cpus {args.cpus}" if args.docker
-             else "local panel serve" if args.serve else url)
+    where = (
+        f"docker {args.docker} --cpus {args.cpus}"
+        if args.docker
+        else "local panel serve"
+        if args.serve
+        else url
+    )
     if server_cpus is not None:
-        where += (f", server on CPU {args.server_cpus}, clients on CPU "
-                  f"{','.join(map(str, sorted(os.sched_getaffinity(0))))}")
-    print(f"load test: {where}, {args.threads} threads, sessions as {args.client} clients, "
-          f"{os.cpu_count()} host cores, "
-          f"load average {os.getloadavg()[0]:.1f}")
+        where += (
+            f", server on CPU {args.server_cpus}, clients on CPU "
+            f"{','.join(map(str, sorted(os.sched_getaffinity(0))))}"
+        )
+    print(
+        f"load test: {where}, {args.threads} threads, sessions as {args.client} clients, "
+        f"{os.cpu_count()} host cores, "
+        f"load average {os.getloadavg()[0]:.1f}"
+    )
     rows, failed = [], False
     try:
         if not args.cold:
@@ -537,39 +631,60 @@ def main(argv: list[str] | None = None) -> int:
                 asyncio.run(wait_server_idle(server.cpu_s, 60))
             cpu0 = server.cpu_s() if server is not None else None
             host0, t0, self0 = host_busy_s(), time.monotonic(), time.process_time()
-            row = asyncio.run(run_level(url, n, args.changes, args.slider, args.timeout,
-                                        not args.no_isolation_check,
-                                        server.cpu_s if server is not None else None,
-                                        args.client))
+            row = asyncio.run(
+                run_level(
+                    url,
+                    n,
+                    args.changes,
+                    args.slider,
+                    args.timeout,
+                    not args.no_isolation_check,
+                    server.cpu_s if server is not None else None,
+                    args.client,
+                )
+            )
             cpu1 = server.cpu_s() if server is not None else None
             row["host_cpu_s"] = host_busy_s() - host0
             row["script_cpu_s"] = time.process_time() - self0  # incl. Bokeh clients
             row["accounted_s"] = time.monotonic() - t0  # incl. the isolation check
             row["server_cpu_s"] = None if cpu0 is None or cpu1 is None else cpu1 - cpu0
             rows.append(row)
-            print(f"\n== {n} concurrent sessions, {row['changes']} changes, "
-                  f"{row['wall_s']:.1f} s wall, {row['distinct_final_states']} distinct "
-                  f"final states checked against lone sessions")
+            print(
+                f"\n== {n} concurrent sessions, {row['changes']} changes, "
+                f"{row['wall_s']:.1f} s wall, {row['distinct_final_states']} distinct "
+                f"final states checked against lone sessions"
+            )
             print(f"   open to settled plots    {summary(row['load_ms'])}   (all opening at once)")
-            print(f"   change -> first update   {summary(row['first_ms'])}   (all changing, "
-                  "once all are open)")
+            print(
+                f"   change -> first update   {summary(row['first_ms'])}   (all changing, "
+                "once all are open)"
+            )
             print(f"   change -> settled        {summary(row['settled_ms'])}")
-            print(f"   change phase {row['change_phase_s']:.1f} s; this script"
-                  f"{' and its Bokeh clients' if args.client == 'bokeh' else ''} busy "
-                  f"{100 * row['script_core_share']:.0f}% of one core meanwhile"
-                  + ("" if row["server_cpu_per_change_s"] is None else
-                     f"; server CPU {1000 * row['server_cpu_per_change_s']:.0f} ms per change"))
+            print(
+                f"   change phase {row['change_phase_s']:.1f} s; this script"
+                f"{' and its Bokeh clients' if args.client == 'bokeh' else ''} busy "
+                f"{100 * row['script_core_share']:.0f}% of one core meanwhile"
+                + (
+                    ""
+                    if row["server_cpu_per_change_s"] is None
+                    else f"; server CPU {1000 * row['server_cpu_per_change_s']:.0f} ms per change"
+                )
+            )
             if args.client == "bokeh" and row["script_core_share"] > CLIENT_LIMIT:
-                print("   CLIENT-LIMITED: the clients' core was nearly saturated; they sent their"
-                      " changes late and this level loaded the server less than it says")
+                print(
+                    "   CLIENT-LIMITED: the clients' core was nearly saturated; they sent their"
+                    " changes late and this level loaded the server less than it says"
+                )
             if row["server_cpu_s"] is not None:
                 # where the cores went: on one machine the browsers compete with the server
-                print(f"   CPU over {row['accounted_s']:.0f} s (sessions and isolation check): "
-                      f"server {row['server_cpu_s']:.1f} s, everything else on the host "
-                      f"{row['host_cpu_s'] - row['server_cpu_s']:.1f} s (of which this "
-                      f"script{' and its Bokeh clients' if args.client == 'bokeh' else ''} "
-                      f"{row['script_cpu_s']:.1f} s), of {os.cpu_count() * row['accounted_s']:.0f}"
-                      " core-seconds")
+                print(
+                    f"   CPU over {row['accounted_s']:.0f} s (sessions and isolation check): "
+                    f"server {row['server_cpu_s']:.1f} s, everything else on the host "
+                    f"{row['host_cpu_s'] - row['server_cpu_s']:.1f} s (of which this "
+                    f"script{' and its Bokeh clients' if args.client == 'bokeh' else ''} "
+                    f"{row['script_cpu_s']:.1f} s), of {os.cpu_count() * row['accounted_s']:.0f}"
+                    " core-seconds"
+                )
             if row["problems"]:
                 failed = True
                 print(f"   PROBLEMS ({len(row['problems'])}):")
@@ -584,16 +699,23 @@ def main(argv: list[str] | None = None) -> int:
             if bad:
                 failed = True
                 print(f"\nserver log has {len(bad)} error lines; the first:")
-                print("\n".join(lines[bad[0]:bad[0] + 25]))
+                print("\n".join(lines[bad[0] : bad[0] + 25]))
     finally:
         if server is not None:
             server.stop()
-    ok = [r["sessions"] for r in rows
-          if not r["problems"] and r["first_ms"] and pct(r["first_ms"], 95) < args.target
-          and r["script_core_share"] <= CLIENT_LIMIT]
-    print(f"\nlargest tested number of sessions with p95 first update < {args.target:.0f} ms"
-          f"{' (clients below saturation)' if args.client == 'bokeh' else ''}: "
-          f"{max(ok) if ok else 'none'}")
+    ok = [
+        r["sessions"]
+        for r in rows
+        if not r["problems"]
+        and r["first_ms"]
+        and pct(r["first_ms"], 95) < args.target
+        and r["script_core_share"] <= CLIENT_LIMIT
+    ]
+    print(
+        f"\nlargest tested number of sessions with p95 first update < {args.target:.0f} ms"
+        f"{' (clients below saturation)' if args.client == 'bokeh' else ''}: "
+        f"{max(ok) if ok else 'none'}"
+    )
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
     return 1 if failed else 0

@@ -167,8 +167,14 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
     port = _positive_int(env, "FBS_PORT", DEFAULT_PORT)
     address = env.get("FBS_ADDRESS", "0.0.0.0").strip() or "0.0.0.0"
     cmd = [
-        str(Path(sys.executable).with_name("panel")), "serve", app,
-        "--address", address, "--port", str(port), "--liveness",
+        str(Path(sys.executable).with_name("panel")),
+        "serve",
+        app,
+        "--address",
+        address,
+        "--port",
+        str(port),
+        "--liveness",
     ]
     threads = _positive_int(env, "FBS_NUM_THREADS", 4)
     if env.get("PANEL_NUM_THREADS"):
@@ -191,8 +197,10 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
         users_file = _write_users(parse_users(env["FBS_BASIC_AUTH"]))
     oauth = bool(env.get("PANEL_OAUTH_PROVIDER"))
     if users_file and oauth:
-        raise SettingError("basic authentication (FBS_BASIC_AUTH*) and PANEL_OAUTH_PROVIDER "
-                           "exclude each other: choose one")
+        raise SettingError(
+            "basic authentication (FBS_BASIC_AUTH*) and PANEL_OAUTH_PROVIDER "
+            "exclude each other: choose one"
+        )
     if users_file:
         cmd += [f"--basic-auth={users_file}"]
 
@@ -201,9 +209,11 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
         raise SettingError("set FBS_COOKIE_SECRET or PANEL_COOKIE_SECRET, not both")
     secret = secret or env.get("PANEL_COOKIE_SECRET", "")
     if secret and len(secret) < MIN_SECRET_LEN:
-        raise SettingError(f"the cookie secret must have at least {MIN_SECRET_LEN} characters "
-                           f"(has {len(secret)}); make one with "
-                           "python3 -c 'import secrets; print(secrets.token_urlsafe(32))'")
+        raise SettingError(
+            f"the cookie secret must have at least {MIN_SECRET_LEN} characters "
+            f"(has {len(secret)}); make one with "
+            "python3 -c 'import secrets; print(secrets.token_urlsafe(32))'"
+        )
     if not secret and (users_file or oauth):
         secret = secrets.token_urlsafe(32)
         warnings.append("no FBS_COOKIE_SECRET: made a random one, logins end at restart")

@@ -64,8 +64,10 @@ def chromium_args() -> dict:
     """Launch arguments: the system chromium when present, else playwright's own."""
     for path in ("/usr/bin/chromium", "/usr/bin/chromium-browser"):
         if os.path.exists(path):
-            return {"executable_path": path,
-                    "args": ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"]}
+            return {
+                "executable_path": path,
+                "args": ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
+            }
     return {}
 
 
@@ -92,8 +94,9 @@ def wait_stable(page, timeout_s: float, quiet_s: float = 1.5) -> str:
     raise AssertionError(f"plot data still changing after {timeout_s:.0f} s")
 
 
-def run(url: str, user: str | None, password: str | None, expect_login: bool,
-        timeout_s: float) -> dict[str, float]:
+def run(
+    url: str, user: str | None, password: str | None, expect_login: bool, timeout_s: float
+) -> dict[str, float]:
     from playwright.sync_api import sync_playwright
 
     ms = timeout_s * 1000
@@ -129,8 +132,7 @@ def run(url: str, user: str | None, password: str | None, expect_login: bool,
             handle.focus()
             t1 = time.monotonic()
             handle.press("ArrowRight")
-            page.wait_for_function(f"() => ({DIGEST_JS})() !== {before!r}", timeout=ms,
-                                   polling=50)
+            page.wait_for_function(f"() => ({DIGEST_JS})() !== {before!r}", timeout=ms, polling=50)
             timings["control change -> plot data updated (ms)"] = (time.monotonic() - t1) * 1e3
             after_values = page.evaluate(SLIDER_VALUES_JS)
             if after_values == values:
@@ -148,8 +150,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("url")
     ap.add_argument("--user")
     ap.add_argument("--password")
-    ap.add_argument("--expect-login", action="store_true",
-                    help="check first that the page without credentials is the login form")
+    ap.add_argument(
+        "--expect-login",
+        action="store_true",
+        help="check first that the page without credentials is the login form",
+    )
     ap.add_argument("--timeout", type=float, default=90.0, help="seconds per wait (90)")
     args = ap.parse_args(argv)
     try:

@@ -105,8 +105,12 @@ def build_chassis(p: ChassisParameters) -> FEModel:
     h = p.element_length
     m.add_node("spindle", p.spindle_xyz)
     m.add_node("apex", p.arm_apex_xyz)
-    corners = {"bushing": (L, W, 0), "bush_rl": (-L, W, 0),
-               "bush_rr": (-L, -W, 0), "bush_fr": (L, -W, 0)}
+    corners = {
+        "bushing": (L, W, 0),
+        "bush_rl": (-L, W, 0),
+        "bush_rr": (-L, -W, 0),
+        "bush_fr": (L, -W, 0),
+    }
     for name, xyz in corners.items():
         m.add_node(name, xyz)
     m.add_node("root_f", (p.arm_roots_x, W, 0))
@@ -116,11 +120,19 @@ def build_chassis(p: ChassisParameters) -> FEModel:
     side, cross = Section.box(*p.side_box), Section.box(*p.cross_box)
     up = (0, 0, 1)
     # left side member (front to rear) through the arm roots, right side member
-    for a, b in (("bushing", "root_f"), ("root_f", "root_r"), ("root_r", "bush_rl"),
-                 ("bush_fr", "bush_rr")):
+    for a, b in (
+        ("bushing", "root_f"),
+        ("root_f", "root_r"),
+        ("root_r", "bush_rl"),
+        ("bush_fr", "bush_rr"),
+    ):
         m.add_beam(a, b, side, steel, _n_el(m.xyz(a), m.xyz(b), h), up, prefix=f"{a}-{b}.")
-    for a, b in (("bushing", "bracket_f"), ("bracket_f", "bush_fr"),
-                 ("bush_rl", "bracket_r"), ("bracket_r", "bush_rr")):
+    for a, b in (
+        ("bushing", "bracket_f"),
+        ("bracket_f", "bush_fr"),
+        ("bush_rl", "bracket_r"),
+        ("bracket_r", "bush_rr"),
+    ):
         m.add_beam(a, b, cross, steel, _n_el(m.xyz(a), m.xyz(b), h), up, prefix=f"{a}-{b}.")
     tube = Section.tube(*p.arm_tube)
     for root in ("root_f", "root_r"):
@@ -135,8 +147,14 @@ def build_chassis(p: ChassisParameters) -> FEModel:
     Rb = np.kron(np.eye(2), R)
     k_link = Rb.T @ np.diag(p.link_stiffness) @ Rb
     centre = np.add(p.spindle_xyz, p.link_offset)
-    m.add_spring("spindle", "apex", k_link, p.link_loss, offset_a=p.link_offset,
-                 offset_b=centre - np.asarray(p.arm_apex_xyz))
+    m.add_spring(
+        "spindle",
+        "apex",
+        k_link,
+        p.link_loss,
+        offset_a=p.link_offset,
+        offset_b=centre - np.asarray(p.arm_apex_xyz),
+    )
     for name in corners:
         m.add_spring(name, None, p.bushing_stiffness, p.bushing_loss)
     return m
@@ -238,8 +256,7 @@ class ChassisModel:
             raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
         data = _synth(self._p, f.tobytes(), tuple(outputs), tuple(inputs))
         jw = 1j * 2 * np.pi * f
-        return FRF(f, data * (jw ** QUANTITIES[quantity])[:, None, None], outputs, inputs,
-                   quantity)
+        return FRF(f, data * (jw ** QUANTITIES[quantity])[:, None, None], outputs, inputs, quantity)
 
     def driving_point(self, freq) -> FRF:
         """``Y_jj^E``: spindle mobility, 6 x 6 (``spindle:*`` to ``spindle:*``).
@@ -308,8 +325,13 @@ def read_chassis_frf(path) -> FRF:
         def labels(key):
             return [v.decode() if isinstance(v, bytes) else str(v) for v in g.attrs[key]]
 
-        return FRF(g["freq"][()], g["data"][()], labels("outputs"), labels("inputs"),
-                   str(g.attrs["quantity"]))
+        return FRF(
+            g["freq"][()],
+            g["data"][()],
+            labels("outputs"),
+            labels("inputs"),
+            str(g.attrs["quantity"]),
+        )
 
 
 @functools.lru_cache(maxsize=1)

@@ -91,8 +91,14 @@ def _check_unique(*groups: Sequence[str]) -> None:
         seen.update(g)
 
 
-def couple_receptance(a: FRF, b: FRF, interface, *, rcond: float | None = None,
-                      max_cond: float | None = kernels.MAX_COND) -> FRF:
+def couple_receptance(
+    a: FRF,
+    b: FRF,
+    interface,
+    *,
+    rcond: float | None = None,
+    max_cond: float | None = kernels.MAX_COND,
+) -> FRF:
     """Receptance (mobility) coupling of two subsystems, thesis eq. 2.44.
 
     The general form is used, with ``Y_ja`` and ``Y_je`` taken as they are, so
@@ -131,8 +137,19 @@ def couple_receptance(a: FRF, b: FRF, interface, *, rcond: float | None = None,
     _check_unique([a.outputs[k] for k in a_o] + ja, [b.outputs[k] for k in b_o])
     _check_unique([a.inputs[k] for k in a_i] + ja, [b.inputs[k] for k in b_i])
     data = kernels.receptance_coupling(
-        a.data, b.data, a_o, a_i, ja_o, ja_i, b_o, b_i, jb_o, jb_i,
-        rcond=rcond, max_cond=max_cond, freq=a.freq,
+        a.data,
+        b.data,
+        a_o,
+        a_i,
+        ja_o,
+        ja_i,
+        b_o,
+        b_i,
+        jb_o,
+        jb_i,
+        rcond=rcond,
+        max_cond=max_cond,
+        freq=a.freq,
     )
     return FRF(a.freq, data, outs, ins, a.quantity)
 
@@ -184,9 +201,7 @@ def _qualified(subsystems: Mapping[str, FRF]) -> tuple[list[str], list[FRF]]:
             raise DOFError(f"subsystem name {name!r} must be non-empty without '/' or ':'")
         _require_square(Y, f"subsystem {name!r}")
         if Y.inputs != Y.outputs:
-            raise DataFormatError(
-                f"subsystem {name!r}: list inputs in the same order as outputs"
-            )
+            raise DataFormatError(f"subsystem {name!r}: list inputs in the same order as outputs")
         labels += [f"{name}/{d}" for d in Y.outputs]
     return labels, frfs
 
@@ -209,8 +224,13 @@ def _connection_pairs(labels: list[str], connections) -> list[tuple[int, int]]:
     return idx
 
 
-def couple_lm(subsystems: Mapping[str, FRF], connections: Sequence[Pair], *,
-              rcond: float | None = None, max_cond: float | None = kernels.MAX_COND) -> FRF:
+def couple_lm(
+    subsystems: Mapping[str, FRF],
+    connections: Sequence[Pair],
+    *,
+    rcond: float | None = None,
+    max_cond: float | None = kernels.MAX_COND,
+) -> FRF:
     """Lagrange-multiplier FBS (de Klerk, Rixen & Voormeeren, AIAA J. 46(5), 2008).
 
     ``Y* = Y - Y B^T (B Y B^T)^-1 B Y`` for any number of subsystems, with the
@@ -237,14 +257,19 @@ def couple_lm(subsystems: Mapping[str, FRF], connections: Sequence[Pair], *,
     labels, frfs = _qualified(subsystems)
     pm = np.array(_connection_pairs(labels, connections), int)
     Y = _block_diag([f.data for f in frfs])
-    data = kernels.lm_fbs_pairs(Y, pm[:, 0], pm[:, 1], rcond=rcond, max_cond=max_cond,
-                                freq=frfs[0].freq)
+    data = kernels.lm_fbs_pairs(
+        Y, pm[:, 0], pm[:, 1], rcond=rcond, max_cond=max_cond, freq=frfs[0].freq
+    )
     return FRF(frfs[0].freq, data, labels, labels, frfs[0].quantity)
 
 
-def couple_generalized(subsystems: Mapping[str, FRF], connections: Sequence[Pair], *,
-                       rcond: float | None = None,
-                       max_cond: float | None = kernels.MAX_COND) -> FRF:
+def couple_generalized(
+    subsystems: Mapping[str, FRF],
+    connections: Sequence[Pair],
+    *,
+    rcond: float | None = None,
+    max_cond: float | None = kernels.MAX_COND,
+) -> FRF:
     """Jetmundsen's generalized receptance coupling, thesis eq. 2.46.
 
     The connections are grouped into interfaces, one per pair of subsystems
@@ -291,8 +316,13 @@ def couple_generalized(subsystems: Mapping[str, FRF], connections: Sequence[Pair
         interfaces[minus][k] = np.array([m - start[minus] for _, m in groups[key]], int)
     internal = [np.arange(len(f.outputs)) for f in frfs]
     data = kernels.generalized_receptance(
-        [f.data for f in frfs], internal, interfaces, Mbool,
-        rcond=rcond, max_cond=max_cond, freq=frfs[0].freq,
+        [f.data for f in frfs],
+        internal,
+        interfaces,
+        Mbool,
+        rcond=rcond,
+        max_cond=max_cond,
+        freq=frfs[0].freq,
     )
     return FRF(frfs[0].freq, data, labels, labels, frfs[0].quantity)
 
@@ -327,9 +357,17 @@ def _interface_pairs(tire: FRF, chassis: FRF, interface) -> list[Pair]:
     return pairs
 
 
-def couple_response(Y_ej: FRF, Y_jj_A: FRF, Y_jj_E: FRF, v_j: FRF, *, interface=None,
-                    couple: Sequence[str] | None = None, rcond: float | None = None,
-                    max_cond: float | None = kernels.MAX_COND) -> FRF:
+def couple_response(
+    Y_ej: FRF,
+    Y_jj_A: FRF,
+    Y_jj_E: FRF,
+    v_j: FRF,
+    *,
+    interface=None,
+    couple: Sequence[str] | None = None,
+    rcond: float | None = None,
+    max_cond: float | None = kernels.MAX_COND,
+) -> FRF:
     """Response at the receiver for a load on the source, thesis eq. 4.1.
 
     ``v_e* = Y_ej^E (Y_jj^A + Y_jj^E)^-1 (Y_ja^A F_a)``: one batched solve of
@@ -376,8 +414,9 @@ def couple_response(Y_ej: FRF, Y_jj_A: FRF, Y_jj_E: FRF, v_j: FRF, *, interface=
     YjjE = Y_jj_E.sel(outputs=tc, inputs=tc).data
     Yej = Y_ej.sel(inputs=tc).data
     vj = v_j.sel(outputs=ta).data
-    data = kernels.couple_response_kernel(Yej, YjjA, YjjE, vj, rcond=rcond, max_cond=max_cond,
-                                          freq=Y_ej.freq)
+    data = kernels.couple_response_kernel(
+        Yej, YjjA, YjjE, vj, rcond=rcond, max_cond=max_cond, freq=Y_ej.freq
+    )
     return FRF(Y_ej.freq, data, Y_ej.outputs, v_j.inputs, Y_ej.quantity)
 
 

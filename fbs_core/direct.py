@@ -76,12 +76,21 @@ class SecondOrderSystem:
     def dynamic_stiffness(self, omega: float):
         """``K - omega^2 M + j omega C`` at one angular frequency (eq. 2.2)."""
         if any(sp.issparse(a) for a in (self.M, self.C, self.K)):
-            return (sp.csc_matrix(self.K) - omega**2 * sp.csc_matrix(self.M)
-                    + 1j * omega * sp.csc_matrix(self.C)).tocsc()
+            return (
+                sp.csc_matrix(self.K)
+                - omega**2 * sp.csc_matrix(self.M)
+                + 1j * omega * sp.csc_matrix(self.C)
+            ).tocsc()
         return self.K - omega**2 * self.M + 1j * omega * self.C
 
-    def frf(self, freq, outputs: Iterable[str] | None = None, inputs: Iterable[str] | None = None,
-            quantity: str = "mobility", loads: dict[str, np.ndarray] | None = None) -> FRF:
+    def frf(
+        self,
+        freq,
+        outputs: Iterable[str] | None = None,
+        inputs: Iterable[str] | None = None,
+        quantity: str = "mobility",
+        loads: dict[str, np.ndarray] | None = None,
+    ) -> FRF:
         """FRFs by direct solution at every line.
 
         Parameters
@@ -126,12 +135,14 @@ class SecondOrderSystem:
         return FRF(f, out, outputs, names, quantity)
 
     def to_dense(self) -> SecondOrderSystem:
-        return SecondOrderSystem(self._dense(self.M), self._dense(self.C), self._dense(self.K),
-                                 self.dofs)
+        return SecondOrderSystem(
+            self._dense(self.M), self._dense(self.C), self._dense(self.K), self.dofs
+        )
 
 
-def assemble(systems: dict[str, SecondOrderSystem],
-             connections: Sequence[tuple[str, str]]) -> SecondOrderSystem:
+def assemble(
+    systems: dict[str, SecondOrderSystem], connections: Sequence[tuple[str, str]]
+) -> SecondOrderSystem:
     """Primal assembly of several systems, merging connected DOFs.
 
     Parameters

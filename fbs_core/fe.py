@@ -112,8 +112,12 @@ class Section:
             raise DataFormatError(f"box wall t={t} must be positive and < min(b, h)/2")
         bi, hi = b - 2 * t, h - 2 * t
         Am, pm = (b - t) * (h - t), 2 * (b + h - 2 * t)
-        return cls(A=b * h - bi * hi, Iy=(b * h**3 - bi * hi**3) / 12,
-                   Iz=(h * b**3 - hi * bi**3) / 12, J=4 * Am**2 * t / pm)
+        return cls(
+            A=b * h - bi * hi,
+            Iy=(b * h**3 - bi * hi**3) / 12,
+            Iz=(h * b**3 - hi * bi**3) / 12,
+            J=4 * Am**2 * t / pm,
+        )
 
     @classmethod
     def tube(cls, d: float, t: float) -> Section:
@@ -125,8 +129,9 @@ class Section:
         return cls(A=np.pi / 4 * (d**2 - di**2), Iy=I, Iz=I, J=2 * I)
 
 
-def beam_local_matrices(length: float, section: Section,
-                        material: Material) -> tuple[np.ndarray, np.ndarray]:
+def beam_local_matrices(
+    length: float, section: Section, material: Material
+) -> tuple[np.ndarray, np.ndarray]:
     """Stiffness and consistent mass of a 3D Euler-Bernoulli beam in local axes.
 
     DOF order: ``u1 v1 w1 tx1 ty1 tz1 u2 v2 w2 tx2 ty2 tz2`` with x along the
@@ -154,25 +159,41 @@ def beam_local_matrices(length: float, section: Section,
         M[idx] += m * bar_m
     # bending: (v, tz) uses Iz with +L terms; (w, ty) uses Iy with -L terms
     for I, dofs, s in ((Iz, [1, 5, 7, 11], 1.0), (Iy, [2, 4, 8, 10], -1.0)):
-        k = E * I / L**3 * np.array([
-            [12, 6 * L * s, -12, 6 * L * s],
-            [6 * L * s, 4 * L**2, -6 * L * s, 2 * L**2],
-            [-12, -6 * L * s, 12, -6 * L * s],
-            [6 * L * s, 2 * L**2, -6 * L * s, 4 * L**2],
-        ])
-        m = rho * A * L / 420 * np.array([
-            [156, 22 * L * s, 54, -13 * L * s],
-            [22 * L * s, 4 * L**2, 13 * L * s, -3 * L**2],
-            [54, 13 * L * s, 156, -22 * L * s],
-            [-13 * L * s, -3 * L**2, -22 * L * s, 4 * L**2],
-        ])
+        k = (
+            E
+            * I
+            / L**3
+            * np.array(
+                [
+                    [12, 6 * L * s, -12, 6 * L * s],
+                    [6 * L * s, 4 * L**2, -6 * L * s, 2 * L**2],
+                    [-12, -6 * L * s, 12, -6 * L * s],
+                    [6 * L * s, 2 * L**2, -6 * L * s, 4 * L**2],
+                ]
+            )
+        )
+        m = (
+            rho
+            * A
+            * L
+            / 420
+            * np.array(
+                [
+                    [156, 22 * L * s, 54, -13 * L * s],
+                    [22 * L * s, 4 * L**2, 13 * L * s, -3 * L**2],
+                    [54, 13 * L * s, 156, -22 * L * s],
+                    [-13 * L * s, -3 * L**2, -22 * L * s, 4 * L**2],
+                ]
+            )
+        )
         K[np.ix_(dofs, dofs)] += k
         M[np.ix_(dofs, dofs)] += m
     return K * (1 + 1j * material.eta), M
 
 
-def beam_rotation(p1: Sequence[float], p2: Sequence[float],
-                  up: Sequence[float] | None = None) -> np.ndarray:
+def beam_rotation(
+    p1: Sequence[float], p2: Sequence[float], up: Sequence[float] | None = None
+) -> np.ndarray:
     """Direction cosines of a beam's local axes.
 
     Parameters
@@ -205,8 +226,9 @@ def beam_rotation(p1: Sequence[float], p2: Sequence[float],
     return np.vstack([ex, ey, ez])
 
 
-def beam_element(p1, p2, section: Section, material: Material,
-                 up=None) -> tuple[np.ndarray, np.ndarray]:
+def beam_element(
+    p1, p2, section: Section, material: Material, up=None
+) -> tuple[np.ndarray, np.ndarray]:
     """Global 12x12 stiffness and mass ``T^T K_local T`` of one beam element."""
     R = beam_rotation(p1, p2, up)
     T = np.kron(np.eye(4), R)
@@ -314,8 +336,16 @@ class FEModel:
             raise DataFormatError(f"blocks on {len(nodes)} nodes must be {size}x{size}")
         self._blocks.append((list(nodes), K, M))
 
-    def add_beam(self, start: str, end: str, section: Section, material: Material,
-                 n_elements: int, up=None, prefix: str | None = None) -> list[str]:
+    def add_beam(
+        self,
+        start: str,
+        end: str,
+        section: Section,
+        material: Material,
+        n_elements: int,
+        up=None,
+        prefix: str | None = None,
+    ) -> list[str]:
         """Mesh a straight beam from node ``start`` to ``end`` with equal elements.
 
         Intermediate nodes are created as ``f"{prefix}{i}"``, i = 1 .. n-1
@@ -344,8 +374,9 @@ class FEModel:
         """Add a 6x6 mass block (e.g. :func:`rigid_body_mass`) at a node."""
         self.add_block([node], M=mass6)
 
-    def add_spring(self, a: str, b: str | None, k, eta: float = 0.0,
-                   offset_a=None, offset_b=None) -> np.ndarray:
+    def add_spring(
+        self, a: str, b: str | None, k, eta: float = 0.0, offset_a=None, offset_b=None
+    ) -> np.ndarray:
         """Add a 6x6 spring (``k`` diagonal of 6 or 6x6) between nodes or to ground.
 
         The spring acts between a point rigidly attached to ``a`` (at

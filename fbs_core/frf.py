@@ -115,9 +115,7 @@ class FRF:
                 f"output {outs[bad[1]]!r}, input {ins[bad[2]]!r})"
             )
         if quantity not in QUANTITIES:
-            raise QuantityError(
-                f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}"
-            )
+            raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
         object.__setattr__(self, "_freq", _frozen(f))
         object.__setattr__(self, "_data", _frozen(d.astype(complex)))
         object.__setattr__(self, "_outputs", outs)
@@ -183,8 +181,9 @@ class FRF:
         return FRF(**kw)
 
     # -- selection -----------------------------------------------------------------
-    def sel(self, outputs: str | Iterable[str] | None = None,
-            inputs: str | Iterable[str] | None = None) -> FRF:
+    def sel(
+        self, outputs: str | Iterable[str] | None = None, inputs: str | Iterable[str] | None = None
+    ) -> FRF:
         """Select by DOF label (like xarray's ``sel``); ``None`` keeps all.
 
         Raises

@@ -136,9 +136,7 @@ class Harmonic:
 
 
 #: The seven cases, ``HARMONICS[k - 1] == harmonic(k)``.
-HARMONICS: tuple[Harmonic, ...] = tuple(
-    Harmonic(k + 1, lam) for k, lam in enumerate(WAVELENGTHS)
-)
+HARMONICS: tuple[Harmonic, ...] = tuple(Harmonic(k + 1, lam) for k, lam in enumerate(WAVELENGTHS))
 
 
 def harmonic(k) -> Harmonic:

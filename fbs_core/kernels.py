@@ -49,8 +49,13 @@ def _tsvd_solve(A: np.ndarray, B: np.ndarray, rcond: float) -> np.ndarray:
     return np.conj(np.swapaxes(Vh, -1, -2)) @ (s_inv[..., :, None] * UhB)
 
 
-def solve_interface(A: np.ndarray, B: np.ndarray, rcond: float | None = None,
-                    max_cond: float | None = None, freq: np.ndarray | None = None) -> np.ndarray:
+def solve_interface(
+    A: np.ndarray,
+    B: np.ndarray,
+    rcond: float | None = None,
+    max_cond: float | None = None,
+    freq: np.ndarray | None = None,
+) -> np.ndarray:
     """Solve ``A X = B`` for a stack of interface matrices ``A (..., n, n)``.
 
     Parameters

@@ -87,22 +87,40 @@ def _tire_frfs(tire, h: Harmonic, f: np.ndarray, n_modes, speed_kmh):
 def _cached(k: int, n_modes, fbytes: bytes, coupling: str, speed_kmh) -> FRF:
     from . import reference_tire  # the tire package registers it at import
 
-    return _compute(reference_tire(), reference_chassis(), harmonic(k),
-                    np.frombuffer(fbytes, float), n_modes, coupling, speed_kmh)
+    return _compute(
+        reference_tire(),
+        reference_chassis(),
+        harmonic(k),
+        np.frombuffer(fbytes, float),
+        n_modes,
+        coupling,
+        speed_kmh,
+    )
 
 
 def _compute(tire, chassis: ChassisModel, h: Harmonic, f, n_modes, coupling, speed_kmh):
     Y_A, v_A = _tire_frfs(tire, h, f, n_modes, speed_kmh)
     Y_E = chassis.mobility(f, outputs=SPINDLE + BUSHING, inputs=SPINDLE)
     return couple_response(
-        Y_E.sel(outputs=BUSHING), Y_A, Y_E.sel(outputs=SPINDLE), v_A,
-        interface=_interface(), couple=coupled_dofs(coupling),
+        Y_E.sel(outputs=BUSHING),
+        Y_A,
+        Y_E.sel(outputs=SPINDLE),
+        v_A,
+        interface=_interface(),
+        couple=coupled_dofs(coupling),
     )
 
 
-def bushing_response(harmonic_case, n_modes: int | None = None, freq=None,
-                     coupling: str = "6dof", *, speed_kmh: float | None = None,
-                     tire=None, chassis: ChassisModel | None = None) -> FRF:
+def bushing_response(
+    harmonic_case,
+    n_modes: int | None = None,
+    freq=None,
+    coupling: str = "6dof",
+    *,
+    speed_kmh: float | None = None,
+    tire=None,
+    chassis: ChassisModel | None = None,
+) -> FRF:
     """Velocity at the chosen bushing for the patch load of a harmonic case (eq. 4.1).
 
     Parameters
@@ -154,8 +172,15 @@ def bushing_response(harmonic_case, n_modes: int | None = None, freq=None,
         from . import reference_tire
 
         tire = reference_tire()
-    return _compute(tire, reference_chassis() if chassis is None else chassis, h, f, n_modes,
-                    coupling, speed_kmh)
+    return _compute(
+        tire,
+        reference_chassis() if chassis is None else chassis,
+        h,
+        f,
+        n_modes,
+        coupling,
+        speed_kmh,
+    )
 
 
 _HARMONIC_SET = {harmonic(k) for k in range(1, 8)}

@@ -57,8 +57,11 @@ def write_h5(ch: ChassisModel, path: Path, freq: np.ndarray) -> None:
     and ``/modes``."""
     s = ch.system()
     Y = ch.mobility(freq)
-    meta = {"model": "reference rear-corner chassis", "coordinates": COORDINATES,
-            "script": "scripts/build_reference_chassis.py"}
+    meta = {
+        "model": "reference rear-corner chassis",
+        "coordinates": COORDINATES,
+        "script": "scripts/build_reference_chassis.py",
+    }
     path.write_bytes(write_hdf5(Y, metadata=meta))
     with h5py.File(path, "a") as h:
         h.attrs["model"] = "reference chassis"
@@ -93,8 +96,10 @@ def main(argv=None) -> int:
     print("eigenfrequencies below 600 Hz:", np.array2string(f[f < 600], precision=1))
     freq = np.arange(1.0, 600.0 + 1e-9, 1.0)
     write_h5(ch, args.out, freq)
-    print(f"wrote {args.out} ({len(SPINDLE + BUSHING)} outputs x {len(SPINDLE)} inputs, "
-          f"{freq.size} lines {freq[0]:g}-{freq[-1]:g} Hz)")
+    print(
+        f"wrote {args.out} ({len(SPINDLE + BUSHING)} outputs x {len(SPINDLE)} inputs, "
+        f"{freq.size} lines {freq[0]:g}-{freq[-1]:g} Hz)"
+    )
     return 0
 
 

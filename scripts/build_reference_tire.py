@@ -38,11 +38,16 @@ def main(argv=None) -> Path:
     t0 = time.perf_counter()
     model = build_modal_model()
     path = save_tire_model(model, args.out, DESCRIPTION)
-    print(f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB, {model.n_modes} complex modes at "
-          f"{', '.join(f'{v:g}' for v in model.speeds)} km/h) in {time.perf_counter() - t0:.1f} s")
-    print("tracking between operating points: median MAC",
-          ", ".join(f"{m:.2f}" for m in model.meta["mac_median"]), "; share with MAC > 0.9",
-          ", ".join(f"{m:.2f}" for m in model.meta["mac_share_above_0.9"]))
+    print(
+        f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB, {model.n_modes} complex modes at "
+        f"{', '.join(f'{v:g}' for v in model.speeds)} km/h) in {time.perf_counter() - t0:.1f} s"
+    )
+    print(
+        "tracking between operating points: median MAC",
+        ", ".join(f"{m:.2f}" for m in model.meta["mac_median"]),
+        "; share with MAC > 0.9",
+        ", ".join(f"{m:.2f}" for m in model.meta["mac_share_above_0.9"]),
+    )
     return path
 
 

@@ -44,9 +44,11 @@ def main(argv=None) -> int:
     ap.add_argument("--df", type=float, default=0.25, help="frequency step in Hz")
     ap.add_argument("--top", type=int, default=3, help="peaks listed per DOF")
     args = ap.parse_args(argv)
-    print(f"coupled response at the bushing, {args.coupling} coupling, "
-          f"{'all' if args.n_modes is None else args.n_modes} tire modes; "
-          "levels in dB re 1 m/s (rad/s) per m of road amplitude")
+    print(
+        f"coupled response at the bushing, {args.coupling} coupling, "
+        f"{'all' if args.n_modes is None else args.n_modes} tire modes; "
+        "levels in dB re 1 m/s (rad/s) per m of road amplitude"
+    )
     for k in range(1, 8):
         h = harmonic(k)
         f = h.frequencies(df=args.df)
@@ -54,8 +56,9 @@ def main(argv=None) -> int:
         lo, hi = h.freq_range
         print(f"\n{h.name} (lambda = {h.wavelength:g} m, {lo:.1f}-{hi:.1f} Hz)")
         for i, dof in enumerate(v.outputs):
-            cells = "  ".join(f"{fr:6.1f} Hz {db:7.1f} dB" for fr, db in
-                              peaks(v.freq, v.data[:, i, 0], args.top))
+            cells = "  ".join(
+                f"{fr:6.1f} Hz {db:7.1f} dB" for fr, db in peaks(v.freq, v.data[:, i, 0], args.top)
+            )
             print(f"  {dof:<11} {cells}")
     return 0
 

@@ -55,8 +55,9 @@ def main():
     M, _, _, K = system_matrices(0.0, p)
     w2, phi = sla.eigh(K, M)
     labels = belt_labels(p)
-    cols = 6 + np.flatnonzero([lab.startswith("belt.ip.") and not lab.endswith("n00")
-                               for lab in labels])
+    cols = 6 + np.flatnonzero(
+        [lab.startswith("belt.ip.") and not lab.endswith("n00") for lab in labels]
+    )
     e = phi**2 * np.diag(M)[:, None]
     share = e[cols].sum(0) / e.sum(0)
     f0 = np.sqrt(w2) / (2 * np.pi)
@@ -75,8 +76,10 @@ def main():
         fr = tire.eigenfrequencies(s)
         pol = tire.poles_at(s)[0::2]
         z = -pol.real / np.abs(pol)
-        print(f"   {s:5.0f} {fr.size:4d} {np.sum(fr < 160):7d} {np.sum(fr < 800):8d} "
-              f"{fr[-1]:8.0f} Hz  {z.min():.3f}-{z.max():.3f}")
+        print(
+            f"   {s:5.0f} {fr.size:4d} {np.sum(fr < 160):7d} {np.sum(fr < 800):8d} "
+            f"{fr[-1]:8.0f} Hz  {z.min():.3f}-{z.max():.3f}"
+        )
 
     print("\n6. Eigenfrequency of the N-th complex mode at 80 km/h (thesis table 5.1 / fig 5.8)")
     fr = tire.eigenfrequencies(80.0)
@@ -108,26 +111,36 @@ def main():
         Y = tire.hub_mobility(fm_, sp).data
         Yd = tire.system(sp).frf(fm_, HUB_DOFS, HUB_DOFS).data
         err = np.linalg.norm(Y - Yd, axis=(1, 2)) / np.linalg.norm(Yd, axis=(1, 2))
-        print(f"   {sp:5.0f} km/h: median {np.median(err):.3f}, 90th percentile "
-              f"{np.percentile(err, 90):.3f} (relative Frobenius error per line)")
+        print(
+            f"   {sp:5.0f} km/h: median {np.median(err):.3f}, 90th percentile "
+            f"{np.percentile(err, 90):.3f} (relative Frobenius error per line)"
+        )
 
     print("   patch response along the harmonic lines (every 8th line, vs direct solve):")
     for k in (1, 3, 5, 7):
         h = harmonic(k)
         fl = h.frequencies()[::8]
         vm = tire.patch_response(fl, h).data[:, :, 0]
-        vd = np.array([
-            tire.system(sp).frf([x], HUB_DOFS, [], loads={"p": tire.patch_load(sp, h.wavelength)})
-            .data[0, :, 0] for x, sp in zip(fl, h.speed_at(fl), strict=True)])
+        vd = np.array(
+            [
+                tire.system(sp)
+                .frf([x], HUB_DOFS, [], loads={"p": tire.patch_load(sp, h.wavelength)})
+                .data[0, :, 0]
+                for x, sp in zip(fl, h.speed_at(fl), strict=True)
+            ]
+        )
         err = np.linalg.norm(vm - vd, axis=1) / np.linalg.norm(vd, axis=1)
-        print(f"   case {k}: median {np.median(err):.3f}, 90th percentile "
-              f"{np.percentile(err, 90):.3f}")
+        print(
+            f"   case {k}: median {np.median(err):.3f}, 90th percentile "
+            f"{np.percentile(err, 90):.3f}"
+        )
 
-    print("\n9. Tracking between operating points:",
-          "median MAC", tire.meta.get("mac_median"))
+    print("\n9. Tracking between operating points:", "median MAC", tire.meta.get("mac_median"))
     h = harmonic(1)
-    print(f"\nHarmonic case 1: wavelength {h.wavelength} m, {h.freq_range[0]:.1f}-"
-          f"{h.freq_range[1]:.1f} Hz")
+    print(
+        f"\nHarmonic case 1: wavelength {h.wavelength} m, {h.freq_range[0]:.1f}-"
+        f"{h.freq_range[1]:.1f} Hz"
+    )
 
 
 if __name__ == "__main__":

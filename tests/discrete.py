@@ -59,13 +59,13 @@ def build(partition: dict[str, list[int]], gyro: float, seed: int = 0):
                 k = rng.uniform(2e3, 8e3)
                 c = 1e-3 * k
                 ia, ib = loc[label(a, d)], loc[label(b, d)]
-                for (i, j, sgn) in ((ia, ia, 1), (ib, ib, 1), (ia, ib, -1), (ib, ia, -1)):
+                for i, j, sgn in ((ia, ia, 1), (ib, ib, 1), (ia, ib, -1), (ib, ia, -1)):
                     K[i, j] += sgn * k
                     C[i, j] += sgn * c
             # a cross spring x_a - y_b makes the stiffness fully coupled
             kc = rng.uniform(5e2, 1e3)
             ia, ib = loc[label(a, "x")], loc[label(b, "y")]
-            for (i, j, sgn) in ((ia, ia, 1), (ib, ib, 1), (ia, ib, -1), (ib, ia, -1)):
+            for i, j, sgn in ((ia, ia, 1), (ib, ib, 1), (ia, ib, -1), (ib, ia, -1)):
                 K[i, j] += sgn * kc
         # grounding springs on the first node of every subsystem
         for d in DIRS:

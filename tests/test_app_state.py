@@ -121,8 +121,9 @@ def test_csv_round_trip_with_metadata_header():
     f = np.array([10.0, 10.5, 11.0])
     v = np.array([1 + 2j, 3 - 1j, 1e-9j])
     db = np.array([-93.123456789012345, 1.0 / 3.0, 0.0])
-    text = to_csv({"freq_Hz": f, "level_dB": db, "v": v},
-                  {"harmonic": 1, "N": 50, "seed": 0}, "coupled")
+    text = to_csv(
+        {"freq_Hz": f, "level_dB": db, "v": v}, {"harmonic": 1, "N": 50, "seed": 0}, "coupled"
+    )
     assert text.startswith("# tire-fbs dashboard export (coupled)\n")
     meta, cols = read_csv(text)
     assert meta == {"harmonic": "1", "N": "50", "seed": "0"}

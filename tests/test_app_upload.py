@@ -47,8 +47,11 @@ def doubled_mat(chassis_frf):
 
 
 def _data_hashes():
-    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted((ROOT / "data").iterdir()) if p.is_file()}
+    return {
+        p.name: hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted((ROOT / "data").iterdir())
+        if p.is_file()
+    }
 
 
 def _tire_bytes(tmp_path, model, name="tire.h5"):
@@ -58,8 +61,15 @@ def _tire_bytes(tmp_path, model, name="tire.h5"):
 def _sub_tire(n_modes=None, speeds=slice(None)):
     T = fbs_core.reference_tire()
     m = slice(None) if n_modes is None else slice(0, n_modes)
-    return TireModel(T.speeds[speeds], T.poles[speeds, m], T.psi[speeds, m], T.chi[speeds, m],
-                     T.wavelengths, T.participation[speeds][:, :, m], meta={"source": "test"})
+    return TireModel(
+        T.speeds[speeds],
+        T.poles[speeds, m],
+        T.psi[speeds, m],
+        T.chi[speeds, m],
+        T.wavelengths,
+        T.participation[speeds][:, :, m],
+        meta={"source": "test"},
+    )
 
 
 # -- the chassis upload ----------------------------------------------------------------------
@@ -196,8 +206,16 @@ def test_upload_view_shows_the_summary_or_the_error(doubled_mat):
 
 
 # -- the views on the session's models (app.compute keys its caches on them) -----------------
-NAMES = ["mobility.reference", "mobility.truncated", "truncation.map", "scatter.minmax",
-         "scatter.percentile", "scatter.reference", "scatter.round", "eigen.f_80"]
+NAMES = [
+    "mobility.reference",
+    "mobility.truncated",
+    "truncation.map",
+    "scatter.minmax",
+    "scatter.percentile",
+    "scatter.reference",
+    "scatter.round",
+    "eigen.f_80",
+]
 
 
 def _plot_data(root):
@@ -211,10 +229,15 @@ def _plot_data(root):
 
 
 def _moved(a, b):
-    return {n for n in a if not all(
-        np.shape(a[n][k]) == np.shape(b[n][k]) and np.array_equal(a[n][k], b[n][k],
-                                                                   equal_nan=True)
-        for k in a[n])}
+    return {
+        n
+        for n in a
+        if not all(
+            np.shape(a[n][k]) == np.shape(b[n][k])
+            and np.array_equal(a[n][k], b[n][k], equal_nan=True)
+            for k in a[n]
+        )
+    }
 
 
 def test_the_page_runs_every_view_on_an_upload_of_this_session_only(doubled_mat):
@@ -232,8 +255,9 @@ def test_the_page_runs_every_view_on_an_upload_of_this_session_only(doubled_mat)
     # the tire did not change: the eigenfrequencies stay; every coupled view moves
     assert _moved(before, after) == set(NAMES) - {"eigen.f_80"}
     c = state.case
-    br = fbs_core.bushing_response(c.harmonic, n_modes=c.n_modes, coupling=c.coupling,
-                                   chassis=state.data.models.chassis)
+    br = fbs_core.bushing_response(
+        c.harmonic, n_modes=c.n_modes, coupling=c.coupling, chassis=state.data.models.chassis
+    )
     want = 20 * np.log10(np.abs(br.sel(outputs=f"bushing:{c.dof}").data[:, 0, 0]))
     np.testing.assert_allclose(after["mobility.truncated"]["level"], want, rtol=1e-9)
     state.data.reset()
@@ -269,8 +293,9 @@ def test_doubled_chassis_shows_6_db_more_uncoupled_mobility(doubled_mat):
     ref = unc.data()
     assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
     got = unc.data()
-    np.testing.assert_allclose(got["chassis_db"], ref["chassis_db"] + 20 * np.log10(2.0),
-                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        got["chassis_db"], ref["chassis_db"] + 20 * np.log10(2.0), rtol=0, atol=1e-9
+    )
     np.testing.assert_array_equal(got["tire_truncated"], ref["tire_truncated"])
 
 
@@ -332,10 +357,12 @@ def test_free_rolling_coupling_runs_on_an_upload(doubled_mat):
     assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
     state.case.param.update(coupling="5dof", harmonic=4, n_modes=80)
     mob = MobilityView(case=state.case).data()
-    br = fbs_core.bushing_response(4, n_modes=80, coupling="5dof",
-                                   chassis=state.data.models.chassis)
-    np.testing.assert_allclose(mob["truncated"], br.sel(outputs="bushing:z").data[:, 0, 0],
-                               rtol=1e-9)
+    br = fbs_core.bushing_response(
+        4, n_modes=80, coupling="5dof", chassis=state.data.models.chassis
+    )
+    np.testing.assert_allclose(
+        mob["truncated"], br.sel(outputs="bushing:z").data[:, 0, 0], rtol=1e-9
+    )
     tab = SuggestedModesView(case=state.case, truncation=state.truncation).table()
     assert list(tab["harmonic"]) == list(range(1, 8)) and np.all(tab["n_modes"] > 0)
 
@@ -351,16 +378,26 @@ def test_tire_from_matlab_in_the_documented_layout():
 
     T = _sub_tire(n_modes=120)
     buf = io.BytesIO()
-    savemat(buf, {"speeds": T.speeds, "poles": T.poles, "psi": T.psi, "chi": T.chi,
-                  "wavelengths": T.wavelengths, "participation": T.participation})
+    savemat(
+        buf,
+        {
+            "speeds": T.speeds,
+            "poles": T.poles,
+            "psi": T.psi,
+            "chi": T.chi,
+            "wavelengths": T.wavelengths,
+            "participation": T.participation,
+        },
+    )
     state = DashboardState()
     assert state.data.load_tire(buf.getvalue(), "supplier_tire.mat"), state.data.error
     assert "120 complex modes" in state.data.tire_summary
     assert "MATLAB" in state.data.tire_summary
     state.case.param.update(harmonic=5, n_modes=60)
     mob = MobilityView(case=state.case).data()
-    np.testing.assert_allclose(mob["truncated"], compute.mobility_data(5, 60, "z", "6dof")
-                               ["truncated"], rtol=1e-9)
+    np.testing.assert_allclose(
+        mob["truncated"], compute.mobility_data(5, 60, "z", "6dof")["truncated"], rtol=1e-9
+    )
 
 
 def test_changed_settings_re_read_the_chassis_even_after_a_stale_click(chassis_frf):

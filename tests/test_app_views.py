@@ -10,8 +10,16 @@ from app import compute
 from app.main import create_app
 from app.state import DashboardState
 
-NAMES = ["mobility.reference", "mobility.truncated", "truncation.map", "scatter.minmax",
-         "scatter.percentile", "scatter.reference", "scatter.round", "eigen.f_80"]
+NAMES = [
+    "mobility.reference",
+    "mobility.truncated",
+    "truncation.map",
+    "scatter.minmax",
+    "scatter.percentile",
+    "scatter.reference",
+    "scatter.round",
+    "eigen.f_80",
+]
 
 
 @pytest.fixture(scope="module")
@@ -34,14 +42,15 @@ def _sources(root):
 
 
 def _snapshot(root):
-    return {n: {k: np.array(v, copy=True) for k, v in s.data.items()}
-            for n, s in _sources(root).items()}
+    return {
+        n: {k: np.array(v, copy=True) for k, v in s.data.items()} for n, s in _sources(root).items()
+    }
 
 
 def _same(a, b):
     return a.keys() == b.keys() and all(
-        np.shape(a[k]) == np.shape(b[k]) and np.array_equal(a[k], b[k], equal_nan=True)
-        for k in a)
+        np.shape(a[k]) == np.shape(b[k]) and np.array_equal(a[k], b[k], equal_nan=True) for k in a
+    )
 
 
 def test_plotted_mobility_is_the_core_prediction(page):
@@ -60,11 +69,32 @@ def test_plotted_mobility_is_the_core_prediction(page):
 @pytest.mark.parametrize(
     ("group", "name", "value", "changed"),
     [
-        ("case", "n_modes", 120, {"mobility.truncated", "scatter.minmax", "scatter.percentile",
-                                  "scatter.reference", "scatter.round"}),
-        ("case", "dof", "rx", {"mobility.reference", "mobility.truncated", "truncation.map",
-                               "scatter.minmax", "scatter.percentile", "scatter.reference",
-                               "scatter.round"}),
+        (
+            "case",
+            "n_modes",
+            120,
+            {
+                "mobility.truncated",
+                "scatter.minmax",
+                "scatter.percentile",
+                "scatter.reference",
+                "scatter.round",
+            },
+        ),
+        (
+            "case",
+            "dof",
+            "rx",
+            {
+                "mobility.reference",
+                "mobility.truncated",
+                "truncation.map",
+                "scatter.minmax",
+                "scatter.percentile",
+                "scatter.reference",
+                "scatter.round",
+            },
+        ),
         ("truncation", "map_mode", "max over 6 DOFs", {"truncation.map"}),
         ("truncation", "threshold", 5.0, set()),
         ("noise", "single_round", 17, {"scatter.round"}),
@@ -97,8 +127,9 @@ def test_view_data_and_csv_columns_agree(page):
 
     mob = MobilityView(case=state.case)
     d = mob.data()
-    want = compute.mobility_data(state.case.harmonic, state.case.n_modes, state.case.dof,
-                                 state.case.coupling)
+    want = compute.mobility_data(
+        state.case.harmonic, state.case.n_modes, state.case.dof, state.case.coupling
+    )
     np.testing.assert_array_equal(d["truncated_db"], want["truncated_db"])
     cols = mob._csv_columns()
     np.testing.assert_array_equal(cols["truncated_dB"], d["truncated_db"])
@@ -116,8 +147,10 @@ def test_view_data_and_csv_columns_agree(page):
     assert np.all(b["upper"] <= b["maximum"] + 1e-12)
     r = sv.round_data()
     band = compute.band(*sv.key())
-    np.testing.assert_array_equal(r["round"], band.round(state.noise.single_round)[
-        :, band.dofs.index(f"bushing:{state.case.dof}")])
+    np.testing.assert_array_equal(
+        r["round"],
+        band.round(state.noise.single_round)[:, band.dofs.index(f"bushing:{state.case.dof}")],
+    )
 
 
 def test_zero_noise_band_collapses_on_the_reference():
@@ -198,8 +231,10 @@ def test_caption_text_is_escaped_html_with_bold_and_middots():
     from app.views.common import inline_html
 
     # a DOF label from a user's file is text, never markup
-    assert (inline_html("**Harmonic 2** &middot; bushing:<img src=x onerror=1> & co")
-            == "<b>Harmonic 2</b> &middot; bushing:&lt;img src=x onerror=1&gt; &amp; co")
+    assert (
+        inline_html("**Harmonic 2** &middot; bushing:<img src=x onerror=1> & co")
+        == "<b>Harmonic 2</b> &middot; bushing:&lt;img src=x onerror=1&gt; &amp; co"
+    )
 
 
 def test_live_text_follows_its_parameters():

@@ -100,8 +100,11 @@ def _option(cmd: list[str], name: str) -> str:
 
 
 def test_basic_auth_users_go_to_a_private_file_not_the_command_line(app_file):
-    env = {"FBS_APP": str(app_file), "FBS_BASIC_AUTH": f"{USER}:{PASSWORD}",
-           "FBS_COOKIE_SECRET": SECRET}
+    env = {
+        "FBS_APP": str(app_file),
+        "FBS_BASIC_AUTH": f"{USER}:{PASSWORD}",
+        "FBS_COOKIE_SECRET": SECRET,
+    }
     cmd, _ = entrypoint.build_command(env, [])
     assert PASSWORD not in " ".join(cmd)
     users_file = Path(_option(cmd, "--basic-auth"))
@@ -149,8 +152,7 @@ def test_refused_users_file(app_file, tmp_path, content):
     users = tmp_path / "users.json"
     users.write_text(content)
     with pytest.raises(SettingError, match="FBS_BASIC_AUTH_FILE"):
-        entrypoint.build_command({"FBS_APP": str(app_file), "FBS_BASIC_AUTH_FILE": str(users)},
-                                 [])
+        entrypoint.build_command({"FBS_APP": str(app_file), "FBS_BASIC_AUTH_FILE": str(users)}, [])
 
 
 # ---- the served app with authentication on -----------------------------------------------
@@ -188,8 +190,9 @@ def _get(opener, url):
         return e.code, e.headers.get("Location"), e.read().decode()
 
 
-async def _websocket_session(port: int, cookie: str | None,
-                             token: str | None = None) -> tuple[str, str]:
+async def _websocket_session(
+    port: int, cookie: str | None, token: str | None = None
+) -> tuple[str, str]:
     """Open the app's Bokeh websocket as bokehjs does, then pull the document.
 
     Returns the type of the server's first message and the pulled document's content.
@@ -229,13 +232,21 @@ def server(tmp_path_factory):
     port = _free_port()
     env = {
         **os.environ,
-        "FBS_APP": str(app), "FBS_PORT": str(port), "FBS_ADDRESS": "127.0.0.1",
-        "FBS_BASIC_AUTH": f"{USER}:{PASSWORD}", "FBS_COOKIE_SECRET": SECRET,
-        "FBS_NUM_THREADS": "2", "BOKEH_ALLOW_WS_ORIGIN": f"127.0.0.1:{port}",
+        "FBS_APP": str(app),
+        "FBS_PORT": str(port),
+        "FBS_ADDRESS": "127.0.0.1",
+        "FBS_BASIC_AUTH": f"{USER}:{PASSWORD}",
+        "FBS_COOKIE_SECRET": SECRET,
+        "FBS_NUM_THREADS": "2",
+        "BOKEH_ALLOW_WS_ORIGIN": f"127.0.0.1:{port}",
     }
     log = open(folder / "server.log", "w+")  # noqa: SIM115 (closed below)
-    proc = subprocess.Popen([sys.executable, str(ROOT / "docker" / "entrypoint.py")],
-                            env=env, stdout=log, stderr=subprocess.STDOUT)
+    proc = subprocess.Popen(
+        [sys.executable, str(ROOT / "docker" / "entrypoint.py")],
+        env=env,
+        stdout=log,
+        stderr=subprocess.STDOUT,
+    )
     base = f"http://127.0.0.1:{port}"
     try:
         deadline = time.monotonic() + 25

@@ -64,8 +64,9 @@ def test_modal_synthesis_equals_direct_solution(chassis):
 def test_reciprocal_and_labelled(chassis):
     f = np.array([20.0, 200.0])
     Y = chassis.mobility(f, outputs=SPINDLE + BUSHING, inputs=SPINDLE + BUSHING)
-    np.testing.assert_allclose(Y.data, np.swapaxes(Y.data, 1, 2), rtol=1e-8,
-                               atol=1e-10 * np.abs(Y.data).max())
+    np.testing.assert_allclose(
+        Y.data, np.swapaxes(Y.data, 1, 2), rtol=1e-8, atol=1e-10 * np.abs(Y.data).max()
+    )
     Y = chassis.mobility(f)
     assert Y.outputs == SPINDLE + BUSHING and Y.inputs == SPINDLE
     assert Y.quantity == "mobility"
@@ -80,8 +81,13 @@ def test_mass_equals_sum_of_parts(chassis):
     p = chassis.params
     L, W = p.subframe_half
     frame = 2 * (2 * L) * Section.box(*p.side_box).A + 2 * (2 * W) * Section.box(*p.cross_box).A
-    arm = 2 * np.hypot(np.hypot(*np.subtract(p.arm_apex_xyz[:2], (p.arm_roots_x, W))),
-                       p.arm_apex_xyz[2]) * Section.tube(*p.arm_tube).A
+    arm = (
+        2
+        * np.hypot(
+            np.hypot(*np.subtract(p.arm_apex_xyz[:2], (p.arm_roots_x, W))), p.arm_apex_xyz[2]
+        )
+        * Section.tube(*p.arm_tube).A
+    )
     expected = p.carrier_mass + 2 * p.bracket_mass + STEEL_RHO * (frame + arm)
     s = chassis.system()
     u = np.zeros(s.n)
@@ -109,8 +115,9 @@ def test_static_loads_at_the_bushings_go_straight_to_ground(chassis):
 def test_stored_file_matches_the_model(chassis):
     Y = read_chassis_frf(DATA)
     # a regression check of the file (LAPACK results vary at ~1e-9 with the thread count)
-    np.testing.assert_allclose(Y.data, chassis.mobility(Y.freq).data, rtol=1e-6,
-                               atol=1e-9 * np.abs(Y.data).max())
+    np.testing.assert_allclose(
+        Y.data, chassis.mobility(Y.freq).data, rtol=1e-6, atol=1e-9 * np.abs(Y.data).max()
+    )
     assert Y.outputs == SPINDLE + BUSHING
     # the project's generic reader (sandboxed HDF5 import) sees the same FRF
     from fbs_core.io import load_frf

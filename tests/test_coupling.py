@@ -58,10 +58,13 @@ def test_receptance_with_label_pairs_and_partial_columns(two):
     # rename B's interface node; a receiver FRF with only some outputs
     B = Y["B"]
     ren = {label(3, "x"): "s:x", label(3, "y"): "s:y"}
-    B2 = B.replace(outputs=[ren.get(o, o) for o in B.outputs],
-                   inputs=[ren.get(i, i) for i in B.inputs])
-    A_part = Y["A"].sel(outputs=[label(0, "x"), label(3, "x"), label(3, "y")],
-                        inputs=[label(1, "y"), label(3, "x"), label(3, "y")])
+    B2 = B.replace(
+        outputs=[ren.get(o, o) for o in B.outputs], inputs=[ren.get(i, i) for i in B.inputs]
+    )
+    A_part = Y["A"].sel(
+        outputs=[label(0, "x"), label(3, "x"), label(3, "y")],
+        inputs=[label(1, "y"), label(3, "x"), label(3, "y")],
+    )
     Ys = fc.couple_receptance(A_part, B2, [(label(3, "x"), "s:x"), (label(3, "y"), "s:y")])
     assert Ys.inputs[0] == label(1, "y")
     ref = Yd.sel(outputs=Ys.outputs, inputs=Ys.inputs)
@@ -88,8 +91,11 @@ def test_five_subsystems_equal_direct(method, gyro):
 def test_lm_equals_generalized_and_chain_of_two():
     subs, glob = build(FIVE, gyro=25.0, seed=4)
     Y = _subfrfs(subs)
-    conns = [(f"{n}/{label(k, d)}", f"E/{label(k, d)}")
-             for n, k in (("A", 0), ("B", 1), ("C", 3), ("D", 5)) for d in "xy"]
+    conns = [
+        (f"{n}/{label(k, d)}", f"E/{label(k, d)}")
+        for n, k in (("A", 0), ("B", 1), ("C", 3), ("D", 5))
+        for d in "xy"
+    ]
     lm = fc.couple_lm(Y, conns)
     gr = fc.couple_generalized(Y, conns)
     assert lm.outputs == gr.outputs
@@ -99,8 +105,9 @@ def test_lm_equals_generalized_and_chain_of_two():
     for name, node in (("A", 0), ("B", 1), ("C", 3), ("D", 5)):
         iface = [label(node, "x"), label(node, "y")]
         Yseq = fc.couple_receptance(Yseq, Y[name], iface)
-    ref = lm.sel(outputs=[f"E/{o}" if f"E/{o}" in lm.outputs else _owner(lm, o)
-                          for o in Yseq.outputs])
+    ref = lm.sel(
+        outputs=[f"E/{o}" if f"E/{o}" in lm.outputs else _owner(lm, o) for o in Yseq.outputs]
+    )
     ref = ref.sel(inputs=ref.outputs)
     assert _rel(Yseq.data, ref.data) < 1e-10
 
@@ -130,11 +137,11 @@ def test_fast_path_equals_full_coupling(gyro):
     load[Y["A"].inputs.index(label(2, "y"))] = -0.5j
     vj = fc.FRF(FREQ, Y["A"].sel(outputs=j).data @ load[:, None], j, ["patch"])
     e = [label(5, "x"), label(6, "y"), label(4, "x")]
-    ve = fc.couple_response(Y["B"].sel(outputs=e, inputs=j), Y["A"].sel(j, j),
-                            Y["B"].sel(j, j), vj)
+    ve = fc.couple_response(Y["B"].sel(outputs=e, inputs=j), Y["A"].sel(j, j), Y["B"].sel(j, j), vj)
     assert ve.outputs == tuple(e) and ve.inputs == ("patch",)
     direct = Yd.sel(outputs=e, inputs=[label(1, "x"), label(2, "y")]).data @ np.array(
-        [[1.0], [-0.5j]])
+        [[1.0], [-0.5j]]
+    )
     assert _rel(ve.data, direct) < 1e-10
 
 
@@ -160,12 +167,18 @@ def test_fast_path_release_equals_direct_with_released_dof():
     j = [label(3, "x"), label(3, "y")]
     vj = Y["A"].sel(outputs=j, inputs=[label(1, "y")])
     e = [label(5, "x"), label(6, "y")]
-    ve = fc.couple_response(Y["B"].sel(outputs=e, inputs=j), Y["A"].sel(j, j), Y["B"].sel(j, j),
-                            vj, couple=[label(3, "x")])
+    ve = fc.couple_response(
+        Y["B"].sel(outputs=e, inputs=j),
+        Y["A"].sel(j, j),
+        Y["B"].sel(j, j),
+        vj,
+        couple=[label(3, "x")],
+    )
     ref = Yd.sel(outputs=e, inputs=[label(1, "y")])
     assert _rel(ve.data, ref.data) < 1e-10
-    full = fc.couple_response(Y["B"].sel(outputs=e, inputs=j), Y["A"].sel(j, j),
-                              Y["B"].sel(j, j), vj)
+    full = fc.couple_response(
+        Y["B"].sel(outputs=e, inputs=j), Y["A"].sel(j, j), Y["B"].sel(j, j), vj
+    )
     assert _rel(full.data, ref.data) > 1e-3  # releasing a DOF changes the answer
 
 
@@ -208,7 +221,8 @@ def test_rods_end_to_end_equal_closed_form(method):
     else:
         fn = fc.couple_lm if method == "lm" else fc.couple_generalized
         Ys = fn({"r1": r1, "r2": r2}, [("r1/j:x", "r2/k:x")]).sel(
-            outputs=["r1/a:x", "r2/b:x"], inputs=["r1/a:x", "r2/b:x"])
+            outputs=["r1/a:x", "r2/b:x"], inputs=["r1/a:x", "r2/b:x"]
+        )
     err = np.abs(Ys.data - ref.data) / np.abs(ref.data)
     assert err.max() < 1e-8
     assert Ys.quantity == "receptance"
@@ -242,8 +256,9 @@ def test_condition_number_and_singular_interface():
     # truncated SVD regularisation gives the finite minimum-norm answer
     reg = fc.couple_response(Bd, Ad, Bd, Ad.sel(inputs=[labs[0]]), rcond=1e-8)
     assert np.all(np.isfinite(reg.data))
-    ok = fc.couple_response(Y["B"].sel(j, j), Y["A"].sel(j, j), Y["B"].sel(j, j),
-                            Y["A"].sel(j, [j[0]]))
+    ok = fc.couple_response(
+        Y["B"].sel(j, j), Y["A"].sel(j, j), Y["B"].sel(j, j), Y["A"].sel(j, [j[0]])
+    )
     assert _rel(reg.data[:, :2], ok.data) < 1e-6
 
 
@@ -276,8 +291,10 @@ def test_bad_inputs(two):
         fc.couple_lm({"A/1": A, "B": B}, [("A/1/n3:x", "B/n3:x")])
     j = ["n3:x", "n3:y"]
     with pytest.raises(fc.DOFError, match="unknown coupled interface DOF 'n3:rz'"):
-        fc.couple_response(B.sel(inputs=j), A.sel(j, j), B.sel(j, j), A.sel(j, ["n1:x"]),
-                           couple=["n3:rz"])
+        fc.couple_response(
+            B.sel(inputs=j), A.sel(j, j), B.sel(j, j), A.sel(j, ["n1:x"]), couple=["n3:rz"]
+        )
     with pytest.raises(fc.DOFError, match="different directions"):
-        fc.couple_response(B.sel(inputs=j), A.sel(j, j), B.sel(j[::-1], j[::-1]),
-                           A.sel(j, ["n1:x"]))
+        fc.couple_response(
+            B.sel(inputs=j), A.sel(j, j), B.sel(j[::-1], j[::-1]), A.sel(j, ["n1:x"])
+        )

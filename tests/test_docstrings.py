@@ -26,10 +26,12 @@ def test_public_callable_is_documented(name):
     except (TypeError, ValueError):
         return
     missing = [
-        p for p in sig.parameters
-        if p not in ("self", "cls") and not p.startswith("_")
-        and sig.parameters[p].kind not in (inspect.Parameter.VAR_POSITIONAL,
-                                           inspect.Parameter.VAR_KEYWORD)
+        p
+        for p in sig.parameters
+        if p not in ("self", "cls")
+        and not p.startswith("_")
+        and sig.parameters[p].kind
+        not in (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD)
         and p not in doc
     ]
     assert not missing, f"fbs_core.{name}: parameters {missing} are not described in its docstring"

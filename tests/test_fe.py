@@ -36,9 +36,11 @@ def test_free_free_beam_frequencies_match_closed_form_in_any_orientation():
     f = np.sqrt(np.abs(w2)) / (2 * np.pi)
     assert np.all(f[:6] < 0.1)  # six rigid-body modes
     mu = STEEL.rho * BAR.A
-    exact = np.sort(np.concatenate([
-        BETA_L**2 / (2 * np.pi * L**2) * np.sqrt(STEEL.E * I / mu) for I in (BAR.Iy, BAR.Iz)
-    ]))[:4]
+    exact = np.sort(
+        np.concatenate(
+            [BETA_L**2 / (2 * np.pi * L**2) * np.sqrt(STEEL.E * I / mu) for I in (BAR.Iy, BAR.Iz)]
+        )
+    )[:4]
     bending = np.sort(f[6:12])[:4]
     np.testing.assert_allclose(bending, exact, rtol=1e-4)
 

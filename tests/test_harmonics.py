@@ -7,8 +7,15 @@ from fbs_core.errors import FBSError, FrequencyGridError
 from fbs_core.harmonics import HARMONICS, Harmonic, HarmonicError, harmonic
 
 # band edges of thesis table 5.1 (Hz)
-TABLE_5_1 = [(12.9, 51.5), (16.7, 67.0), (24.6, 97.9), (34.8, 139.0), (50.2, 200.0),
-             (72.1, 288.1), (105.6, 422.3)]
+TABLE_5_1 = [
+    (12.9, 51.5),
+    (16.7, 67.0),
+    (24.6, 97.9),
+    (34.8, 139.0),
+    (50.2, 200.0),
+    (72.1, 288.1),
+    (105.6, 422.3),
+]
 
 
 @pytest.mark.parametrize("k", range(1, 8))

@@ -61,14 +61,17 @@ def test_size_limit_and_empty(tmp_path):
         load_frf(12345)
 
 
-@pytest.mark.parametrize("raw,name,found", [
-    (b"PK\x03\x04" + b"\x00" * 100, "a.uff", "ZIP"),
-    (b"\x80\x04\x95" + b"\x00" * 50, "a.mat", "pickle"),
-    (b"\x89HDF\r\n\x1a\n" + b"\x00" * 100, "a.csv", "HDF5"),
-    (b"freq,Re(a:x / a:x)\n1,2\n", "a.mat", "text"),
-    (b"%PDF-1.4 ...", "a.h5", "PDF"),
-    (bytes(range(256)) * 4, "a.csv", "binary"),
-])
+@pytest.mark.parametrize(
+    "raw,name,found",
+    [
+        (b"PK\x03\x04" + b"\x00" * 100, "a.uff", "ZIP"),
+        (b"\x80\x04\x95" + b"\x00" * 50, "a.mat", "pickle"),
+        (b"\x89HDF\r\n\x1a\n" + b"\x00" * 100, "a.csv", "HDF5"),
+        (b"freq,Re(a:x / a:x)\n1,2\n", "a.mat", "text"),
+        (b"%PDF-1.4 ...", "a.h5", "PDF"),
+        (bytes(range(256)) * 4, "a.csv", "binary"),
+    ],
+)
 def test_content_must_match_the_ending(raw, name, found):
     with pytest.raises(DataFormatError, match=found):
         load_frf(raw, filename=name)
@@ -110,8 +113,7 @@ def test_unknown_direction_in_mat_and_csv():
 
 def test_required_dofs_are_listed():
     with pytest.raises(DOFError, match="lacks outputs bushing:z"):
-        load_frf(save_frf(sdof(), format="csv"), filename="a.csv",
-                 require_outputs=["bushing:z"])
+        load_frf(save_frf(sdof(), format="csv"), filename="a.csv", require_outputs=["bushing:z"])
     with pytest.raises(DOFError, match="inputs spindle:x"):
         require_dofs(sdof(), inputs=["spindle:x"])
 
@@ -158,8 +160,9 @@ def test_csv_layout_errors_name_line_and_column():
     with pytest.raises(DataFormatError, match="first column must be the frequency"):
         load_frf(good.replace("freq [Hz]", "speed").encode(), filename="a.csv")
     with pytest.raises(DataFormatError, match="needs Re and Im"):
-        load_frf(good.replace("Im(hub:z / hub:z)", "Phase(hub:z / hub:z)").encode(),
-                 filename="a.csv")
+        load_frf(
+            good.replace("Im(hub:z / hub:z)", "Phase(hub:z / hub:z)").encode(), filename="a.csv"
+        )
     with pytest.raises(DataFormatError, match="content is binary data"):
         load_frf(b"freq,Re(a:x / a:x)\n\xff\xfe1,2\n", filename="a.csv")
     with pytest.raises(DataFormatError, match="not UTF-8"):
@@ -169,10 +172,14 @@ def test_csv_layout_errors_name_line_and_column():
 def test_csv_magnitude_phase_layout():
     Y = sdof()
     d = Y.data[:, 0, 0]
-    rows = "\n".join(f"{float(f)!r},{float(abs(z))!r},{float(np.degrees(np.angle(z)))!r}"
-                     for f, z in zip(Y.freq, d, strict=True))
-    text = ("# quantity: mobility\n# layout: mag-phase\n# phase_unit: deg\n"
-            "freq [Hz],Mag(hub:z / hub:z),Phase(hub:z / hub:z)\n" + rows)
+    rows = "\n".join(
+        f"{float(f)!r},{float(abs(z))!r},{float(np.degrees(np.angle(z)))!r}"
+        for f, z in zip(Y.freq, d, strict=True)
+    )
+    text = (
+        "# quantity: mobility\n# layout: mag-phase\n# phase_unit: deg\n"
+        "freq [Hz],Mag(hub:z / hub:z),Phase(hub:z / hub:z)\n" + rows
+    )
     r = load_frf(text.encode(), filename="a.csv")
     assert r.frf.allclose(Y, rtol=1e-12)
 
@@ -209,16 +216,19 @@ def test_quantity_must_be_known_and_consistent():
         load_frf(mat5(**GOOD), filename="a.mat", quantity="velocity")
 
 
-@pytest.mark.parametrize("label,quantity,length,force,g", [
-    ("m/N", "receptance", 1.0, 1.0, False),
-    ("m/(N s)", "mobility", 1.0, 1.0, False),
-    ("m/s/N", "mobility", 1.0, 1.0, False),
-    ("(m/s)/N", "mobility", 1.0, 1.0, False),
-    ("mm/s/N", "mobility", 1e-3, 1.0, False),
-    ("m s^-2 N^-1", "accelerance", 1.0, 1.0, False),
-    ("m/s2/kN", "accelerance", 1.0, 1e3, False),
-    ("g/N", "accelerance", 1.0, 1.0, True),
-])
+@pytest.mark.parametrize(
+    "label,quantity,length,force,g",
+    [
+        ("m/N", "receptance", 1.0, 1.0, False),
+        ("m/(N s)", "mobility", 1.0, 1.0, False),
+        ("m/s/N", "mobility", 1.0, 1.0, False),
+        ("(m/s)/N", "mobility", 1.0, 1.0, False),
+        ("mm/s/N", "mobility", 1e-3, 1.0, False),
+        ("m s^-2 N^-1", "accelerance", 1.0, 1.0, False),
+        ("m/s2/kN", "accelerance", 1.0, 1e3, False),
+        ("g/N", "accelerance", 1.0, 1.0, True),
+    ],
+)
 def test_units_parser(label, quantity, length, force, g):
     u = parse_units(label)
     assert (u.quantity, u.length, u.force, u.g) == (quantity, length, force, g)
@@ -249,9 +259,11 @@ def test_receptance_declared_as_mobility_gets_a_note():
 def test_mat5_objects_structs_sparse_are_refused():
     arr = np.zeros((1, 1), dtype=[("a", object)])
     arr[0, 0]["a"] = np.array([[1.0]])
-    for extra, cls in (({"o": MatlabObject(arr, "evil")}, "object"),
-                       ({"s": {"a": 1.0}}, "struct"),
-                       ({"sp": scipy.sparse.eye(3)}, "sparse")):
+    for extra, cls in (
+        ({"o": MatlabObject(arr, "evil")}, "object"),
+        ({"s": {"a": 1.0}}, "struct"),
+        ({"sp": scipy.sparse.eye(3)}, "sparse"),
+    ):
         with pytest.raises(DataFormatError, match=f"class '{cls}'"):
             load_frf(mat5(**GOOD, **extra), filename="a.mat")
     cell = np.empty((1, 2), dtype=object)
@@ -293,8 +305,13 @@ def test_mat73_function_handles_structs_and_links_are_refused(tmp_path):
     def soft(h):
         h["alias"] = h5py.SoftLink("/freq")
 
-    for build, match in ((handle, "function_handle"), (struct, "struct"), (obj, "evil"),
-                         (external, "ExternalLink"), (soft, "SoftLink")):
+    for build, match in (
+        (handle, "function_handle"),
+        (struct, "struct"),
+        (obj, "evil"),
+        (external, "ExternalLink"),
+        (soft, "SoftLink"),
+    ):
         with pytest.raises(DataFormatError, match=match):
             load_frf(mat73(build), filename="a.mat")
 
@@ -342,8 +359,11 @@ def test_all_errors_are_value_errors_too():
 
 def test_named_nodes_are_renamed_to_spindle_and_bushing():
     Y = sdof(labels=("knuckle:z", "mount3:z"))
-    r = load_frf(save_frf(Y, format="csv"), filename="a.csv",
-                 nodes={"knuckle": "spindle", "mount3": "bushing"})
+    r = load_frf(
+        save_frf(Y, format="csv"),
+        filename="a.csv",
+        nodes={"knuckle": "spindle", "mount3": "bushing"},
+    )
     assert r.frf.outputs == ("spindle:z", "bushing:z") == r.frf.inputs
     np.testing.assert_array_equal(r.frf.data, Y.data)
 

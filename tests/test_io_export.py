@@ -25,9 +25,18 @@ def truncation_map() -> TruncationMap:
     centres = np.array([26.0, 30.0, 34.0])
     resp = rng.normal(size=(3, F.size, 2)) + 1j * rng.normal(size=(3, F.size, 2))
     return TruncationMap(
-        harmonic=3, n_modes=n, n_modes_total=30, centres=centres, dofs=DOFS,
-        error=rng.uniform(size=(3, 3, 2)), freq=F, response=resp, reference=resp[-1],
-        width=12.0, step=4.0, edges="clip",
+        harmonic=3,
+        n_modes=n,
+        n_modes_total=30,
+        centres=centres,
+        dofs=DOFS,
+        error=rng.uniform(size=(3, 3, 2)),
+        freq=F,
+        response=resp,
+        reference=resp[-1],
+        width=12.0,
+        step=4.0,
+        edges="clip",
     )
 
 
@@ -38,10 +47,23 @@ def scatter() -> ScatterBand:
     conv = Convergence(np.array([10, 100]), np.stack([lo, lo]), np.stack([hi, hi]))
     arg = np.zeros((F.size, 2), int)
     return ScatterBand(
-        freq=F, dofs=DOFS, reference=ref, lower=lo, upper=hi, argmin_round=arg,
-        argmax_round=arg, q=np.array([5.0, 95.0]), percentiles=np.stack([lo, hi]),
-        convergence=conv, noise=0.1, target="both", rounds=100, frequency_dependent=True,
-        seed=42, harmonic=1, _inputs=(),
+        freq=F,
+        dofs=DOFS,
+        reference=ref,
+        lower=lo,
+        upper=hi,
+        argmin_round=arg,
+        argmax_round=arg,
+        q=np.array([5.0, 95.0]),
+        percentiles=np.stack([lo, hi]),
+        convergence=conv,
+        noise=0.1,
+        target="both",
+        rounds=100,
+        frequency_dependent=True,
+        seed=42,
+        harmonic=1,
+        _inputs=(),
     )
 
 
@@ -104,8 +126,9 @@ def test_uff_export_of_functions_of_frequency(tmp_path):
 
 def test_coupled_frf_result_round_trips_through_every_export():
     w = 2 * np.pi * F
-    Y = FRF(F, (1j * w / (5e4 - 2 * w**2 + 3j * w))[:, None, None], ["bushing:z"],
-            ["patch"], "mobility")
+    Y = FRF(
+        F, (1j * w / (5e4 - 2 * w**2 + 3j * w))[:, None, None], ["bushing:z"], ["patch"], "mobility"
+    )
     for fmt, end in (("csv", "csv"), ("uff", "uff"), ("hdf5", "h5")):
         raw = export_result(Y, format=fmt, metadata={"harmonic": 1, "N": 40})
         if fmt == "csv":  # a result CSV holds one table per item; the FRF table loads
@@ -115,9 +138,11 @@ def test_coupled_frf_result_round_trips_through_every_export():
 
 
 def test_mapping_results_and_refusals(tmp_path):
-    res = {"error": (("n_modes", "freq"), np.ones((2, 3))),
-           "coords": {"n_modes": [10, 20], "freq": [1.0, 2.0, 3.0]},
-           "metadata": {"noise": 0.1}}
+    res = {
+        "error": (("n_modes", "freq"), np.ones((2, 3))),
+        "coords": {"n_modes": [10, 20], "freq": [1.0, 2.0, 3.0]},
+        "metadata": {"noise": 0.1},
+    }
     res["labels"] = (("n_modes", "k"), np.array([["a", "b"], ["c", "d"]]))
     p = export_result(res, tmp_path / "m.h5")
     with h5py.File(p, "r") as h:
@@ -126,8 +151,7 @@ def test_mapping_results_and_refusals(tmp_path):
     with pytest.raises(DataFormatError, match="cannot export a object"):
         export_result(object(), format="csv")
     with pytest.raises(DataFormatError, match="coordinate has 4"):
-        export_result({"e": (("a",), np.ones(3)), "coords": {"a": [1, 2, 3, 4]}},
-                      format="csv")
+        export_result({"e": (("a",), np.ones(3)), "coords": {"a": [1, 2, 3, 4]}}, format="csv")
     with pytest.raises(DataFormatError, match="no function of frequency"):
         export_result({"e": (("a",), np.ones(3))}, format="uff")
     with pytest.raises(DataFormatError, match="not 'mat'"):
@@ -137,10 +161,17 @@ def test_mapping_results_and_refusals(tmp_path):
 
 
 def test_suggested_modes_table_is_indexed_by_harmonic():
-    sm = SuggestedModes(harmonics=(1, 2, 3), n_modes=np.array([40, 70, 130]),
-                        eigenfrequency=np.array([144.0, 236.0, 347.0]),
-                        freq_range=np.array([[12.9, 51.5], [16.7, 67.0], [24.6, 97.9]]),
-                        threshold=0.2, f_max=160.0, speed=80.0, dof=None, maps=())
+    sm = SuggestedModes(
+        harmonics=(1, 2, 3),
+        n_modes=np.array([40, 70, 130]),
+        eigenfrequency=np.array([144.0, 236.0, 347.0]),
+        freq_range=np.array([[12.9, 51.5], [16.7, 67.0], [24.6, 97.9]]),
+        threshold=0.2,
+        f_max=160.0,
+        speed=80.0,
+        dof=None,
+        maps=(),
+    )
     res = as_result_data(sm)
     assert res.arrays["n_modes"][0] == ("harmonics",)
     assert res.arrays["freq_range"][0] == ("harmonics", "freq_range_dim1")
@@ -162,10 +193,12 @@ def test_hdf5_result_reads_back_with_axes_and_metadata(tmp_path):
     np.testing.assert_array_equal(v, band.percentiles)
     np.testing.assert_array_equal(res.coords["dofs"], DOFS)
     w = 2 * np.pi * F
-    Y = FRF(F, (1j * w / (5e4 - 2 * w**2 + 3j * w))[:, None, None], ["bushing:z"],
-            ["patch"], "mobility")
-    back = load_result(export_result({"coupled": Y, "metadata": {"N": 40}}, format="hdf5"),
-                       filename="r.h5")
+    Y = FRF(
+        F, (1j * w / (5e4 - 2 * w**2 + 3j * w))[:, None, None], ["bushing:z"], ["patch"], "mobility"
+    )
+    back = load_result(
+        export_result({"coupled": Y, "metadata": {"N": 40}}, format="hdf5"), filename="r.h5"
+    )
     assert back.frfs["coupled"].allclose(Y) and back.metadata["N"] == 40
     b = io.BytesIO()
     with h5py.File(b, "w") as h:

@@ -27,8 +27,9 @@ def small_tire(seed=0) -> TireModel:
     psi[:, 1::2] = psi[:, 0::2].conj()
     chi = psi.copy()
     part = rng.normal(size=(n_s, 1, 2 * n_p)) + 0j
-    return TireModel(np.array([20.0, 120.0]), poles, psi, chi, np.array([0.646]), part,
-                     meta={"supplier": "test"})
+    return TireModel(
+        np.array([20.0, 120.0]), poles, psi, chi, np.array([0.646]), part, meta={"supplier": "test"}
+    )
 
 
 def mat5(**v) -> bytes:
@@ -53,8 +54,14 @@ def test_tire_model_round_trip_gives_the_same_mobility(version):
 
 def _vars(tire=None, **changes):
     t = tire or small_tire()
-    v = dict(speeds=t.speeds, poles=t.poles, psi=t.psi, chi=t.chi,
-             wavelengths=t.wavelengths, participation=t.participation)
+    v = dict(
+        speeds=t.speeds,
+        poles=t.poles,
+        psi=t.psi,
+        chi=t.chi,
+        wavelengths=t.wavelengths,
+        participation=t.participation,
+    )
     v.update(changes)
     return {k: val for k, val in v.items() if val is not None}
 

@@ -137,8 +137,9 @@ def test_mat73_cell_array_labels_as_matlab_writes_them():
             del h[var]
             refs = []
             for k, lab in enumerate(getattr(Y, var)):
-                d = h.create_dataset(f"#refs#/{var}{k}",
-                                     data=np.array([[ord(c)] for c in lab], np.uint16))
+                d = h.create_dataset(
+                    f"#refs#/{var}{k}", data=np.array([[ord(c)] for c in lab], np.uint16)
+                )
                 d.attrs["MATLAB_class"] = np.bytes_("char")
                 d.attrs["MATLAB_int_decode"] = np.int32(2)
                 refs.append(d.ref)

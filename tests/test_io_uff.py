@@ -17,8 +17,14 @@ def pyuff_file(tmp_path, records, name="pyuff.uff", force_double=True):
     path = tmp_path / name
     uff = pyuff.UFF(str(path))
     for r in records:
-        base = dict(func_type=4, abscissa_spacing=1, abscissa_spec_data_type=18,
-                    ordinate_spec_data_type=12, orddenom_spec_data_type=13, binary=0)
+        base = dict(
+            func_type=4,
+            abscissa_spacing=1,
+            abscissa_spec_data_type=18,
+            ordinate_spec_data_type=12,
+            orddenom_spec_data_type=13,
+            binary=0,
+        )
         base.update(r)
         uff.write_sets(pyuff.prepare_58(**base), mode="add", force_double=force_double)
     return path
@@ -35,23 +41,40 @@ def test_pyuff_written_accelerances(tmp_path):
     A = sdof_accelerance(f)
     recs = []
     for node, d, scale in ((1, 3, 1.0), (2, 1, 0.5), (2, 5, 0.25)):
-        recs.append(dict(rsp_node=node, rsp_dir=d, ref_node=1, ref_dir=3,
-                         data=A * scale, x=f, id1="measured"))
+        recs.append(
+            dict(
+                rsp_node=node, rsp_dir=d, ref_node=1, ref_dir=3, data=A * scale, x=f, id1="measured"
+            )
+        )
     p = pyuff_file(tmp_path, recs)
     r = load_frf(p, nodes={1: "spindle", 2: "bushing"})
     assert r.frf.quantity == "accelerance"
     assert r.frf.outputs == ("spindle:z", "bushing:x", "bushing:ry")
     assert r.frf.inputs == ("spindle:z",)
     np.testing.assert_allclose(r.frf.freq, f)
-    np.testing.assert_allclose(r.frf.data[:, :, 0],
-                               np.stack([A, 0.5 * A, 0.25 * A], axis=1), rtol=1e-10)
+    np.testing.assert_allclose(
+        r.frf.data[:, :, 0], np.stack([A, 0.5 * A, 0.25 * A], axis=1), rtol=1e-10
+    )
 
 
 def test_pyuff_uneven_binary_and_negative_directions(tmp_path):
     f = np.array([1.0, 1.5, 3.0, 7.5, 12.0])
     A = sdof_accelerance(f)
-    p = pyuff_file(tmp_path, [dict(rsp_node=4, rsp_dir=-2, ref_node=4, ref_dir=2, data=A, x=f,
-                                   abscissa_spacing=0, binary=1)])
+    p = pyuff_file(
+        tmp_path,
+        [
+            dict(
+                rsp_node=4,
+                rsp_dir=-2,
+                ref_node=4,
+                ref_dir=2,
+                data=A,
+                x=f,
+                abscissa_spacing=0,
+                binary=1,
+            )
+        ],
+    )
     r = load_frf(p)
     assert r.frf.outputs == ("4:y",) and r.frf.inputs == ("4:y",)
     np.testing.assert_allclose(r.frf.data[:, 0, 0], -A, rtol=1e-12)
@@ -61,16 +84,21 @@ def test_pyuff_uneven_binary_and_negative_directions(tmp_path):
 def test_pyuff_single_precision(tmp_path):
     f = np.arange(1, 21) * 1.0
     A = sdof_accelerance(f)
-    p = pyuff_file(tmp_path, [dict(rsp_node=1, rsp_dir=3, ref_node=1, ref_dir=3, data=A, x=f,
-                                   ord_data_type=5)], force_double=False)
+    p = pyuff_file(
+        tmp_path,
+        [dict(rsp_node=1, rsp_dir=3, ref_node=1, ref_dir=3, data=A, x=f, ord_data_type=5)],
+        force_double=False,
+    )
     r = load_frf(p)
     np.testing.assert_allclose(r.frf.data[:, 0, 0], A, rtol=1e-5)
 
 
 def test_pyuff_scalar_direction_gives_generalised_dof(tmp_path):
     f = np.arange(1, 6) * 1.0
-    p = pyuff_file(tmp_path, [dict(rsp_node=1, rsp_dir=3, ref_node=9, ref_dir=0,
-                                   data=sdof_accelerance(f), x=f)])
+    p = pyuff_file(
+        tmp_path,
+        [dict(rsp_node=1, rsp_dir=3, ref_node=9, ref_dir=0, data=sdof_accelerance(f), x=f)],
+    )
     assert load_frf(p, nodes={9: "patch", 1: "hub"}).frf.inputs == ("patch",)
 
 
@@ -117,8 +145,7 @@ NONE
 
 
 def test_hand_written_from_the_specification():
-    r = load_frf(HAND_WRITTEN.encode(), filename="hand.uff",
-                 nodes={1: "spindle", 2: "bushing"})
+    r = load_frf(HAND_WRITTEN.encode(), filename="hand.uff", nodes={1: "spindle", 2: "bushing"})
     frf = r.frf
     assert frf.quantity == "mobility"
     assert frf.outputs == ("bushing:z", "bushing:x") and frf.inputs == ("spindle:z",)
@@ -141,10 +168,13 @@ def test_hand_written_variants_are_refused_with_reasons():
     with pytest.raises(DOFError, match="direction code 7"):
         load_frf(bad, filename="x.uff")
     # force over displacement is a dynamic stiffness
-    bad = _edit(HAND_WRITTEN, "        11    0    0    0 Velocity             m/s\n"
-                "        13    0    0    0 Force                N",
-                "        13    0    0    0 Force                N\n"
-                "         8    0    0    0 Displacement         m")
+    bad = _edit(
+        HAND_WRITTEN,
+        "        11    0    0    0 Velocity             m/s\n"
+        "        13    0    0    0 Force                N",
+        "        13    0    0    0 Force                N\n"
+        "         8    0    0    0 Displacement         m",
+    )
     with pytest.raises(QuantityError, match="inverse FRF"):
         load_frf(bad, filename="x.uff")
     # a velocity whose units say acceleration
@@ -167,8 +197,9 @@ def test_hand_written_variants_are_refused_with_reasons():
     with pytest.raises(DataFormatError, match="announces 4 values"):
         load_frf(bad, filename="x.uff")
     # time data is not an FRF
-    bad = _edit(HAND_WRITTEN, "        18    0    0    0 Frequency",
-                "        17    0    0    0 Time     ")
+    bad = _edit(
+        HAND_WRITTEN, "        18    0    0    0 Frequency", "        17    0    0    0 Time     "
+    )
     with pytest.raises(DataFormatError, match="frequency"):
         load_frf(bad, filename="x.uff")
     # a coherence record alone: no FRF
@@ -181,8 +212,13 @@ def test_hand_written_variants_are_refused_with_reasons():
 def test_missing_pair_is_named(tmp_path):
     f = np.arange(1, 6) * 1.0
     A = sdof_accelerance(f)
-    p = pyuff_file(tmp_path, [dict(rsp_node=1, rsp_dir=3, ref_node=1, ref_dir=3, data=A, x=f),
-                              dict(rsp_node=2, rsp_dir=3, ref_node=1, ref_dir=1, data=A, x=f)])
+    p = pyuff_file(
+        tmp_path,
+        [
+            dict(rsp_node=1, rsp_dir=3, ref_node=1, ref_dir=3, data=A, x=f),
+            dict(rsp_node=2, rsp_dir=3, ref_node=1, ref_dir=1, data=A, x=f),
+        ],
+    )
     with pytest.raises(DataFormatError, match="1:z/1:x"):
         load_frf(p)
 

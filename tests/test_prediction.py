@@ -31,8 +31,7 @@ def _direct(k: int, coupling: str, speed: float, freq_key: tuple) -> np.ndarray:
     pos = {d: i for i, d in enumerate(S.dofs)}
     load = np.zeros(S.n, complex)
     load[[pos[f"tire/{d}"] for d in ts.dofs]] = tire.patch_load(speed, h.wavelength)
-    D = S.frf(np.array(freq_key), [f"chassis/{b}" for b in BUSHING], [],
-              loads={"patch": load})
+    D = S.frf(np.array(freq_key), [f"chassis/{b}" for b in BUSHING], [], loads={"patch": load})
     return D.data
 
 

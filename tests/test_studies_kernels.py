@@ -46,8 +46,19 @@ def _numba_solve(A, b):
     for x in args:
         x.setflags(write=False)  # the signature the library compiles
     out = np.empty((1, m, n), complex)
-    _kernels.noisy_block_run(*args, 0, m, _rng.seed_key(0), np.zeros(1, np.int64), 0.0, False,
-                             False, False, np.empty((0, 0, 0)), out)
+    _kernels.noisy_block_run(
+        *args,
+        0,
+        m,
+        _rng.seed_key(0),
+        np.zeros(1, np.int64),
+        0.0,
+        False,
+        False,
+        False,
+        np.empty((0, 0, 0)),
+        out,
+    )
     return out[0]
 
 
@@ -69,8 +80,9 @@ def test_numba_solve_any_small_size(n):
     rng = np.random.default_rng(n)
     A = _rand_c(rng, 40, n, n)
     b = _rand_c(rng, 40, n)
-    np.testing.assert_allclose(_numba_solve(A, b), np.linalg.solve(A, b[..., None])[..., 0],
-                               rtol=1e-10)
+    np.testing.assert_allclose(
+        _numba_solve(A, b), np.linalg.solve(A, b[..., None])[..., 0], rtol=1e-10
+    )
 
 
 def test_numpy_factors_equal_kernel_factors():
@@ -80,15 +92,25 @@ def test_numpy_factors_equal_kernel_factors():
     a = np.ones((m, n), complex)
     eye = np.ascontiguousarray(np.broadcast_to(np.eye(n), (m, n, n)))
     zero = np.zeros((m, n, n))
-    args = [eye, zero, a.real.copy(), a.imag.copy(), zero, zero, eye, zero,
-            np.tile(np.arange(n), (m, 1))]
+    args = [
+        eye,
+        zero,
+        a.real.copy(),
+        a.imag.copy(),
+        zero,
+        zero,
+        eye,
+        zero,
+        np.tile(np.arange(n), (m, 1)),
+    ]
     for x in args:
         x.setflags(write=False)
     rids = np.array([0, 7, 33], np.int64)
     out = np.empty((3, m, n), complex)
     key = _rng.seed_key(9)
-    _kernels.noisy_block_run(*args, 0, m, key, rids, 0.1, True, False, True,
-                             np.empty((0, 0, 0)), out)
+    _kernels.noisy_block_run(
+        *args, 0, m, key, rids, 0.1, True, False, True, np.empty((0, 0, 0)), out
+    )
     lines = np.tile(np.arange(m), 3)
     s = _kernels.noise_factors(key, np.repeat(rids, m), lines, 0.1, n, n, True, False)
     S = fc.studies.scatter.split_factors(s.reshape(3, m, -1), n, n)
@@ -112,8 +134,9 @@ def test_lane_kernel_equals_numpy_on_random_systems():
         args.append(_kernels.pivot_order(A, E))
         for x in args:
             x.setflags(write=False)
-        _kernels.noisy_block_run(*args, 0, nf, key, rids, 0.1, True, True, fd,
-                                 np.empty((0, 0, 0)), out)
+        _kernels.noisy_block_run(
+            *args, 0, nf, key, rids, 0.1, True, True, fd, np.empty((0, 0, 0)), out
+        )
         lines = np.tile(np.arange(nf) if fd else np.zeros(nf, np.int64), rids.size)
         s = _kernels.noise_factors(key, np.repeat(rids, nf), lines, 0.1, nj, ne, True, True)
         S = fc.studies.scatter.split_factors(s.reshape(rids.size, nf, -1), nj, ne)
@@ -142,13 +165,33 @@ def test_row_order_changes_no_result():
     # the kernel pre-orders rows by pivoting; any other order gives the same solution
     eye = np.ascontiguousarray(np.broadcast_to(np.eye(n), (m, n, n)))
     zero = np.zeros((m, n, n))
-    args = [A.real.copy(), A.imag.copy(), b.real.copy(), b.imag.copy(), zero, zero, eye, zero,
-            np.tile(np.arange(n)[::-1].copy(), (m, 1))]
+    args = [
+        A.real.copy(),
+        A.imag.copy(),
+        b.real.copy(),
+        b.imag.copy(),
+        zero,
+        zero,
+        eye,
+        zero,
+        np.tile(np.arange(n)[::-1].copy(), (m, 1)),
+    ]
     for y in args:
         y.setflags(write=False)
     out = np.empty((1, m, n), complex)
-    _kernels.noisy_block_run(*args, 0, m, _rng.seed_key(0), np.zeros(1, np.int64), 0.0, False,
-                             False, False, np.empty((0, 0, 0)), out)
+    _kernels.noisy_block_run(
+        *args,
+        0,
+        m,
+        _rng.seed_key(0),
+        np.zeros(1, np.int64),
+        0.0,
+        False,
+        False,
+        False,
+        np.empty((0, 0, 0)),
+        out,
+    )
     np.testing.assert_allclose(out[0], x, rtol=1e-10)
 
 
@@ -232,8 +275,9 @@ def test_band_percentiles_when_the_sample_misleads():
     m = _kernels._SAMPLE
     col[(np.arange(m) * R) // m] = 1e-3 * (1 + np.arange(m))  # sample: all tiny
     col[1] = 1e9  # an outlier: the histogram's bins are too coarse, it declines too
-    assert not _kernels._order_stats_histogram(col, col.min(), col.max(),
-                                               np.array([R // 2]), np.empty(1))
+    assert not _kernels._order_stats_histogram(
+        col, col.min(), col.max(), np.array([R // 2]), np.empty(1)
+    )
     mag = np.ascontiguousarray(np.broadcast_to(col, (1, 1, R)))
     qs = (5.0, 50.0, 95.0)
     _, pct = _stats(mag.copy(), qs)

@@ -76,8 +76,8 @@ def test_batch_axes_broadcast_like_a_loop():
     for n in range(4):
         for d in range(3):
             np.testing.assert_allclose(
-                e[n, :, d], floating_band_error(F, vt[:, d], vm[n, :, d], 8.0, 2.0)[1],
-                rtol=1e-13)
+                e[n, :, d], floating_band_error(F, vt[:, d], vm[n, :, d], 8.0, 2.0)[1], rtol=1e-13
+            )
 
 
 def test_width_and_step_are_settable_and_default_to_thesis():

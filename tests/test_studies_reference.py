@@ -71,9 +71,12 @@ def test_scatter_band_on_reference_models():
     C = fc.reference_chassis().mobility(f)
     spindle = [f"spindle:{d}" for d in fc.DIRECTIONS]
     r = fc.coupling.couple_response(
-        C.sel(outputs=[f"bushing:{d}" for d in fc.DIRECTIONS]), fc.FRF(f, Y[0], hub, hub),
-        C.sel(outputs=spindle), fc.FRF(f, v[0][..., None], hub, ["patch"]),
-        interface=list(zip(hub, spindle, strict=True)))
+        C.sel(outputs=[f"bushing:{d}" for d in fc.DIRECTIONS]),
+        fc.FRF(f, Y[0], hub, hub),
+        C.sel(outputs=spindle),
+        fc.FRF(f, v[0][..., None], hub, ["patch"]),
+        interface=list(zip(hub, spindle, strict=True)),
+    )
     np.testing.assert_allclose(b0.reference, r.data[..., 0], rtol=1e-9)
     b = fc.scatter_band(4, noise=0.1, rounds=500, frequency_dependent=True, seed=1)
     assert np.all(b.lower <= mag) and np.all(mag <= b.upper)

@@ -39,7 +39,7 @@ def arrays():
     YjjA = YA[:, :NJ, :NJ]
     vj = YA[:, :NJ, NJ:] @ np.array([1.0, -0.5, 0.3])  # load on A's internal DOFs
     YjjE = YE[:, :NJ, :NJ]
-    YejE = YE[:, NJ:NJ + NE, :NJ]
+    YejE = YE[:, NJ : NJ + NE, :NJ]
     return YjjA, vj, YjjE, YejE
 
 
@@ -56,8 +56,9 @@ def test_zero_noise_reproduces_the_reference_exactly(arrays):
     np.testing.assert_array_equal(b.percentiles, np.broadcast_to(ref, b.percentiles.shape))
     # the reference is eq. 4.1 (second method: numpy batched solve)
     YjjA, vj, YjjE, YejE = arrays
-    np.testing.assert_allclose(b.reference, kernels.couple_response_kernel(YejE, YjjA, YjjE, vj),
-                               rtol=1e-10)
+    np.testing.assert_allclose(
+        b.reference, kernels.couple_response_kernel(YejE, YjjA, YjjE, vj), rtol=1e-10
+    )
 
 
 @pytest.mark.parametrize("fd", [False, True], ids=["freq-independent", "freq-dependent"])
@@ -68,8 +69,9 @@ def test_every_round_inside_band_and_band_is_the_extremes(arrays, fd, target):
     assert np.all(all_rounds >= b.lower) and np.all(all_rounds <= b.upper)
     np.testing.assert_array_equal(b.lower, all_rounds.min(0))
     np.testing.assert_array_equal(b.upper, all_rounds.max(0))
-    np.testing.assert_allclose(b.percentiles, np.percentile(all_rounds, (5, 50, 95), axis=0),
-                               rtol=1e-13)
+    np.testing.assert_allclose(
+        b.percentiles, np.percentile(all_rounds, (5, 50, 95), axis=0), rtol=1e-13
+    )
     # the recorded rounds attain the extremes
     li, di = np.meshgrid(np.arange(NF), np.arange(NE), indexing="ij")
     np.testing.assert_array_equal(all_rounds[b.argmax_round, li, di], b.upper)
@@ -92,8 +94,9 @@ def test_regenerated_round_equals_the_batch(arrays):
     S = [b.factors(r, line=k) for k in range(NF)]
     st = {k: np.stack([s[k] for s in S]) for k in S[0]}
     x = np.linalg.solve(st["Yjj_A"] * YjjA + st["Yjj_E"] * YjjE, (st["vj_A"] * vj)[..., None])
-    np.testing.assert_allclose(one, np.einsum("fek,fk->fe", st["Yej_E"] * YejE, x[..., 0]),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        one, np.einsum("fek,fk->fe", st["Yej_E"] * YejE, x[..., 0]), rtol=1e-9
+    )
 
 
 def test_tire_noise_leaves_vehicle_untouched_and_vice_versa(arrays):
@@ -127,8 +130,9 @@ def test_frequency_independent_noise_is_one_set_per_round(arrays):
     # one set per round: every curve is the reference with fixed scaled matrices
     YjjA, vj, YjjE, YejE = arrays
     S = fi.factors(8)
-    ref = kernels.couple_response_kernel(S["Yej_E"] * YejE, S["Yjj_A"] * YjjA,
-                                         S["Yjj_E"] * YjjE, S["vj_A"] * vj)
+    ref = kernels.couple_response_kernel(
+        S["Yej_E"] * YejE, S["Yjj_A"] * YjjA, S["Yjj_E"] * YjjE, S["vj_A"] * vj
+    )
     np.testing.assert_allclose(fi.round(8), ref, rtol=1e-9)
 
 
@@ -245,7 +249,8 @@ def test_concurrent_bands_from_threads_agree(arrays):
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(3) as ex:
-        bands = list(ex.map(lambda s: _band(arrays, seed=s % 2, frequency_dependent=True),
-                            range(4)))
+        bands = list(
+            ex.map(lambda s: _band(arrays, seed=s % 2, frequency_dependent=True), range(4))
+        )
     np.testing.assert_array_equal(bands[0].upper, bands[2].upper)
     np.testing.assert_array_equal(bands[1].upper, bands[3].upper)

@@ -150,8 +150,12 @@ def test_map_equals_metric_of_direct_truncated_couplings(tire, chassis):
     out = []
     for k in range(3):
         r = fc.coupling.couple_response(
-            Yej, fc.FRF(FREQ, Y[k], hub, hub), YjjE, fc.FRF(FREQ, v[k][..., None], hub, ["patch"]),
-            interface=pairs)
+            Yej,
+            fc.FRF(FREQ, Y[k], hub, hub),
+            YjjE,
+            fc.FRF(FREQ, v[k][..., None], hub, ["patch"]),
+            interface=pairs,
+        )
         out.append(r.data[..., 0])
     np.testing.assert_allclose(m.response, np.stack(out[:2]), rtol=1e-9)
     c, e = fc.studies.floating_band_error(FREQ, out[2], np.stack(out[:2]), 8.0, 2.0)
@@ -175,12 +179,14 @@ def test_arrays_entry_point_carries_axes(tire, chassis):
 def test_suggest_reads_the_stays_below_rule():
     c = np.array([20.0, 40.0, 60.0])
     n = np.array([10, 20, 30, 40])
-    err = np.array([
-        [0.5, 0.5, 0.9],
-        [0.1, 0.1, 0.9],  # fine up to 40 Hz
-        [0.1, 0.3, 0.1],  # rises again at 40 Hz
-        [0.1, 0.1, 0.1],
-    ])
+    err = np.array(
+        [
+            [0.5, 0.5, 0.9],
+            [0.1, 0.1, 0.9],  # fine up to 40 Hz
+            [0.1, 0.3, 0.1],  # rises again at 40 Hz
+            [0.1, 0.1, 0.1],
+        ]
+    )
     assert suggest_n_modes(err, c, n, 0.2, f_max=40.0) == 40  # 20 fails to stay below
     assert suggest_n_modes(err, c, n, 0.35, f_max=40.0) == 20
     assert suggest_n_modes(err, c, n, 0.2, f_max=20.0) == 20

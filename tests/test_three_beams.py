@@ -129,10 +129,12 @@ def test_three_beams_coupled_equal_direct_solution(method):
 def test_fig_3_2_transfer_node_5_to_307():
     """Fig. 3.2: transfer from node 5 (a0) to node 307 (j2), both methods and direct."""
     Y = _separate()
-    rc = couple_receptance(couple_receptance(Y["a"], Y["b"], node_labels("j1")), Y["c"],
-                           node_labels("j2")).sel(outputs="j2:z", inputs="a0:z")
-    ic = couple_impedance(couple_impedance(Y["a"], Y["b"], node_labels("j1")), Y["c"],
-                          node_labels("j2")).sel(outputs="j2:z", inputs="a0:z")
+    rc = couple_receptance(
+        couple_receptance(Y["a"], Y["b"], node_labels("j1")), Y["c"], node_labels("j2")
+    ).sel(outputs="j2:z", inputs="a0:z")
+    ic = couple_impedance(
+        couple_impedance(Y["a"], Y["b"], node_labels("j1")), Y["c"], node_labels("j2")
+    ).sel(outputs="j2:z", inputs="a0:z")
     d = _direct().sel(outputs="j2:z", inputs="a0:z")
     scale = np.abs(d.data)
     assert np.max(np.abs(rc.data - d.data) / scale) < 1e-8

@@ -69,8 +69,9 @@ def test_patch_response_follows_the_speed_line(tire):
     for k, speed in enumerate((80.0, 100.0)):
         s = tire.system(speed)
         vd = s.frf([f[::-1][k]], HUB_DOFS, [], loads={"p": tire.patch_load(speed, h.wavelength)})
-        np.testing.assert_allclose(v[k], vd.data[0, :, 0], rtol=1e-6,
-                                   atol=1e-9 * np.abs(vd.data).max())
+        np.testing.assert_allclose(
+            v[k], vd.data[0, :, 0], rtol=1e-6, atol=1e-9 * np.abs(vd.data).max()
+        )
 
 
 def test_interpolation_between_operating_points(tire):
@@ -100,8 +101,12 @@ def test_truncations_equal_separate_syntheses(tire):
     Yjj, vj = tire.truncations(f, h, ns)
     assert Yjj.shape == (4, f.size, 6, 6) and vj.shape == (4, f.size, 6)
     for i, n in enumerate(ns):
-        np.testing.assert_allclose(vj[i], tire.patch_response(f, h, n_modes=n).data[:, :, 0],
-                                   rtol=1e-10, atol=1e-12 * np.abs(vj[-1]).max())
+        np.testing.assert_allclose(
+            vj[i],
+            tire.patch_response(f, h, n_modes=n).data[:, :, 0],
+            rtol=1e-10,
+            atol=1e-12 * np.abs(vj[-1]).max(),
+        )
     # brute force at single lines: sum of the first N modes at the interpolated speed
     for j in (0, f.size // 2, f.size - 1):
         speed = h.speed_at(f[j])
@@ -170,25 +175,33 @@ def test_bad_harmonics_and_frequencies(tire):
 
 
 def test_model_without_parameters_has_no_matrices(tire):
-    bare = TireModel(tire.speeds, tire.poles, tire.psi, tire.chi, tire.wavelengths,
-                     tire.participation)
-    np.testing.assert_allclose(bare.hub_mobility([30.0], 60.0).data,
-                               tire.hub_mobility([30.0], 60.0).data)
+    bare = TireModel(
+        tire.speeds, tire.poles, tire.psi, tire.chi, tire.wavelengths, tire.participation
+    )
+    np.testing.assert_allclose(
+        bare.hub_mobility([30.0], 60.0).data, tire.hub_mobility([30.0], 60.0).data
+    )
     with pytest.raises(DataFormatError, match="no physical parameters"):
         bare.system(60.0)
 
 
 def test_inconsistent_model_data(tire):
     with pytest.raises(DataFormatError, match="psi has shape"):
-        TireModel(tire.speeds, tire.poles, tire.psi[:, :10], tire.chi, tire.wavelengths,
-                  tire.participation)
+        TireModel(
+            tire.speeds,
+            tire.poles,
+            tire.psi[:, :10],
+            tire.chi,
+            tire.wavelengths,
+            tire.participation,
+        )
     for bad in (tire.poles[:, ::-1], np.repeat(tire.poles[:, 0::2], 2, axis=1)):
         with pytest.raises(DataFormatError, match="conjugate pairs"):
-            TireModel(tire.speeds, bad, tire.psi, tire.chi, tire.wavelengths,
-                      tire.participation)
+            TireModel(tire.speeds, bad, tire.psi, tire.chi, tire.wavelengths, tire.participation)
     with pytest.raises(DataFormatError, match="increasing"):
-        TireModel(tire.speeds[::-1], tire.poles, tire.psi, tire.chi, tire.wavelengths,
-                  tire.participation)
+        TireModel(
+            tire.speeds[::-1], tire.poles, tire.psi, tire.chi, tire.wavelengths, tire.participation
+        )
 
 
 def test_shipped_file_is_reproducible(tmp_path):

@@ -173,8 +173,9 @@ def test_first_belt_radial_modes_between_80_and_100_hz():
     M, _, _, K = system_matrices(0.0)
     w2, phi = sla.eigh(K, M)
     labels = belt_labels()
-    ring_cols = 6 + np.flatnonzero([lab.startswith("belt.ip.") and not lab.endswith("n00")
-                                    for lab in labels])
+    ring_cols = 6 + np.flatnonzero(
+        [lab.startswith("belt.ip.") and not lab.endswith("n00") for lab in labels]
+    )
     e = phi**2 * np.diag(M)[:, None]
     share = e[ring_cols].sum(0) / e.sum(0)
     f = np.sqrt(w2) / (2 * np.pi)
@@ -213,8 +214,11 @@ def test_short_wavelengths_excite_higher_orders():
     from fbs_core.harmonics import HARMONICS
 
     labels = belt_labels()
-    radial = [(i, int(lab.split(".")[2][1:3])) for i, lab in enumerate(labels)
-              if lab.startswith("belt.w2.")]
+    radial = [
+        (i, int(lab.split(".")[2][1:3]))
+        for i, lab in enumerate(labels)
+        if lab.startswith("belt.w2.")
+    ]
     R = DEFAULT_PARAMETERS.R
     dominant, high_share = [], []
     for h in HARMONICS[:6]:

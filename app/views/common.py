@@ -54,8 +54,15 @@ def _encoded(text: str) -> str:
     return html.escape(f"<p>{inline_html(text)}</p>")
 
 
-def live_text(text: Callable[[], str], watch: list[tuple], *, css_classes=(), styles=None,
-              margin=(0, 10), height=None) -> pn.pane.Bokeh:
+def live_text(
+    text: Callable[[], str],
+    watch: list[tuple],
+    *,
+    css_classes=(),
+    styles=None,
+    margin=(0, 10),
+    height=None,
+) -> pn.pane.Bokeh:
     """A line of text showing ``text()``, rewritten when a watched parameter changes.
 
     ``watch`` holds ``(parameterized, [parameter names])`` pairs; ``text`` may use
@@ -66,15 +73,21 @@ def live_text(text: Callable[[], str], watch: list[tuple], *, css_classes=(), st
     several times as much per rewrite (markdown rendering, Panel's per-property
     bookkeeping), three rewrites per control change.
     """
-    div = PanelHTML(text=_encoded(text()), css_classes=list(css_classes),
-                    styles=dict(styles or {}), margin=margin, height=height,
-                    sizing_mode="stretch_width")
+    div = PanelHTML(
+        text=_encoded(text()),
+        css_classes=list(css_classes),
+        styles=dict(styles or {}),
+        margin=margin,
+        height=height,
+        sizing_mode="stretch_width",
+    )
     pusher = Pusher()
 
     def rewrite(*_):
         def make():
             new = _encoded(text())
             return lambda: None if div.text == new else setattr(div, "text", new)
+
         pusher(make)
 
     for obj, names in watch:
@@ -82,8 +95,9 @@ def live_text(text: Callable[[], str], watch: list[tuple], *, css_classes=(), st
     return pn.pane.Bokeh(div, sizing_mode="stretch_width", margin=0)
 
 
-def download_button(view: str, columns: Callable[[], dict], meta: Callable[[], dict],
-                    filename: Callable[[], str]) -> pn.widgets.FileDownload:
+def download_button(
+    view: str, columns: Callable[[], dict], meta: Callable[[], dict], filename: Callable[[], str]
+) -> pn.widgets.FileDownload:
     """A CSV download of the data behind a view, built when clicked."""
 
     def callback():
@@ -92,8 +106,12 @@ def download_button(view: str, columns: Callable[[], dict], meta: Callable[[], d
         return io.StringIO(to_csv(columns(), m, view))
 
     btn = pn.widgets.FileDownload(
-        callback=callback, filename=filename(), label="CSV", button_type="light",
-        width=90, embed=False,
+        callback=callback,
+        filename=filename(),
+        label="CSV",
+        button_type="light",
+        width=90,
+        embed=False,
         css_classes=[f"download-{view}"],
     )
     return btn

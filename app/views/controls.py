@@ -32,35 +32,45 @@ class Controls(Viewer):
             W = pn.widgets
             self._widgets = {
                 "case.harmonic": W.IntSlider.from_param(
-                    c.param.harmonic, name="Harmonic case", start=1, end=7, step=1),
+                    c.param.harmonic, name="Harmonic case", start=1, end=7, step=1
+                ),
                 "case.n_modes": W.DiscreteSlider.from_param(
-                    c.param.n_modes, name="Retained tire modes N"),
+                    c.param.n_modes, name="Retained tire modes N"
+                ),
                 "case.dof": W.RadioButtonGroup.from_param(
-                    c.param.dof, name="Response DOF at the bushing"),
+                    c.param.dof, name="Response DOF at the bushing"
+                ),
                 "case.coupling": W.RadioButtonGroup.from_param(
-                    c.param.coupling, name="Hub coupling"),
+                    c.param.coupling, name="Hub coupling"
+                ),
                 "case.show_uncoupled": W.Checkbox.from_param(
-                    c.param.show_uncoupled, name="Show uncoupled tire and chassis FRFs"),
+                    c.param.show_uncoupled, name="Show uncoupled tire and chassis FRFs"
+                ),
                 "truncation.threshold": W.EditableFloatSlider.from_param(
-                    t.param.threshold, name="Error threshold (%)", format="0.0"),
+                    t.param.threshold, name="Error threshold (%)", format="0.0"
+                ),
                 "truncation.f_max": W.EditableFloatSlider.from_param(
-                    t.param.f_max, name="Upper frequency for suggestion (Hz)", format="0"),
+                    t.param.f_max, name="Upper frequency for suggestion (Hz)", format="0"
+                ),
                 "truncation.map_mode": W.RadioButtonGroup.from_param(
-                    t.param.map_mode, name="Error map of"),
+                    t.param.map_mode, name="Error map of"
+                ),
                 "noise.noise": W.EditableFloatSlider.from_param(
-                    n.param.noise, name="Noise level p (%)", format="0.0"),
-                "noise.target": W.RadioButtonGroup.from_param(
-                    n.param.target, name="Noise in"),
+                    n.param.noise, name="Noise level p (%)", format="0.0"
+                ),
+                "noise.target": W.RadioButtonGroup.from_param(n.param.target, name="Noise in"),
                 "noise.frequency_dependent": W.Checkbox.from_param(
                     n.param.frequency_dependent,
-                    name="Frequency-dependent noise (new S at every line)"),
-                "noise.rounds": W.IntInput.from_param(
-                    n.param.rounds, name="Rounds R", step=1000),
+                    name="Frequency-dependent noise (new S at every line)",
+                ),
+                "noise.rounds": W.IntInput.from_param(n.param.rounds, name="Rounds R", step=1000),
                 "noise.seed": W.IntInput.from_param(n.param.seed, name="Seed"),
                 "noise.single_round": W.IntInput.from_param(
-                    n.param.single_round, name="Single round #"),
+                    n.param.single_round, name="Single round #"
+                ),
                 "noise.percentile": W.Select.from_param(
-                    n.param.percentile, name="Central percentile band (%)"),
+                    n.param.percentile, name="Central percentile band (%)"
+                ),
             }
             for key, w in self._widgets.items():
                 w.css_classes = [*w.css_classes, "ctl-" + key.replace(".", "-")]
@@ -72,18 +82,24 @@ class Controls(Viewer):
         label = pn.pane.Markdown
         return pn.Column(
             label("#### Case", margin=(0, 5)),
-            w["case.harmonic"], w["case.n_modes"],
-            label("Response DOF at the bushing", margin=(0, 10)), w["case.dof"],
+            w["case.harmonic"],
+            w["case.n_modes"],
+            label("Response DOF at the bushing", margin=(0, 10)),
+            w["case.dof"],
             label("Hub coupling: 6 DOFs (braked) / 5 DOFs (spin free)", margin=(0, 10)),
-            w["case.coupling"], w["case.show_uncoupled"],
+            w["case.coupling"],
+            w["case.show_uncoupled"],
             pn.layout.Divider(),
             label("#### Truncation study", margin=(0, 5)),
-            w["truncation.threshold"], w["truncation.f_max"],
-            label("Error map of", margin=(0, 10)), w["truncation.map_mode"],
+            w["truncation.threshold"],
+            w["truncation.f_max"],
+            label("Error map of", margin=(0, 10)),
+            w["truncation.map_mode"],
             pn.layout.Divider(),
             label("#### Noise study", margin=(0, 5)),
             w["noise.noise"],
-            label("Noise in", margin=(0, 10)), w["noise.target"],
+            label("Noise in", margin=(0, 10)),
+            w["noise.target"],
             w["noise.frequency_dependent"],
             pn.Row(w["noise.rounds"], w["noise.seed"]),
             pn.Row(w["noise.single_round"]),

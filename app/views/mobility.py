@@ -29,8 +29,10 @@ class MobilityView(Viewer):
     """Coupled bushing response v_e* in dB versus frequency (thesis eq. 4.1)."""
 
     case = param.ClassSelector(class_=CaseState)
-    x_range = param.Parameter(default=None, doc="Frequency range shared with other views "
-                              "(linked zoom and pan); a new one if None.")
+    x_range = param.Parameter(
+        default=None,
+        doc="Frequency range shared with other views (linked zoom and pan); a new one if None.",
+    )
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -46,9 +48,12 @@ class MobilityView(Viewer):
         c = self.case
         return {
             "view": "coupled bushing response v_e* (thesis eq. 4.1)",
-            "harmonic": c.harmonic, "N (retained tire modes)": c.n_modes,
-            "reference": "all tire modes", "response DOF": f"bushing:{c.dof}",
-            "coupling": c.coupling, "unit": compute.level_unit(c.dof),
+            "harmonic": c.harmonic,
+            "N (retained tire modes)": c.n_modes,
+            "reference": "all tire modes",
+            "response DOF": f"bushing:{c.dof}",
+            "coupling": c.coupling,
+            "unit": compute.level_unit(c.dof),
             "models": c.models.describe(),
         }
 
@@ -56,15 +61,28 @@ class MobilityView(Viewer):
     def _build(self):
         if self.x_range is None:
             self.x_range = frequency_range()
-        fig = new_figure(x_label=FREQ_LABEL, y_label=level_label(self.case.dof),
-                         x_range=self.x_range, name="mobility.figure")
+        fig = new_figure(
+            x_label=FREQ_LABEL,
+            y_label=level_label(self.case.dof),
+            x_range=self.x_range,
+            name="mobility.figure",
+        )
         self._fig = fig
-        self._ref = add_line(fig, "mobility.reference", color=COLORS["reference"],
-                             legend="all modes (reference)",
-                             tooltips=level_tooltips("all modes"))
-        self._tr = add_line(fig, "mobility.truncated", color=COLORS["truncated"],
-                            legend="N retained modes", dash="dashed",
-                            tooltips=level_tooltips("N retained modes"))
+        self._ref = add_line(
+            fig,
+            "mobility.reference",
+            color=COLORS["reference"],
+            legend="all modes (reference)",
+            tooltips=level_tooltips("all modes"),
+        )
+        self._tr = add_line(
+            fig,
+            "mobility.truncated",
+            color=COLORS["truncated"],
+            legend="N retained modes",
+            dash="dashed",
+            tooltips=level_tooltips("N retained modes"),
+        )
         self._apply(self.data(), self.case.dof)()
         self.case.param.watch(self._changed, CASE_KEYS)
         return fig
@@ -88,7 +106,9 @@ class MobilityView(Viewer):
             return self._layout
         c = self.case
         dl = download_button(
-            "mobility", self._csv_columns, self.meta,
+            "mobility",
+            self._csv_columns,
+            self.meta,
             lambda: f"bushing_response_h{c.harmonic}_N{c.n_modes}_{c.dof}_{c.coupling}.csv",
         )
         caption = live_text(self._caption, [(c, ["harmonic", "n_modes", "dof", "coupling"])])
@@ -101,14 +121,18 @@ class MobilityView(Viewer):
 
     def _caption(self) -> str:
         c = self.case
-        return (f"**Harmonic {c.harmonic}** &middot; bushing:{c.dof} &middot; N = {c.n_modes} "
-                f"&middot; {c.coupling} coupling")
+        return (
+            f"**Harmonic {c.harmonic}** &middot; bushing:{c.dof} &middot; N = {c.n_modes} "
+            f"&middot; {c.coupling} coupling"
+        )
 
     def _csv_columns(self) -> dict:
         d = self.data()
         return {
-            "freq_Hz": d["freq"], "reference_dB": d["reference_db"],
-            "truncated_dB": d["truncated_db"], "reference": d["reference"],
+            "freq_Hz": d["freq"],
+            "reference_dB": d["reference_db"],
+            "truncated_dB": d["truncated_db"],
+            "reference": d["reference"],
             "truncated": d["truncated"],
         }
 
@@ -126,8 +150,7 @@ class UncoupledView(Viewer):
 
     def data(self) -> dict:
         c = self.case
-        return compute.uncoupled_data(c.harmonic, c.n_modes, c.dof, c.spindle_input,
-                                      c.models)
+        return compute.uncoupled_data(c.harmonic, c.n_modes, c.dof, c.spindle_input, c.models)
 
     @staticmethod
     def _chassis_label(dof: str, spindle_input: str) -> str:
@@ -140,21 +163,38 @@ class UncoupledView(Viewer):
             self.x_range = frequency_range()
         c = self.case
         self._tire_fig = tire = new_figure(
-            x_label=FREQ_LABEL, y_label=level_label(c.dof), x_range=self.x_range,
-            min_height=300)
-        self._tire_ref = add_line(tire, "uncoupled.tire_reference", color=COLORS["reference"],
-                                  legend="all modes", tooltips=level_tooltips("all modes"))
-        self._tire_tr = add_line(tire, "uncoupled.tire_truncated", color=COLORS["tire"],
-                                 legend="N retained modes", dash="dashed",
-                                 tooltips=level_tooltips("N retained modes"))
+            x_label=FREQ_LABEL, y_label=level_label(c.dof), x_range=self.x_range, min_height=300
+        )
+        self._tire_ref = add_line(
+            tire,
+            "uncoupled.tire_reference",
+            color=COLORS["reference"],
+            legend="all modes",
+            tooltips=level_tooltips("all modes"),
+        )
+        self._tire_tr = add_line(
+            tire,
+            "uncoupled.tire_truncated",
+            color=COLORS["tire"],
+            legend="N retained modes",
+            dash="dashed",
+            tooltips=level_tooltips("N retained modes"),
+        )
         self._chassis_fig = chassis = new_figure(
-            x_label=FREQ_LABEL, y_label=self._chassis_label(c.dof, c.spindle_input),
-            x_range=self.x_range, min_height=300)
-        self._chassis = add_line(chassis, "uncoupled.chassis", color=COLORS["chassis"],
-                                 legend=None, tooltips=level_tooltips("chassis mobility"))
+            x_label=FREQ_LABEL,
+            y_label=self._chassis_label(c.dof, c.spindle_input),
+            x_range=self.x_range,
+            min_height=300,
+        )
+        self._chassis = add_line(
+            chassis,
+            "uncoupled.chassis",
+            color=COLORS["chassis"],
+            legend=None,
+            tooltips=level_tooltips("chassis mobility"),
+        )
         self._apply(self.data())()
-        c.param.watch(self._changed,
-                      ["harmonic", "n_modes", "dof", "spindle_input", "models"])
+        c.param.watch(self._changed, ["harmonic", "n_modes", "dof", "spindle_input", "models"])
         return tire, chassis
 
     def _apply(self, d: dict):
@@ -168,8 +208,9 @@ class UncoupledView(Viewer):
             self._chassis.data = {"freq": d["freq"], "level": d["chassis_db"]}
             self._tire_fig.title.text = f"Tire: free hub velocity hub:{dof} (figs. 4.6-4.7)"
             self._tire_fig.yaxis[0].axis_label = level_label(dof)
-            self._chassis_fig.title.text = (f"Chassis: spindle:{inp} -> bushing:{dof} "
-                                            "(figs. 4.2-4.3)")
+            self._chassis_fig.title.text = (
+                f"Chassis: spindle:{inp} -> bushing:{dof} (figs. 4.2-4.3)"
+            )
             self._chassis_fig.yaxis[0].axis_label = self._chassis_label(dof, inp)
 
         return update
@@ -183,27 +224,46 @@ class UncoupledView(Viewer):
         c = self.case
         tire, chassis = self._build()
         dl = download_button(
-            "uncoupled", self._csv_columns, self._meta,
+            "uncoupled",
+            self._csv_columns,
+            self._meta,
             lambda: f"uncoupled_h{c.harmonic}_N{c.n_modes}_{c.dof}_in{c.spindle_input}.csv",
         )
-        inp = pn.widgets.Select.from_param(c.param.spindle_input, name="Chassis spindle input",
-                                           width=160)
+        inp = pn.widgets.Select.from_param(
+            c.param.spindle_input, name="Chassis spindle input", width=160
+        )
         self._layout = pn.Column(
             pn.Row(inp, pn.layout.HSpacer(), dl),
-            pn.Row(pn.pane.Bokeh(tire, sizing_mode="stretch_both", min_height=300),
-                   pn.pane.Bokeh(chassis, sizing_mode="stretch_both", min_height=300),
-                   sizing_mode="stretch_both"),
+            pn.Row(
+                pn.pane.Bokeh(tire, sizing_mode="stretch_both", min_height=300),
+                pn.pane.Bokeh(chassis, sizing_mode="stretch_both", min_height=300),
+                sizing_mode="stretch_both",
+            ),
             sizing_mode="stretch_both",
         )
         return self._layout
 
     def _meta(self) -> dict:
         c = self.case
-        return {"view": "uncoupled subsystems", "harmonic": c.harmonic,
-                "N (retained tire modes)": c.n_modes, "tire output": f"hub:{c.dof}",
-                "chassis": f"spindle:{c.spindle_input} -> bushing:{c.dof}"}
+        return {
+            "view": "uncoupled subsystems",
+            "harmonic": c.harmonic,
+            "N (retained tire modes)": c.n_modes,
+            "tire output": f"hub:{c.dof}",
+            "chassis": f"spindle:{c.spindle_input} -> bushing:{c.dof}",
+        }
 
     def _csv_columns(self) -> dict:
         d = self.data()
-        return {k: d[k] for k in ("freq", "tire_reference_db", "tire_truncated_db", "chassis_db",
-                                  "tire_reference", "tire_truncated", "chassis")}
+        return {
+            k: d[k]
+            for k in (
+                "freq",
+                "tire_reference_db",
+                "tire_truncated_db",
+                "chassis_db",
+                "tire_reference",
+                "tire_truncated",
+                "chassis",
+            )
+        }

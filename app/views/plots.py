@@ -77,15 +77,29 @@ def fit_range(rng, values: np.ndarray) -> None:
         rng.update(start=lo, end=hi, reset_start=lo, reset_end=hi)
 
 
-def new_figure(*, x_label: str, y_label: str, x_range=None, y_range=None,
-               title: str | None = None, min_height: int = 320, name: str | None = None):
+def new_figure(
+    *,
+    x_label: str,
+    y_label: str,
+    x_range=None,
+    y_range=None,
+    title: str | None = None,
+    min_height: int = 320,
+    name: str | None = None,
+):
     """A responsive figure with pan/zoom/box-zoom/reset/save, wheel zoom active."""
     fig = figure(
         x_range=x_range if x_range is not None else DataRange1d(range_padding=0.0),
-        y_range=y_range if y_range is not None else DataRange1d(range_padding=0.05,
-                                                                only_visible=True),
-        tools=TOOLS, active_scroll="wheel_zoom", toolbar_location="above",
-        sizing_mode="stretch_both", min_height=min_height, title=title or "", name=name,
+        y_range=y_range
+        if y_range is not None
+        else DataRange1d(range_padding=0.05, only_visible=True),
+        tools=TOOLS,
+        active_scroll="wheel_zoom",
+        toolbar_location="above",
+        sizing_mode="stretch_both",
+        min_height=min_height,
+        title=title or "",
+        name=name,
     )
     fig.xaxis.axis_label = x_label
     fig.yaxis.axis_label = y_label
@@ -101,10 +115,19 @@ def _legend(fig, location: str) -> None:
         fig.legend.label_text_font_size = "9pt"
 
 
-def add_line(fig, name: str, *, color: str, legend: str | None,
-             tooltips: Sequence[tuple[str, str]], x: str = "freq", y: str = "level",
-             dash: str = "solid", width: float = 2.0,
-             legend_location: str = "bottom_left") -> ColumnDataSource:
+def add_line(
+    fig,
+    name: str,
+    *,
+    color: str,
+    legend: str | None,
+    tooltips: Sequence[tuple[str, str]],
+    x: str = "freq",
+    y: str = "level",
+    dash: str = "solid",
+    width: float = 2.0,
+    legend_location: str = "bottom_left",
+) -> ColumnDataSource:
     """A line fed by a new named source with columns ``x``, ``y``; hover along x."""
     src = ColumnDataSource({x: np.zeros(0), y: np.zeros(0)}, name=name)
     kw = {"legend_label": legend} if legend else {}
@@ -114,13 +137,22 @@ def add_line(fig, name: str, *, color: str, legend: str | None,
     return src
 
 
-def add_band(fig, name: str, *, color: str, alpha: float, legend: str,
-             legend_location: str = "bottom_left") -> ColumnDataSource:
+def add_band(
+    fig, name: str, *, color: str, alpha: float, legend: str, legend_location: str = "bottom_left"
+) -> ColumnDataSource:
     """A filled band between ``lower`` and ``upper`` over ``freq`` (a named source)."""
-    src = ColumnDataSource({"freq": np.zeros(0), "lower": np.zeros(0), "upper": np.zeros(0)},
-                           name=name)
-    fig.varea("freq", "lower", "upper", source=src, fill_color=color, fill_alpha=alpha,
-              legend_label=legend)
+    src = ColumnDataSource(
+        {"freq": np.zeros(0), "lower": np.zeros(0), "upper": np.zeros(0)}, name=name
+    )
+    fig.varea(
+        "freq",
+        "lower",
+        "upper",
+        source=src,
+        fill_color=color,
+        fill_alpha=alpha,
+        legend_label=legend,
+    )
     _legend(fig, legend_location)
     return src
 
@@ -131,22 +163,35 @@ def add_image(fig, name: str, *, tooltips: Sequence[tuple[str, str]], colorbar_t
     Returns ``(source, mapper, colorbar)``; the source's columns are ``image`` (a list with
     one 2-D array, row 0 at the bottom), ``x``, ``y``, ``dw``, ``dh``.
     """
-    src = ColumnDataSource({"image": [np.zeros((1, 1))], "x": [0.0], "y": [0.0],
-                            "dw": [1.0], "dh": [1.0]}, name=name)
+    src = ColumnDataSource(
+        {"image": [np.zeros((1, 1))], "x": [0.0], "y": [0.0], "dw": [1.0], "dh": [1.0]}, name=name
+    )
     mapper = LinearColorMapper(palette=ERROR_PALETTE, low=0.0, high=1.0)
-    r = fig.image(image="image", x="x", y="y", dw="dw", dh="dh", source=src,
-                  color_mapper=mapper)
+    r = fig.image(image="image", x="x", y="y", dw="dw", dh="dh", source=src, color_mapper=mapper)
     fig.add_tools(HoverTool(renderers=[r], tooltips=list(tooltips)))
     bar = ColorBar(color_mapper=mapper, title=colorbar_title, width=12)
     fig.add_layout(bar, "right")
     return src, mapper, bar
 
 
-def add_span(fig, *, dimension: str, color: str, dash: str = "solid",
-             width: float = 2.0, name: str | None = None) -> Span:
+def add_span(
+    fig,
+    *,
+    dimension: str,
+    color: str,
+    dash: str = "solid",
+    width: float = 2.0,
+    name: str | None = None,
+) -> Span:
     """A horizontal (``dimension="width"``) or vertical (``"height"``) line at a location."""
-    span = Span(location=0.0, dimension=dimension, line_color=color, line_dash=dash,
-                line_width=width, name=name)
+    span = Span(
+        location=0.0,
+        dimension=dimension,
+        line_color=color,
+        line_dash=dash,
+        line_width=width,
+        name=name,
+    )
     fig.add_layout(span)
     return span
 

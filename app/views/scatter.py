@@ -42,8 +42,10 @@ class ScatterBandView(Viewer):
     result = param.Parameter(default=None, doc="The current scatter-band result object.")
     busy = param.Boolean(default=False, doc="True while a band is being computed.")
     seconds = param.Number(default=None, allow_None=True, doc="Wall time of the last band.")
-    x_range = param.Parameter(default=None, doc="Frequency range shared with other views "
-                              "(linked zoom and pan); a new one if None.")
+    x_range = param.Parameter(
+        default=None,
+        doc="Frequency range shared with other views (linked zoom and pan); a new one if None.",
+    )
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -56,8 +58,17 @@ class ScatterBandView(Viewer):
     # -- computation -------------------------------------------------------------------
     def key(self) -> tuple:
         c, n = self.case, self.noise
-        return (c.harmonic, c.n_modes, c.coupling, float(n.noise), n.target,
-                bool(n.frequency_dependent), int(n.rounds), int(n.seed), c.models)
+        return (
+            c.harmonic,
+            c.n_modes,
+            c.coupling,
+            float(n.noise),
+            n.target,
+            bool(n.frequency_dependent),
+            int(n.rounds),
+            int(n.seed),
+            c.models,
+        )
 
     def compute_now(self):
         """Compute (or fetch from the cache) the band of the current state, blocking."""
@@ -131,25 +142,48 @@ class ScatterBandView(Viewer):
         if self.seconds is None or self.result is None:
             return ""
         conv = compute.convergence_db(self.result)
-        return (f"{self.result.rounds:,} rounds in {self.seconds:.2f} s &middot; largest edge "
-                f"change in the last half of the rounds: {conv:.1f} dB")
+        return (
+            f"{self.result.rounds:,} rounds in {self.seconds:.2f} s &middot; largest edge "
+            f"change in the last half of the rounds: {conv:.1f} dB"
+        )
 
     # -- plot ----------------------------------------------------------------------------
     def _build(self):
         if self.x_range is None:
             self.x_range = frequency_range()
-        fig = new_figure(x_label=FREQ_LABEL, y_label=level_label(self.case.dof, "Band level"),
-                         x_range=self.x_range, name="scatter.figure",
-                         title="Click a frequency: the round with the highest level there")
+        fig = new_figure(
+            x_label=FREQ_LABEL,
+            y_label=level_label(self.case.dof, "Band level"),
+            x_range=self.x_range,
+            name="scatter.figure",
+            title="Click a frequency: the round with the highest level there",
+        )
         self._fig = fig
-        self._minmax = add_band(fig, "scatter.minmax", color=COLORS["band"], alpha=0.35,
-                                legend="min-max corridor")
-        self._pct = add_band(fig, "scatter.percentile", color=COLORS["percentile"],
-                             alpha=0.45, legend="central percentile band")
-        self._ref = add_line(fig, "scatter.reference", color=COLORS["reference"],
-                             legend="unpolluted", tooltips=level_tooltips("unpolluted"))
-        self._round = add_line(fig, "scatter.round", color=COLORS["round"], width=1.5,
-                               legend="single round", tooltips=level_tooltips("single round"))
+        self._minmax = add_band(
+            fig, "scatter.minmax", color=COLORS["band"], alpha=0.35, legend="min-max corridor"
+        )
+        self._pct = add_band(
+            fig,
+            "scatter.percentile",
+            color=COLORS["percentile"],
+            alpha=0.45,
+            legend="central percentile band",
+        )
+        self._ref = add_line(
+            fig,
+            "scatter.reference",
+            color=COLORS["reference"],
+            legend="unpolluted",
+            tooltips=level_tooltips("unpolluted"),
+        )
+        self._round = add_line(
+            fig,
+            "scatter.round",
+            color=COLORS["round"],
+            width=1.5,
+            legend="single round",
+            tooltips=level_tooltips("single round"),
+        )
         # click on the plot: show the round with the highest level at that frequency
         fig.on_event(Tap, lambda event: self._pick_peak_round(event.x, event.y))
         self._apply(*self._plot_state())()
@@ -162,8 +196,11 @@ class ScatterBandView(Viewer):
         res, dof, n = self.result, self.case.dof, self.noise
         if res is None:
             return None, None, dof
-        return (compute.band_data(res, dof, n.percentile),
-                compute.single_round_data(res, n.single_round, dof), dof)
+        return (
+            compute.band_data(res, dof, n.percentile),
+            compute.single_round_data(res, n.single_round, dof),
+            dof,
+        )
 
     def _apply(self, band, single, dof):
         empty = np.zeros(0)
@@ -177,8 +214,11 @@ class ScatterBandView(Viewer):
                 return
             f = band["freq"]
             fit_range(self.x_range, f)
-            self._minmax.data = {"freq": f, "lower": band["minimum_db"],
-                                 "upper": band["maximum_db"]}
+            self._minmax.data = {
+                "freq": f,
+                "lower": band["minimum_db"],
+                "upper": band["maximum_db"],
+            }
             self._pct.data = {"freq": f, "lower": band["lower_db"], "upper": band["upper_db"]}
             self._ref.data = {"freq": f, "level": band["reference_db"]}
             self._round.data = {"freq": f, "level": single["round_db"]}
@@ -196,15 +236,26 @@ class ScatterBandView(Viewer):
         # content does not make the browser lay out the page again (toggling visibility
         # did, and delayed every plot update sent with it by 100-200 ms).
         progress = pn.indicators.Progress(
-            active=self.busy, value=-1 if self.busy else 0, max=100, bar_color="primary",
-            width=160, height=12, css_classes=["scatter-progress"], margin=(12, 10))
+            active=self.busy,
+            value=-1 if self.busy else 0,
+            max=100,
+            bar_color="primary",
+            width=160,
+            height=12,
+            css_classes=["scatter-progress"],
+            margin=(12, 10),
+        )
         # its own line, two lines high: the text's length changes, its box does not
-        status = live_text(self._status_text, [(self, ["busy", "seconds", "result"])],
-                           height=40, css_classes=["scatter-status"],
-                           styles={"font-size": "0.85em", "line-height": "1.3"})
+        status = live_text(
+            self._status_text,
+            [(self, ["busy", "seconds", "result"])],
+            height=40,
+            css_classes=["scatter-status"],
+            styles={"font-size": "0.85em", "line-height": "1.3"},
+        )
         self.param.watch(
-            lambda _: progress.param.update(active=self.busy, value=-1 if self.busy else 0),
-            "busy")
+            lambda _: progress.param.update(active=self.busy, value=-1 if self.busy else 0), "busy"
+        )
         dl = download_button("scatter", self._csv_columns, self._meta, self._filename)
         self._layout = pn.Column(
             pn.Row(progress, dl),
@@ -222,26 +273,40 @@ class ScatterBandView(Viewer):
     def _filename(self) -> str:
         c, n = self.case, self.noise
         fd = "fdep" if n.frequency_dependent else "findep"
-        return (f"scatter_band_h{c.harmonic}_{c.dof}_p{n.noise:g}_{n.target}_{fd}"
-                f"_R{n.rounds}_seed{n.seed}.csv")
+        return (
+            f"scatter_band_h{c.harmonic}_{c.dof}_p{n.noise:g}_{n.target}_{fd}"
+            f"_R{n.rounds}_seed{n.seed}.csv"
+        )
 
     def _meta(self) -> dict:
         c, n = self.case, self.noise
         lo = (100 - n.percentile) / 2
         return {
-            "view": "Monte-Carlo scatter band (thesis 5.2)", "harmonic": c.harmonic,
-            "N (retained tire modes)": c.n_modes, "response DOF": f"bushing:{c.dof}",
-            "coupling": c.coupling, "noise_pct": n.noise, "noise target": n.target,
-            "frequency dependent": n.frequency_dependent, "rounds": n.rounds,
-            "seed": n.seed, "single round": n.single_round,
-            "percentiles": f"{lo:g}-{100 - lo:g}", "unit": compute.level_unit(c.dof),
+            "view": "Monte-Carlo scatter band (thesis 5.2)",
+            "harmonic": c.harmonic,
+            "N (retained tire modes)": c.n_modes,
+            "response DOF": f"bushing:{c.dof}",
+            "coupling": c.coupling,
+            "noise_pct": n.noise,
+            "noise target": n.target,
+            "frequency dependent": n.frequency_dependent,
+            "rounds": n.rounds,
+            "seed": n.seed,
+            "single round": n.single_round,
+            "percentiles": f"{lo:g}-{100 - lo:g}",
+            "unit": compute.level_unit(c.dof),
             "lower/upper": "min/max of |v_e| over the rounds; percentiles numpy 'linear'",
             "models": c.models.describe(),
         }
 
     def _csv_columns(self) -> dict:
         d, r = self.data(), self.round_data()
-        return {"freq_Hz": d["freq"], "reference_dB": d["reference_db"],
-                "minimum_dB": d["minimum_db"], "maximum_dB": d["maximum_db"],
-                "lower_dB": d["lower_db"], "upper_dB": d["upper_db"],
-                f"round_{self.noise.single_round}_dB": r["round_db"]}
+        return {
+            "freq_Hz": d["freq"],
+            "reference_dB": d["reference_db"],
+            "minimum_dB": d["minimum_db"],
+            "maximum_dB": d["maximum_db"],
+            "lower_dB": d["lower_db"],
+            "upper_dB": d["upper_db"],
+            f"round_{self.noise.single_round}_dB": r["round_db"],
+        }

@@ -32,29 +32,41 @@ class UploadView(Viewer):
         super().__init__(**params)
         ds = self.data
         W = pn.widgets
-        self.chassis_file = W.FileInput(accept=CHASSIS_ACCEPT, multiple=False,
-                                        css_classes=["upload-chassis"], width=260)
-        self.tire_file = W.FileInput(accept=TIRE_ACCEPT, multiple=False,
-                                     css_classes=["upload-tire"], width=260)
-        self.spindle = W.TextInput.from_param(ds.param.spindle, name="Spindle node",
-                                              width=120, css_classes=["upload-spindle"])
-        self.bushing = W.TextInput.from_param(ds.param.bushing, name="Bushing node",
-                                              width=120, css_classes=["upload-bushing"])
+        self.chassis_file = W.FileInput(
+            accept=CHASSIS_ACCEPT, multiple=False, css_classes=["upload-chassis"], width=260
+        )
+        self.tire_file = W.FileInput(
+            accept=TIRE_ACCEPT, multiple=False, css_classes=["upload-tire"], width=260
+        )
+        self.spindle = W.TextInput.from_param(
+            ds.param.spindle, name="Spindle node", width=120, css_classes=["upload-spindle"]
+        )
+        self.bushing = W.TextInput.from_param(
+            ds.param.bushing, name="Bushing node", width=120, css_classes=["upload-bushing"]
+        )
         self.interpolate = W.Checkbox.from_param(
-            ds.param.interpolate, name="Interpolate onto the analysis grid (linear Re/Im)",
-            css_classes=["upload-interpolate"])
-        self.reread = W.Button(name="Read chassis again", button_type="light", width=150,
-                               css_classes=["upload-reread"])
-        self.reset = W.Button(name="Use reference data", button_type="warning", width=160,
-                              css_classes=["upload-reset"])
+            ds.param.interpolate,
+            name="Interpolate onto the analysis grid (linear Re/Im)",
+            css_classes=["upload-interpolate"],
+        )
+        self.reread = W.Button(
+            name="Read chassis again", button_type="light", width=150, css_classes=["upload-reread"]
+        )
+        self.reset = W.Button(
+            name="Use reference data",
+            button_type="warning",
+            width=160,
+            css_classes=["upload-reset"],
+        )
         self.chassis_file.param.watch(self._on_chassis, "value")
         self.tire_file.param.watch(self._on_tire, "value")
         self.reread.on_click(lambda _: self._run(ds.load_chassis))
         # a new node name or the interpolation choice re-reads the chassis file at once;
         # this also settles a click on "Read chassis again" that overtook the change
         # (Panel hands both to its worker threads, in either order)
-        ds.param.watch(lambda *_: self._run(ds.reread_if_changed),
-                       ["spindle", "bushing", "interpolate"])
+        ds.param.watch(
+            lambda *_: self._run(ds.reread_if_changed), ["spindle", "bushing", "interpolate"]
+        )
         self.reset.on_click(lambda _: ds.reset())
 
     # -- actions (each a call into the data source; errors land in ``data.error``) --------
@@ -83,27 +95,43 @@ class UploadView(Viewer):
         ds = self.data
         parts = [f"**In use: {ds.describe()}**"]
         for title, text in (("Chassis", ds.chassis_summary), ("Tire", ds.tire_summary)):
-            if text and ((title == "Chassis" and ds.models.chassis is not None)
-                         or (title == "Tire" and ds.models.tire is not None)):
+            if text and (
+                (title == "Chassis" and ds.models.chassis is not None)
+                or (title == "Tire" and ds.models.tire is not None)
+            ):
                 parts.append(f"{title}:\n```\n{text}\n```")
         kind = "success" if not ds.models.is_reference else "secondary"
-        return pn.pane.Alert("\n\n".join(parts), alert_type=kind, margin=(4, 5),
-                             css_classes=["upload-summary"], sizing_mode="stretch_width")
+        return pn.pane.Alert(
+            "\n\n".join(parts),
+            alert_type=kind,
+            margin=(4, 5),
+            css_classes=["upload-summary"],
+            sizing_mode="stretch_width",
+        )
 
     @param.depends("data.error")
     def _error(self):
         return pn.pane.Alert(
-            f"**File refused, nothing changed.** {self.data.error}", alert_type="danger",
-            visible=bool(self.data.error), margin=(4, 5), css_classes=["upload-error"],
-            sizing_mode="stretch_width")
+            f"**File refused, nothing changed.** {self.data.error}",
+            alert_type="danger",
+            visible=bool(self.data.error),
+            margin=(4, 5),
+            css_classes=["upload-error"],
+            sizing_mode="stretch_width",
+        )
 
     def __panel__(self):
         label = pn.pane.Markdown
         return pn.Column(
             label(HELP, margin=(0, 10), styles={"color": "#495057", "font-size": "0.9em"}),
             pn.Row(
-                pn.Column(label("**Chassis FRF**", margin=(0, 5)), self.chassis_file,
-                          pn.Row(self.spindle, self.bushing), self.interpolate, self.reread),
+                pn.Column(
+                    label("**Chassis FRF**", margin=(0, 5)),
+                    self.chassis_file,
+                    pn.Row(self.spindle, self.bushing),
+                    self.interpolate,
+                    self.reread,
+                ),
                 pn.Column(label("**Modal tire model**", margin=(0, 5)), self.tire_file),
                 pn.Column(label("&nbsp;", margin=(0, 5)), self.reset),
             ),

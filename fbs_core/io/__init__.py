@@ -93,8 +93,15 @@ class ImportResult:
         return iter((self.frf if self.model is None else self.model, self.summary))
 
 
-def _finish(frf: FRF, notes: list[str], meta: dict, name: str, fmt: str,
-            require_outputs=(), require_inputs=()) -> ImportResult:
+def _finish(
+    frf: FRF,
+    notes: list[str],
+    meta: dict,
+    name: str,
+    fmt: str,
+    require_outputs=(),
+    require_inputs=(),
+) -> ImportResult:
     require_dofs(frf, require_outputs, require_inputs, what=f"{name!r}")
     notes = list(notes) + quantity_notes(frf)
     text = f"{name} ({fmt}): " + describe(frf)
@@ -103,11 +110,20 @@ def _finish(frf: FRF, notes: list[str], meta: dict, name: str, fmt: str,
     return ImportResult(frf, text, tuple(notes), dict(meta), name, fmt)
 
 
-def load_frf(source, *, filename: str | None = None, format: str | None = None,
-             nodes: Mapping | None = None, quantity: str | None = None, freq=None,
-             name: str | None = None, require_outputs=(), require_inputs=(),
-             max_bytes: int = DEFAULT_MAX_BYTES, timeout: float = DEFAULT_TIMEOUT
-             ) -> ImportResult:
+def load_frf(
+    source,
+    *,
+    filename: str | None = None,
+    format: str | None = None,
+    nodes: Mapping | None = None,
+    quantity: str | None = None,
+    freq=None,
+    name: str | None = None,
+    require_outputs=(),
+    require_inputs=(),
+    max_bytes: int = DEFAULT_MAX_BYTES,
+    timeout: float = DEFAULT_TIMEOUT,
+) -> ImportResult:
     """Read an FRF from UFF 58, MATLAB (.mat v5 / v7.3), CSV or HDF5, with checks.
 
     Parameters
@@ -185,10 +201,15 @@ def load_frf(source, *, filename: str | None = None, format: str | None = None,
     else:
         from .hdf5 import read_hdf5
 
-        frf, notes, meta = read_hdf5(src, nodes=nodes, quantity=quantity, name=name,
-                                     timeout=timeout)
-    label = {"mat": "MATLAB v5" if kind == "mat5" else "MATLAB v7.3", "uff": "UFF 58",
-             "csv": "CSV", "hdf5": "HDF5"}[fmt]
+        frf, notes, meta = read_hdf5(
+            src, nodes=nodes, quantity=quantity, name=name, timeout=timeout
+        )
+    label = {
+        "mat": "MATLAB v5" if kind == "mat5" else "MATLAB v7.3",
+        "uff": "UFF 58",
+        "csv": "CSV",
+        "hdf5": "HDF5",
+    }[fmt]
     return _finish(frf, notes, meta, src.name, label, require_outputs, require_inputs)
 
 
@@ -217,9 +238,17 @@ def _deliver(raw: bytes, path):
     return p
 
 
-def save_frf(frf: FRF, path=None, *, format: str | None = None,
-             metadata: Mapping | None = None, nodes: Mapping | None = None,
-             mat_version: str = "5", binary: bool = False, round_abscissa: bool = False):
+def save_frf(
+    frf: FRF,
+    path=None,
+    *,
+    format: str | None = None,
+    metadata: Mapping | None = None,
+    nodes: Mapping | None = None,
+    mat_version: str = "5",
+    binary: bool = False,
+    round_abscissa: bool = False,
+):
     """Write an FRF as UFF 58, MATLAB, CSV or HDF5 in the documented layouts.
 
     Parameters
@@ -254,8 +283,9 @@ def save_frf(frf: FRF, path=None, *, format: str | None = None,
     if fmt == "uff":
         from .uff import write_uff
 
-        raw = write_uff(frf, nodes=nodes, metadata=metadata, binary=binary,
-                        round_abscissa=round_abscissa)
+        raw = write_uff(
+            frf, nodes=nodes, metadata=metadata, binary=binary, round_abscissa=round_abscissa
+        )
     elif fmt == "mat":
         from .matlab import write_mat
 
@@ -271,9 +301,15 @@ def save_frf(frf: FRF, path=None, *, format: str | None = None,
     return _deliver(raw, path)
 
 
-def export_result(result, path=None, *, format: str | None = None,
-                  metadata: Mapping | None = None, nodes: Mapping | None = None,
-                  round_abscissa: bool = False):
+def export_result(
+    result,
+    path=None,
+    *,
+    format: str | None = None,
+    metadata: Mapping | None = None,
+    nodes: Mapping | None = None,
+    round_abscissa: bool = False,
+):
     """Export a coupled or study result as CSV, UFF 58 or HDF5, with metadata.
 
     Parameters
@@ -318,8 +354,13 @@ def export_result(result, path=None, *, format: str | None = None,
     return _deliver(raw, path)
 
 
-def load_result(source, *, filename: str | None = None, max_bytes: int = DEFAULT_MAX_BYTES,
-                timeout: float = DEFAULT_TIMEOUT) -> ResultData:
+def load_result(
+    source,
+    *,
+    filename: str | None = None,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+    timeout: float = DEFAULT_TIMEOUT,
+) -> ResultData:
     """Read a result exported with :func:`export_result` as HDF5 back.
 
     Parameters
@@ -346,9 +387,14 @@ def load_result(source, *, filename: str | None = None, max_bytes: int = DEFAULT
     return read_hdf5_result(src, timeout=timeout)
 
 
-def load_tire_model(source, *, filename: str | None = None, format: str | None = None,
-                    max_bytes: int = DEFAULT_MAX_BYTES, timeout: float = DEFAULT_TIMEOUT
-                    ) -> ImportResult:
+def load_tire_model(
+    source,
+    *,
+    filename: str | None = None,
+    format: str | None = None,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+    timeout: float = DEFAULT_TIMEOUT,
+) -> ImportResult:
     """Read a modal tire model: the project's own format or MATLAB (.mat v5 / v7.3).
 
     Parameters
@@ -384,11 +430,17 @@ def load_tire_model(source, *, filename: str | None = None, format: str | None =
         label = "tire-fbs tire model"
     else:
         raise DataFormatError(
-            f"tire models are read from MATLAB (.mat) or the project's format (.h5), "
-            f"not {fmt!r}"
+            f"tire models are read from MATLAB (.mat) or the project's format (.h5), not {fmt!r}"
         )
-    return ImportResult(None, f"{src.name} ({label}): " + describe_tire(model), (),
-                        dict(model.meta), src.name, label, model)
+    return ImportResult(
+        None,
+        f"{src.name} ({label}): " + describe_tire(model),
+        (),
+        dict(model.meta),
+        src.name,
+        label,
+        model,
+    )
 
 
 def describe_tire(model) -> str:
@@ -396,13 +448,14 @@ def describe_tire(model) -> str:
     import numpy as np
 
     f = np.abs(np.asarray(model.poles).imag) / (2 * np.pi)
-    return "\n".join([
-        f"modal tire model, {model.n_modes} complex modes ({model.n_modes // 2} pairs), "
-        f"eigenfrequencies {f.min():.1f}-{f.max():.1f} Hz",
-        "operating points: " + ", ".join(f"{v:g}" for v in model.speeds) + " km/h",
-        "hub DOFs: " + ", ".join(model.hub_dofs),
-        "patch participation for wavelengths: "
-        + ", ".join(f"{w:g}" for w in model.wavelengths) + " m",
-    ])
-
-
+    return "\n".join(
+        [
+            f"modal tire model, {model.n_modes} complex modes ({model.n_modes // 2} pairs), "
+            f"eigenfrequencies {f.min():.1f}-{f.max():.1f} Hz",
+            "operating points: " + ", ".join(f"{v:g}" for v in model.speeds) + " km/h",
+            "hub DOFs: " + ", ".join(model.hub_dofs),
+            "patch participation for wavelengths: "
+            + ", ".join(f"{w:g}" for w in model.wavelengths)
+            + " m",
+        ]
+    )

@@ -108,7 +108,11 @@ os.register_at_fork(after_in_child=_after_fork)
 
 
 def parse_isolated(
-    kind: str, raw: bytes, what: str, *, timeout: float = DEFAULT_TIMEOUT,
+    kind: str,
+    raw: bytes,
+    what: str,
+    *,
+    timeout: float = DEFAULT_TIMEOUT,
     mem_bytes: int | None = None,
 ) -> tuple[dict, list[np.ndarray]]:
     """Parse ``raw`` with handler ``kind`` ("mat5" or "hdf5") in the sandbox.

@@ -91,8 +91,17 @@ def _jsonable(v):
 
 # -- MATLAB v5 -----------------------------------------------------------------------
 _MAT_NUMERIC = {
-    "double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
-    "int64", "uint64", "logical",
+    "double",
+    "single",
+    "int8",
+    "uint8",
+    "int16",
+    "uint16",
+    "int32",
+    "uint32",
+    "int64",
+    "uint64",
+    "logical",
 }
 
 
@@ -126,8 +135,12 @@ def parse_mat5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
             )
     names = [n for n, _, _ in info]
     data = scipy.io.loadmat(
-        io.BytesIO(raw), mat_dtype=False, squeeze_me=False, chars_as_strings=True,
-        variable_names=names, verify_compressed_data_integrity=True,
+        io.BytesIO(raw),
+        mat_dtype=False,
+        squeeze_me=False,
+        chars_as_strings=True,
+        variable_names=names,
+        verify_compressed_data_integrity=True,
     )
     for name in names:
         v = data.get(name)
@@ -160,7 +173,6 @@ def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
 
     datasets, groups, arrays = {}, {}, []
     with h5py.File(io.BytesIO(raw), "r") as f:
-
         errors: list[Exception] = []
 
         def guarded(func):

@@ -83,8 +83,7 @@ class Source:
         return Path(self.name).suffix.lower()
 
 
-def read_source(source, filename: str | None = None,
-                max_bytes: int = DEFAULT_MAX_BYTES) -> Source:
+def read_source(source, filename: str | None = None, max_bytes: int = DEFAULT_MAX_BYTES) -> Source:
     """Read a path, or take bytes (an upload) with the file name they came with.
 
     Parameters
@@ -119,9 +118,7 @@ def read_source(source, filename: str | None = None,
         except OSError as e:
             raise DataFormatError(f"cannot read {str(path)!r}: {e.strerror or e}") from None
     else:
-        raise DataFormatError(
-            f"expected a path or the file's bytes, got {type(source).__name__}"
-        )
+        raise DataFormatError(f"expected a path or the file's bytes, got {type(source).__name__}")
     if len(raw) > max_bytes:
         raise DataFormatError(_too_large(name, len(raw), max_bytes))
     if not raw:
@@ -164,7 +161,9 @@ def sniff(raw: bytes) -> str:
     if head.startswith(b"MATLAB 7.3 MAT-file") and raw[512:520] == _HDF5_SIG:
         return "mat73"
     if head.startswith(b"MATLAB 5.0 MAT-file") or (
-        len(raw) >= 128 and raw[126:128] in (b"IM", b"MI") and raw[:116].isascii()
+        len(raw) >= 128
+        and raw[126:128] in (b"IM", b"MI")
+        and raw[:116].isascii()
         and head[:6] == b"MATLAB"
     ):
         return "mat5"
@@ -309,8 +308,9 @@ def check_finite(a: np.ndarray, what: str) -> np.ndarray:
     return a
 
 
-def require_dofs(frf: FRF, outputs: Iterable[str] = (), inputs: Iterable[str] = (),
-                 what: str = "FRF") -> None:
+def require_dofs(
+    frf: FRF, outputs: Iterable[str] = (), inputs: Iterable[str] = (), what: str = "FRF"
+) -> None:
     """Raise DOFError listing every required output/input label the FRF lacks."""
     miss_o = [o for o in outputs if o not in frf.outputs]
     miss_i = [i for i in inputs if i not in frf.inputs]
@@ -364,8 +364,12 @@ def interface_check(a: FRF, b: FRF, interface=None, max_cond: float = 1e8) -> np
     return cond
 
 
-def prepare_chassis(frf: FRF, spindle: str = "spindle", bushing: str = "bushing",
-                    directions: Sequence[str] = DIRECTIONS) -> tuple[FRF, list[str]]:
+def prepare_chassis(
+    frf: FRF,
+    spindle: str = "spindle",
+    bushing: str = "bushing",
+    directions: Sequence[str] = DIRECTIONS,
+) -> tuple[FRF, list[str]]:
     """Make a user's chassis FRF fit the contract of ``ChassisModel.mobility``.
 
     Parameters
@@ -405,10 +409,14 @@ def prepare_chassis(frf: FRF, spindle: str = "spindle", bushing: str = "bushing"
         taken = {"spindle", "bushing"} - {spindle, bushing}
         clash = [x for x in frf.outputs + frf.inputs if parse_label(x)[0] in taken]
         if clash:
-            raise DOFError(f"cannot rename: labels {', '.join(clash[:4])} already use "
-                           f"{'/'.join(sorted(taken))}")
-        frf = frf.replace(outputs=[rename_node(x, ren) for x in frf.outputs],
-                          inputs=[rename_node(x, ren) for x in frf.inputs])
+            raise DOFError(
+                f"cannot rename: labels {', '.join(clash[:4])} already use "
+                f"{'/'.join(sorted(taken))}"
+            )
+        frf = frf.replace(
+            outputs=[rename_node(x, ren) for x in frf.outputs],
+            inputs=[rename_node(x, ren) for x in frf.inputs],
+        )
         notes.append(f"nodes {spindle!r} -> 'spindle', {bushing!r} -> 'bushing'")
     sp = [f"spindle:{d}" for d in directions]
     require_dofs(frf, outputs=sp, inputs=sp, what="the chassis FRF")
@@ -442,6 +450,5 @@ def describe(frf: FRF, operating_points: Sequence[float] | None = None) -> str:
         "nodes: " + "; ".join(f"{n} ({', '.join(v)})" for n, v in nodes.items()),
     ]
     if operating_points is not None:
-        lines.append("operating points: " + ", ".join(f"{v:g}" for v in operating_points)
-                     + " km/h")
+        lines.append("operating points: " + ", ".join(f"{v:g}" for v in operating_points) + " km/h")
     return "\n".join(lines)

@@ -55,8 +55,9 @@ def _split_pair(text: str, where: str) -> tuple[str, str]:
     return o.strip(), i.strip()
 
 
-def read_csv(src: Source, *, nodes: Mapping | None = None,
-             quantity: str | None = None) -> tuple[FRF, list[str], dict]:
+def read_csv(
+    src: Source, *, nodes: Mapping | None = None, quantity: str | None = None
+) -> tuple[FRF, list[str], dict]:
     """Read an FRF from CSV in the documented layout.
 
     Raises
@@ -105,8 +106,9 @@ def read_csv(src: Source, *, nodes: Mapping | None = None,
                 f"{name!r} line {k + 1} column {c + 1}: header {h!r} is not Re(out / in), "
                 "Im(out / in), Mag(out / in) or Phase(out / in)"
             )
-        part = {"re": "re", "im": "im", "mag": "mag", "abs": "mag", "phase": "ph",
-                "ph": "ph"}[mm.group(1).lower()]
+        part = {"re": "re", "im": "im", "mag": "mag", "abs": "mag", "phase": "ph", "ph": "ph"}[
+            mm.group(1).lower()
+        ]
         o, i = _split_pair(mm.group(2), f"{name!r} column {c + 1}")
         key = (o, i)
         if part in cols.setdefault(key, {}):
@@ -187,8 +189,11 @@ def read_csv(src: Source, *, nodes: Mapping | None = None,
     if units is not None and not units.is_si:
         frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs)[None])
         notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
-    extra = {k: v for k, v in meta.items() if k not in
-             ("quantity", "units", "layout", "phase_unit", "freq_unit")}
+    extra = {
+        k: v
+        for k, v in meta.items()
+        if k not in ("quantity", "units", "layout", "phase_unit", "freq_unit")
+    }
     return frf, notes, extra
 
 
@@ -214,7 +219,9 @@ def _header(metadata: Mapping | None, title: str) -> list[str]:
 def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
     """An FRF as CSV in the documented ``re-im`` layout (full double precision)."""
     lines = _header(metadata, "FRF") + [
-        f"# quantity: {frf.quantity}", f"# units: {UNITS[frf.quantity]}", "# layout: re-im",
+        f"# quantity: {frf.quantity}",
+        f"# units: {UNITS[frf.quantity]}",
+        "# layout: re-im",
     ]
     cols = ["freq [Hz]"]
     for o in frf.outputs:
@@ -229,8 +236,11 @@ def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
     return ("\n".join(lines) + "\n").encode()
 
 
-def write_csv_tables(tables: list[tuple[str, list[str], np.ndarray]],
-                     metadata: Mapping | None = None, title: str = "result") -> bytes:
+def write_csv_tables(
+    tables: list[tuple[str, list[str], np.ndarray]],
+    metadata: Mapping | None = None,
+    title: str = "result",
+) -> bytes:
     """Several tables in one CSV text, each introduced by ``# table: <name>``.
 
     ``tables`` holds ``(name, column_names, rows)`` with ``rows`` a 2-D array;
@@ -243,6 +253,14 @@ def write_csv_tables(tables: list[tuple[str, list[str], np.ndarray]],
         w = _csv.writer(out, lineterminator="\n")
         w.writerow(columns)
         for row in np.atleast_2d(rows):
-            w.writerow([x if isinstance(x, str) else repr(float(x)) if np.isreal(x)
-                        else repr(complex(x)) for x in row])
+            w.writerow(
+                [
+                    x
+                    if isinstance(x, str)
+                    else repr(float(x))
+                    if np.isreal(x)
+                    else repr(complex(x))
+                    for x in row
+                ]
+            )
     return out.getvalue().encode()

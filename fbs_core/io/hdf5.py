@@ -110,8 +110,7 @@ def write_hdf5_result(result, metadata: Mapping) -> bytes:
         for name, (dims, values) in result.arrays.items():
             v = np.asarray(values)
             if v.dtype.kind == "U":
-                d = h.require_group("arrays").create_dataset(name, data=v.astype(object),
-                                                             dtype=s)
+                d = h.require_group("arrays").create_dataset(name, data=v.astype(object), dtype=s)
             else:
                 d = h.require_group("arrays").create_dataset(name, data=v)
             d.attrs.create("dims", np.array(dims, dtype=object), dtype=s)
@@ -126,9 +125,14 @@ def _strings(v, what: str) -> list[str]:
     raise DataFormatError(f"{what} must be a list of DOF labels")
 
 
-def read_hdf5(src: Source, *, nodes: Mapping | None = None, quantity: str | None = None,
-              name: str | None = None, timeout: float = DEFAULT_TIMEOUT
-              ) -> tuple[FRF, list[str], dict]:
+def read_hdf5(
+    src: Source,
+    *,
+    nodes: Mapping | None = None,
+    quantity: str | None = None,
+    name: str | None = None,
+    timeout: float = DEFAULT_TIMEOUT,
+) -> tuple[FRF, list[str], dict]:
     """Read an FRF group (``/frf``, ``/frfs/<name>`` or ``name``) from HDF5 content.
 
     Raises
@@ -138,8 +142,7 @@ def read_hdf5(src: Source, *, nodes: Mapping | None = None, quantity: str | None
     what = f"HDF5 file {src.name!r}"
     meta, arrays = parse_isolated("hdf5", src.raw, what, timeout=timeout)
     ds, groups = meta["datasets"], meta["groups"]
-    cands = [g for g in groups if f"{g.rstrip('/')}/freq" in ds and
-             f"{g.rstrip('/')}/data" in ds]
+    cands = [g for g in groups if f"{g.rstrip('/')}/freq" in ds and f"{g.rstrip('/')}/data" in ds]
     if name is not None:
         g = "/" + name.strip("/")
         if g not in cands and f"/frfs{g}" in cands:
@@ -154,8 +157,12 @@ def read_hdf5(src: Source, *, nodes: Mapping | None = None, quantity: str | None
         g = cands[0]
     else:
         raise DataFormatError(
-            f"{what}: " + (f"several FRF groups ({', '.join(cands)}); pass name=..." if cands
-                           else "no FRF group (a group with datasets 'freq' and 'data')")
+            f"{what}: "
+            + (
+                f"several FRF groups ({', '.join(cands)}); pass name=..."
+                if cands
+                else "no FRF group (a group with datasets 'freq' and 'data')"
+            )
         )
     base = g.rstrip("/")
     attrs = groups[g]
@@ -197,8 +204,7 @@ def read_hdf5(src: Source, *, nodes: Mapping | None = None, quantity: str | None
     if isinstance(ul, str) and ul.strip() and units is None:
         notes.append(f"units {ul!r} not understood; not checked")
     decl = attrs.get("quantity")
-    q = reconcile_quantity(decl if isinstance(decl, str) and decl else None, units, quantity,
-                           what)
+    q = reconcile_quantity(decl if isinstance(decl, str) and decl else None, units, quantity, what)
     frf = FRF(freq, data * np.outer(so, si)[None], outs, ins, q)
     if units is not None and not units.is_si:
         frf = frf.replace(data=frf.data * si_factors(units, outs, ins)[None])
@@ -243,7 +249,7 @@ def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
 
     for path, e in ds.items():
         if path.startswith("/coords/"):
-            res.coords[path[len("/coords/"):]] = values(e)
+            res.coords[path[len("/coords/") :]] = values(e)
         elif path.startswith("/arrays/"):
             dims = e["attrs"].get("dims")
             v = values(e)
@@ -253,10 +259,10 @@ def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
                 raise DataFormatError(f"{what}: {path} lacks its axis names (attribute dims)")
             if "strings" in e:
                 v = v.reshape(e["shape"])
-            res.arrays[path[len("/arrays/"):]] = (tuple(dims), v)
+            res.arrays[path[len("/arrays/") :]] = (tuple(dims), v)
     for g in groups:
         if g.startswith("/frfs/") and f"{g}/freq" in ds:
-            res.frfs[g[len("/frfs/"):]] = read_hdf5(src, name=g, timeout=timeout)[0]
+            res.frfs[g[len("/frfs/") :]] = read_hdf5(src, name=g, timeout=timeout)[0]
     if "/frf/freq" in ds:
         res.frfs["frf"] = read_hdf5(src, name="frf", timeout=timeout)[0]
     return res

@@ -51,8 +51,19 @@ __all__ = ["read_mat_vars", "read_mat", "write_mat", "frf_from_vars", "MatVars"]
 #: Variables of a MAT-file: numeric arrays (MATLAB index order) or lists of strings.
 MatVars = dict[str, "np.ndarray | list[str]"]
 
-_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
-            "int64", "uint64", "logical"}
+_NUMERIC = {
+    "double",
+    "single",
+    "int8",
+    "uint8",
+    "int16",
+    "uint16",
+    "int32",
+    "uint32",
+    "int64",
+    "uint64",
+    "logical",
+}
 H_NAMES = ("H", "Y", "FRF", "frf")
 
 
@@ -177,8 +188,9 @@ def _strip1(shape) -> tuple:
     return tuple(s)
 
 
-def frf_from_vars(v: MatVars, name: str, *, nodes: Mapping | None = None,
-                  quantity: str | None = None) -> tuple[FRF, list[str], dict]:
+def frf_from_vars(
+    v: MatVars, name: str, *, nodes: Mapping | None = None, quantity: str | None = None
+) -> tuple[FRF, list[str], dict]:
     """Build the FRF from MAT-file variables in the documented layout."""
     notes: list[str] = []
     if "freq" not in v:
@@ -237,11 +249,13 @@ def frf_from_vars(v: MatVars, name: str, *, nodes: Mapping | None = None,
     return frf, notes, meta
 
 
-def read_mat(src: Source, kind: str, *, nodes=None, quantity=None,
-             timeout: float = DEFAULT_TIMEOUT) -> tuple[FRF, list[str], dict]:
+def read_mat(
+    src: Source, kind: str, *, nodes=None, quantity=None, timeout: float = DEFAULT_TIMEOUT
+) -> tuple[FRF, list[str], dict]:
     """Read an FRF from a MAT-file in the documented layout."""
-    return frf_from_vars(read_mat_vars(src, kind, timeout=timeout), src.name, nodes=nodes,
-                         quantity=quantity)
+    return frf_from_vars(
+        read_mat_vars(src, kind, timeout=timeout), src.name, nodes=nodes, quantity=quantity
+    )
 
 
 # -- writing ---------------------------------------------------------------------------
@@ -296,8 +310,9 @@ def _write_mat73(variables: Mapping) -> bytes:
             if isinstance(val, str | list):
                 rows = [val] if isinstance(val, str) else list(val)
                 width = max((len(s) for s in rows), default=0)
-                codes = np.array([[ord(c) for c in s.ljust(width)] for s in rows],
-                                 dtype=np.uint16).reshape(len(rows), width)
+                codes = np.array(
+                    [[ord(c) for c in s.ljust(width)] for s in rows], dtype=np.uint16
+                ).reshape(len(rows), width)
                 d = h.create_dataset(k, data=codes.T)
                 d.attrs["MATLAB_class"] = np.bytes_("char")
                 d.attrs["MATLAB_int_decode"] = np.int32(2)
@@ -317,8 +332,10 @@ def _write_mat73(variables: Mapping) -> bytes:
             d = h.create_dataset(k, data=a.T)
             d.attrs["MATLAB_class"] = np.bytes_(cls)
     raw = bytearray(b.getvalue())
-    text = (f"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: "
-            f"{time.strftime('%a %b %d %H:%M:%S %Y')} HDF5 schema 1.00 .").ljust(116)
+    text = (
+        f"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: "
+        f"{time.strftime('%a %b %d %H:%M:%S %Y')} HDF5 schema 1.00 ."
+    ).ljust(116)
     header = text.encode("ascii")[:116] + b" " * 8 + b"\x00\x02" + b"IM"
     raw[: len(header)] = header
     return bytes(raw)

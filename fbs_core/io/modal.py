@@ -81,8 +81,13 @@ def tire_from_vars(v: MatVars, name: str):
     lam = _num(v, "wavelengths", name).ravel().astype(float)
     psi = _shaped(_num(v, "psi", name), (n_s, n_m, 6), "psi", name, "n_speeds x n_modes x 6")
     chi = _shaped(_num(v, "chi", name), (n_s, n_m, 6), "chi", name, "n_speeds x n_modes x 6")
-    part = _shaped(_num(v, "participation", name), (n_s, lam.size, n_m), "participation",
-                   name, "n_speeds x n_wavelengths x n_modes")
+    part = _shaped(
+        _num(v, "participation", name),
+        (n_s, lam.size, n_m),
+        "participation",
+        name,
+        "n_speeds x n_wavelengths x n_modes",
+    )
     hub = tuple(f"hub:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))
     if "hub_dofs" in v:
         labels = v["hub_dofs"]
@@ -110,17 +115,19 @@ def read_tire_mat(src: Source, kind: str, **kw):
 
 def write_tire_mat(model, *, version: str = "5") -> bytes:
     """A tire model as MAT-file content in the documented layout."""
-    return write_mat_vars({
-        "speeds": np.asarray(model.speeds, float),
-        "poles": np.asarray(model.poles),
-        "psi": np.asarray(model.psi),
-        "chi": np.asarray(model.chi),
-        "wavelengths": np.asarray(model.wavelengths, float),
-        "participation": np.asarray(model.participation),
-        "hub_dofs": list(model.hub_dofs),
-        "metadata": json.dumps(dict(model.meta), default=str),
-    }, version=version)
-
+    return write_mat_vars(
+        {
+            "speeds": np.asarray(model.speeds, float),
+            "poles": np.asarray(model.poles),
+            "psi": np.asarray(model.psi),
+            "chi": np.asarray(model.chi),
+            "wavelengths": np.asarray(model.wavelengths, float),
+            "participation": np.asarray(model.participation),
+            "hub_dofs": list(model.hub_dofs),
+            "metadata": json.dumps(dict(model.meta), default=str),
+        },
+        version=version,
+    )
 
 
 def read_tire_native(src: Source, *, timeout: float = DEFAULT_TIMEOUT):

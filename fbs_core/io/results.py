@@ -28,8 +28,14 @@ from ..dofs import parse_label
 from ..errors import DataFormatError, DOFError
 from ..frf import FRF
 
-__all__ = ["ResultData", "as_result_data", "result_to_csv", "result_to_uff",
-           "result_to_hdf5", "FREQ_DIMS"]
+__all__ = [
+    "ResultData",
+    "as_result_data",
+    "result_to_csv",
+    "result_to_uff",
+    "result_to_hdf5",
+    "FREQ_DIMS",
+]
 
 #: Axis names treated as a frequency axis in Hz (abscissa of UFF records).
 FREQ_DIMS = ("freq", "frequency", "centres", "centers")
@@ -59,8 +65,7 @@ class ResultData:
     metadata: dict = field(default_factory=dict)
 
 
-_SHAPE_DOC = re.compile(r"^\s*([\w ,]+?)\s*:[^\n]*?\b(?:shape|length)\s*\(?([\w ,]*)\)?",
-                        re.M)
+_SHAPE_DOC = re.compile(r"^\s*([\w ,]+?)\s*:[^\n]*?\b(?:shape|length)\s*\(?([\w ,]*)\)?", re.M)
 
 
 def _doc_dims(cls) -> dict[str, tuple[str, ...]]:
@@ -101,8 +106,11 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
         out.frfs[prefix.rstrip("/") or "frf"] = obj
         return
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        items = {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)
-                 if not f.name.startswith("_")}
+        items = {
+            f.name: getattr(obj, f.name)
+            for f in dataclasses.fields(obj)
+            if not f.name.startswith("_")
+        }
         docdims = _doc_dims(type(obj))
     elif isinstance(obj, Mapping):
         items = dict(obj)
@@ -121,8 +129,11 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
     # results see the axes of their parent (ScatterBand.convergence shares n_f, n_dof)
     local: dict[str, str] = {}
     for k, syms in docdims.items():
-        if len(syms) == 1 and k in items and (_labels(items[k]) or (
-                isinstance(items[k], np.ndarray) and items[k].ndim == 1)):
+        if (
+            len(syms) == 1
+            and k in items
+            and (_labels(items[k]) or (isinstance(items[k], np.ndarray) and items[k].ndim == 1))
+        ):
             local.setdefault(syms[0], prefix + k)  # the first documented field labels it
     # an undocumented tuple of numbers or labels ahead of that field labels an axis when
     # its length fits exactly one symbol (SuggestedModes.harmonics for n_h)
@@ -134,12 +145,17 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
             for sym, n in zip(syms, v.shape, strict=True):
                 sizes.setdefault(sym, set()).add(n)
     for k, v in items.items():
-        if k in docdims or not isinstance(v, tuple | list) or not v or not all(
-                isinstance(x, int | float | str | np.number) for x in v):
+        if (
+            k in docdims
+            or not isinstance(v, tuple | list)
+            or not v
+            or not all(isinstance(x, int | float | str | np.number) for x in v)
+        ):
             continue
         fits = [sym for sym, n in sizes.items() if n == {len(v)}]
-        if len(fits) == 1 and (fits[0] not in local or order.index(k) <
-                               order.index(local[fits[0]][len(prefix):])):
+        if len(fits) == 1 and (
+            fits[0] not in local or order.index(k) < order.index(local[fits[0]][len(prefix) :])
+        ):
             local[fits[0]] = prefix + k
             out.coords[prefix + k] = np.asarray(v)
     axis_coord = {**(inherited or {}), **local}
@@ -149,21 +165,27 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
             continue
         if isinstance(v, FRF):
             out.frfs[key] = v
-        elif isinstance(v, tuple | list) and v and all(
+        elif (
+            isinstance(v, tuple | list)
+            and v
+            and all(
                 isinstance(x, FRF) or (dataclasses.is_dataclass(x) and not isinstance(x, type))
-                for x in v):
+                for x in v
+            )
+        ):
             for i, x in enumerate(v):
                 _flatten(x, f"{key}/{i}/", out, axis_coord)
         elif isinstance(v, tuple) and len(v) == 2 and _labels(v[0]) and hasattr(v[1], "shape"):
             out.arrays[key] = (tuple(prefix + d for d in v[0]), np.asarray(v[1]))
         elif _labels(v):
             out.coords[key] = np.asarray(v, dtype=str)
-        elif isinstance(v, np.ndarray) and v.ndim >= 1 and (_is_numeric(v) or v.dtype.kind
-                                                           == "U"):
+        elif isinstance(v, np.ndarray) and v.ndim >= 1 and (_is_numeric(v) or v.dtype.kind == "U"):
             syms = docdims.get(k, ())
             if len(syms) == v.ndim:
-                dims = tuple(f"{key}_dim{i}" if s.isdigit() else axis_coord.get(s, prefix + s)
-                             for i, s in enumerate(syms))
+                dims = tuple(
+                    f"{key}_dim{i}" if s.isdigit() else axis_coord.get(s, prefix + s)
+                    for i, s in enumerate(syms)
+                )
             else:
                 dims = tuple(f"{key}_dim{d}" for d in range(v.ndim))
             if v.ndim == 1 and dims[0] == key:
@@ -171,7 +193,8 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
             else:
                 out.arrays[key] = (dims, v)
         elif (dataclasses.is_dataclass(v) and not isinstance(v, type)) or (
-                isinstance(v, Mapping) and not all(_scalar(x) for x in v.values())):
+            isinstance(v, Mapping) and not all(_scalar(x) for x in v.values())
+        ):
             _flatten(v, key + "/", out, axis_coord)
         elif _scalar(v) or isinstance(v, Mapping | tuple | list | np.ndarray):
             out.metadata[key] = _jsonable(v)
@@ -184,8 +207,7 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
                 )
 
 
-def as_result_data(obj, metadata: Mapping | None = None, kind: str | None = None
-                   ) -> ResultData:
+def as_result_data(obj, metadata: Mapping | None = None, kind: str | None = None) -> ResultData:
     """Flatten a result object into :class:`ResultData`, adding traceability metadata.
 
     Parameters
@@ -211,8 +233,9 @@ def as_result_data(obj, metadata: Mapping | None = None, kind: str | None = None
     from .. import __version__
 
     if isinstance(obj, ResultData):
-        out = ResultData(obj.kind, dict(obj.arrays), dict(obj.coords), dict(obj.frfs),
-                         dict(obj.metadata))
+        out = ResultData(
+            obj.kind, dict(obj.arrays), dict(obj.coords), dict(obj.frfs), dict(obj.metadata)
+        )
     else:
         out = ResultData(kind or type(obj).__name__)
         _flatten(obj, "", out)
@@ -232,8 +255,10 @@ def _long_table(name: str, dims, values, coords) -> tuple[str, list[str], list[l
     idx = np.indices(v.shape).reshape(v.ndim, -1).T
     rows = []
     for ix, x in zip(idx, v.ravel(), strict=True):
-        row = [axes[k][i].item() if hasattr(axes[k][i], "item") else axes[k][i]
-               for k, i in enumerate(ix)]
+        row = [
+            axes[k][i].item() if hasattr(axes[k][i], "item") else axes[k][i]
+            for k, i in enumerate(ix)
+        ]
         row += [float(x.real), float(x.imag)] if np.iscomplexobj(v) else [x.item()]
         rows.append(row)
     return name, cols, rows
@@ -255,8 +280,14 @@ def result_to_csv(res: ResultData) -> bytes:
     for name, frf in res.frfs.items():
         out.write(f"\n# table: {name}\n")
         body = write_csv(frf).decode().splitlines()
-        out.write("\n".join(ln for ln in body if not ln.startswith("# tire-fbs")
-                            and not ln.startswith("# fbs_core_version")) + "\n")
+        out.write(
+            "\n".join(
+                ln
+                for ln in body
+                if not ln.startswith("# tire-fbs") and not ln.startswith("# fbs_core_version")
+            )
+            + "\n"
+        )
     for name, (dims, values) in res.arrays.items():
         t, cols, rows = _long_table(name, dims, values, res.coords)
         out.write(f"\n# table: {t}\n")
@@ -274,8 +305,9 @@ def result_to_hdf5(res: ResultData) -> bytes:
     return write_hdf5_result(res, res.metadata)
 
 
-def result_to_uff(res: ResultData, *, nodes: Mapping | None = None,
-                  round_abscissa: bool = False) -> bytes:
+def result_to_uff(
+    res: ResultData, *, nodes: Mapping | None = None, round_abscissa: bool = False
+) -> bytes:
     """The functions of frequency in a result as UFF dataset-58 records.
 
     FRFs are written as FRF records (function type 4). Every other array with a
@@ -307,8 +339,9 @@ def result_to_uff(res: ResultData, *, nodes: Mapping | None = None,
     skipped = []
     for name, (dims, values) in res.arrays.items():
         v = np.asarray(values)
-        fd = [k for k, d in enumerate(dims) if d.rsplit("/", 1)[-1] in FREQ_DIMS
-              and d in res.coords]
+        fd = [
+            k for k, d in enumerate(dims) if d.rsplit("/", 1)[-1] in FREQ_DIMS and d in res.coords
+        ]
         if not fd or v.dtype.kind not in "biufc":
             skipped.append(name)
             continue
@@ -335,18 +368,32 @@ def result_to_uff(res: ResultData, *, nodes: Mapping | None = None,
                 node = _node_numbers([label], nodes)[nn]
                 code, ent = DIR_CODES.get(dr, 0), _ent(nn)
             y = moved[ix]
-            recs.append(dict(
-                func_type=0, ver_num=0, load_case_id=0,
-                id1=f"{name} [{', '.join(parts)}]"[:80],
-                id2=ids[0][:80], id3=ids[1][:80], id4=(ids[2] if len(ids) > 2 else "NONE")[:80],
-                id5="NONE",
-                rsp_node=node, rsp_dir=code, rsp_ent_name=ent,
-                ref_node=0, ref_dir=0, ref_ent_name="NONE",
-                data=np.asarray(y, dtype=complex if np.iscomplexobj(y) else float),
-                x=x, abscissa_spacing=even, abscissa_spec_data_type=18,
-                abscissa_axis_units_lab="Hz", ordinate_spec_data_type=0,
-                orddenom_spec_data_type=0, z_axis_spec_data_type=0,
-            ))
+            recs.append(
+                dict(
+                    func_type=0,
+                    ver_num=0,
+                    load_case_id=0,
+                    id1=f"{name} [{', '.join(parts)}]"[:80],
+                    id2=ids[0][:80],
+                    id3=ids[1][:80],
+                    id4=(ids[2] if len(ids) > 2 else "NONE")[:80],
+                    id5="NONE",
+                    rsp_node=node,
+                    rsp_dir=code,
+                    rsp_ent_name=ent,
+                    ref_node=0,
+                    ref_dir=0,
+                    ref_ent_name="NONE",
+                    data=np.asarray(y, dtype=complex if np.iscomplexobj(y) else float),
+                    x=x,
+                    abscissa_spacing=even,
+                    abscissa_spec_data_type=18,
+                    abscissa_axis_units_lab="Hz",
+                    ordinate_spec_data_type=0,
+                    orddenom_spec_data_type=0,
+                    z_axis_spec_data_type=0,
+                )
+            )
     if not recs:
         raise DataFormatError(
             f"the {res.kind} has no function of frequency; UFF 58 cannot carry it "

@@ -45,11 +45,30 @@ _CODE_DIRS = {v: k for k, v in DIR_CODES.items()}
 SPEC_TYPES: dict[str, int] = {"receptance": 8, "mobility": 11, "accelerance": 12}
 _SPEC_QUANTITY = {v: k for k, v in SPEC_TYPES.items()}
 _FORCE_TYPES = (9, 13)
-_FUNC_NAMES = {0: "general", 1: "time response", 2: "auto spectrum", 3: "cross spectrum",
-               4: "FRF", 5: "transmissibility", 6: "coherence", 9: "PSD", 12: "spectrum"}
+_FUNC_NAMES = {
+    0: "general",
+    1: "time response",
+    2: "auto spectrum",
+    3: "cross spectrum",
+    4: "FRF",
+    5: "transmissibility",
+    6: "coherence",
+    9: "PSD",
+    12: "spectrum",
+}
 
-_REQUIRED = ("func_type", "rsp_node", "rsp_dir", "ref_node", "ref_dir", "ord_data_type",
-             "num_pts", "abscissa_spacing", "x", "data")
+_REQUIRED = (
+    "func_type",
+    "rsp_node",
+    "rsp_dir",
+    "ref_node",
+    "ref_dir",
+    "ord_data_type",
+    "num_pts",
+    "abscissa_spacing",
+    "x",
+    "data",
+)
 
 
 def _read_sets(src: Source) -> list[dict]:
@@ -65,9 +84,7 @@ def _read_sets(src: Source) -> list[dict]:
                 n = uff.get_n_sets()
                 sets = uff.read_sets() if n else []
         except Exception as e:
-            raise DataFormatError(
-                f"{src.name!r} is not a readable Universal File: {e}"
-            ) from None
+            raise DataFormatError(f"{src.name!r} is not a readable Universal File: {e}") from None
     if isinstance(sets, dict):
         sets = [sets]
     if not sets:
@@ -81,8 +98,9 @@ def _dof(node, code, ent, what: str, nodes: Mapping | None, ent_names: dict) -> 
     try:
         node, code = int(node), int(code)
     except (TypeError, ValueError):
-        raise DataFormatError(f"{what}: node {node!r} / direction {code!r} are not integers")\
-            from None
+        raise DataFormatError(
+            f"{what}: node {node!r} / direction {code!r} are not integers"
+        ) from None
     if abs(code) > 6:
         raise DOFError(
             f"{what}: unknown direction code {code}; allowed: 0 (scalar), 1..3 (+X..+Z "
@@ -160,8 +178,9 @@ def _units_label(s: dict) -> str:
     return num
 
 
-def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None = None,
-             freq=None) -> tuple[FRF, list[str], dict]:
+def read_uff(
+    src: Source, *, nodes: Mapping | None = None, quantity: str | None = None, freq=None
+) -> tuple[FRF, list[str], dict]:
     """Read the FRF records (dataset 58, function type 4) of a Universal File.
 
     Parameters
@@ -213,8 +232,13 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
             )
     frf_sets = [s for s in f58 if int(s["func_type"]) == 4]
     if len(frf_sets) < len(f58):
-        kinds = sorted({_FUNC_NAMES.get(int(s["func_type"]), str(s["func_type"]))
-                        for s in f58 if int(s["func_type"]) != 4})
+        kinds = sorted(
+            {
+                _FUNC_NAMES.get(int(s["func_type"]), str(s["func_type"]))
+                for s in f58
+                if int(s["func_type"]) != 4
+            }
+        )
         notes.append(f"skipped {len(f58) - len(frf_sets)} non-FRF records ({', '.join(kinds)})")
     if not frf_sets:
         raise DataFormatError(
@@ -233,10 +257,8 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
     n_flipped = 0
     for k, s in enumerate(frf_sets):
         what = f"{src.name!r} FRF record {k + 1}"
-        out, so = _dof(s["rsp_node"], s["rsp_dir"], s.get("rsp_ent_name"), what, nodes,
-                       ent_names)
-        inp, si = _dof(s["ref_node"], s["ref_dir"], s.get("ref_ent_name"), what, nodes,
-                       ent_names)
+        out, so = _dof(s["rsp_node"], s["rsp_dir"], s.get("rsp_ent_name"), what, nodes, ent_names)
+        inp, si = _dof(s["ref_node"], s["ref_dir"], s.get("ref_ent_name"), what, nodes, ent_names)
         what = f"{what} ({out} / {inp})"
         x = np.asarray(s["x"])
         y = np.asarray(s["data"])
@@ -289,8 +311,10 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
         present = {str(int(s[k])) for s in frf_sets for k in ("rsp_node", "ref_node")}
         unused = [str(k) for k in nodes if str(k) not in present]
         if unused:
-            notes.append(f"node numbers {', '.join(unused)} of the node map are not in the file "
-                         f"(nodes in the file: {', '.join(sorted(present, key=int))})")
+            notes.append(
+                f"node numbers {', '.join(unused)} of the node map are not in the file "
+                f"(nodes in the file: {', '.join(sorted(present, key=int))})"
+            )
 
     missing = [(o, i) for o in outputs for i in inputs if (o, i) not in entries]
     if missing:
@@ -318,8 +342,10 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
         )
     if len(unit_labels) > 1:
         parsed = {lab: parse_units(lab) for lab in unit_labels}
-        if len({(u.quantity, u.length, u.force, u.g) if u else lab
-                for lab, u in parsed.items()}) > 1:
+        if (
+            len({(u.quantity, u.length, u.force, u.g) if u else lab for lab, u in parsed.items()})
+            > 1
+        ):
             raise QuantityError(
                 f"{src.name!r} mixes units across records: {', '.join(sorted(unit_labels))}"
             )
@@ -335,10 +361,15 @@ def read_uff(src: Source, *, nodes: Mapping | None = None, quantity: str | None 
         if not (lf > 0 and ff > 0 and math.isfinite(lf) and math.isfinite(ff)):
             raise DataFormatError(f"{src.name!r}: dataset 164 has invalid unit factors")
         if (lf, ff) != (1.0, 1.0):
-            units = Units(f"dataset 164 ({str(u.get('units_description', '')).strip()})",
-                          units.quantity if units else None, 1.0 / lf, 1.0 / ff)
-    q = reconcile_quantity(next(iter(declared)) if declared else None, units, quantity,
-                           repr(src.name))
+            units = Units(
+                f"dataset 164 ({str(u.get('units_description', '')).strip()})",
+                units.quantity if units else None,
+                1.0 / lf,
+                1.0 / ff,
+            )
+    q = reconcile_quantity(
+        next(iter(declared)) if declared else None, units, quantity, repr(src.name)
+    )
     frf = FRF(target, data, outputs, inputs, q)
     if units is not None and not units.is_si:
         frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs)[None])
@@ -418,8 +449,13 @@ def write_uff_records(records: list[dict], *, binary: bool = False) -> bytes:
     return b"".join(parts)
 
 
-def frf_records(frf: FRF, *, nodes: Mapping | None = None, id_lines: Sequence[str] = (),
-                round_abscissa: bool = False) -> list[dict]:
+def frf_records(
+    frf: FRF,
+    *,
+    nodes: Mapping | None = None,
+    id_lines: Sequence[str] = (),
+    round_abscissa: bool = False,
+) -> list[dict]:
     """pyuff dictionaries of one dataset 58 per output/input pair of ``frf``."""
     even = _abscissa(frf.freq, round_abscissa)
     numbers = _node_numbers(frf.outputs + frf.inputs, nodes)
@@ -428,25 +464,45 @@ def frf_records(frf: FRF, *, nodes: Mapping | None = None, id_lines: Sequence[st
     for o, out in enumerate(frf.outputs):
         for i, inp in enumerate(frf.inputs):
             (no, do), (ni, di) = parse_label(out), parse_label(inp)
-            recs.append(dict(
-                func_type=4, ver_num=0, load_case_id=0,
-                id1=f"{frf.quantity} {out} / {inp}"[:80],
-                id2=ids[0][:80], id3=ids[1][:80], id4=ids[2][:80], id5=ids[3][:80],
-                rsp_node=numbers[no], rsp_dir=DIR_CODES.get(do, 0), rsp_ent_name=_ent(no),
-                ref_node=numbers[ni], ref_dir=DIR_CODES.get(di, 0), ref_ent_name=_ent(ni),
-                data=np.array(frf.data[:, o, i], dtype=complex), x=np.array(frf.freq),
-                abscissa_spacing=even, abscissa_spec_data_type=18,
-                abscissa_axis_units_lab="Hz",
-                ordinate_spec_data_type=SPEC_TYPES[frf.quantity],
-                ordinate_axis_units_lab=UNITS[frf.quantity],
-                orddenom_spec_data_type=13, orddenom_axis_units_lab="N",
-                z_axis_spec_data_type=0,
-            ))
+            recs.append(
+                dict(
+                    func_type=4,
+                    ver_num=0,
+                    load_case_id=0,
+                    id1=f"{frf.quantity} {out} / {inp}"[:80],
+                    id2=ids[0][:80],
+                    id3=ids[1][:80],
+                    id4=ids[2][:80],
+                    id5=ids[3][:80],
+                    rsp_node=numbers[no],
+                    rsp_dir=DIR_CODES.get(do, 0),
+                    rsp_ent_name=_ent(no),
+                    ref_node=numbers[ni],
+                    ref_dir=DIR_CODES.get(di, 0),
+                    ref_ent_name=_ent(ni),
+                    data=np.array(frf.data[:, o, i], dtype=complex),
+                    x=np.array(frf.freq),
+                    abscissa_spacing=even,
+                    abscissa_spec_data_type=18,
+                    abscissa_axis_units_lab="Hz",
+                    ordinate_spec_data_type=SPEC_TYPES[frf.quantity],
+                    ordinate_axis_units_lab=UNITS[frf.quantity],
+                    orddenom_spec_data_type=13,
+                    orddenom_axis_units_lab="N",
+                    z_axis_spec_data_type=0,
+                )
+            )
     return recs
 
 
-def write_uff(frf: FRF, *, nodes: Mapping | None = None, metadata: Mapping | None = None,
-              binary: bool = False, round_abscissa: bool = False) -> bytes:
+def write_uff(
+    frf: FRF,
+    *,
+    nodes: Mapping | None = None,
+    metadata: Mapping | None = None,
+    binary: bool = False,
+    round_abscissa: bool = False,
+) -> bytes:
     """An FRF as a Universal File of dataset-58 records (one per output/input pair).
 
     Node names become entity names (when at most 10 characters) and node numbers from
@@ -459,8 +515,7 @@ def write_uff(frf: FRF, *, nodes: Mapping | None = None, metadata: Mapping | Non
         When the grid is not representable in E13.5 (see ``round_abscissa``).
     """
     return write_uff_records(
-        frf_records(frf, nodes=nodes, id_lines=id_lines(metadata),
-                    round_abscissa=round_abscissa),
+        frf_records(frf, nodes=nodes, id_lines=id_lines(metadata), round_abscissa=round_abscissa),
         binary=binary,
     )
 

@@ -30,8 +30,16 @@ __all__ = [
     "quantity_notes",
 ]
 
-_LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "µm": 1e-6, "μm": 1e-6,
-           "in": 0.0254, "ft": 0.3048}
+_LENGTH = {
+    "m": 1.0,
+    "mm": 1e-3,
+    "cm": 1e-2,
+    "um": 1e-6,
+    "µm": 1e-6,
+    "μm": 1e-6,
+    "in": 0.0254,
+    "ft": 0.3048,
+}
 _FORCE = {"n": 1.0, "kn": 1e3, "lbf": 4.4482216152605}
 _G = 9.80665
 
@@ -159,8 +167,8 @@ def si_factors(units: Units, outputs: Sequence[str], inputs: Sequence[str]) -> n
     t_out = np.array([parse_label(o)[1] in ("x", "y", "z") for o in outputs], dtype=float)
     r_in = np.array([parse_label(i)[1] in ("rx", "ry", "rz") for i in inputs], dtype=float)
     length = units.length * (_G if units.g else 1.0)
-    out = length ** t_out
-    inn = (1.0 / units.force) * (units.length ** r_in)
+    out = length**t_out
+    inn = (1.0 / units.force) * (units.length**r_in)
     return out[:, None] / inn[None, :]
 
 
@@ -213,8 +221,9 @@ def check_quantity_arg(quantity: str | None) -> str | None:
     return quantity
 
 
-def reconcile_quantity(declared: str | None, units: Units | None, given: str | None,
-                       where: str) -> str:
+def reconcile_quantity(
+    declared: str | None, units: Units | None, given: str | None, where: str
+) -> str:
     """Decide the quantity from the file's declaration, its units and the caller.
 
     Raises
@@ -247,8 +256,16 @@ def reconcile_quantity(declared: str | None, units: Units | None, given: str | N
 def frequency_from_units(freq: np.ndarray, unit: str | None, where: str) -> np.ndarray:
     """Convert an abscissa in Hz, rad/s, kHz or cpm to Hz (anything else raises)."""
     u = (unit or "Hz").strip().lower().replace(" ", "")
-    factors = {"hz": 1.0, "hertz": 1.0, "1/s": 1.0, "khz": 1e3, "rad/s": 1 / (2 * np.pi),
-               "cpm": 1 / 60.0, "none": 1.0, "": 1.0}
+    factors = {
+        "hz": 1.0,
+        "hertz": 1.0,
+        "1/s": 1.0,
+        "khz": 1e3,
+        "rad/s": 1 / (2 * np.pi),
+        "cpm": 1 / 60.0,
+        "none": 1.0,
+        "": 1.0,
+    }
     if u not in factors:
         raise FrequencyGridError(
             f"{where}: unknown frequency unit {unit!r}; allowed: Hz, kHz, rad/s, cpm"

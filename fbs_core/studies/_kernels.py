@@ -79,8 +79,9 @@ def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
 
 
 @njit(**_JIT)
-def _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, s, nv, Wr, Wi, xr, xi, Pr, Pi, piv, pm,
-                yr, yi):
+def _lane_solve(
+    Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, s, nv, Wr, Wi, xr, xi, Pr, Pi, piv, pm, yr, yi
+):
     """Noisy eq. 4.1 at one line for all lanes: ``y (n_e, LANES)`` from factors ``s``.
 
     Rows enter in ``order`` (the partial-pivoting order of the noise-free matrix),
@@ -201,8 +202,9 @@ def _workspace(nj, ne, n_el):
 
 
 @njit(parallel=True, **_JIT)
-def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p, tire, vehicle,
-                    freq_dep, mag, cplx):
+def noisy_block_run(
+    Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p, tire, vehicle, freq_dep, mag, cplx
+):
     """Noisy responses of rounds ``rids`` at lines ``l0 .. l1-1``.
 
     ``order (n_f, n_j)`` is the row order of each line (:func:`pivot_order`).
@@ -234,14 +236,35 @@ def noisy_block_run(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p,
                     _lane_factors(key, lane_ids, nv, stream_line, p, 0, k_tire, s, base)
                 if vehicle:
                     _lane_factors(key, lane_ids, nv, stream_line, p, k_tire, k_all, s, base)
-            _lane_solve(Ar[line], Ai[line], ar[line], ai[line], Er[line], Ei[line], Br[line],
-                        Bi[line], order[line], s, nv, W[0], W[1], X[0], X[1], X[2], X[3], piv,
-                        pm, Y[0], Y[1])
+            _lane_solve(
+                Ar[line],
+                Ai[line],
+                ar[line],
+                ai[line],
+                Er[line],
+                Ei[line],
+                Br[line],
+                Bi[line],
+                order[line],
+                s,
+                nv,
+                W[0],
+                W[1],
+                X[0],
+                X[1],
+                X[2],
+                X[3],
+                piv,
+                pm,
+                Y[0],
+                Y[1],
+            )
             if want_mag:
                 for e in range(ne):
                     for v in range(nv):
-                        mag[line - l0, e, r0 + v] = np.sqrt(Y[0, e, v] * Y[0, e, v]
-                                                            + Y[1, e, v] * Y[1, e, v])
+                        mag[line - l0, e, r0 + v] = np.sqrt(
+                            Y[0, e, v] * Y[0, e, v] + Y[1, e, v] * Y[1, e, v]
+                        )
             else:
                 for e in range(ne):
                     for v in range(nv):
@@ -266,8 +289,8 @@ def pivot_order(A, E):
         piv = W[:, k, k]
         ok = piv != 0
         m = np.zeros((nf, n - k - 1), np.complex128)
-        m[ok] = W[ok, k + 1:, k] / piv[ok, None]
-        W[:, k + 1:, k:] -= m[:, :, None] * W[:, None, k, k:]
+        m[ok] = W[ok, k + 1 :, k] / piv[ok, None]
+        W[:, k + 1 :, k:] -= m[:, :, None] * W[:, None, k, k:]
     return order
 
 
@@ -294,7 +317,7 @@ def noise_factors(key, rounds, lines, p, nj, ne, tire, vehicle):
     if tire:
         out[:, : 2 * k_tire] = s[:, : 2 * k_tire]
     if vehicle:
-        out[:, 2 * k_tire:] = s[:, 2 * k_tire:]
+        out[:, 2 * k_tire :] = s[:, 2 * k_tire :]
     return out
 
 
@@ -429,7 +452,7 @@ def _order_stats_histogram(col, mn, mx, ranks, out):
     for i in range(ranks.size):
         b = rank_bin[i]
         end = fill[b]  # one past the bin's segment after the gather
-        seg = buf[end - counts[b]:end]
+        seg = buf[end - counts[b] : end]
         k = ranks[i] - starts[b]
         _select(seg, k, 0)
         out[i] = seg[k]

@@ -129,8 +129,9 @@ def band_power_sums(freq, v_ref, v_mod, centres, width: float = 12.0, edges: str
     return num, den
 
 
-def floating_band_error(freq, v_ref, v_mod, width: float = 12.0, step: float = 1.0,
-                        edges: str = "clip", centres=None):
+def floating_band_error(
+    freq, v_ref, v_mod, width: float = 12.0, step: float = 1.0, edges: str = "clip", centres=None
+):
     """Thesis eq. 5.1 over a floating band: error versus centre frequency.
 
     Parameters

@@ -101,8 +101,7 @@ class Convergence:
     def summary(self) -> str:
         """One line per checkpoint: rounds and the remaining change of both edges in dB."""
         lines = ["rounds   upper edge to final (dB)   lower edge to final (dB)"]
-        for r, u, lo in zip(self.rounds, self.upper_change_db, self.lower_change_db,
-                            strict=True):
+        for r, u, lo in zip(self.rounds, self.upper_change_db, self.lower_change_db, strict=True):
             lines.append(f"{int(r):>6d}   {u:24.3f}   {lo:24.3f}")
         return "\n".join(lines)
 
@@ -178,8 +177,7 @@ class ScatterBand:
             raise FBSError(f"round indices must be in 0..{self.rounds - 1}, got {rids.tolist()}")
         arrays, key = self._inputs
         tire, vehicle = _flags(self.target)
-        return _run_complex(arrays, key, rids, self.noise, tire, vehicle,
-                            self.frequency_dependent)
+        return _run_complex(arrays, key, rids, self.noise, tire, vehicle, self.frequency_dependent)
 
     def peak_round(self, freq: float, dof, which: str = "max") -> int:
         """The round giving the highest (``"max"``) or lowest (``"min"``) ``|v_e|`` at the
@@ -198,8 +196,9 @@ class ScatterBand:
         nj, ne = arrays[2].shape[1], arrays[6].shape[1]
         tire, vehicle = _flags(self.target)
         stream_line = line if self.frequency_dependent else 0
-        s = _kernels.noise_factors(key, np.array([r], np.int64), np.array([stream_line]),
-                                   self.noise, nj, ne, tire, vehicle)[0]
+        s = _kernels.noise_factors(
+            key, np.array([r], np.int64), np.array([stream_line]), self.noise, nj, ne, tire, vehicle
+        )[0]
         return split_factors(s, nj, ne)
 
 
@@ -210,7 +209,7 @@ def split_factors(s: np.ndarray, nj: int, ne: int) -> dict[str, np.ndarray]:
         "Yjj_A": s[..., :o1].reshape(s.shape[:-1] + (nj, nj)),
         "vj_A": s[..., o1:o2],
         "Yjj_E": s[..., o2:o3].reshape(s.shape[:-1] + (nj, nj)),
-        "Yej_E": s[..., o3:o3 + ne * nj].reshape(s.shape[:-1] + (ne, nj)),
+        "Yej_E": s[..., o3 : o3 + ne * nj].reshape(s.shape[:-1] + (ne, nj)),
     }
 
 
@@ -229,8 +228,9 @@ def _run_complex(arrays, key, rids, p, tire, vehicle, freq_dep):
     nf, ne = arrays[0].shape[0], arrays[6].shape[1]
     out = np.empty((rids.size, nf, ne), np.complex128)
     with _LOCK:
-        _kernels.noisy_block_run(*arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep,
-                                 _EMPTY_MAG, out)
+        _kernels.noisy_block_run(
+            *arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep, _EMPTY_MAG, out
+        )
     return out
 
 
@@ -254,8 +254,9 @@ def _check_inputs(YjjA, vj, YjjE, YejE):
     if YjjE.shape != (nf, nj, nj):
         raise DataFormatError(f"YjjE must have shape {(nf, nj, nj)}, got {YjjE.shape}")
     if YejE.ndim != 3 or YejE.shape[0] != nf or YejE.shape[2] != nj:
-        raise DataFormatError(f"YejE must have shape (n_f, n_e, {nj}) with n_f = {nf}, "
-                              f"got {YejE.shape}")
+        raise DataFormatError(
+            f"YejE must have shape (n_f, n_e, {nj}) with n_f = {nf}, got {YejE.shape}"
+        )
     for name, x in (("YjjA", YjjA), ("vj", vj), ("YjjE", YjjE), ("YejE", YejE)):
         if not np.all(np.isfinite(x)):
             raise DataFormatError(f"{name} contains non-finite values")
@@ -263,10 +264,24 @@ def _check_inputs(YjjA, vj, YjjE, YejE):
     return (*_split(YjjA), *_split(vj), *_split(YjjE), *_split(YejE), order)
 
 
-def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = "both",
-                        rounds: int = 10_000, frequency_dependent: bool = False, seed=0, *,
-                        freq=None, dofs=None, harmonic=None, percentiles=(5.0, 95.0),
-                        checkpoints=None, max_chunk_bytes: float = 64e6) -> ScatterBand:
+def scatter_band_arrays(
+    YjjA,
+    vj,
+    YjjE,
+    YejE,
+    noise: float = 0.1,
+    target: str = "both",
+    rounds: int = 10_000,
+    frequency_dependent: bool = False,
+    seed=0,
+    *,
+    freq=None,
+    dofs=None,
+    harmonic=None,
+    percentiles=(5.0, 95.0),
+    checkpoints=None,
+    max_chunk_bytes: float = 64e6,
+) -> ScatterBand:
     """The scatter band from arrays (the kernel behind :func:`scatter_band`).
 
     Parameters
@@ -325,8 +340,10 @@ def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = 
         raise FBSError(f"percentiles must be levels in [0, 100] %, got {qs.tolist()}")
     ck = default_checkpoints(rounds) if checkpoints is None else np.asarray(checkpoints, np.int64)
     if ck.ndim != 1 or ck.size == 0 or np.any(np.diff(ck) <= 0) or ck[0] < 1 or ck[-1] > rounds:
-        raise FBSError(f"checkpoints must be ascending round counts in 1..{rounds}, "
-                       f"got {np.asarray(checkpoints).tolist()}")
+        raise FBSError(
+            f"checkpoints must be ascending round counts in 1..{rounds}, "
+            f"got {np.asarray(checkpoints).tolist()}"
+        )
     if ck[-1] != rounds:
         ck = np.append(ck, rounds)
     f = np.arange(nf, dtype=float) if freq is None else check_grid(freq)
@@ -356,8 +373,19 @@ def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = 
         l1 = min(nf, l0 + chunk)
         m = mag[: l1 - l0]
         with _LOCK:
-            _kernels.noisy_block_run(*arrays, l0, l1, key, rids, float(noise), tire, vehicle,
-                                     bool(frequency_dependent), m, _EMPTY_CPLX)
+            _kernels.noisy_block_run(
+                *arrays,
+                l0,
+                l1,
+                key,
+                rids,
+                float(noise),
+                tire,
+                vehicle,
+                bool(frequency_dependent),
+                m,
+                _EMPTY_CPLX,
+            )
             _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
     del mag
     for name, x in (("reference", np.abs(ref)), ("upper edge", hi), ("lower edge", lo)):
@@ -368,19 +396,44 @@ def scatter_band_arrays(YjjA, vj, YjjE, YejE, noise: float = 0.1, target: str = 
                 "interface matrix Y_jj^A + Y_jj^E is singular there"
             )
     return ScatterBand(
-        freq=_ro(f), dofs=dofs, reference=_ro(ref), lower=_ro(lo), upper=_ro(hi),
-        argmin_round=_ro(alo), argmax_round=_ro(ahi), q=_ro(qs), percentiles=_ro(pct),
-        convergence=Convergence(_ro(ck), _ro(clo), _ro(chi)), noise=float(noise),
-        target=target, rounds=rounds, frequency_dependent=bool(frequency_dependent),
-        seed=seed, harmonic=harmonic, _inputs=(arrays, key),
+        freq=_ro(f),
+        dofs=dofs,
+        reference=_ro(ref),
+        lower=_ro(lo),
+        upper=_ro(hi),
+        argmin_round=_ro(alo),
+        argmax_round=_ro(ahi),
+        q=_ro(qs),
+        percentiles=_ro(pct),
+        convergence=Convergence(_ro(ck), _ro(clo), _ro(chi)),
+        noise=float(noise),
+        target=target,
+        rounds=rounds,
+        frequency_dependent=bool(frequency_dependent),
+        seed=seed,
+        harmonic=harmonic,
+        _inputs=(arrays, key),
     )
 
 
-def scatter_band(harmonic, noise: float = 0.1, target: str = "both", rounds: int = 10_000,
-                 frequency_dependent: bool = False, seed=0, *, n_modes=None, freq=None,
-                 df: float = 0.5, tire=None, chassis=None, coupling="6dof",
-                 percentiles=(5.0, 95.0), checkpoints=None,
-                 max_chunk_bytes: float = 64e6) -> ScatterBand:
+def scatter_band(
+    harmonic,
+    noise: float = 0.1,
+    target: str = "both",
+    rounds: int = 10_000,
+    frequency_dependent: bool = False,
+    seed=0,
+    *,
+    n_modes=None,
+    freq=None,
+    df: float = 0.5,
+    tire=None,
+    chassis=None,
+    coupling="6dof",
+    percentiles=(5.0, 95.0),
+    checkpoints=None,
+    max_chunk_bytes: float = 64e6,
+) -> ScatterBand:
     """Noise scatter band of the bushing response for one harmonic (thesis 5.2, eqs. 5.2-5.4).
 
     Parameters
@@ -421,7 +474,19 @@ def scatter_band(harmonic, noise: float = 0.1, target: str = "both", rounds: int
     YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
     YjjA, vj = _models.tire_arrays(tire, f, h, [n], dirs)
     return scatter_band_arrays(
-        YjjA[0], vj[0], YjjE, YejE, noise, target, rounds, frequency_dependent, seed,
-        freq=f, dofs=resp, harmonic=h.k, percentiles=percentiles, checkpoints=checkpoints,
+        YjjA[0],
+        vj[0],
+        YjjE,
+        YejE,
+        noise,
+        target,
+        rounds,
+        frequency_dependent,
+        seed,
+        freq=f,
+        dofs=resp,
+        harmonic=h.k,
+        percentiles=percentiles,
+        checkpoints=checkpoints,
         max_chunk_bytes=max_chunk_bytes,
     )

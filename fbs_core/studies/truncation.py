@@ -105,12 +105,19 @@ class TruncationMap:
         See :func:`suggest_n_modes`; ``dof=None`` uses the maximum over DOFs.
         """
         err = self.max_error if dof is None else self.dof_error(dof)
-        return suggest_n_modes(err, self.centres, self.n_modes, threshold, f_max,
-                               self.n_modes_total)
+        return suggest_n_modes(
+            err, self.centres, self.n_modes, threshold, f_max, self.n_modes_total
+        )
 
 
-def suggest_n_modes(error, centres, n_modes, threshold: float = 0.2, f_max: float = 160.0,
-                    n_total: int | None = None) -> int:
+def suggest_n_modes(
+    error,
+    centres,
+    n_modes,
+    threshold: float = 0.2,
+    f_max: float = 160.0,
+    n_total: int | None = None,
+) -> int:
     """Thesis table 5.1: the smallest ``N`` from which the error stays below the threshold.
 
     ``N`` qualifies when, for it and for every larger count in ``n_modes``, the error
@@ -158,9 +165,24 @@ def suggest_n_modes(error, centres, n_modes, threshold: float = 0.2, f_max: floa
     return int(n_total if n_total is not None else n[-1])
 
 
-def truncation_map_arrays(freq, YjjA, vj, YjjA_ref, vj_ref, YjjE, YejE, n_modes, *,
-                          dofs=None, harmonic=None, n_modes_total=None, width: float = 12.0,
-                          step: float = 1.0, edges: str = "clip", centres=None) -> TruncationMap:
+def truncation_map_arrays(
+    freq,
+    YjjA,
+    vj,
+    YjjA_ref,
+    vj_ref,
+    YjjE,
+    YejE,
+    n_modes,
+    *,
+    dofs=None,
+    harmonic=None,
+    n_modes_total=None,
+    width: float = 12.0,
+    step: float = 1.0,
+    edges: str = "clip",
+    centres=None,
+) -> TruncationMap:
     """The error map from arrays (the kernel behind :func:`truncation_map`).
 
     Parameters
@@ -224,9 +246,20 @@ def default_n_modes(n_total: int, step: int = 10) -> np.ndarray:
     return np.arange(step, n_total + 1, step)
 
 
-def truncation_map(harmonic, n_modes=None, *, freq=None, df: float = 0.5, width: float = 12.0,
-                   step: float = 1.0, edges: str = "clip", centres=None, tire=None,
-                   chassis=None, coupling="6dof") -> TruncationMap:
+def truncation_map(
+    harmonic,
+    n_modes=None,
+    *,
+    freq=None,
+    df: float = 0.5,
+    width: float = 12.0,
+    step: float = 1.0,
+    edges: str = "clip",
+    centres=None,
+    tire=None,
+    chassis=None,
+    coupling="6dof",
+) -> TruncationMap:
     """Truncation error map of one harmonic (thesis figs. 5.3, 5.6, 5.7).
 
     Parameters
@@ -272,8 +305,21 @@ def truncation_map(harmonic, n_modes=None, *, freq=None, df: float = 0.5, width:
     YjjA, vj = _models.tire_arrays(tire, f, h, list(n) + ([] if has_all else [n_total]), dirs)
     k = n.size
     return truncation_map_arrays(
-        f, YjjA[:k], vj[:k], YjjA[-1], vj[-1], YjjE, YejE, n, dofs=resp, harmonic=h.k,
-        n_modes_total=n_total, width=width, step=step, edges=edges, centres=centres,
+        f,
+        YjjA[:k],
+        vj[:k],
+        YjjA[-1],
+        vj[-1],
+        YjjE,
+        YejE,
+        n,
+        dofs=resp,
+        harmonic=h.k,
+        n_modes_total=n_total,
+        width=width,
+        step=step,
+        edges=edges,
+        centres=centres,
     )
 
 
@@ -386,10 +432,23 @@ class SuggestedModes:
         return "\n".join([head] + [f"{t:<20s}" + "".join(v) for t, v in rows])
 
 
-def suggest_modes(threshold: float = 0.2, f_max: float = 160.0, *, harmonics=(1, 2, 3, 4, 5, 6, 7),
-                  dof: str | None = None, speed: float = 80.0, maps=None, n_modes=None,
-                  df: float = 0.5, width: float = 12.0, step: float = 1.0, edges: str = "clip",
-                  tire=None, chassis=None, coupling="6dof") -> SuggestedModes:
+def suggest_modes(
+    threshold: float = 0.2,
+    f_max: float = 160.0,
+    *,
+    harmonics=(1, 2, 3, 4, 5, 6, 7),
+    dof: str | None = None,
+    speed: float = 80.0,
+    maps=None,
+    n_modes=None,
+    df: float = 0.5,
+    width: float = 12.0,
+    step: float = 1.0,
+    edges: str = "clip",
+    tire=None,
+    chassis=None,
+    coupling="6dof",
+) -> SuggestedModes:
     """Suggested number of tire modes for every harmonic (thesis table 5.1).
 
     Parameters
@@ -416,8 +475,17 @@ def suggest_modes(threshold: float = 0.2, f_max: float = 160.0, *, harmonics=(1,
     tire = _models.resolve_tire(tire)
     if maps is None:
         maps = tuple(
-            truncation_map(k, n_modes, df=df, width=width, step=step, edges=edges, tire=tire,
-                           chassis=chassis, coupling=coupling)
+            truncation_map(
+                k,
+                n_modes,
+                df=df,
+                width=width,
+                step=step,
+                edges=edges,
+                tire=tire,
+                chassis=chassis,
+                coupling=coupling,
+            )
             for k in harmonics
         )
     else:
@@ -429,5 +497,14 @@ def suggest_modes(threshold: float = 0.2, f_max: float = 160.0, *, harmonics=(1,
         ef[n > 0] = _highest_retained(tire, speed, n[n > 0])
     hs = [_models.resolve_harmonic(k) for k in harmonics]
     fr = np.array([h.freq_range for h in hs])
-    return SuggestedModes(tuple(int(k) for k in harmonics), _ro(n, int), _ro(ef), _ro(fr),
-                          float(threshold), float(f_max), float(speed), dof, maps)
+    return SuggestedModes(
+        tuple(int(k) for k in harmonics),
+        _ro(n, int),
+        _ro(ef),
+        _ro(fr),
+        float(threshold),
+        float(f_max),
+        float(speed),
+        dof,
+        maps,
+    )

@@ -23,8 +23,9 @@ __all__ = ["OPERATING_POINTS", "build_modal_model"]
 OPERATING_POINTS: tuple[float, ...] = (20.0, 40.0, 60.0, 80.0, 100.0, 120.0)
 
 
-def build_modal_model(params: TireParameters = DEFAULT_PARAMETERS,
-                      speeds=OPERATING_POINTS, wavelengths=WAVELENGTHS) -> TireModel:
+def build_modal_model(
+    params: TireParameters = DEFAULT_PARAMETERS, speeds=OPERATING_POINTS, wavelengths=WAVELENGTHS
+) -> TireModel:
     """Complex-mode model of the physical tire at the given operating points.
 
     Parameters
@@ -56,5 +57,13 @@ def build_modal_model(params: TireParameters = DEFAULT_PARAMETERS,
         "mac_median": np.median(macs, axis=1).round(4).tolist(),
         "mac_share_above_0.9": np.mean(macs > 0.9, axis=1).round(4).tolist(),
     }
-    return TireModel(np.asarray(speeds, float), poles, psi, chi, np.asarray(wavelengths, float),
-                     part, params=params, meta=meta)
+    return TireModel(
+        np.asarray(speeds, float),
+        poles,
+        psi,
+        chi,
+        np.asarray(wavelengths, float),
+        part,
+        params=params,
+        meta=meta,
+    )

@@ -107,13 +107,20 @@ class TireModel:
                 f"participation has shape {part.shape}, expected {(n_s, lam.size, n_m)}"
             )
         if not np.allclose(poles[:, 1::2], np.conj(poles[:, 0::2])) or np.any(
-                poles[:, 0::2].imag <= 0):
+            poles[:, 0::2].imag <= 0
+        ):
             raise DataFormatError(
                 "poles must come in conjugate pairs [r, conj(r), ...] with the member of "
                 "positive eigenfrequency first"
             )
-        for name, val in (("speeds", sp), ("poles", poles), ("psi", self.psi),
-                          ("chi", self.chi), ("wavelengths", lam), ("participation", part)):
+        for name, val in (
+            ("speeds", sp),
+            ("poles", poles),
+            ("psi", self.psi),
+            ("chi", self.chi),
+            ("wavelengths", lam),
+            ("participation", part),
+        ):
             object.__setattr__(self, name, _ro(np.asarray(val)))
         object.__setattr__(self, "hub_dofs", tuple(self.hub_dofs))
         # residues, invariant to the scaling of the shapes: (n_s, n_m, 6 * 6 + 6 * n_h)
@@ -160,8 +167,12 @@ class TireModel:
     def _check_n(self, n_modes) -> int:
         if n_modes is None:
             return self.n_modes
-        ok = (isinstance(n_modes, int | np.integer) and not isinstance(n_modes, bool)
-              and n_modes % 2 == 0 and 10 <= n_modes <= self.n_modes)
+        ok = (
+            isinstance(n_modes, int | np.integer)
+            and not isinstance(n_modes, bool)
+            and n_modes % 2 == 0
+            and 10 <= n_modes <= self.n_modes
+        )
         if not ok:
             raise ModeCountError(
                 f"n_modes must be an even integer from 10 to {self.n_modes} (modes are kept "
@@ -227,8 +238,9 @@ class TireModel:
         Y, _ = self._sums(f, np.full(f.size, float(speed_kmh)), [n], None)
         return FRF(f, Y[0], self.hub_dofs, self.hub_dofs, "mobility")
 
-    def patch_response(self, freq, harmonic_case, n_modes: int | None = None,
-                       speed_kmh: float | None = None) -> FRF:
+    def patch_response(
+        self, freq, harmonic_case, n_modes: int | None = None, speed_kmh: float | None = None
+    ) -> FRF:
         """Free hub velocity ``Y_ja^A F_a`` for the patch load of a harmonic case.
 
         Parameters
@@ -277,8 +289,10 @@ class TireModel:
         """
         h = harmonic(harmonic_case)
         f = check_grid(freq)
-        ns = [self._check_n(int(n)) if isinstance(n, int | np.integer) else self._check_n(n)
-              for n in n_modes_list]
+        ns = [
+            self._check_n(int(n)) if isinstance(n, int | np.integer) else self._check_n(n)
+            for n in n_modes_list
+        ]
         if not ns or np.any(np.diff(ns) <= 0):
             raise ModeCountError(f"n_modes_list must be non-empty and increasing, got {ns}")
         return self._sums(f, h.speed_at(f), ns, self._harmonic_index(h))

@@ -229,8 +229,15 @@ def _operators(params: TireParameters):
     n_p = params.T_p / b
     E_m = 12 * params.EI_lat / b**3
     Kb = (
-        n_p / R**2 * (_gram(dd_r, wts) + _gram(F["u_th"], wts) - _gram(F["u"], wts)
-                      + _gram(F["v_th"], wts) - _gram(F["v_hat"], wts))
+        n_p
+        / R**2
+        * (
+            _gram(dd_r, wts)
+            + _gram(F["u_th"], wts)
+            - _gram(F["u"], wts)
+            + _gram(F["v_th"], wts)
+            - _gram(F["v_hat"], wts)
+        )
         + params.EI / b / R**4 * _gram(F["w_thth"] + F["w"], wts)
         + params.D_y * _gram(F["w_yy"], wts)
         + params.D_t / R**2 * _gram(F["w_thy"] - F["u_y"], wts)
@@ -254,8 +261,11 @@ def _operators(params: TireParameters):
     for ye in (-b / 2, b / 2):
         Fe = _fields(params, basis, theta, np.array([ye]))
         rr, rt, ry = _rim_local(theta, ye, R)
-        for belt, rim, k in ((Fe["w"], rr, params.k_w), (Fe["u"], rt, params.k_v),
-                             (Fe["v"], ry, params.k_lat)):
+        for belt, rim, k in (
+            (Fe["w"], rr, params.k_w),
+            (Fe["u"], rt, params.k_v),
+            (Fe["v"], ry, params.k_lat),
+        ):
             rel = np.hstack([-rim, belt])
             K0 += 0.5 * k * _gram(rel, wth)
 
@@ -270,8 +280,9 @@ def _operators(params: TireParameters):
     dx = Fc["w"] * np.cos(thp) - Fc["u"] * np.sin(thp)
     dz = -Fc["w"] * np.sin(thp) - Fc["u"] * np.cos(thp)
     area = params.L_c * params.b_c
-    Kc = (params.k_cx * _gram(dx, wc) + params.k_cy * _gram(Fc["v"], wc)
-          + params.k_cz * _gram(dz, wc)) / area
+    Kc = (
+        params.k_cx * _gram(dx, wc) + params.k_cy * _gram(Fc["v"], wc) + params.k_cz * _gram(dz, wc)
+    ) / area
     K0[6:, 6:] += Kc
     x_patch = -R * (thp[:, 0] - np.pi / 2)  # forward coordinate in the patch
     contact = (x_patch, wc, dx, dz)
@@ -311,8 +322,9 @@ def system_matrices(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETER
     return _sym(M), _damping(params), G, K
 
 
-def build_tire_system(speed_kmh: float,
-                      params: TireParameters = DEFAULT_PARAMETERS) -> SecondOrderSystem:
+def build_tire_system(
+    speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS
+) -> SecondOrderSystem:
     """The rolling tire as a labelled second-order system at ``speed_kmh``.
 
     Parameters
@@ -355,8 +367,9 @@ def patch_load(wavelength: float, params: TireParameters = DEFAULT_PARAMETERS) -
     return f
 
 
-def ring_closed_form(n: int, speed_kmh: float,
-                     params: TireParameters = DEFAULT_PARAMETERS) -> tuple[float, float]:
+def ring_closed_form(
+    n: int, speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS
+) -> tuple[float, float]:
     """Forward and backward in-plane ring frequencies (Hz) of order ``n``, rim fixed.
 
     ``M_n = rhoA (n^2+1)``, ``K_n = EI n^2 (n^2-1)^2/R^4 + T_p n^2 (n^2-1)/R^2
@@ -367,8 +380,12 @@ def ring_closed_form(n: int, speed_kmh: float,
     p = params
     Om = omega_of_speed(speed_kmh, p)
     Mn = p.rhoA * (n**2 + 1)
-    Kn = (p.EI * n**2 * (n**2 - 1) ** 2 / p.R**4 + p.T_p * n**2 * (n**2 - 1) / p.R**2
-          + p.k_w * n**2 + p.k_v)
+    Kn = (
+        p.EI * n**2 * (n**2 - 1) ** 2 / p.R**4
+        + p.T_p * n**2 * (n**2 - 1) / p.R**2
+        + p.k_w * n**2
+        + p.k_v
+    )
     g = p.rhoA * Om * n * (n**2 - 1)
     r = np.sqrt(g**2 + Mn * Kn)
     return (g + r) / Mn / (2 * np.pi), (-g + r) / Mn / (2 * np.pi)

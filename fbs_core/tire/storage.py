@@ -30,8 +30,14 @@ from .model import TireModel
 from .params import TireParameters
 from .ring import HUB_DOFS
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "DATA_FILE", "save_tire_model", "load_tire_model",
-           "reference_tire"]
+__all__ = [
+    "FORMAT",
+    "FORMAT_VERSION",
+    "DATA_FILE",
+    "save_tire_model",
+    "load_tire_model",
+    "reference_tire",
+]
 
 FORMAT = "tire-fbs/modal-tire"
 FORMAT_VERSION = 1
@@ -41,19 +47,28 @@ DATA_FILE = Path(__file__).resolve().parents[2] / "data" / "reference_tire.h5"
 
 _DATASETS = {
     "speeds": ("km/h", "operating points (vehicle speed)"),
-    "poles": ("rad/s", "complex poles lambda_r in conjugate pairs [r, conj(r), ...], pairs "
-                       "ordered by eigenfrequency averaged over the speeds; mode r is the same "
-                       "tracked mode at every speed"),
-    "psi": ("m or rad per unit modal coordinate",
-            "right mode shapes at the hub DOFs, normalised with the left ones so that "
-            "a_r = chi_r^T (2 lambda_r M + C) psi_r = 1"),
-    "chi": ("m or rad per unit modal coordinate",
-            "left mode shapes at the hub DOFs (a_r = 1); receptance "
-            "H = sum_r psi_r chi_r^T / (j omega - lambda_r)"),
+    "poles": (
+        "rad/s",
+        "complex poles lambda_r in conjugate pairs [r, conj(r), ...], pairs "
+        "ordered by eigenfrequency averaged over the speeds; mode r is the same "
+        "tracked mode at every speed",
+    ),
+    "psi": (
+        "m or rad per unit modal coordinate",
+        "right mode shapes at the hub DOFs, normalised with the left ones so that "
+        "a_r = chi_r^T (2 lambda_r M + C) psi_r = 1",
+    ),
+    "chi": (
+        "m or rad per unit modal coordinate",
+        "left mode shapes at the hub DOFs (a_r = 1); receptance "
+        "H = sum_r psi_r chi_r^T / (j omega - lambda_r)",
+    ),
     "wavelengths": ("m", "road wavelengths of the patch loads"),
-    "participation": ("N/m (load per metre of road amplitude, per unit modal coordinate)",
-                      "modal participation chi_r^T f_patch of the distributed patch load "
-                      "exp(j 2 pi x / lambda) per speed and wavelength"),
+    "participation": (
+        "N/m (load per metre of road amplitude, per unit modal coordinate)",
+        "modal participation chi_r^T f_patch of the distributed patch load "
+        "exp(j 2 pi x / lambda) per speed and wavelength",
+    ),
 }
 
 
@@ -75,10 +90,13 @@ def save_tire_model(model: TireModel, path, description: str = "") -> Path:
             ds = f.create_dataset(name, data=np.asarray(getattr(model, name)))
             ds.attrs["unit"] = unit
             ds.attrs["description"] = desc
-        ds = f.create_dataset("hub_dofs", data=np.array(model.hub_dofs, dtype=object),
-                              dtype=h5py.string_dtype())
-        ds.attrs["description"] = ("hub DOF labels, vehicle coordinates ISO 8855: x forward, "
-                                   "y left, z up; rotations about these axes")
+        ds = f.create_dataset(
+            "hub_dofs", data=np.array(model.hub_dofs, dtype=object), dtype=h5py.string_dtype()
+        )
+        ds.attrs["description"] = (
+            "hub DOF labels, vehicle coordinates ISO 8855: x forward, "
+            "y left, z up; rotations about these axes"
+        )
         if model.params is not None:
             g = f.create_group("parameters")
             g.attrs["description"] = "physical parameters (SI units), fbs_core.tire.TireParameters"
@@ -125,9 +143,17 @@ def load_tire_model(path) -> TireModel:
         raise DataFormatError(f"cannot read {path} as HDF5: {e}") from e
     if hub != HUB_DOFS:
         raise DataFormatError(f"hub_dofs must be {list(HUB_DOFS)}, got {list(hub)}")
-    return TireModel(data["speeds"], data["poles"], data["psi"], data["chi"],
-                     data["wavelengths"], data["participation"], params=params, meta=meta,
-                     hub_dofs=hub)
+    return TireModel(
+        data["speeds"],
+        data["poles"],
+        data["psi"],
+        data["chi"],
+        data["wavelengths"],
+        data["participation"],
+        params=params,
+        meta=meta,
+        hub_dofs=hub,
+    )
 
 
 @lru_cache(maxsize=1)

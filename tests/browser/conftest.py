@@ -19,15 +19,26 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 SYSTEM_CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
-    "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-    "--disable-component-update", "--no-first-run", "--disable-sync",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+    "--disable-sync",
 ]
 #: Script served; overridable for debugging the harness itself.
 APP_SCRIPT = os.environ.get("FBS_DASHBOARD_SCRIPT", str(ROOT / "app" / "main.py"))
 #: Names of the ColumnDataSources that every page shows (set by the views' hooks).
 SOURCES = [
-    "mobility.reference", "mobility.truncated", "truncation.map", "scatter.minmax",
-    "scatter.percentile", "scatter.reference", "scatter.round", "eigen.f_20", "eigen.f_80",
+    "mobility.reference",
+    "mobility.truncated",
+    "truncation.map",
+    "scatter.minmax",
+    "scatter.percentile",
+    "scatter.reference",
+    "scatter.round",
+    "eigen.f_20",
+    "eigen.f_80",
     "eigen.f_120",
 ]
 
@@ -58,13 +69,30 @@ class DashboardServer:
         self.port = free_port()
         name = Path(script).stem
         self.url = f"http://127.0.0.1:{self.port}/{name}"
-        cmd = [sys.executable, "-m", "panel", "serve", script, "--port", str(self.port),
-               "--address", "127.0.0.1", "--num-threads", str(num_threads),
-               "--allow-websocket-origin", f"127.0.0.1:{self.port}",
-               # as scripts/serve.sh and the image: uploads up to 150 MB fit one message
-               "--websocket-max-message-size", str(200 * 1024 * 1024)]
+        cmd = [
+            sys.executable,
+            "-m",
+            "panel",
+            "serve",
+            script,
+            "--port",
+            str(self.port),
+            "--address",
+            "127.0.0.1",
+            "--num-threads",
+            str(num_threads),
+            "--allow-websocket-origin",
+            f"127.0.0.1:{self.port}",
+            # as scripts/serve.sh and the image: uploads up to 150 MB fit one message
+            "--websocket-max-message-size",
+            str(200 * 1024 * 1024),
+        ]
         self.proc = subprocess.Popen(
-            cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+            cmd,
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
             env={**os.environ, "PYTHONUNBUFFERED": "1"},
         )
         self.log: list[str] = []
@@ -168,7 +196,8 @@ def wait_loaded(page, names=SOURCES, timeout=90_000):
              const d = ms[0].data; const k = Object.keys(d)[0];
              return k !== undefined && d[k].length > 0;
            })""",
-        arg=list(names), timeout=timeout,
+        arg=list(names),
+        timeout=timeout,
     )
 
 
@@ -176,7 +205,8 @@ def wait_changed(page, name: str, before: str, timeout=30_000):
     """Wait until the fingerprint of a source differs from ``before``."""
     page.wait_for_function(
         f"([name, before]) => ({JS_FINGERPRINT})(name) !== before",
-        arg=[name, before], timeout=timeout,
+        arg=[name, before],
+        timeout=timeout,
     )
 
 
@@ -185,7 +215,9 @@ def wait_band_idle(page, timeout=120_000):
     page.wait_for_function(
         "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
         "m.css_classes.includes('scatter-progress')).every(m => m.active === false)",
-        timeout=timeout, polling=50)
+        timeout=timeout,
+        polling=50,
+    )
 
 
 def set_model_value(page, css_class: str, value, model_type: str | None = None):
@@ -239,8 +271,7 @@ def color_high(page) -> float:
 @pytest.fixture(scope="module")
 def shared_page(browser, dashboard):
     """One page for a sequence of control changes (a page load costs seconds)."""
-    context = browser.new_context(viewport={"width": 1600, "height": 1200},
-                                  accept_downloads=True)
+    context = browser.new_context(viewport={"width": 1600, "height": 1200}, accept_downloads=True)
     page = context.new_page()
     page.errors = []
     page.on("console", lambda m: m.type == "error" and page.errors.append(m.text))
@@ -258,5 +289,4 @@ def pytest_runtest_makereport(item, call):
     report = outcome.get_result()
     server = item.funcargs.get("dashboard") if hasattr(item, "funcargs") else None
     if report.failed and isinstance(server, DashboardServer):
-        report.sections.append(("dashboard server log (last 80 lines)",
-                                "".join(server.log[-80:])))
+        report.sections.append(("dashboard server log (last 80 lines)", "".join(server.log[-80:])))

@@ -46,42 +46,59 @@ def _type(page, cls, value):
 
 # control -> (action, sources that must change, sources that must not change)
 STEPS = {
-    "harmonic": (lambda p: set_model_value(p, "ctl-case-harmonic", 2, "Slider"),
-                 MOBILITY + MAP + BAND, EIGEN),
-    "n_modes": (lambda p: set_model_value(p, "ctl-case-n_modes", 9, "Slider"),  # N = 100
-                ["mobility.truncated"] + BAND,
-                ["mobility.reference"] + MAP + EIGEN),
-    "dof": (lambda p: _radio(p, "ctl-case-dof", "x"),
-            MOBILITY + MAP + BAND, EIGEN),
-    "coupling": (lambda p: _radio(p, "ctl-case-coupling", "5dof"),
-                 MOBILITY + MAP + BAND, EIGEN),
-    "map_mode": (lambda p: _radio(p, "ctl-truncation-map_mode", "max over 6 DOFs"),
-                 MAP, MOBILITY + BAND + EIGEN),
-    "noise": (lambda p: _type(p, "ctl-noise-noise", 4.5),
-              ["scatter.minmax", "scatter.percentile", "scatter.round"],
-              MOBILITY + MAP + ["scatter.reference"] + EIGEN),
-    "target": (lambda p: _radio(p, "ctl-noise-target", "tire"),
-               ["scatter.minmax", "scatter.percentile", "scatter.round"],
-               MOBILITY + MAP + ["scatter.reference"] + EIGEN),
+    "harmonic": (
+        lambda p: set_model_value(p, "ctl-case-harmonic", 2, "Slider"),
+        MOBILITY + MAP + BAND,
+        EIGEN,
+    ),
+    "n_modes": (
+        lambda p: set_model_value(p, "ctl-case-n_modes", 9, "Slider"),  # N = 100
+        ["mobility.truncated"] + BAND,
+        ["mobility.reference"] + MAP + EIGEN,
+    ),
+    "dof": (lambda p: _radio(p, "ctl-case-dof", "x"), MOBILITY + MAP + BAND, EIGEN),
+    "coupling": (lambda p: _radio(p, "ctl-case-coupling", "5dof"), MOBILITY + MAP + BAND, EIGEN),
+    "map_mode": (
+        lambda p: _radio(p, "ctl-truncation-map_mode", "max over 6 DOFs"),
+        MAP,
+        MOBILITY + BAND + EIGEN,
+    ),
+    "noise": (
+        lambda p: _type(p, "ctl-noise-noise", 4.5),
+        ["scatter.minmax", "scatter.percentile", "scatter.round"],
+        MOBILITY + MAP + ["scatter.reference"] + EIGEN,
+    ),
+    "target": (
+        lambda p: _radio(p, "ctl-noise-target", "tire"),
+        ["scatter.minmax", "scatter.percentile", "scatter.round"],
+        MOBILITY + MAP + ["scatter.reference"] + EIGEN,
+    ),
     "frequency_dependent": (
         lambda p: p.locator(".ctl-noise-frequency_dependent input").click(),
         ["scatter.minmax", "scatter.percentile", "scatter.round"],
-        MOBILITY + MAP + ["scatter.reference"] + EIGEN),
-    "seed": (lambda p: _type(p, "ctl-noise-seed", 11),
-             ["scatter.minmax", "scatter.percentile", "scatter.round"],
-             MOBILITY + MAP + ["scatter.reference"] + EIGEN),
+        MOBILITY + MAP + ["scatter.reference"] + EIGEN,
+    ),
+    "seed": (
+        lambda p: _type(p, "ctl-noise-seed", 11),
+        ["scatter.minmax", "scatter.percentile", "scatter.round"],
+        MOBILITY + MAP + ["scatter.reference"] + EIGEN,
+    ),
     # the same round index is the same round whatever R: only the band edges move
-    "rounds": (lambda p: _type(p, "ctl-noise-rounds", 2000),
-               ["scatter.minmax", "scatter.percentile"],
-               MOBILITY + MAP + ["scatter.reference", "scatter.round"] + EIGEN),
-    "single_round": (lambda p: _type(p, "ctl-noise-single_round", 5),
-                     ["scatter.round"],
-                     MOBILITY + MAP + ["scatter.minmax", "scatter.percentile",
-                                       "scatter.reference"] + EIGEN),
-    "percentile": (lambda p: p.locator(".ctl-noise-percentile select").select_option("50"),
-                   ["scatter.percentile"],
-                   MOBILITY + MAP + ["scatter.minmax", "scatter.reference", "scatter.round"]
-                   + EIGEN),
+    "rounds": (
+        lambda p: _type(p, "ctl-noise-rounds", 2000),
+        ["scatter.minmax", "scatter.percentile"],
+        MOBILITY + MAP + ["scatter.reference", "scatter.round"] + EIGEN,
+    ),
+    "single_round": (
+        lambda p: _type(p, "ctl-noise-single_round", 5),
+        ["scatter.round"],
+        MOBILITY + MAP + ["scatter.minmax", "scatter.percentile", "scatter.reference"] + EIGEN,
+    ),
+    "percentile": (
+        lambda p: p.locator(".ctl-noise-percentile select").select_option("50"),
+        ["scatter.percentile"],
+        MOBILITY + MAP + ["scatter.minmax", "scatter.reference", "scatter.round"] + EIGEN,
+    ),
 }
 
 
@@ -93,8 +110,9 @@ def test_page_loads_without_console_errors(shared_page, dashboard):
     for name in SOURCES:
         data = source(page, name)
         assert data is not None, name
-        assert all(np.isfinite(np.asarray(v, float)).all() for k, v in data.items()
-                   if k != "image"), name
+        assert all(
+            np.isfinite(np.asarray(v, float)).all() for k, v in data.items() if k != "image"
+        ), name
 
 
 @pytest.mark.parametrize("control", list(STEPS))
@@ -118,7 +136,8 @@ def test_threshold_caps_the_colour_and_f_max_changes_the_table(shared_page):
     _type(page, "ctl-truncation-threshold", 7)
     page.wait_for_function(
         "() => [...Bokeh.documents[0]._all_models.values()].some("
-        "m => m.type === 'LinearColorMapper' && m.high === 7)")
+        "m => m.type === 'LinearColorMapper' && m.high === 7)"
+    )
     assert color_high(page) == 7
     page.wait_for_function(f"(t) => ({_js_table()})('suggested-table') !== t", arg=table)
     table2 = table_json(page, "suggested-table")
@@ -134,8 +153,7 @@ def test_uncoupled_subsystems_on_request(shared_page):
     assert not row.is_visible()
     page.locator(".ctl-case-show_uncoupled input").click()
     row.wait_for(state="visible")
-    wait_loaded(page, ["uncoupled.tire_reference", "uncoupled.tire_truncated",
-                       "uncoupled.chassis"])
+    wait_loaded(page, ["uncoupled.tire_reference", "uncoupled.tire_truncated", "uncoupled.chassis"])
     before = {n: fingerprint(page, n) for n in ["uncoupled.chassis", "uncoupled.tire_reference"]}
     page.locator(".uncoupled-row select").select_option("x")  # spindle input
     wait_changed(page, "uncoupled.chassis", before["uncoupled.chassis"])
@@ -148,8 +166,10 @@ def _js_table():
     return JS_TABLE
 
 
-URL = ("?h=3&N=120&dof=rx&coupling=5dof&noise=5.5&target=tire&fdep=true&rounds=800&seed=3"
-       "&round=7&pct=50&thr=10&fmax=130&map=max+over+6+DOFs")
+URL = (
+    "?h=3&N=120&dof=rx&coupling=5dof&noise=5.5&target=tire&fdep=true&rounds=800&seed=3"
+    "&round=7&pct=50&thr=10&fmax=130&map=max+over+6+DOFs"
+)
 
 
 def test_url_restores_the_state(browser, dashboard):
@@ -185,8 +205,13 @@ def test_csv_downloads_match_the_plotted_data(shared_page):
     with page.expect_download() as info:
         page.locator(".download-mobility").first.click()
     meta, cols = read_csv(open(info.value.path()).read())
-    assert {"harmonic", "N (retained tire modes)", "response DOF", "coupling",
-            "fbs_core version"} <= set(meta)
+    assert {
+        "harmonic",
+        "N (retained tire modes)",
+        "response DOF",
+        "coupling",
+        "fbs_core version",
+    } <= set(meta)
     ref, tr = source(page, "mobility.reference"), source(page, "mobility.truncated")
     np.testing.assert_allclose(cols["freq_Hz"], ref["freq"])
     np.testing.assert_allclose(cols["reference_dB"], ref["level"], rtol=1e-12)
@@ -201,14 +226,14 @@ def test_csv_downloads_match_the_plotted_data(shared_page):
     np.testing.assert_allclose(cols["maximum_dB"], mm["upper"], rtol=1e-12)
     np.testing.assert_allclose(cols["minimum_dB"], mm["lower"], rtol=1e-12)
     rnd = [k for k in cols if k.startswith("round_")]
-    np.testing.assert_allclose(cols[rnd[0]], source(page, "scatter.round")["level"],
-                               rtol=1e-12)
+    np.testing.assert_allclose(cols[rnd[0]], source(page, "scatter.round")["level"], rtol=1e-12)
 
     with page.expect_download() as info:
         page.locator(".download-truncation").first.click()
     meta, cols = read_csv(open(info.value.path()).read())
-    np.testing.assert_allclose(cols["error_pct"], source(page, "truncation.map")["image"],
-                               rtol=1e-12)
+    np.testing.assert_allclose(
+        cols["error_pct"], source(page, "truncation.map")["image"], rtol=1e-12
+    )
 
 
 def test_long_computation_in_one_session_does_not_block_another(browser, dashboard):

@@ -58,10 +58,15 @@ def test_upload_changes_the_views_of_this_session_only(browser, dashboard, tmp_p
         try:
             wait_changed(a, n, before[n], timeout=120_000)
         except Exception as exc:  # say which view, with the server's side of the story
-            raise AssertionError(f"{n} did not change after the upload; server log:\n"
-                                 + "".join(dashboard.log[-60:])) from exc
-    for words in ("uploaded chassis 'reference_chassis.mat'", "bushing:rz", "1 to 600 Hz",
-                  "interpolated onto the analysis grids"):
+            raise AssertionError(
+                f"{n} did not change after the upload; server log:\n" + "".join(dashboard.log[-60:])
+            ) from exc
+    for words in (
+        "uploaded chassis 'reference_chassis.mat'",
+        "bushing:rz",
+        "1 to 600 Hz",
+        "interpolated onto the analysis grids",
+    ):
         _shows(a, "upload-summary", words)
     wait_band_idle(b)
     assert {n: fingerprint(b, n) for n in VIEWS} == other  # the other session: unchanged
@@ -74,15 +79,19 @@ def test_upload_changes_the_views_of_this_session_only(browser, dashboard, tmp_p
                   const now = ({JS_FINGERPRINT})(n);
                   const cols = s => s.split(';').filter(x => x).sort().join(';');
                   return now !== null && cols(now) === cols(fp);
-                }}""", arg=[n, before[n]], timeout=60_000)
+                }}""",
+            arg=[n, before[n]],
+            timeout=60_000,
+        )
     assert a.errors == [] and b.errors == []
     assert hashlib.sha256(shipped.read_bytes()).hexdigest() == digest
     for p in pages:
         p.context.close()
 
 
-def test_a_file_above_bokehs_default_message_limit_gets_a_clear_answer(browser, dashboard,
-                                                                        tmp_path):
+def test_a_file_above_bokehs_default_message_limit_gets_a_clear_answer(
+    browser, dashboard, tmp_path
+):
     """22 MB of bytes that are no MAT-file: base64-encoded, the upload is a 29 MB websocket
     message, above Bokeh's default limit (20 MB), which would close the connection and
     leave the page without an answer. With the served limit it reaches the server and is
