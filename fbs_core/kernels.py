@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import SingularInterfaceError
+from .errors import FBSError, SingularInterfaceError
 
 __all__ = [
     "solve_interface",
@@ -79,7 +79,15 @@ def solve_interface(
         Naming the first offending frequency line.
     """
     if rcond is not None:
-        return _tsvd_solve(A, B, rcond)
+        r = float(rcond) if isinstance(rcond, int | float | np.number) else None
+        if isinstance(rcond, bool) or r is None or not 0.0 <= r < 1.0:
+            # rcond >= 1 (or NaN) would drop every singular value: the "coupled" result
+            # would silently be the uncoupled one
+            raise FBSError(
+                f"rcond must be a number in [0, 1) (relative cut-off of the singular values, "
+                f"e.g. 1e-6), got {rcond!r}"
+            )
+        return _tsvd_solve(A, B, r)
     if max_cond is not None:
         c = condition_number(A)
         bad = ~(c <= max_cond)
@@ -158,17 +166,30 @@ def impedance_coupling(YA, YB, a, ja, b, jb):
     -------
     ndarray, shape (n_freq, n_a + n_j + n_b, n_a + n_j + n_b), order ``[a, j, b]``.
     """
-    ZA = np.linalg.inv(YA[:, np.r_[a, ja]][:, :, np.r_[a, ja]])
-    ZB = np.linalg.inv(YB[:, np.r_[jb, b]][:, :, np.r_[jb, b]])
+    ZA = _inv(YA[:, np.r_[a, ja]][:, :, np.r_[a, ja]], "subsystem A's FRF matrix")
+    ZB = _inv(YB[:, np.r_[jb, b]][:, :, np.r_[jb, b]], "subsystem B's FRF matrix")
     na, nj, nb = len(a), len(ja), len(b)
     n = na + nj + nb
     Z = np.zeros((YA.shape[0], n, n), complex)
     Z[:, : na + nj, : na + nj] += ZA
     Z[:, na:, na:] += ZB
+    return _inv(Z, "the assembled impedance matrix")
+
+
+def _inv(M: np.ndarray, what: str) -> np.ndarray:
+    """Inverse of every matrix of a stack; SingularInterfaceError naming the first
+    singular line instead of numpy's LinAlgError."""
     try:
-        return np.linalg.inv(Z)
-    except np.linalg.LinAlgError as err:
-        raise SingularInterfaceError(f"assembled impedance matrix is singular: {err}") from None
+        return np.linalg.inv(M)
+    except np.linalg.LinAlgError:
+        c = condition_number(M)
+        bad = ~np.isfinite(c) | (c > 1 / np.finfo(float).eps)
+        line = int(np.argmax(bad)) if bad.any() else 0
+        raise SingularInterfaceError(
+            f"{what} is singular at line {line} (condition number {c[line]:.3g}); impedance "
+            "coupling inverts every FRF matrix, use couple_receptance for singular or "
+            "rank-deficient subsystems"
+        ) from None
 
 
 def lm_fbs(Y: np.ndarray, B: np.ndarray, **solve_kw) -> np.ndarray:

@@ -207,3 +207,30 @@ def test_hdf5_result_reads_back_with_axes_and_metadata(tmp_path):
         load_result(b.getvalue(), filename="foreign.h5")
     chassis = load_result(Path(__file__).parents[1] / "data" / "reference_chassis.h5")
     assert "spindle:z" in chassis.frfs["frf"].inputs
+
+
+def test_csv_cells_cannot_start_a_formula():
+    """A file name or setting beginning with = + - @ is text in the exported CSV."""
+    import csv as _csv
+    import io as _io
+
+    Y = FRF([10.0, 20.0], np.ones((2, 1, 1)), ["a:z"], ["b:z"], "mobility")
+    hostile = {
+        "chassis_file": '=HYPERLINK("http://x","y")',
+        "note": "ok,=1+2;@SUM(A1);\t-3+4",
+        "tire_file": "+cmd|' /C calc'!A0",
+    }
+    for raw in (
+        export_result(Y, format="csv", metadata=hostile),
+        fbs_core.io.save_frf(Y, format="csv", metadata=hostile),
+    ):
+        text = raw.decode()
+        for delim in (",", ";", "\t"):
+            for row in _csv.reader(_io.StringIO(text), delimiter=delim):
+                for cell in row:
+                    assert not cell.lstrip(" ").startswith(("=", "+", "-", "@")), (delim, cell)
+        # the content is kept, readable after the apostrophe
+        assert "'=1+2" in text and "'@SUM(A1)" in text
+    # numbers (also negative) are still numbers
+    Z = Y.replace(data=-np.ones((2, 1, 1)))
+    assert ",-1.0," in fbs_core.io.save_frf(Z, format="csv").decode()

@@ -212,8 +212,29 @@ def _header(metadata: Mapping | None, title: str) -> list[str]:
     if "fbs_core_version" not in (metadata or {}):
         lines.append(f"# fbs_core_version: {__version__}")
     for k, v in (metadata or {}).items():
-        lines.append(f"# {k}: {str(v).replace(chr(10), ' ')}")
+        text = str(v).replace("\r", " ").replace("\n", " ")
+        lines.append(safe_text(f"# {k}: {text}"))
     return lines
+
+
+_FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "\uff1d", "\uff0b", "\uff0d", "\uff20")
+_SEPARATORS = re.compile(r"([,;\t])")
+
+
+def safe_cell(text: str) -> str:
+    """A text cell a spreadsheet will not run as a formula (CSV injection).
+
+    Text starting with ``= + - @``, a tab or a carriage return (also the full-width
+    forms) gets a leading apostrophe, which spreadsheets show as plain text.
+    """
+    return "'" + text if text.lstrip(" ").startswith(_FORMULA_START) else text
+
+
+def safe_text(text: str) -> str:
+    """Apply :func:`safe_cell` to every piece of a line a spreadsheet may split into
+    cells (at commas, semicolons and tabs)."""
+    parts = _SEPARATORS.split(text)
+    return "".join(p if k % 2 else safe_cell(p) for k, p in enumerate(parts))
 
 
 def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
@@ -255,7 +276,7 @@ def write_csv_tables(
         for row in np.atleast_2d(rows):
             w.writerow(
                 [
-                    x
+                    safe_cell(x)
                     if isinstance(x, str)
                     else repr(float(x))
                     if np.isreal(x)

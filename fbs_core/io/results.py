@@ -273,7 +273,7 @@ def result_to_csv(res: ResultData) -> bytes:
     import csv as _csv
     import io
 
-    from .csv import _header, write_csv
+    from .csv import _header, safe_cell, write_csv
 
     out = io.StringIO()
     out.write("\n".join(_header(res.metadata, res.kind)) + "\n")
@@ -294,7 +294,12 @@ def result_to_csv(res: ResultData) -> bytes:
         w = _csv.writer(out, lineterminator="\n")
         w.writerow(cols)
         for r in rows:
-            w.writerow([repr(x) if isinstance(x, float) else x for x in r])
+            w.writerow(
+                [
+                    repr(x) if isinstance(x, float) else safe_cell(x) if isinstance(x, str) else x
+                    for x in r
+                ]
+            )
     return out.getvalue().encode()
 
 

@@ -38,6 +38,10 @@ from ..frf import check_grid
 from . import _kernels, _models
 from ._rng import as_seed, seed_key
 
+#: Largest number of Monte-Carlo rounds of one band (one line's working memory,
+#: ``8 R n_e`` bytes, stays below 50 MB for six responses).
+MAX_ROUNDS = 1_000_000
+
 __all__ = ["TARGETS", "ScatterBand", "Convergence", "scatter_band", "scatter_band_arrays"]
 
 #: Where the noise goes.
@@ -334,6 +338,11 @@ def scatter_band_arrays(
     tire, vehicle = _flags(target)
     if isinstance(rounds, bool) or not isinstance(rounds, int | np.integer) or rounds < 1:
         raise FBSError(f"rounds must be a positive integer, got {rounds!r}")
+    if rounds > MAX_ROUNDS:
+        raise FBSError(
+            f"rounds must be at most {MAX_ROUNDS:,} (the band edges settle long before; "
+            f"see the convergence checkpoints), got {rounds:,}"
+        )
     rounds = int(rounds)
     qs = np.atleast_1d(np.asarray(percentiles, float))
     if qs.ndim != 1 or np.any(~np.isfinite(qs) | (qs < 0) | (qs > 100)):
