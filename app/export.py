@@ -20,6 +20,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from fbs_core.io.csv import safe_text
+
 __all__ = ["to_csv", "read_csv"]
 
 
@@ -53,7 +55,7 @@ def to_csv(columns: Mapping[str, np.ndarray], meta: Mapping[str, object], view: 
         text = str(value)
         if "\n" in text or "\n" in str(key):
             raise ValueError(f"header entry {key!r} must be a single line")
-        buf.write(f"# {key}: {text}\n")
+        buf.write(safe_text(f"# {key}: {text}") + "\n")  # no formula cells (CSV injection)
     buf.write(",".join(names) + "\n")
     if arrays:
         np.savetxt(buf, np.column_stack(arrays), delimiter=",", fmt="%.17g")

@@ -8,7 +8,7 @@ method returns a new :class:`FRF`.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -23,6 +23,23 @@ QUANTITIES: dict[str, int] = {"receptance": 0, "mobility": 1, "accelerance": 2}
 
 #: SI units of a translational response per force, by quantity.
 UNITS: dict[str, str] = {"receptance": "m/N", "mobility": "m/(N s)", "accelerance": "m/(N s^2)"}
+
+
+def _check_kinds(kinds, outs, ins) -> dict[str, str] | None:
+    if not kinds:
+        return None
+    from .units import INPUT_KINDS, OUTPUT_KINDS
+
+    if not isinstance(kinds, Mapping):
+        raise DataFormatError(f"kinds must map DOF labels to kinds, got {type(kinds).__name__}")
+    allowed = dict.fromkeys([*OUTPUT_KINDS, *INPUT_KINDS])
+    out = {}
+    for lab, k in kinds.items():
+        if k not in allowed:
+            raise DataFormatError(f"unknown kind {k!r} for {lab!r}; allowed: {', '.join(allowed)}")
+        if lab in outs or lab in ins:
+            out[str(lab)] = str(k)
+    return out or None
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -72,6 +89,11 @@ class FRF:
         (e.g. ``"patch"``); see :mod:`fbs_core.dofs`.
     quantity : {"receptance", "mobility", "accelerance"}
         What the response is per unit input (thesis table 2.1).
+    kinds : mapping, optional
+        Kind of DOFs whose direction does not tell it, e.g. ``{"patch": "road"}``
+        (:mod:`fbs_core.units`); by default ``x y z`` are translations / forces,
+        ``rx ry rz`` rotations / moments, ``patch`` a road input. The unit of every
+        entry follows (:attr:`units`, :meth:`unit`).
 
     Raises
     ------
@@ -86,7 +108,7 @@ class FRF:
     (2, 1, 1)
     """
 
-    __slots__ = ("_freq", "_data", "_outputs", "_inputs", "_quantity")
+    __slots__ = ("_freq", "_data", "_outputs", "_inputs", "_quantity", "_kinds")
 
     def __init__(
         self,
@@ -95,6 +117,7 @@ class FRF:
         outputs: Iterable[str],
         inputs: Iterable[str],
         quantity: str = "mobility",
+        kinds: Mapping[str, str] | None = None,
     ) -> None:
         f = check_grid(freq)
         d = np.asarray(data)
@@ -121,6 +144,7 @@ class FRF:
         object.__setattr__(self, "_outputs", outs)
         object.__setattr__(self, "_inputs", ins)
         object.__setattr__(self, "_quantity", quantity)
+        object.__setattr__(self, "_kinds", _check_kinds(kinds, outs, ins))
 
     def __setattr__(self, name, value):
         raise AttributeError("FRF objects are immutable; methods return new objects")
@@ -157,6 +181,59 @@ class FRF:
     def shape(self) -> tuple[int, int, int]:
         return self._data.shape
 
+    # -- units -----------------------------------------------------------------------
+    @property
+    def kinds(self) -> dict[str, str]:
+        """The kind overrides given at construction (label -> kind)."""
+        return dict(self._kinds or {})
+
+    @property
+    def output_kinds(self) -> tuple[str, ...]:
+        """``translation`` / ``rotation`` / ``generalised`` per output."""
+        from .units import output_kind
+
+        return tuple(output_kind(o, self._kinds) for o in self._outputs)
+
+    @property
+    def input_kinds(self) -> tuple[str, ...]:
+        """``force`` / ``moment`` / ``road`` / ``generalised`` per input."""
+        from .units import input_kind
+
+        return tuple(input_kind(i, self._kinds) for i in self._inputs)
+
+    @property
+    def units(self) -> np.ndarray:
+        """SI unit of every entry, shape ``(n_out, n_in)`` of str (e.g. ``m/(N s)``)."""
+        from .units import frf_unit
+
+        ok, ik = self.output_kinds, self.input_kinds
+        u = np.empty((len(ok), len(ik)), dtype=object)
+        for a, o in enumerate(ok):
+            for b, i in enumerate(ik):
+                u[a, b] = frf_unit(o, i, self._quantity)
+        return u
+
+    def unit(self, output: str | None = None, input: str | None = None) -> str:
+        """SI unit of one entry (for plot labels); without labels, the common unit of
+        all entries, or the units joined by ``" | "`` when they differ.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> Y = FRF([1.0], np.ones((1, 2, 1)), ["hub:z", "hub:ry"], ["patch"])
+        >>> Y.unit("hub:ry", "patch"), Y.unit()
+        ('(rad/s)/m', '(m/s)/m | (rad/s)/m')
+        """
+        from .units import frf_unit, input_kind, output_kind
+
+        if output is not None or input is not None:
+            o = output if output is not None else self._outputs[0]
+            i = input if input is not None else self._inputs[0]
+            index_of(self._outputs, o, "output DOF")
+            index_of(self._inputs, i, "input DOF")
+            return frf_unit(output_kind(o, self._kinds), input_kind(i, self._kinds), self._quantity)
+        return " | ".join(dict.fromkeys(self.units.ravel().tolist()))
+
     def __repr__(self) -> str:
         f = self._freq
         return (
@@ -173,6 +250,7 @@ class FRF:
             outputs=self._outputs,
             inputs=self._inputs,
             quantity=self._quantity,
+            kinds=self._kinds,
         )
         unknown = set(changes) - set(kw)
         if unknown:
@@ -221,6 +299,7 @@ class FRF:
             [self._outputs[i] for i in oi],
             [self._inputs[i] for i in ii],
             self._quantity,
+            self._kinds,
         )
 
     def crop(self, fmin: float | None = None, fmax: float | None = None) -> FRF:

@@ -30,11 +30,15 @@ from .units import (  # noqa: F401  (re-exported: the importers take them from h
     Units,
     check_quantity_arg,
     frequency_from_units,
+    kinds_text,
     low_frequency_slope,
+    parse_kinds,
     parse_units,
     quantity_notes,
     reconcile_quantity,
     si_factors,
+    units_line,
+    units_note,
 )
 
 __all__ = [
@@ -292,6 +296,25 @@ def rename_node(label: str, nodes: Mapping | None) -> str:
     return label
 
 
+def missing_pairs(outputs, inputs, present) -> tuple[int, list[tuple[str, str]]]:
+    """How many output/input pairs of the full matrix are not in ``present`` (a set or
+    dict of pairs), and the first eight of them.
+
+    Linear in the number of pairs present: a file naming many outputs and inputs but
+    few pairs is refused without enumerating the whole matrix.
+    """
+    n = len(outputs) * len(inputs) - len(present)
+    first: list[tuple[str, str]] = []
+    if n > 0:
+        for o in outputs:
+            for i in inputs:
+                if (o, i) not in present:
+                    first.append((o, i))
+                    if len(first) == 8:
+                        return n, first
+    return n, first
+
+
 # -- values ----------------------------------------------------------------------------
 def check_finite(a: np.ndarray, what: str) -> np.ndarray:
     """Raise DataFormatError naming the first non-finite entry of ``a``."""
@@ -447,6 +470,7 @@ def describe(frf: FRF, operating_points: Sequence[float] | None = None) -> str:
         f"{f.size} lines from {f[0]:g} to {f[-1]:g} Hz{step}",
         "outputs: " + ", ".join(frf.outputs),
         "inputs: " + ", ".join(frf.inputs),
+        "units (SI): " + frf.unit(),
         "nodes: " + "; ".join(f"{n} ({', '.join(v)})" for n, v in nodes.items()),
     ]
     if operating_points is not None:

@@ -28,15 +28,20 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import DataFormatError
-from ..frf import FRF, UNITS
+from ..frf import FRF
 from .checks import (
     Source,
     frequency_from_units,
+    kinds_text,
+    missing_pairs,
     normalize_label,
+    parse_kinds,
     parse_units,
     reconcile_quantity,
     rename_node,
     si_factors,
+    units_line,
+    units_note,
 )
 
 __all__ = ["read_csv", "write_csv", "write_csv_tables"]
@@ -157,42 +162,60 @@ def read_csv(
     freq = frequency_from_units(a[:, 0], freq_unit, repr(name))
 
     norm = {}
+    labels: dict[tuple[str, str], tuple[str, int]] = {}
+
+    def norm_label(text: str, what: str) -> tuple[str, int]:
+        key = (text, what)
+        if key not in labels:
+            lab, sign = normalize_label(text, what)
+            labels[key] = (rename_node(lab, nodes), sign)
+        return labels[key]
+
     for (o, i), v in cols.items():
-        (lo, so), (li, si) = normalize_label(o, "output"), normalize_label(i, "input")
-        key = (rename_node(lo, nodes), rename_node(li, nodes))
+        (lo, so), (li, si) = norm_label(o, "output"), norm_label(i, "input")
+        key = (lo, li)
         if key in norm:
             raise DataFormatError(f"{name!r}: two column pairs for {key[0]} / {key[1]}")
         norm[key] = (v, so * si)
     outputs = list(dict.fromkeys(o for o, _ in norm))
     inputs = list(dict.fromkeys(i for _, i in norm))
-    missing = [(o, i) for o in outputs for i in inputs if (o, i) not in norm]
-    if missing:
-        shown = ", ".join(f"{o} / {i}" for o, i in missing[:8])
+    n_missing, missing = missing_pairs(outputs, inputs, norm)
+    if n_missing:
+        shown = ", ".join(f"{o} / {i}" for o, i in missing)
         raise DataFormatError(
-            f"{name!r}: {len(missing)} output/input pairs have no columns: {shown}; a full "
+            f"{name!r}: {n_missing} output/input pairs have no columns: {shown}; a full "
             "matrix of outputs x inputs is needed"
         )
+    o_pos = {o: k for k, o in enumerate(outputs)}
+    i_pos = {i: k for k, i in enumerate(inputs)}
+    first, second = ("re", "im") if got == "re-im" else ("mag", "ph")
+    c1 = np.fromiter((v[first] for v, _ in norm.values()), np.intp, len(norm))
+    c2 = np.fromiter((v[second] for v, _ in norm.values()), np.intp, len(norm))
+    sg = np.fromiter((s for _, s in norm.values()), float, len(norm))
+    oi = np.fromiter((o_pos[o] for o, _ in norm), np.intp, len(norm))
+    ii = np.fromiter((i_pos[i] for _, i in norm), np.intp, len(norm))
+    if got == "re-im":
+        z = a[:, c1] + 1j * a[:, c2]
+    else:
+        z = a[:, c1] * np.exp(1j * a[:, c2] * (np.pi / 180 if phase_unit == "deg" else 1.0))
     data = np.empty((a.shape[0], len(outputs), len(inputs)), dtype=complex)
-    for (o, i), (v, sign) in norm.items():
-        if got == "re-im":
-            z = a[:, v["re"]] + 1j * a[:, v["im"]]
-        else:
-            ph = a[:, v["ph"]] * (np.pi / 180 if phase_unit == "deg" else 1.0)
-            z = a[:, v["mag"]] * np.exp(1j * ph)
-        data[:, outputs.index(o), inputs.index(i)] = sign * z
+    data[:, oi, ii] = z * sg
     notes = []
     units = parse_units(meta.get("units"))
     if meta.get("units") and units is None:
         notes.append(f"units {meta['units']!r} not understood; not checked")
-    q = reconcile_quantity(meta.get("quantity") or None, units, quantity, repr(name))
-    frf = FRF(freq, data, outputs, inputs, q)
+    q = reconcile_quantity(
+        meta.get("quantity") or None, units, quantity, repr(name), meta.get("units")
+    )
+    frf = FRF(freq, data, outputs, inputs, q, kinds=parse_kinds(meta.get("kinds"), repr(name)))
+    notes += units_note(units)
     if units is not None and not units.is_si:
-        frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs)[None])
-        notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
+        frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs, frf.kinds, q)[None])
+        notes.append(f"converted from {units.label} to SI ({frf.unit()})")
     extra = {
         k: v
         for k, v in meta.items()
-        if k not in ("quantity", "units", "layout", "phase_unit", "freq_unit")
+        if k not in ("quantity", "units", "layout", "phase_unit", "freq_unit", "kinds")
     }
     return frf, notes, extra
 
@@ -241,9 +264,11 @@ def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
     """An FRF as CSV in the documented ``re-im`` layout (full double precision)."""
     lines = _header(metadata, "FRF") + [
         f"# quantity: {frf.quantity}",
-        f"# units: {UNITS[frf.quantity]}",
+        f"# units: {units_line(frf)}",
         "# layout: re-im",
     ]
+    if frf.kinds:
+        lines.append(f"# kinds: {kinds_text(frf.kinds)}")
     cols = ["freq [Hz]"]
     for o in frf.outputs:
         for i in frf.inputs:

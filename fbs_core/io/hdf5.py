@@ -25,17 +25,21 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import DataFormatError
-from ..frf import FRF, UNITS
+from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import (
     Source,
     check_finite,
     frequency_from_units,
+    kinds_text,
     normalize_label,
+    parse_kinds,
     parse_units,
     reconcile_quantity,
     rename_node,
     si_factors,
+    units_line,
+    units_note,
 )
 
 __all__ = ["read_hdf5", "read_hdf5_result", "write_hdf5", "write_hdf5_result", "root_attrs"]
@@ -65,7 +69,9 @@ def _put_frf(g, frf: FRF) -> None:
     g["freq"].attrs["unit"] = "Hz"
     g.create_dataset("data", data=np.asarray(frf.data, dtype=complex))
     g.attrs["quantity"] = frf.quantity
-    g.attrs["units"] = UNITS[frf.quantity]
+    g.attrs["units"] = units_line(frf)
+    if frf.kinds:
+        g.attrs["kinds"] = kinds_text(frf.kinds)
     s = h5py.string_dtype()
     g.attrs.create("outputs", np.array(frf.outputs, dtype=object), dtype=s)
     g.attrs.create("inputs", np.array(frf.inputs, dtype=object), dtype=s)
@@ -204,11 +210,20 @@ def read_hdf5(
     if isinstance(ul, str) and ul.strip() and units is None:
         notes.append(f"units {ul!r} not understood; not checked")
     decl = attrs.get("quantity")
-    q = reconcile_quantity(decl if isinstance(decl, str) and decl else None, units, quantity, what)
-    frf = FRF(freq, data * np.outer(so, si)[None], outs, ins, q)
+    q = reconcile_quantity(
+        decl if isinstance(decl, str) and decl else None,
+        units,
+        quantity,
+        what,
+        ul if isinstance(ul, str) else None,
+    )
+    frf = FRF(
+        freq, data * np.outer(so, si)[None], outs, ins, q, parse_kinds(attrs.get("kinds"), what)
+    )
+    notes += units_note(units)
     if units is not None and not units.is_si:
-        frf = frf.replace(data=frf.data * si_factors(units, outs, ins)[None])
-        notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
+        frf = frf.replace(data=frf.data * si_factors(units, outs, ins, frf.kinds, q)[None])
+        notes.append(f"converted from {units.label} to SI ({frf.unit()})")
     md = {}
     root = groups.get("/", {})
     if isinstance(root.get("metadata"), str):

@@ -33,17 +33,21 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import DataFormatError
-from ..frf import FRF, UNITS
+from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import (
     Source,
     check_finite,
     frequency_from_units,
+    kinds_text,
     normalize_label,
+    parse_kinds,
     parse_units,
     reconcile_quantity,
     rename_node,
     si_factors,
+    units_line,
+    units_note,
 )
 
 __all__ = ["read_mat_vars", "read_mat", "write_mat", "frf_from_vars", "MatVars"]
@@ -234,11 +238,15 @@ def frf_from_vars(
     units = parse_units(units_label)
     if units_label and units is None:
         notes.append(f"units {units_label!r} not understood; not checked")
-    q = reconcile_quantity(_text(v, "quantity", name) or None, units, quantity, repr(name))
-    frf = FRF(f, H * sign[None], outs, ins, q)
+    q = reconcile_quantity(
+        _text(v, "quantity", name) or None, units, quantity, repr(name), units_label
+    )
+    kinds = parse_kinds(_text(v, "kinds", name), repr(name))
+    frf = FRF(f, H * sign[None], outs, ins, q, kinds)
+    notes += units_note(units)
     if units is not None and not units.is_si:
-        frf = frf.replace(data=frf.data * si_factors(units, outs, ins)[None])
-        notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
+        frf = frf.replace(data=frf.data * si_factors(units, outs, ins, frf.kinds, q)[None])
+        notes.append(f"converted from {units.label} to SI ({frf.unit()})")
     meta = {}
     mtext = _text(v, "metadata", name)
     if mtext:
@@ -266,7 +274,8 @@ def _mat_vars(frf: FRF, metadata: Mapping | None) -> dict:
         "outputs": list(frf.outputs),
         "inputs": list(frf.inputs),
         "quantity": frf.quantity,
-        "units": UNITS[frf.quantity],
+        "units": units_line(frf),
+        **({"kinds": kinds_text(frf.kinds)} if frf.kinds else {}),
         "freq_unit": "Hz",
         "metadata": json.dumps(dict(metadata or {}), default=str),
     }

@@ -13,7 +13,6 @@ system. Abscissa values are single precision in the format (E13.5).
 from __future__ import annotations
 
 import math
-import re
 import tempfile
 import time
 import warnings
@@ -24,15 +23,17 @@ import numpy as np
 
 from ..dofs import DIRECTIONS, parse_label
 from ..errors import DataFormatError, DOFError, FBSError, FrequencyGridError, QuantityError
-from ..frf import FRF, UNITS
+from ..frf import FRF
+from ..units import response_unit
 from .checks import (
     Source,
     Units,
     check_finite,
     frequency_from_units,
+    missing_pairs,
     parse_units,
     reconcile_quantity,
-    si_factors,
+    units_note,
 )
 
 __all__ = ["read_uff", "write_uff", "write_uff_records", "DIR_CODES"]
@@ -45,6 +46,9 @@ _CODE_DIRS = {v: k for k, v in DIR_CODES.items()}
 SPEC_TYPES: dict[str, int] = {"receptance": 8, "mobility": 11, "accelerance": 12}
 _SPEC_QUANTITY = {v: k for k, v in SPEC_TYPES.items()}
 _FORCE_TYPES = (9, 13)
+#: Record 10 (ordinate denominator) of each input kind: specific data type, name, unit.
+_DEN_SPEC = {"force": 13, "moment": 13, "road": 8, "generalised": 0}
+_DEN_UNITS = {"force": "N", "moment": "N m", "road": "m", "generalised": "NONE"}
 _FUNC_NAMES = {
     0: "general",
     1: "time response",
@@ -152,10 +156,11 @@ def _quantity_of(s: dict, what: str) -> str | None:
             f"{what} is force per {_SPEC_QUANTITY[den]} motion (an inverse FRF: dynamic "
             "stiffness, impedance or apparent mass); invert it to an FRF first"
         )
-    if den not in (0, 1) + _FORCE_TYPES:
+    if den not in (0, 1, 8) + _FORCE_TYPES:
         raise QuantityError(
             f"{what}: ordinate denominator specific data type {den} is not a force "
-            "(allowed: 9 reaction force, 13 excitation force, 0 unknown)"
+            "(allowed: 9 reaction force, 13 excitation force (or moment), 8 displacement "
+            "of a road input, 0 unknown)"
         )
     if num in _SPEC_QUANTITY:
         return _SPEC_QUANTITY[num]
@@ -168,14 +173,21 @@ def _quantity_of(s: dict, what: str) -> str | None:
 
 
 def _units_label(s: dict) -> str:
-    """The FRF units of a record: record 9's label, over record 10's when that is a force."""
+    """The FRF units of a record: record 9's label, over record 10's (the excitation)
+    unless record 9 already is a whole FRF unit such as ``m/s/N``."""
     num = str(s.get("ordinate_axis_units_lab", "") or "").strip()
     den = str(s.get("orddenom_axis_units_lab", "") or "").strip()
     if not num or num.upper() == "NONE":
         return ""
-    if den.lower() in ("n", "kn", "lbf") and not re.search(r"(?i)\b(k?n|lbf)\b", num):
-        return f"({num})/{den}"
-    return num
+    if not den or den.upper() == "NONE":
+        return num
+    try:
+        u = parse_units(num)
+    except QuantityError:
+        return num
+    if u is not None and u.kinds is not None and u.kinds[1] != "generalised":
+        return num  # the whole FRF unit in record 9 (e.g. "m/(N s)" over "N")
+    return f"({num})/({den})"
 
 
 def read_uff(
@@ -249,11 +261,12 @@ def read_uff(
     ent_names = {} if nodes else _entity_names(frf_sets)
 
     entries: dict[tuple[str, str], np.ndarray] = {}
-    outputs: list[str] = []
-    inputs: list[str] = []
+    outputs: dict[str, None] = {}
+    inputs: dict[str, None] = {}
     grid = None
     declared: set[str] = set()
     unit_labels: set[str] = set()
+    rec_labels: dict[tuple[str, str], str] = {}
     n_flipped = 0
     for k, s in enumerate(frf_sets):
         what = f"{src.name!r} FRF record {k + 1}"
@@ -288,6 +301,7 @@ def read_uff(
         lab = _units_label(s)
         if lab:
             unit_labels.add(lab)
+        rec_labels[(out, inp)] = lab
         if (out, inp) in entries:
             raise DataFormatError(f"{what}: a second record for the same output/input pair")
         if grid is None:
@@ -303,8 +317,8 @@ def read_uff(
         if so * si < 0:
             n_flipped += 1
         entries[(out, inp)] = (x, y.astype(complex) * so * si)
-        outputs += [out] if out not in outputs else []
-        inputs += [inp] if inp not in inputs else []
+        outputs.setdefault(out, None)
+        inputs.setdefault(inp, None)
     if n_flipped:
         notes.append(f"{n_flipped} records had negative direction codes; their sign was flipped")
     if nodes:
@@ -316,23 +330,25 @@ def read_uff(
                 f"(nodes in the file: {', '.join(sorted(present, key=int))})"
             )
 
-    missing = [(o, i) for o in outputs for i in inputs if (o, i) not in entries]
-    if missing:
-        shown = ", ".join(f"{o}/{i}" for o, i in missing[:8])
-        more = f" and {len(missing) - 8} more" if len(missing) > 8 else ""
+    n_missing, missing = missing_pairs(outputs, inputs, entries)
+    if n_missing:
+        shown = ", ".join(f"{o}/{i}" for o, i in missing)
+        more = f" and {n_missing - 8} more" if n_missing > 8 else ""
         raise DataFormatError(
-            f"{src.name!r}: {len(missing)} of {len(outputs) * len(inputs)} output/input "
+            f"{src.name!r}: {n_missing} of {len(outputs) * len(inputs)} output/input "
             f"pairs have no record: {shown}{more}; a full matrix of outputs x inputs is needed"
         )
     target = grid if freq is None else np.asarray(freq, dtype=float)
     data = np.empty((len(target), len(outputs), len(inputs)), dtype=complex)
+    o_pos = {o: k for k, o in enumerate(outputs)}
+    i_pos = {i: k for k, i in enumerate(inputs)}
     for (o, i), (x, y) in entries.items():
         if freq is not None:
             try:
                 y = FRF(x, y[:, None, None], ["a"], ["b"]).interpolate(target).data[:, 0, 0]
             except FBSError as e:
                 raise type(e)(f"{src.name!r} record {o}/{i}: {e}") from None
-        data[:, outputs.index(o), inputs.index(i)] = y
+        data[:, o_pos[o], i_pos[i]] = y
     if freq is not None:
         notes.append(f"records interpolated onto the requested grid of {len(target)} lines")
 
@@ -340,19 +356,22 @@ def read_uff(
         raise QuantityError(
             f"{src.name!r} mixes quantities across records: {', '.join(sorted(declared))}"
         )
-    if len(unit_labels) > 1:
-        parsed = {lab: parse_units(lab) for lab in unit_labels}
-        if (
-            len({(u.quantity, u.length, u.force, u.g) if u else lab for lab, u in parsed.items()})
-            > 1
-        ):
-            raise QuantityError(
-                f"{src.name!r} mixes units across records: {', '.join(sorted(unit_labels))}"
+    parsed = {lab: parse_units(lab) for lab in unit_labels}
+    by_q = {u.quantity for u in parsed.values() if u is not None and u.quantity}
+    if len(by_q) > 1:
+        raise QuantityError(
+            f"{src.name!r} mixes units across records: "
+            + ", ".join(
+                f"{lab!r} ({u.quantity})" for lab, u in sorted(parsed.items()) if u is not None
             )
-    units = parse_units(next(iter(unit_labels))) if unit_labels else None
-    if unit_labels and units is None:
-        notes.append(f"units {next(iter(unit_labels))!r} not understood; not checked")
-    if (units is None or units.is_si) and units164:
+        )
+    unread = sorted(lab for lab, u in parsed.items() if u is None)
+    if unread:
+        notes.append(f"units {', '.join(map(repr, unread))} not understood; not checked")
+    understood = [u for u in parsed.values() if u is not None]
+    units = next((u for u in understood if u.quantity), understood[0] if understood else None)
+    sys164 = None
+    if units164:
         u = units164[0]
         try:
             lf, ff = float(u["length"]), float(u["force"])
@@ -360,20 +379,43 @@ def read_uff(
             raise DataFormatError(f"{src.name!r}: damaged units dataset 164") from None
         if not (lf > 0 and ff > 0 and math.isfinite(lf) and math.isfinite(ff)):
             raise DataFormatError(f"{src.name!r}: dataset 164 has invalid unit factors")
-        if (lf, ff) != (1.0, 1.0):
-            units = Units(
-                f"dataset 164 ({str(u.get('units_description', '')).strip()})",
-                units.quantity if units else None,
-                1.0 / lf,
-                1.0 / ff,
-            )
+        # dataset 164 gives the factors that turn SI into file units (1000 for mm)
+        sys164 = Units(
+            f"dataset 164 ({str(u.get('units_description', '')).strip()})",
+            None,
+            1.0 / lf,
+            1.0 / ff,
+        )
     q = reconcile_quantity(
-        next(iter(declared)) if declared else None, units, quantity, repr(src.name)
+        next(iter(declared)) if declared else None,
+        units,
+        quantity,
+        repr(src.name),
+        unread[0] if unread and not understood else None,
     )
-    frf = FRF(target, data, outputs, inputs, q)
-    if units is not None and not units.is_si:
-        frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs)[None])
-        notes.append(f"converted from {units.label} to SI ({UNITS[q]})")
+    frf = FRF(target, data, list(outputs), list(inputs), q)
+    # every record by its own label (and kinds); records without a label understood
+    # take the unit system of dataset 164 when the labels say nothing else
+    fac = np.ones((len(outputs), len(inputs)))
+    ok, ik = frf.output_kinds, frf.input_kinds
+    any_labels = any(not u.is_si for u in understood)
+    for (o, i), lab in rec_labels.items():
+        a, b = o_pos[o], i_pos[i]
+        u = parsed.get(lab) if lab else None
+        if u is None and sys164 is not None and not any_labels:
+            u = sys164
+        if u is not None:
+            fac[a, b] = u.factor(ok[a], ik[b], q)
+    notes += units_note(units)
+    if sys164 is not None and not sys164.is_si:
+        if any_labels:
+            notes.append(f"{sys164.label} ignored: the records' unit labels are not SI")
+        else:
+            notes.append(f"{sys164.label}: {sys164.summary()} (converted to SI)")
+    if np.any(fac != 1.0):
+        frf = frf.replace(data=frf.data * fac[None])
+        label = units.label if units is not None and any_labels else sys164.label
+        notes.append(f"converted from {label} to SI ({frf.unit()})")
     first = frf_sets[0]
     meta = {f"id{k}": str(first.get(f"id{k}", "")).strip() for k in range(1, 6)}
     return frf, notes, meta
@@ -461,6 +503,7 @@ def frf_records(
     numbers = _node_numbers(frf.outputs + frf.inputs, nodes)
     ids = list(id_lines)[:4] + ["NONE"] * 4
     recs = []
+    ok, ik = frf.output_kinds, frf.input_kinds
     for o, out in enumerate(frf.outputs):
         for i, inp in enumerate(frf.inputs):
             (no, do), (ni, di) = parse_label(out), parse_label(inp)
@@ -486,9 +529,12 @@ def frf_records(
                     abscissa_spec_data_type=18,
                     abscissa_axis_units_lab="Hz",
                     ordinate_spec_data_type=SPEC_TYPES[frf.quantity],
-                    ordinate_axis_units_lab=UNITS[frf.quantity],
-                    orddenom_spec_data_type=13,
-                    orddenom_axis_units_lab="N",
+                    ordinate_len_unit_exp=int(ok[o] == "translation"),
+                    ordinate_axis_units_lab=response_unit(ok[o], frf.quantity),
+                    orddenom_spec_data_type=_DEN_SPEC[ik[i]],
+                    orddenom_len_unit_exp=int(ik[i] in ("moment", "road")),
+                    orddenom_force_unit_exp=int(ik[i] in ("force", "moment")),
+                    orddenom_axis_units_lab=_DEN_UNITS[ik[i]],
                     z_axis_spec_data_type=0,
                 )
             )

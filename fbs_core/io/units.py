@@ -9,15 +9,13 @@ declaration against the low-frequency slope of the data.
 
 from __future__ import annotations
 
-import re
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..dofs import parse_label
 from ..errors import FrequencyGridError, QuantityError
 from ..frf import FRF, QUANTITIES
+from ..units import Units, kinds_of, parse_units
 
 __all__ = [
     "Units",
@@ -28,148 +26,71 @@ __all__ = [
     "frequency_from_units",
     "low_frequency_slope",
     "quantity_notes",
+    "kinds_text",
+    "parse_kinds",
+    "units_line",
+    "units_note",
 ]
 
-_LENGTH = {
-    "m": 1.0,
-    "mm": 1e-3,
-    "cm": 1e-2,
-    "um": 1e-6,
-    "µm": 1e-6,
-    "μm": 1e-6,
-    "in": 0.0254,
-    "ft": 0.3048,
-}
-_FORCE = {"n": 1.0, "kn": 1e3, "lbf": 4.4482216152605}
-_G = 9.80665
+
+def units_line(frf: FRF) -> str:
+    """The single ``units`` label a file stores for an FRF: the SI unit of its first
+    entry (``m/(N s)`` for a translation per force). Readers derive the unit system
+    and the quantity from it and convert every entry by its kind."""
+    return str(frf.units[0, 0])
 
 
-@dataclass(frozen=True)
-class Units:
-    """An FRF units label and what it means in SI.
-
-    ``quantity`` is None when the label does not identify one; the scales turn
-    file units into SI (a length of 1 file unit is ``length`` m, and so on).
-    """
-
-    label: str
-    quantity: str | None
-    length: float = 1.0
-    force: float = 1.0
-    g: bool = False
-
-    @property
-    def is_si(self) -> bool:
-        return self.length == 1.0 and self.force == 1.0 and not self.g
+def units_note(units: Units | None) -> list[str]:
+    """Import note saying how the file's units label was understood."""
+    if units is None:
+        return []
+    what = f"{units.quantity}, " if units.quantity else ""
+    conv = "SI, no conversion" if units.is_si else "converted to SI"
+    return [f"units {units.label!r} read as {what}{units.summary()} ({conv})"]
 
 
-def parse_units(label: str | None) -> Units | None:
-    """Read an FRF units label such as ``"m/(N s)"``, ``"mm/s/N"`` or ``"g/N"``.
+def kinds_text(kinds: Mapping[str, str]) -> str:
+    """``"patch=road; q1=generalised"``: kind overrides as text for file headers."""
+    return "; ".join(f"{k}={v}" for k, v in kinds.items())
 
-    Exponents as ``s^2``, ``s2`` or ``s**2``; ``/`` divides the next factor or
-    parenthesised group. Returns None for an empty label or one that is not
-    understood (the caller reports it as unchecked).
 
-    Raises
-    ------
-    QuantityError
-        For units that are an inverse FRF (dynamic stiffness, impedance, apparent
-        mass), so that they are not mistaken for an FRF.
-    """
-    if label is None or not str(label).strip() or str(label).strip().upper() == "NONE":
+def parse_kinds(text, where: str) -> dict[str, str] | None:
+    """Inverse of :func:`kinds_text` (None for an empty text)."""
+    from ..units import INPUT_KINDS, OUTPUT_KINDS
+
+    if not isinstance(text, str) or not text.strip():
         return None
-    s = str(label).strip().replace("**", "^").replace("·", " ").replace("*", " ")
-    tokens = re.findall(r"\(|\)|/|[A-Za-zµμ]+\^?-?\d*", s)
-    if "".join(tokens).replace(" ", "") != re.sub(r"[\s.]", "", s):
-        return None
-    dims = {"L": 0, "T": 0, "F": 0}
-    scale = {"L": 1.0, "F": 1.0}
-    g = [False]
-
-    def factor(tok: str, power: int) -> bool:
-        m = re.fullmatch(r"([A-Za-zµμ]+)\^?(-?\d{0,2})", tok)
-        if m is None or m.group(2) == "-":
-            return False
-        name, e = m.group(1), int(m.group(2) or 1)
-        if abs(e) > 4:
-            return False
-        p = power * e
-        low = name.lower()
-        if name in _LENGTH or low in ("m", "mm", "cm", "um"):
-            dims["L"] += p
-            scale["L"] *= _LENGTH.get(name, _LENGTH.get(low, 1.0)) ** p
-        elif low in ("s", "sec"):
-            dims["T"] += p
-        elif low in _FORCE:
-            dims["F"] += p
-            scale["F"] *= _FORCE[low] ** p
-        elif low == "kg":  # N s^2 / m
-            dims["F"] += p
-            dims["T"] += 2 * p
-            dims["L"] -= p
-        elif name == "g":
-            dims["L"] += p
-            dims["T"] -= 2 * p
-            g[0] = True
-        elif low == "rad":
-            pass
-        else:
-            return False
-        return True
-
-    def group(i: int, power: int) -> int | None:
-        sign = 1
-        while i < len(tokens):
-            t = tokens[i]
-            if t == ")":
-                return i
-            if t == "/":
-                sign = -1
-                i += 1
-                continue
-            if t == "(":
-                j = group(i + 1, power * sign)
-                if j is None or j >= len(tokens):
-                    return None
-                i = j + 1
-            elif not factor(t, power * sign):
-                return None
-            else:
-                i += 1
-            sign = 1
-        return i
-
-    end = group(0, 1)
-    if end is None or end != len(tokens):
-        return None
-    L, T, F = dims["L"], dims["T"], dims["F"]
-    if (L, F) == (-1, 1) or (L, F) == (0, 1):
-        kind = {0: "dynamic stiffness", -1: "impedance", -2: "apparent mass"}.get(-T, "inverse")
-        raise QuantityError(
-            f"units {label!r} are those of a {kind} (force per motion), not of an FRF; "
-            "invert the data to receptance, mobility or accelerance first"
-        )
-    quantity = None
-    if L == 1 and F == -1:
-        quantity = {0: "receptance", -1: "mobility", -2: "accelerance"}.get(T)
-    length = scale["L"] if L == 1 else 1.0
-    force = 1.0 / scale["F"] if F == -1 else 1.0
-    return Units(str(label).strip(), quantity, length, force, g[0])
+    out = {}
+    for part in text.split(";"):
+        if not part.strip():
+            continue
+        lab, sep, k = part.partition("=")
+        if not sep or k.strip() not in {*OUTPUT_KINDS, *INPUT_KINDS}:
+            raise QuantityError(
+                f"{where}: kinds entry {part.strip()!r} is not label=kind with kind one of "
+                f"{', '.join(dict.fromkeys([*OUTPUT_KINDS, *INPUT_KINDS]))}"
+            )
+        out[lab.strip()] = k.strip()
+    return out or None
 
 
-def si_factors(units: Units, outputs: Sequence[str], inputs: Sequence[str]) -> np.ndarray:
+def si_factors(
+    units: Units,
+    outputs: Sequence[str],
+    inputs: Sequence[str],
+    kinds: Mapping[str, str] | None = None,
+    quantity: str | None = None,
+) -> np.ndarray:
     """Factors ``(n_out, n_in)`` turning each entry from file units into SI.
 
-    A translational output scales with the length unit (and ``g``), a moment input
-    with force x length, a force input with the force unit; rotations in rad do not
-    scale.
+    Each entry is converted by what it is (:func:`fbs_core.units.output_kind`,
+    :func:`~fbs_core.units.input_kind`): a translation scales with the length unit
+    (or ``g``), a rotation with the angle unit, both over the time unit to the power
+    of the quantity; a force input with the force unit, a moment with force x length,
+    a road input with the length unit (:meth:`fbs_core.units.Units.factor`).
     """
-    t_out = np.array([parse_label(o)[1] in ("x", "y", "z") for o in outputs], dtype=float)
-    r_in = np.array([parse_label(i)[1] in ("rx", "ry", "rz") for i in inputs], dtype=float)
-    length = units.length * (_G if units.g else 1.0)
-    out = length**t_out
-    inn = (1.0 / units.force) * (units.length**r_in)
-    return out[:, None] / inn[None, :]
+    outs, ins = kinds_of(outputs, inputs, kinds)
+    return np.array([[units.factor(o, i, quantity) for i in ins] for o in outs], dtype=float)
 
 
 def low_frequency_slope(frf: FRF) -> float | None:
@@ -181,7 +102,8 @@ def low_frequency_slope(frf: FRF) -> float | None:
     the lowest positive frequency (at least 3). None when there are no driving
     points or too few lines.
     """
-    pts = [(frf.outputs.index(d), frf.inputs.index(d)) for d in frf.inputs if d in frf.outputs]
+    o_pos = {o: k for k, o in enumerate(frf.outputs)}
+    pts = [(o_pos[d], k) for k, d in enumerate(frf.inputs) if d in o_pos]
     pos = np.flatnonzero(frf.freq > 0)
     if not pts or pos.size < 3:
         return None
@@ -222,7 +144,11 @@ def check_quantity_arg(quantity: str | None) -> str | None:
 
 
 def reconcile_quantity(
-    declared: str | None, units: Units | None, given: str | None, where: str
+    declared: str | None,
+    units: Units | None,
+    given: str | None,
+    where: str,
+    label: str | None = None,
 ) -> str:
     """Decide the quantity from the file's declaration, its units and the caller.
 
@@ -245,6 +171,13 @@ def reconcile_quantity(
             f"loading with FRF.to({given!r}) instead"
         )
     q = q or given
+    if q is None and label and str(label).strip() and str(label).strip().upper() != "NONE":
+        raise QuantityError(
+            f"{where}: its units label {str(label).strip()!r} is not understood as an FRF "
+            "unit (known: m mm cm um in ft / N kN mN lbf / s ms / rad deg / g, e.g. "
+            "'mm/(s N)', 'g/lbf', '(1/N)*(m/s²)'), and nothing else says whether it holds "
+            "receptance, mobility or accelerance; pass quantity=..."
+        )
     if q is None:
         raise QuantityError(
             f"{where} does not say whether it holds receptance, mobility or accelerance; "

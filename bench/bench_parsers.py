@@ -1,0 +1,134 @@
+"""Parse cost of the text importers (issue 20.1 / 20.3 / 12): linear time, bounded memory.
+
+Prints, for the code of the working tree it is run from:
+
+* CSV files of 10k / 20k / 40k column pairs (outputs x one input, 4 lines): parse time
+  and the ratio to the 10k file (2.0 and 4.0 for a linear reader);
+* UFF files of 1k / 2k / 4k dataset-58 records: the same;
+* a 2.8 MB UFF file of ``-1`` lines (refused; the time it takes);
+* a ~100 MiB CSV (12 outputs x 6 inputs, re-im): parse time and the peak resident
+  memory of the process that called ``load_frf`` (the server) and of its children
+  (the sandboxed parser), each measured in a fresh interpreter.
+
+Run: ``.venv/bin/python bench/bench_parsers.py`` (``--quick`` skips the 100 MiB file).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def wide_csv(n_pairs: int) -> bytes:
+    head = "# quantity: mobility\n# units: m/(N s)\nfreq [Hz]," + ",".join(
+        f"Re(n{k}:z / s:z),Im(n{k}:z / s:z)" for k in range(n_pairs)
+    )
+    rows = [",".join([f"{f:.1f}"] + ["1e-3"] * (2 * n_pairs)) for f in (1.0, 2.0, 3.0, 4.0)]
+    return (head + "\n" + "\n".join(rows) + "\n").encode()
+
+
+def many_records_uff(n_rec: int) -> bytes:
+    import fbs_core as fc
+    from fbs_core.io import save_frf
+
+    f = np.arange(1, 9) * 1.0
+    Y = fc.FRF(f, np.ones((8, n_rec, 1)) * 1e-3, [f"{k + 1}:z" for k in range(n_rec)], ["0:z"])
+    return save_frf(Y, format="uff")
+
+
+def timed(fn, repeat=3):
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def scaling(title, make, sizes, filename):
+    from fbs_core.io import load_frf
+
+    print(title)
+    base = None
+    for n in sizes:
+        raw = make(n)
+        t = timed(lambda raw=raw: load_frf(raw, filename=filename), repeat=2)
+        base = base or t
+        print(f"  {n:>6}: {len(raw) / 1e6:6.2f} MB  {t:7.3f} s  ratio {t / base:4.1f}")
+
+
+_PEAK = r"""
+import json, resource, sys, time
+from fbs_core.io import load_frf
+t0 = time.perf_counter()
+r = load_frf(sys.argv[1])
+t = time.perf_counter() - t0
+me = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+print(json.dumps(dict(t=t, self_mb=me, child_mb=kids, shape=list(r.frf.shape))))
+"""
+
+
+def big_csv(path: Path, target_bytes: int = 100 * 2**20) -> None:
+    import fbs_core as fc
+
+    outs = fc.node_labels("spindle") + fc.node_labels("bushing")
+    ins = fc.node_labels("spindle")
+    cols = ["freq [Hz]"] + [f"{p}({o} / {i})" for o in outs for i in ins for p in ("Re", "Im")]
+    rng = np.random.default_rng(0)
+    block = rng.normal(size=(1000, len(cols) - 1)) * 1e-4
+    with path.open("w") as fh:
+        fh.write("# quantity: mobility\n# units: m/(N s)\n" + ",".join(cols) + "\n")
+        k = 0
+        while fh.tell() < target_bytes:
+            for row in block:
+                k += 1
+                fh.write(f"{k * 0.01:.2f}," + ",".join(f"{x:.9e}" for x in row) + "\n")
+
+
+def main() -> None:
+    quick = "--quick" in sys.argv
+    scaling(
+        "CSV, column pairs (outputs x 1 input, 4 lines):",
+        wide_csv,
+        (10_000, 20_000, 40_000),
+        "wide.csv",
+    )
+    scaling("UFF 58, records (8 lines each):", many_records_uff, (1000, 2000, 4000), "many.uff")
+    from fbs_core.errors import FBSError
+    from fbs_core.io import load_frf
+
+    minus = b"    -1\n" * 400_000
+    t0 = time.perf_counter()
+    try:
+        load_frf(minus, filename="minus.uff")
+        msg = "accepted?!"
+    except FBSError as e:
+        msg = str(e)[:90]
+    print(
+        f"UFF of {len(minus) / 1e6:.1f} MB of '-1' lines: {time.perf_counter() - t0:.3f} s: {msg}"
+    )
+    if quick:
+        return
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "big.csv"
+        big_csv(p)
+        out = subprocess.run(
+            [sys.executable, "-c", _PEAK, str(p)], capture_output=True, text=True, check=True
+        )
+        r = json.loads(out.stdout.strip().splitlines()[-1])
+        print(
+            f"CSV of {p.stat().st_size / 2**20:.0f} MiB, FRF {r['shape']}: {r['t']:.1f} s; peak "
+            f"RSS of the calling process {r['self_mb']:.0f} MB, of the parser process "
+            f"{r['child_mb']:.0f} MB"
+        )
+
+
+if __name__ == "__main__":
+    main()
