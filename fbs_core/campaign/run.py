@@ -1,0 +1,530 @@
+"""Running a campaign on a ``dask.distributed`` cluster.
+
+The cluster: an existing one when a scheduler address is given (``scheduler=`` or the
+environment variable ``FBS_DASK_SCHEDULER``, e.g. ``tcp://host:8786``), else a
+:class:`distributed.LocalCluster` started here and closed at the end: by default one
+in-process worker (threads of this process; the compiled kernels use all cores, as
+:func:`fbs_core.scatter_band` does), with ``workers=N`` N worker processes.
+
+The work: model variants read from files are sent to the workers once
+(``client.scatter(..., broadcast=True)``); the subsystem arrays of every (harmonic, models,
+coupling) are one task whose result stays on the cluster and feeds the band blocks of all
+cases that use it; every scatter case is split into blocks of lines holding
+``task_round_lines`` (rounds x lines) of work (see :mod:`.work` for why lines); every
+truncation case is one task. Results are gathered with ``as_completed`` as they finish,
+each written at once as a unit of the result file (:mod:`.store`), so that a stop (Ctrl-C,
+``stop`` event, a killed process) loses at most the tasks in flight and a rerun computes
+only what is missing.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import threading
+import time
+import uuid
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import fbs_core
+
+from . import work
+from .spec import BandCase, Campaign, CampaignError, TruncationCase
+from .store import CampaignStore, file_sha256
+
+__all__ = ["Task", "plan", "run_campaign", "RunReport", "make_client", "SCHEDULER_ENV"]
+
+SCHEDULER_ENV = "FBS_DASK_SCHEDULER"
+
+#: Set while a finished task is being written: a Ctrl-C handler then only sets the stop
+#: event (the command line's handler), so that no write is cut short.
+WRITING = threading.Event()
+
+
+@dataclass(frozen=True)
+class Task:
+    """One unit of work: ``kind`` is "band" or "truncation"."""
+
+    kind: str
+    unit: str
+    case: object = None
+    l0: int = 0
+    l1: int = 0
+    inputs: str = ""
+    rounds: float = 0.0  # rounds of its case this task computes (lines / n_lines x R)
+    work: float = 0.0  # rounds x lines
+
+
+@dataclass
+class RunReport:
+    """What a run did. ``status``: "complete", "stopped" or "failed"."""
+
+    output: str
+    status: str
+    tasks_total: int
+    tasks_skipped: int
+    tasks_done: int
+    rounds_done: float
+    seconds: float
+    errors: list = field(default_factory=list)
+    scheduler: str = ""
+    workers: int = 0
+
+    @property
+    def rounds_per_second(self) -> float:
+        return self.rounds_done / self.seconds if self.seconds > 0 else 0.0
+
+
+def n_lines(harmonic: int, df: float) -> int:
+    from ..harmonics import harmonic as _h
+
+    return int(_h(harmonic).frequencies(df).size)
+
+
+def block_lines(rounds: int, lines: int, task_round_lines: int) -> int:
+    """Lines per task so that a task holds about ``task_round_lines`` of work, with the
+    blocks of a case of equal size (at most one line apart)."""
+    per = max(1, min(lines, task_round_lines // max(1, rounds)))
+    nb = math.ceil(lines / per)
+    return math.ceil(lines / nb)
+
+
+def _missing_runs(lines: int, covered: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    mask = np.ones(lines, bool)
+    for a, b in covered:
+        mask[a:b] = False
+    runs, i = [], 0
+    while i < lines:
+        if mask[i]:
+            j = i
+            while j < lines and mask[j]:
+                j += 1
+            runs.append((i, j))
+            i = j
+        else:
+            i += 1
+    return runs
+
+
+def plan(campaign: Campaign, done: set[str] | None = None) -> tuple[list[Task], int]:
+    """The tasks still to do, and the number of tasks already done.
+
+    A scatter case's missing lines (not covered by stored blocks) are split into blocks of
+    :func:`block_lines`; a truncation case is one task.
+    """
+    done = done or set()
+    covered: dict[str, list[tuple[int, int]]] = {}
+    n_done = 0
+    for u in done:
+        parts = u.split("/")
+        if len(parts) == 4 and parts[0] == "cases" and parts[2] == "blocks":
+            a, b = parts[3].split("_")
+            covered.setdefault(parts[1], []).append((int(a), int(b)))
+    tasks: list[Task] = []
+    for c in campaign.cases:
+        if isinstance(c, TruncationCase):
+            unit = f"cases/{c.name}/result"
+            if unit in done:
+                n_done += 1
+            else:
+                tasks.append(Task("truncation", unit, c))
+            continue
+        nl = n_lines(c.harmonic, c.df)
+        have = covered.get(c.name, [])
+        n_done += len(have)
+        per = block_lines(c.rounds, nl, campaign.task_round_lines)
+        for a, b in _missing_runs(nl, have):
+            for l0 in range(a, b, per):
+                l1 = min(b, l0 + per)
+                tasks.append(
+                    Task(
+                        "band",
+                        f"cases/{c.name}/blocks/{l0}_{l1}",
+                        c,
+                        l0,
+                        l1,
+                        c.inputs_name,
+                        c.rounds * (l1 - l0) / nl,
+                        float(c.rounds) * (l1 - l0),
+                    )
+                )
+    return tasks, n_done
+
+
+def make_client(scheduler: str | None = None, workers: int | None = None):
+    """``(client, cluster)``: join ``scheduler`` (or ``$FBS_DASK_SCHEDULER``), else start a
+    LocalCluster (in-process with one worker thread, or ``workers`` worker processes);
+    ``cluster`` is None when joining an existing one."""
+    from distributed import Client, LocalCluster
+
+    addr = scheduler or os.environ.get(SCHEDULER_ENV) or None
+    if addr:
+        try:
+            return Client(addr, timeout="30s"), None
+        except OSError as e:
+            raise CampaignError(f"cannot reach the Dask scheduler at {addr}: {e}") from None
+    if workers:
+        cluster = LocalCluster(
+            n_workers=int(workers),
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+        )
+    else:
+        cluster = LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+        )
+    return Client(cluster), cluster
+
+
+def _versions() -> dict:
+    import h5py
+    import numba
+    import scipy
+
+    import fbs_core
+
+    out = {
+        "fbs_core": fbs_core.__version__,
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "numba": numba.__version__,
+        "h5py": h5py.__version__,
+    }
+    try:
+        import dask
+        import distributed
+
+        out["dask"] = dask.__version__
+        out["distributed"] = distributed.__version__
+    except ImportError:  # pragma: no cover - a dependency
+        pass
+    return out
+
+
+def _root_attrs(campaign: Campaign) -> dict:
+    return {
+        "campaign_name": campaign.name,
+        "campaign_seed": campaign.seed,
+        "seeds": campaign.seeds,
+        "campaign_toml": campaign.text,
+    }
+
+
+def _model_units(campaign: Campaign, store: CampaignStore, done: set[str]) -> None:
+    for kind, variants in (("tire", campaign.tires), ("chassis", campaign.chassis)):
+        for name, src in variants.items():
+            unit = f"models/{kind}/{name}"
+            if unit in done:
+                continue
+            sha = "" if src == "reference" else file_sha256(src)
+            store.write_unit(unit, {}, {"source": src, "sha256": sha})
+
+
+def _case_attrs(c) -> dict:
+    attrs = {
+        "kind": c.kind,
+        "name": c.name,
+        "digest": c.digest(),
+        "settings": c.settings(),
+        "harmonic": c.harmonic,
+        "coupling": c.coupling,
+        "tire": c.tire,
+        "chassis": c.chassis,
+    }
+    if isinstance(c, BandCase):
+        attrs.update(
+            noise=c.noise,
+            target=c.target,
+            frequency_dependent=c.frequency_dependent,
+            rounds=c.rounds,
+            seed=str(c.seed),  # up to 2**64 - 1: text, exact
+            n_lines=n_lines(c.harmonic, c.df),
+            inputs=c.inputs_name,
+        )
+    return attrs
+
+
+def _write_inputs(store: CampaignStore, name: str, c: BandCase, inp: work.BandInputs) -> None:
+    data = {
+        "freq": inp.freq,
+        "YjjA": inp.YjjA,
+        "vj": inp.vj,
+        "YjjE": inp.YjjE,
+        "YejE": inp.YejE,
+        "reference": inp.reference,
+    }
+    attrs = {
+        "dofs": list(inp.dofs),
+        "harmonic": c.harmonic,
+        "n_modes": "all" if c.n_modes is None else c.n_modes,
+        "n_modes_total": inp.n_modes_total,
+        "coupling": c.coupling,
+        "tire": c.tire,
+        "chassis": c.chassis,
+        "df": c.df,
+    }
+    store.write_unit(f"inputs/{name}", data, attrs)
+
+
+def _write(store: CampaignStore, campaign: Campaign, t: Task, res) -> None:
+    parents = {f"cases/{t.case.name}": _case_attrs(t.case)}
+    prov = {k: res.pop(k) for k in ("worker", "host", "pid", "seconds") if k in res}
+    if t.kind == "band":
+        out = campaign.outputs["scatter"]
+        keys = []
+        if "band" in out:
+            keys += ["lower", "upper", "argmin_round", "argmax_round"]
+        if "percentiles" in out:
+            keys += ["percentiles"]
+        if "convergence" in out:
+            keys += ["checkpoints", "conv_lower", "conv_upper"]
+        attrs = {"l0": res["l0"], "l1": res["l1"], "q": list(t.case.percentiles), **prov}
+        store.write_unit(t.unit, {k: res[k] for k in keys}, attrs, parents)
+    else:
+        out = campaign.outputs["truncation"]
+        keys = ["n_modes", "centres"]
+        if "error" in out:
+            keys += ["error"]
+        if "suggested" in out:
+            keys += ["suggested"]
+        if "responses" in out:
+            keys += ["freq", "response", "reference"]
+        c = t.case
+        attrs = {
+            "dofs": list(res["dofs"]),
+            "n_modes_total": res["n_modes_total"],
+            "thresholds": list(c.thresholds),
+            "f_max": list(c.f_max),
+            "width": res["width"],
+            "step": res["step"],
+            "edges": res["edges"],
+            **prov,
+        }
+        store.write_unit(t.unit, {k: res[k] for k in keys}, attrs, parents)
+
+
+class Progress:
+    """Text progress bar: tasks done/total, rounds per second, time left (to a stream)."""
+
+    def __init__(self, total: int, rounds_total: float, stream=None, every: float = 0.5):
+        import sys
+
+        self.total, self.rounds_total = total, rounds_total
+        self.stream = sys.stderr if stream is None else stream
+        self.every = every
+        self.t0 = time.perf_counter()
+        self.last = 0.0
+        self.done = 0
+        self.rounds = 0.0
+
+    def line(self) -> str:
+        dt = time.perf_counter() - self.t0
+        rate = self.rounds / dt if dt > 0 else 0.0
+        left = (self.rounds_total - self.rounds) / rate if rate > 0 else float("nan")
+        frac = self.done / self.total if self.total else 1.0
+        bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
+        eta = "--:--" if not np.isfinite(left) else time.strftime("%H:%M:%S", time.gmtime(left))
+        return (
+            f"[{bar}] {self.done}/{self.total} tasks  {rate:,.0f} rounds/s  "
+            f"elapsed {time.strftime('%H:%M:%S', time.gmtime(dt))}  left {eta}"
+        )
+
+    def update(self, tasks: int = 1, rounds: float = 0.0, force: bool = False) -> None:
+        self.done += tasks
+        self.rounds += rounds
+        now = time.perf_counter()
+        if force or now - self.last >= self.every or self.done == self.total:
+            self.last = now
+            end = "\n" if self.done == self.total else ""
+            self.stream.write("\r" + self.line() + end)
+            self.stream.flush()
+
+
+def run_campaign(
+    campaign: Campaign,
+    *,
+    client=None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    output=None,
+    progress=None,
+    stop: threading.Event | None = None,
+    max_tasks: int | None = None,
+) -> RunReport:
+    """Run (or resume) a campaign and write its result file.
+
+    Parameters
+    ----------
+    campaign : Campaign
+        From :func:`~fbs_core.campaign.load_campaign`.
+    client : distributed.Client, optional
+        Use this client (not closed here).
+    scheduler : str, optional
+        Address of an existing scheduler (default ``$FBS_DASK_SCHEDULER``, else a
+        LocalCluster is started and closed here).
+    workers : int, optional
+        Worker processes of the LocalCluster (default: one in-process worker).
+    output : path, optional
+        Result file (default the campaign's ``output``).
+    progress : callable or True, optional
+        ``progress(done, total, rounds_done)`` after every task, or True for the text bar.
+    stop : threading.Event, optional
+        Set it to stop: running tasks are cancelled, finished ones kept (resumable).
+    max_tasks : int, optional
+        Stop after this many finished tasks (a partial run; resumable).
+
+    Returns
+    -------
+    RunReport
+    """
+    from distributed import as_completed
+
+    out_path = campaign.output if output is None else output
+    store = CampaignStore(out_path)
+    store.check(campaign)
+    store.commit(_root_attrs(campaign))  # leftovers of a killed run; creates the file
+    done = store.done()
+    _model_units(campaign, store, done)
+    tasks, n_skipped = plan(campaign, done)
+    todo = [t for t in tasks if t.unit not in done]
+    bar = Progress(len(todo), sum(t.rounds for t in todo)) if progress is True else None
+    t_start = time.perf_counter()
+    started = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
+    report = RunReport(str(out_path), "complete", len(tasks), n_skipped, 0, 0.0, 0.0)
+    own = client is None
+    cluster = None
+    if own and todo:
+        client, cluster = make_client(scheduler, workers)
+    try:
+        if todo:
+            report.scheduler = str(client.scheduler.address)
+            report.workers = len(client.scheduler_info().get("workers", {}))
+            numba_threads = None
+            if cluster is not None and workers:
+                numba_threads = max(1, (os.cpu_count() or 1) // int(workers))
+            # model variants from files: loaded here; tires sent to every worker once
+            tire_objs = {n: work.load_model("tire", src) for n, src in campaign.tires.items()}
+            tires = {
+                n: o if isinstance(o, str) else client.scatter(o, broadcast=True)
+                for n, o in tire_objs.items()
+            }
+            chassis_src = {n: work.load_model("chassis", s) for n, s in campaign.chassis.items()}
+            # the chassis on each harmonic's grid and the subsystem arrays of the scatter
+            # cases: computed here once (see fbs_core.campaign.work), stored, scattered
+            grids, inputs_f = {}, {}
+            for t in tasks:
+                c = t.case
+                g = (c.harmonic, c.df, c.chassis)
+                if g not in grids:
+                    f = fbs_core.harmonic(c.harmonic).frequencies(c.df)
+                    grids[g] = work.chassis_on(chassis_src[c.chassis], f)
+                if t.kind == "band" and t.inputs not in inputs_f:
+                    inp = work.prepare_inputs(
+                        tire_objs[c.tire],
+                        grids[g],
+                        c.harmonic,
+                        c.n_modes,
+                        c.coupling,
+                        c.df,
+                    )
+                    if f"inputs/{t.inputs}" not in done:
+                        _write_inputs(store, t.inputs, c, inp)
+                    inputs_f[t.inputs] = client.scatter(inp)
+            grids_f = {g: client.scatter(work.frf_payload(v)) for g, v in grids.items()}
+            futures = {}
+            token = uuid.uuid4().hex[:12]
+            for t in tasks:
+                c = t.case
+                if t.kind == "band":
+                    f = client.submit(
+                        work.band_block,
+                        inputs_f[t.inputs],
+                        c.noise,
+                        c.target,
+                        c.rounds,
+                        c.frequency_dependent,
+                        c.seed,
+                        c.percentiles,
+                        t.l0,
+                        t.l1,
+                        campaign.max_chunk_bytes,
+                        numba_threads,
+                        key=f"band-{c.name}-{t.l0}-{token}",
+                        pure=False,
+                    )
+                else:
+                    f = client.submit(
+                        work.truncation_case,
+                        tires[c.tire],
+                        grids_f[(c.harmonic, c.df, c.chassis)],
+                        c,
+                        key=f"trunc-{c.name}-{token}",
+                        pure=False,
+                    )
+                futures[f] = t
+            ac = as_completed(list(futures))
+            try:
+                for fut in ac:
+                    t = futures.pop(fut)
+                    if fut.status == "error":
+                        exc = fut.exception()
+                        report.errors.append((t.unit, f"{type(exc).__name__}: {exc}"))
+                        if bar:
+                            bar.update(1, 0.0)
+                        continue
+                    if fut.status == "cancelled":
+                        continue
+                    res = fut.result()
+                    WRITING.set()
+                    try:
+                        _write(store, campaign, t, res)
+                    finally:
+                        WRITING.clear()
+                    fut.release()
+                    report.tasks_done += 1
+                    report.rounds_done += t.rounds
+                    if bar:
+                        bar.update(1, t.rounds)
+                    elif callable(progress):
+                        progress(report.tasks_done, len(todo), report.rounds_done)
+                    if (stop is not None and stop.is_set()) or (
+                        max_tasks is not None and report.tasks_done >= max_tasks
+                    ):
+                        report.status = "stopped"
+                        break
+            except KeyboardInterrupt:
+                report.status = "stopped"
+            if report.status == "stopped":
+                ac.clear()
+                client.cancel(list(futures))
+            if report.errors and report.status == "complete":
+                report.status = "failed"
+    except KeyboardInterrupt:
+        report.status = "stopped"
+    finally:
+        report.seconds = time.perf_counter() - t_start
+        if todo:
+            store.write_unit(
+                f"runs/{started.replace(':', '')}_{os.getpid()}",
+                {},
+                {
+                    "started": started,
+                    "seconds": report.seconds,
+                    "status": report.status,
+                    "scheduler": report.scheduler,
+                    "workers": report.workers,
+                    "tasks_done": report.tasks_done,
+                    "tasks_total": report.tasks_total,
+                    "errors": report.errors,
+                    "versions": _versions(),
+                },
+            )
+        store.commit(_root_attrs(campaign))
+        if own and client is not None:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return report

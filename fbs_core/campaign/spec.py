@@ -1,0 +1,471 @@
+"""A sensitivity campaign described in a TOML file: the case matrix, the models, the outputs.
+
+A campaign is the cross product of the settings listed in its ``[scatter]`` table (noise
+scatter bands, thesis 5.2, eqs. 5.2-5.4) and its ``[truncation]`` table (truncation error
+maps and suggested mode counts, thesis 5.1, eq. 5.1 and table 5.1). The layout, with every
+key and its default, is documented in ``campaigns/example.toml``::
+
+    [campaign]
+    name = "example"
+    seed = 2018                 # the campaign seed; every case's seed derives from it
+    seeds = "per-case"          # or "common": every case uses the campaign seed
+    output = "example.h5"       # relative to the TOML file
+
+    [models.tire]               # variants by name: "reference" or a model file
+    reference = "reference"
+    [models.chassis]            # "reference" or an FRF file (interpolated per harmonic)
+    reference = "reference"
+
+    [scatter]
+    harmonics = [1, 4]
+    noise = [0.05, 0.10]        # 0.1 = +-10 %
+    targets = ["tire", "chassis", "both"]
+    frequency_dependent = [false]
+    rounds = 2000
+    ...
+
+Nothing in the file is evaluated: values are checked against the allowed types and ranges
+and a bad one raises :class:`CampaignError` naming the key and what is allowed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import tomllib
+import zlib
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FBSError
+
+__all__ = [
+    "CampaignError",
+    "Campaign",
+    "BandCase",
+    "TruncationCase",
+    "load_campaign",
+    "parse_campaign",
+    "TARGET_NAMES",
+]
+
+#: Noise targets as written in a campaign file -> the target of :func:`fbs_core.scatter_band`.
+TARGET_NAMES = {"tire": "tire", "chassis": "vehicle", "vehicle": "vehicle", "both": "both"}
+COUPLINGS = ("6dof", "5dof")
+SEED_MODES = ("per-case", "common")
+OUTPUTS = {
+    "scatter": ("band", "percentiles", "convergence"),
+    "truncation": ("error", "suggested", "responses"),
+}
+_TOP = ("campaign", "models", "grid", "scatter", "truncation", "outputs", "execution")
+
+
+class CampaignError(FBSError):
+    """A campaign file or result file that cannot be used (bad key, value or mismatch)."""
+
+
+@dataclass(frozen=True)
+class BandCase:
+    """One scatter-band case (thesis eqs. 5.2-5.4); ``target`` uses the library's names."""
+
+    harmonic: int
+    noise: float
+    target: str
+    frequency_dependent: bool
+    rounds: int
+    n_modes: int | None
+    coupling: str
+    tire: str
+    chassis: str
+    seed: int
+    percentiles: tuple[float, ...]
+    df: float
+
+    kind = "scatter"
+
+    @property
+    def name(self) -> str:
+        """Readable, unique id (the group name in the result file)."""
+        nm = "all" if self.n_modes is None else str(self.n_modes)
+        return (
+            f"band_h{self.harmonic}_p{self.noise:g}_{self.target}_"
+            f"{'fdep' if self.frequency_dependent else 'fixed'}_R{self.rounds}_N{nm}_"
+            f"{self.coupling}_{self.tire}_{self.chassis}"
+        )
+
+    @property
+    def inputs_name(self) -> str:
+        """Id of the subsystem arrays this case is computed from (shared by cases)."""
+        nm = "all" if self.n_modes is None else str(self.n_modes)
+        return f"h{self.harmonic}_N{nm}_{self.coupling}_{self.tire}_{self.chassis}_df{self.df:g}"
+
+    def settings(self) -> dict:
+        return {"kind": self.kind, **asdict(self)}
+
+    def digest(self) -> str:
+        return _digest(self.settings())
+
+
+@dataclass(frozen=True)
+class TruncationCase:
+    """One truncation-map case (thesis 5.1): error map and suggested modes of a harmonic."""
+
+    harmonic: int
+    n_modes: tuple[int, ...]
+    coupling: str
+    tire: str
+    chassis: str
+    width: float
+    step: float
+    thresholds: tuple[float, ...]
+    f_max: tuple[float, ...]
+    df: float
+
+    kind = "truncation"
+
+    @property
+    def name(self) -> str:
+        return f"trunc_h{self.harmonic}_{self.coupling}_{self.tire}_{self.chassis}"
+
+    def settings(self) -> dict:
+        return {"kind": self.kind, **asdict(self)}
+
+    def digest(self) -> str:
+        return _digest(self.settings())
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """A parsed campaign: its cases, models, outputs and execution settings.
+
+    Attributes
+    ----------
+    name : str
+    seed : int
+        The campaign seed.
+    seeds : {"per-case", "common"}
+    output : pathlib.Path
+        The result file (HDF5).
+    tires, chassis : dict of str to str
+        Model variants: name -> ``"reference"`` or an absolute file path.
+    cases : tuple of BandCase and TruncationCase
+    outputs : dict of str to tuple of str
+        What is stored of each kind of case.
+    task_round_lines : int
+        Work of one scatter task in rounds x frequency lines.
+    max_chunk_bytes : float
+        Working memory of one chunk of lines inside a task.
+    text : str
+        The TOML text (stored in the result file).
+    """
+
+    name: str
+    seed: int
+    seeds: str
+    output: Path
+    tires: dict
+    chassis: dict
+    cases: tuple
+    outputs: dict
+    task_round_lines: int
+    max_chunk_bytes: float
+    text: str = field(repr=False, default="")
+
+    @property
+    def band_cases(self) -> tuple[BandCase, ...]:
+        return tuple(c for c in self.cases if isinstance(c, BandCase))
+
+    @property
+    def truncation_cases(self) -> tuple[TruncationCase, ...]:
+        return tuple(c for c in self.cases if isinstance(c, TruncationCase))
+
+
+def _digest(settings: dict) -> str:
+    text = json.dumps(settings, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def case_seed(campaign_seed: int, name: str) -> int:
+    """The seed of one case: ``SeedSequence(campaign_seed, spawn_key=(crc32(name),))``.
+
+    A pure function of the campaign seed and the case's settings (its name), not of the
+    case's position in the matrix: adding cases to a campaign leaves the others' seeds.
+    """
+    ss = np.random.SeedSequence(campaign_seed, spawn_key=(zlib.crc32(name.encode()),))
+    return int(ss.generate_state(1, np.uint64)[0])
+
+
+# ---- checking values ------------------------------------------------------------------------
+
+
+def _err(where: str, msg: str) -> CampaignError:
+    return CampaignError(f"campaign file, {where}: {msg}")
+
+
+def _table(d, key: str, where: str) -> dict:
+    v = d.get(key, {})
+    if not isinstance(v, dict):
+        raise _err(where, f"[{key}] must be a table, got {type(v).__name__}")
+    return v
+
+
+def _known(d: dict, allowed, where: str) -> None:
+    bad = sorted(set(d) - set(allowed))
+    if bad:
+        raise _err(where, f"unknown key(s) {bad}; allowed: {', '.join(allowed)}")
+
+
+def _list(v, where: str) -> list:
+    return list(v) if isinstance(v, list) else [v]
+
+
+def _int(v, where: str, lo: int, hi: int | None = None) -> int:
+    if isinstance(v, bool) or not isinstance(v, int) or v < lo or (hi is not None and v > hi):
+        rng = f"{lo}..{hi}" if hi is not None else f">= {lo}"
+        raise _err(where, f"must be an integer {rng}, got {v!r}")
+    return int(v)
+
+
+def _float(v, where: str, lo: float, hi: float, hi_open: bool = False) -> float:
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        raise _err(where, f"must be a number, got {v!r}")
+    x = float(v)
+    if not (lo <= x and (x < hi if hi_open else x <= hi)):
+        raise _err(where, f"must be in [{lo:g}, {hi:g}{')' if hi_open else ']'}, got {v!r}")
+    return x
+
+
+def _choice(v, allowed, where: str) -> str:
+    if not isinstance(v, str) or v not in allowed:
+        raise _err(where, f"{v!r} is not allowed; allowed: {', '.join(allowed)}")
+    return v
+
+
+def _name(v: str, where: str) -> str:
+    if not v or not all(c.isalnum() or c in "-." for c in v):
+        raise _err(where, f"variant name {v!r} must be letters, digits, '-' or '.'")
+    return v
+
+
+def _models(d: dict, base: Path, kind: str) -> dict:
+    where = f"[models.{kind}]"
+    out = {}
+    for name, src in d.items():
+        _name(name, where)
+        if not isinstance(src, str) or not src:
+            raise _err(f"{where} {name}", f"must be 'reference' or a file path, got {src!r}")
+        if src == "reference":
+            out[name] = "reference"
+        else:
+            p = (base / src).resolve()
+            if not p.is_file():
+                raise _err(f"{where} {name}", f"model file {str(p)!r} does not exist")
+            out[name] = str(p)
+    return out or {"reference": "reference"}
+
+
+def _variants(d: dict, key: str, models: dict, where: str) -> list[str]:
+    names = [str(x) for x in _list(d.get(key, list(models)), where)]
+    for n in names:
+        if n not in models:
+            raise _err(f"{where} {key}", f"unknown variant {n!r}; defined: {', '.join(models)}")
+    return names
+
+
+def _couplings(d: dict, where: str) -> list[str]:
+    return [
+        _choice(c, COUPLINGS, f"{where} couplings")
+        for c in _list(d.get("couplings", "6dof"), where)
+    ]
+
+
+def _harmonics(d: dict, where: str) -> list[int]:
+    hs = [_int(h, f"{where} harmonics", 1, 7) for h in _list(d.get("harmonics", [1]), where)]
+    if len(set(hs)) != len(hs):
+        raise _err(f"{where} harmonics", f"duplicates in {hs}")
+    return hs
+
+
+def _unique(xs: list, where: str) -> list:
+    if len(set(xs)) != len(xs):
+        raise _err(where, f"duplicate values in {xs}")
+    return xs
+
+
+def parse_campaign(text: str, base: Path | str = ".") -> Campaign:
+    """Parse the TOML text of a campaign (paths relative to ``base``).
+
+    Raises
+    ------
+    CampaignError
+        For TOML syntax errors, unknown keys, values of the wrong type or range, unknown
+        model variants and missing model files.
+    """
+    base = Path(base)
+    try:
+        d = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise CampaignError(f"campaign file is not valid TOML: {e}") from None
+    _known(d, _TOP, "top level")
+    c = _table(d, "campaign", "top level")
+    _known(c, ("name", "description", "seed", "seeds", "output"), "[campaign]")
+    name = c.get("name", "campaign")
+    if not isinstance(name, str) or not name:
+        raise _err("[campaign] name", f"must be a non-empty string, got {name!r}")
+    seed = _int(c.get("seed", 0), "[campaign] seed", 0, 2**63 - 1)
+    seeds = _choice(c.get("seeds", "per-case"), SEED_MODES, "[campaign] seeds")
+    out = c.get("output", f"{name}.h5")
+    if not isinstance(out, str) or not out:
+        raise _err("[campaign] output", f"must be a file path, got {out!r}")
+    output = (base / out).resolve()
+
+    m = _table(d, "models", "top level")
+    _known(m, ("tire", "chassis"), "[models]")
+    tires = _models(_table(m, "tire", "[models]"), base, "tire")
+    chassis = _models(_table(m, "chassis", "[models]"), base, "chassis")
+
+    g = _table(d, "grid", "top level")
+    _known(g, ("df",), "[grid]")
+    df = _float(g.get("df", 0.5), "[grid] df", 0.01, 10.0)
+
+    cases: list = []
+    s = _table(d, "scatter", "top level")
+    if s:
+        w = "[scatter]"
+        _known(
+            s,
+            (
+                "harmonics",
+                "noise",
+                "targets",
+                "frequency_dependent",
+                "rounds",
+                "n_modes",
+                "percentiles",
+                "couplings",
+                "tires",
+                "chassis",
+            ),
+            w,
+        )
+        hs = _harmonics(s, w)
+        ps = _unique(
+            [_float(p, f"{w} noise", 0.0, 1.0, True) for p in _list(s.get("noise", 0.1), w)],
+            f"{w} noise",
+        )
+        tg = _list(s.get("targets", "both"), w)
+        tg = _unique(
+            [TARGET_NAMES[_choice(t, tuple(TARGET_NAMES), f"{w} targets")] for t in tg],
+            f"{w} targets",
+        )
+        fds = _list(s.get("frequency_dependent", False), w)
+        for v in fds:
+            if not isinstance(v, bool):
+                raise _err(f"{w} frequency_dependent", f"must be true/false, got {v!r}")
+        fds = _unique(fds, f"{w} frequency_dependent")
+        rounds = _int(s.get("rounds", 10_000), f"{w} rounds", 1, 10**9)
+        nm = s.get("n_modes", "all")
+        n_modes = None if nm == "all" else _int(nm, f"{w} n_modes", 1)
+        qs = tuple(
+            _float(q, f"{w} percentiles", 0.0, 100.0)
+            for q in _list(s.get("percentiles", [5.0, 95.0]), w)
+        )
+        for h in hs:
+            for cp in _couplings(s, w):
+                for t in _variants(s, "tires", tires, w):
+                    for ch in _variants(s, "chassis", chassis, w):
+                        for fd in fds:
+                            for tgt in tg:
+                                for p in ps:
+                                    proto = BandCase(
+                                        h, p, tgt, fd, rounds, n_modes, cp, t, ch, seed, qs, df
+                                    )
+                                    cs = seed if seeds == "common" else case_seed(seed, proto.name)
+                                    cases.append(
+                                        BandCase(
+                                            h, p, tgt, fd, rounds, n_modes, cp, t, ch, cs, qs, df
+                                        )
+                                    )
+
+    tr = _table(d, "truncation", "top level")
+    if tr:
+        w = "[truncation]"
+        _known(
+            tr,
+            (
+                "harmonics",
+                "n_modes",
+                "thresholds",
+                "f_max",
+                "width",
+                "step",
+                "couplings",
+                "tires",
+                "chassis",
+            ),
+            w,
+        )
+        nm = tr.get("n_modes", {"from": 10, "to": 400, "step": 10})
+        if isinstance(nm, dict):
+            _known(nm, ("from", "to", "step"), f"{w} n_modes")
+            a = _int(nm.get("from", 10), f"{w} n_modes.from", 1)
+            b = _int(nm.get("to", 400), f"{w} n_modes.to", a)
+            st = _int(nm.get("step", 10), f"{w} n_modes.step", 1)
+            counts = tuple(range(a, b + 1, st))
+        else:
+            counts = tuple(_int(n, f"{w} n_modes", 1) for n in _list(nm, w))
+            if any(y <= x for x, y in zip(counts, counts[1:], strict=False)):
+                raise _err(f"{w} n_modes", f"must be strictly ascending, got {list(counts)}")
+        ths = tuple(
+            _float(x, f"{w} thresholds", 0.0, 100.0) for x in _list(tr.get("thresholds", 0.2), w)
+        )
+        fmx = tuple(_float(x, f"{w} f_max", 0.0, 1e5) for x in _list(tr.get("f_max", 160.0), w))
+        width = _float(tr.get("width", 12.0), f"{w} width", 1e-3, 1e4)
+        step = _float(tr.get("step", 1.0), f"{w} step", 1e-3, 1e4)
+        for h in _harmonics(tr, w):
+            for cp in _couplings(tr, w):
+                for t in _variants(tr, "tires", tires, w):
+                    for ch in _variants(tr, "chassis", chassis, w):
+                        cases.append(
+                            TruncationCase(h, counts, cp, t, ch, width, step, ths, fmx, df)
+                        )
+    if not cases:
+        raise CampaignError("campaign file defines no cases: add a [scatter] or [truncation] table")
+    names = [x.name for x in cases]
+    if len(set(names)) != len(names):  # pragma: no cover - the loops make names unique
+        raise CampaignError("campaign file defines the same case twice")
+
+    o = _table(d, "outputs", "top level")
+    _known(o, tuple(OUTPUTS), "[outputs]")
+    outputs = {}
+    for kind, allowed in OUTPUTS.items():
+        sel = _list(
+            o.get(kind, list(allowed if kind == "scatter" else ("error", "suggested"))), "[outputs]"
+        )
+        outputs[kind] = tuple(_choice(x, allowed, f"[outputs] {kind}") for x in sel)
+
+    e = _table(d, "execution", "top level")
+    _known(e, ("task_round_lines", "max_chunk_bytes"), "[execution]")
+    trl = _int(e.get("task_round_lines", 20_000_000), "[execution] task_round_lines", 1)
+    mcb = _float(e.get("max_chunk_bytes", 64e6), "[execution] max_chunk_bytes", 1e5, 1e11)
+    return Campaign(
+        name, seed, seeds, output, tires, chassis, tuple(cases), outputs, trl, mcb, text
+    )
+
+
+def load_campaign(path) -> Campaign:
+    """Read and check a campaign file (TOML); relative paths are relative to its folder.
+
+    Raises
+    ------
+    CampaignError
+        For a missing or unreadable file and everything :func:`parse_campaign` refuses.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise CampaignError(f"cannot read campaign file {str(p)!r}: {e}") from None
+    return parse_campaign(text, p.parent)

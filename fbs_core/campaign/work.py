@@ -1,0 +1,303 @@
+"""The tasks of a campaign: pure functions of small, explicit arguments (run on Dask workers).
+
+- :func:`prepare_inputs`: the subsystem arrays of one (harmonic, tire, chassis, coupling,
+  retained modes) combination, shared by all the scatter cases that use them (computed
+  once by the client and scattered, see below);
+- :func:`band_block`: the band statistics of one scatter case over a block of frequency
+  lines, with all of the case's rounds;
+- :func:`truncation_case`: the truncation error map and suggested mode counts of one case.
+
+Why a block is a range of lines and not a range of rounds. The noise factors are
+counter based (:mod:`fbs_core.studies._rng`): those of round ``r`` at line ``l`` are a pure
+function of ``(seed, r, l)``, so every (round, line) is already an independent,
+reproducible stream whatever the split, and no per-block stream (``SeedSequence.spawn``)
+is needed: a block computes exactly the numbers the whole band would. The band's
+statistics, however, are not all mergeable over rounds: minimum, maximum, the first round
+attaining them and the convergence checkpoints are, the percentiles are not (an exact
+percentile needs every magnitude of its column, ``8 R`` bytes per line and DOF, shipped
+to one place). Over lines everything is independent, so a block of lines holding all
+rounds gives the exact band with only its statistics sent back; within the task the lines
+are processed in chunks bounded by ``max_chunk_bytes``, as in
+:func:`fbs_core.scatter_band`, so the task size (``rounds x lines``) and the memory bound
+are set independently.
+
+Why the subsystem arrays are computed once, by the client. The chassis synthesis goes
+through LAPACK, whose results depend in the last bits on its thread count: Dask's worker
+processes run with one BLAS thread (``OPENBLAS_NUM_THREADS=1``), a plain Python process
+with all cores, and the chassis mobility then differs by about 1e-10 (relative), which
+the near-singular interface sums amplify to 1e-7 in the band edges at resonances
+(measured on the reference models). Computed once and shipped, the arrays are the same
+for every block, stored in the result file, and equal to those of
+:func:`fbs_core.scatter_band` in the client's process: the band is then the same to the
+last bit. The truncation tasks get the chassis FRF on their grid from the client for the
+same reason (the tire's modal sums do not depend on the BLAS threads).
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import time
+
+import numpy as np
+
+from ..errors import FBSError
+
+__all__ = ["BandInputs", "resolve_model", "prepare_inputs", "band_block", "truncation_case"]
+
+
+class BandInputs:
+    """Subsystem arrays of a scatter case on its frequency grid (read-only).
+
+    Attributes
+    ----------
+    freq : ndarray, shape (n_f,)
+    dofs : tuple of str, length n_e
+    YjjA, vj, YjjE, YejE : ndarray
+        As in :func:`fbs_core.studies.scatter_band_arrays`.
+    reference : ndarray, shape (n_f, n_e)
+        The noise-free response (all factors 1).
+    n_modes_total : int
+    """
+
+    def __init__(self, freq, dofs, YjjA, vj, YjjE, YejE, n_modes_total):
+        from ..studies import scatter as _sc
+
+        self.freq = _sc._ro(freq)
+        self.dofs = tuple(dofs)
+        self.YjjA, self.vj, self.YjjE, self.YejE = (_sc._ro(x) for x in (YjjA, vj, YjjE, YejE))
+        self.n_modes_total = int(n_modes_total)
+        self.arrays = _sc._check_inputs(self.YjjA, self.vj, self.YjjE, self.YejE)
+        ref = _sc._run_complex(
+            self.arrays, np.uint64(0), np.zeros(1, np.int64), 0.0, False, False, False
+        )
+        self.reference = _sc._ro(ref[0])
+
+    def __setstate__(self, state):
+        # arrays arrive writeable from pickling: read-only again, so that the compiled
+        # kernels see the one signature they were compiled (and cached) for
+        for v in state.values():
+            if isinstance(v, np.ndarray):
+                v.setflags(write=False)
+        for v in state["arrays"]:
+            v.setflags(write=False)
+        self.__dict__.update(state)
+
+    @property
+    def n_lines(self) -> int:
+        return int(self.freq.size)
+
+
+def resolve_model(kind: str, spec):
+    """A model from its campaign spec: ``"reference"`` or an already loaded object."""
+    if isinstance(spec, str):
+        if spec != "reference":
+            raise FBSError(f"{kind} model {spec!r}: only 'reference' is resolved by name")
+        import fbs_core
+
+        return fbs_core.reference_tire() if kind == "tire" else fbs_core.reference_chassis()
+    return spec
+
+
+def load_model(kind: str, source: str):
+    """Load a model variant from a file (on the client; the object is then scattered).
+
+    Tire: a modal tire model (:func:`fbs_core.io.load_tire_model`). Chassis: an FRF file
+    (:func:`fbs_core.io.load_frf`) with inputs ``spindle:*``; it is interpolated onto each
+    harmonic's grid (never extrapolated).
+    """
+    if source == "reference":
+        return "reference"
+    from .. import io
+
+    if kind == "tire":
+        return io.load_tire_model(source).model
+    return io.load_frf(source).frf
+
+
+def chassis_on(chassis, f):
+    """The chassis FRF on the grid ``f``: a model's exact synthesis, or an FRF (from a file)
+    interpolated onto ``f`` (never extrapolated; an FRF already on ``f`` as it is)."""
+    from ..frf import FRF
+
+    chassis = frf_from(resolve_model("chassis", chassis))
+    if isinstance(chassis, FRF):
+        if chassis.freq.shape == f.shape and np.array_equal(chassis.freq, f):
+            return chassis
+        return chassis.interpolate(f)
+    return chassis.mobility(f)
+
+
+def frf_payload(frf) -> tuple:
+    """An FRF as plain arrays and labels, to send to a worker (FRF objects do not pickle)."""
+    return (np.asarray(frf.freq), np.asarray(frf.data), frf.outputs, frf.inputs, frf.quantity)
+
+
+def frf_from(payload):
+    """The FRF of :func:`frf_payload` (or the object itself when it is not a payload)."""
+    from ..frf import FRF
+
+    if isinstance(payload, tuple) and len(payload) == 5:
+        return FRF(*payload)
+    return payload
+
+
+def prepare_inputs(tire, chassis, harmonic: int, n_modes, coupling: str, df: float) -> BandInputs:
+    """The arrays of :func:`fbs_core.scatter_band` for one harmonic, model pair and coupling."""
+    from ..studies import _models
+
+    tire = resolve_model("tire", tire)
+    h = _models.resolve_harmonic(harmonic)
+    dirs = _models.coupled_directions(coupling)
+    f = h.frequencies(df)
+    n_total = _models.total_modes(tire)
+    n = n_total if n_modes is None else int(n_modes)
+    if not 1 <= n <= n_total:
+        raise FBSError(f"n_modes must be in 1..{n_total} (the tire's modes), got {n_modes!r}")
+    YjjE, YejE, resp = _models.chassis_arrays(chassis_on(chassis, f), f, dirs)
+    YjjA, vj = _models.tire_arrays(tire, f, h, [n], dirs)
+    return BandInputs(f, resp, YjjA[0], vj[0], YjjE, YejE, n_total)
+
+
+def _where() -> dict:
+    try:
+        from distributed import get_worker
+
+        addr = get_worker().address
+    except (ImportError, ValueError):
+        addr = "client"
+    return {"worker": addr, "host": socket.gethostname(), "pid": os.getpid()}
+
+
+def band_block(
+    inputs: BandInputs,
+    noise: float,
+    target: str,
+    rounds: int,
+    frequency_dependent: bool,
+    seed: int,
+    percentiles,
+    l0: int,
+    l1: int,
+    max_chunk_bytes: float = 64e6,
+    numba_threads: int | None = None,
+) -> dict:
+    """Band statistics of lines ``l0 .. l1 - 1`` over all ``rounds`` (exactly the numbers of
+    :func:`fbs_core.studies.scatter_band_arrays` for those lines).
+
+    Returns
+    -------
+    dict
+        ``lower``, ``upper``, ``argmin_round``, ``argmax_round`` ``(n_l, n_e)``,
+        ``percentiles`` ``(n_q, n_l, n_e)``, ``conv_lower``, ``conv_upper``
+        ``(n_k, n_l, n_e)``, ``checkpoints``, ``l0``, ``l1`` and the provenance of the run
+        (``worker``, ``host``, ``pid``, ``seconds``).
+    """
+    from ..studies import _kernels
+    from ..studies import scatter as _sc
+    from ..studies._rng import seed_key
+
+    t0 = time.perf_counter()
+    if numba_threads:
+        import numba
+
+        numba.set_num_threads(max(1, min(int(numba_threads), numba.config.NUMBA_NUM_THREADS)))
+    nf, ne = inputs.n_lines, len(inputs.dofs)
+    if not 0 <= l0 < l1 <= nf:
+        raise FBSError(f"line block {l0}..{l1} outside 0..{nf}")
+    if not 0.0 <= noise < 1.0:
+        raise FBSError(f"noise must be in [0, 1), got {noise!r}")
+    tire, vehicle = _sc._flags(target)
+    rounds = int(rounds)
+    qs = np.asarray(percentiles, float)
+    ck = _sc.default_checkpoints(rounds)
+    key = seed_key(seed)
+    nl = l1 - l0
+    lo = np.empty((nl, ne))
+    hi = np.empty((nl, ne))
+    alo = np.empty((nl, ne), np.int64)
+    ahi = np.empty((nl, ne), np.int64)
+    pct = np.empty((qs.size, nl, ne))
+    clo = np.empty((ck.size, nl, ne))
+    chi = np.empty((ck.size, nl, ne))
+    chunk = int(max(1, min(nl, max_chunk_bytes // (8 * ne * rounds))))
+    mag = np.empty((chunk, ne, rounds))
+    rids = np.arange(rounds, dtype=np.int64)
+    for a in range(l0, l1, chunk):
+        b = min(l1, a + chunk)
+        m = mag[: b - a]
+        with _sc._LOCK:
+            _kernels.noisy_block_run(
+                *inputs.arrays,
+                a,
+                b,
+                key,
+                rids,
+                float(noise),
+                tire,
+                vehicle,
+                bool(frequency_dependent),
+                m,
+                _sc._EMPTY_CPLX,
+            )
+            _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, a - l0)
+    return {
+        "l0": int(l0),
+        "l1": int(l1),
+        "lower": lo,
+        "upper": hi,
+        "argmin_round": alo,
+        "argmax_round": ahi,
+        "percentiles": pct,
+        "checkpoints": ck,
+        "conv_lower": clo,
+        "conv_upper": chi,
+        "seconds": time.perf_counter() - t0,
+        **_where(),
+    }
+
+
+def truncation_case(tire, chassis, case) -> dict:
+    """Error map (eq. 5.1) and suggested mode counts (table 5.1) of a
+    :class:`~fbs_core.campaign.spec.TruncationCase`.
+
+    Returns
+    -------
+    dict
+        ``n_modes``, ``n_modes_total``, ``centres``, ``dofs``, ``error`` ``(n_N, n_c, n_e)``,
+        ``suggested`` ``(n_threshold, n_fmax)`` (max over DOFs), ``freq``, ``response``
+        ``(n_N, n_f, n_e)``, ``reference`` ``(n_f, n_e)`` and the provenance of the run.
+    """
+    from ..studies import _models
+    from ..studies.truncation import truncation_map
+
+    t0 = time.perf_counter()
+    tire = resolve_model("tire", tire)
+    f = _models.resolve_harmonic(case.harmonic).frequencies(case.df)
+    m = truncation_map(
+        case.harmonic,
+        np.asarray(case.n_modes, int),
+        freq=f,
+        width=case.width,
+        step=case.step,
+        tire=tire,
+        chassis=chassis_on(chassis, f),
+        coupling=case.coupling,
+    )
+    sugg = np.array([[m.suggest(t, fm) for fm in case.f_max] for t in case.thresholds], np.int64)
+    return {
+        "n_modes": np.asarray(m.n_modes),
+        "n_modes_total": int(m.n_modes_total),
+        "centres": np.asarray(m.centres),
+        "dofs": tuple(m.dofs),
+        "error": np.asarray(m.error),
+        "suggested": sugg,
+        "freq": np.asarray(m.freq),
+        "response": np.asarray(m.response),
+        "reference": np.asarray(m.reference),
+        "width": m.width,
+        "step": m.step,
+        "edges": m.edges,
+        "seconds": time.perf_counter() - t0,
+        **_where(),
+    }
