@@ -71,6 +71,9 @@ class RunReport:
     errors: list = field(default_factory=list)
     scheduler: str = ""
     workers: int = 0
+    task_seconds: float = 0.0  # compute time of the finished tasks, summed (on the workers)
+    write_seconds: float = 0.0  # time this process spent writing their results
+    compute_wall: float = 0.0  # from the first task submitted to the last result written
 
     @property
     def rounds_per_second(self) -> float:
@@ -353,6 +356,7 @@ def run_campaign(
     progress=None,
     stop: threading.Event | None = None,
     max_tasks: int | None = None,
+    numba_threads: int | None = None,
 ) -> RunReport:
     """Run (or resume) a campaign and write its result file.
 
@@ -375,6 +379,10 @@ def run_campaign(
         Set it to stop: running tasks are cancelled, finished ones kept (resumable).
     max_tasks : int, optional
         Stop after this many finished tasks (a partial run; resumable).
+    numba_threads : int, optional
+        Threads of the compiled kernels in each task (default: all cores in-process,
+        cores / workers with local worker processes, the workers' own default on an
+        existing cluster).
 
     Returns
     -------
@@ -402,8 +410,7 @@ def run_campaign(
         if todo:
             report.scheduler = str(client.scheduler.address)
             report.workers = len(client.scheduler_info().get("workers", {}))
-            numba_threads = None
-            if cluster is not None and workers:
+            if numba_threads is None and cluster is not None and workers:
                 numba_threads = max(1, (os.cpu_count() or 1) // int(workers))
             # model variants from files: loaded here; tires sent to every worker once
             tire_objs = {n: work.load_model("tire", src) for n, src in campaign.tires.items()}
@@ -436,6 +443,7 @@ def run_campaign(
             grids_f = {g: client.scatter(work.frf_payload(v)) for g, v in grids.items()}
             futures = {}
             token = uuid.uuid4().hex[:12]
+            t_submit = time.perf_counter()
             for t in tasks:
                 c = t.case
                 if t.kind == "band":
@@ -478,11 +486,15 @@ def run_campaign(
                     if fut.status == "cancelled":
                         continue
                     res = fut.result()
+                    report.task_seconds += float(res.get("seconds", 0.0))
+                    tw = time.perf_counter()
                     WRITING.set()
                     try:
                         _write(store, campaign, t, res)
                     finally:
                         WRITING.clear()
+                    report.write_seconds += time.perf_counter() - tw
+                    report.compute_wall = time.perf_counter() - t_submit
                     fut.release()
                     report.tasks_done += 1
                     report.rounds_done += t.rounds
