@@ -365,7 +365,9 @@ def parse_campaign(text: str, base: Path | str = ".") -> Campaign:
             if not isinstance(v, bool):
                 raise _err(f"{w} frequency_dependent", f"must be true/false, got {v!r}")
         fds = _unique(fds, f"{w} frequency_dependent")
-        rounds = _int(s.get("rounds", 10_000), f"{w} rounds", 1, 10**9)
+        from ..studies.scatter import MAX_ROUNDS
+
+        rounds = _int(s.get("rounds", 10_000), f"{w} rounds", 1, MAX_ROUNDS)
         nm = s.get("n_modes", "all")
         n_modes = None if nm == "all" else _int(nm, f"{w} n_modes", 1)
         qs = tuple(
