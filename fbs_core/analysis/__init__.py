@@ -1,0 +1,48 @@
+"""Analysis of coupled results for a design review (issue 18): contributions of the
+interface forces, peaks and nearby modes, phase views and cursors, comparison of
+states, the tire across speed (Campbell diagram, speed-frequency map), and CSV
+export with provenance. See ``docs/analysis.md``.
+"""
+
+from .contributions import (
+    Contributions,
+    bushing_contributions,
+    contribution_kernel,
+    interface_contributions,
+)
+
+__all__ = [
+    "Contributions",
+    "bushing_contributions",
+    "contribution_kernel",
+    "interface_contributions",
+]
+from .peaks import (  # noqa: E402
+    Mode,
+    Peak,
+    coupled_modes_near,
+    coupled_system,
+    find_peaks_db,
+    parabolic_vertex,
+    peak_labels,
+    system_modes_near,
+)
+from .views import Bode, Delta, bode, delta_cursor, level_db, phase_deg, real_imag  # noqa: E402
+
+__all__ += [
+    "Mode",
+    "Peak",
+    "coupled_modes_near",
+    "coupled_system",
+    "find_peaks_db",
+    "parabolic_vertex",
+    "peak_labels",
+    "system_modes_near",
+    "Bode",
+    "Delta",
+    "bode",
+    "delta_cursor",
+    "level_db",
+    "phase_deg",
+    "real_imag",
+]
