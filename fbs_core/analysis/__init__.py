@@ -46,3 +46,20 @@ __all__ += [
     "phase_deg",
     "real_imag",
 ]
+from .campbell import (  # noqa: E402
+    Campbell,
+    Crossing,
+    campbell,
+    classify_branches,
+    harmonic_lines,
+    travelling_index,
+)
+
+__all__ += [
+    "Campbell",
+    "Crossing",
+    "campbell",
+    "classify_branches",
+    "harmonic_lines",
+    "travelling_index",
+]
