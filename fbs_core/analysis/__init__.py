@@ -63,3 +63,6 @@ __all__ += [
     "harmonic_lines",
     "travelling_index",
 ]
+from .speedmap import SpeedMap, speed_map  # noqa: E402
+
+__all__ += ["SpeedMap", "speed_map"]
