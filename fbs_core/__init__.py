@@ -4,7 +4,9 @@ Follows Rosholm & Westers, "Assembly of a tire and a vehicle model to predict
 vibrations at the bushings", Chalmers MSc thesis (2018).
 """
 
+from . import analysis as analysis
 from . import io as io
+from .analysis import bushing_contributions, campbell, peak_labels, speed_map
 from .chassis import ChassisModel, reference_chassis
 from .coupling import (
     couple_generalized,
@@ -84,4 +86,8 @@ __all__ = [
     "parse_label",
     "load_frf",
     "save_frf",
+    "bushing_contributions",
+    "campbell",
+    "peak_labels",
+    "speed_map",
 ]

@@ -66,3 +66,26 @@ __all__ += [
 from .speedmap import SpeedMap, speed_map  # noqa: E402
 
 __all__ += ["SpeedMap", "speed_map"]
+from .compare import (  # noqa: E402
+    LevelDifference,
+    MapDifference,
+    db_difference,
+    truncation_map_difference,
+)
+from .export import export_mapping, to_csv  # noqa: E402
+from .pinned import MAX_PINS, PinnedState, add_pin, digest, pin_state, remove_pin  # noqa: E402
+
+__all__ += [
+    "LevelDifference",
+    "MapDifference",
+    "db_difference",
+    "truncation_map_difference",
+    "export_mapping",
+    "to_csv",
+    "MAX_PINS",
+    "PinnedState",
+    "add_pin",
+    "digest",
+    "pin_state",
+    "remove_pin",
+]

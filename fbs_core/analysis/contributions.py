@@ -148,6 +148,21 @@ class Contributions:
         i = index_of(self.outputs, output, "response DOF")[0]
         return FRF(self.freq, self.terms[:, i : i + 1, :], [output], self.interface, self.quantity)
 
+    def export_mapping(self) -> dict:
+        """Arrays with axes for :func:`fbs_core.io.export_result`: the complex terms, the
+        total and the interface forces."""
+        return {
+            "terms": (("freq", "output", "interface"), self.terms),
+            "total": (("freq", "output"), self.terms.sum(-1)),
+            "forces": (("freq", "interface"), self.forces),
+            "coords": {
+                "freq": self.freq,
+                "output": list(self.outputs),
+                "interface": list(self.interface),
+            },
+            "metadata": {"load": self.load, "quantity": self.quantity},
+        }
+
     def levels_db(self, output: str, ref: float = 1.0) -> np.ndarray:
         """``20 log10 |term| / ref`` of every term at one response, shape ``(n_f, n_j)``."""
         i = index_of(self.outputs, output, "response DOF")[0]
