@@ -1,0 +1,406 @@
+"""The content of a report, independent of its format (HTML and PDF render the same blocks).
+
+:func:`report_content` turns a :class:`~app.report.snapshot.Snapshot` into sections of
+title blocks, figures and tables whose numbers are formatted once here, so the HTML file and
+the PDF hold the same text.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+import fbs_core
+
+from . import figures
+from .method import EQUATIONS, METHOD_PARAGRAPHS, THESIS, Equation
+from .snapshot import SETTING_KEYS, ReportError, Snapshot
+from .titles import (
+    TitleBlock,
+    coupling_description,
+    file_stem,
+    harmonic_description,
+    title_block,
+)
+
+__all__ = [
+    "Table",
+    "FigureBlock",
+    "Section",
+    "Report",
+    "report_content",
+    "level_db",
+    "plot_file",
+]
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of formatted cells."""
+
+    caption: str
+    header: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+
+
+@dataclass(frozen=True)
+class FigureBlock:
+    """A plot: its title block and a function drawing it into a matplotlib figure region.
+
+    ``draw(fig, rect)`` adds axes inside ``rect = (left, bottom, width, height)`` (figure
+    fraction), legends included; ``aspect`` is the height / width ratio it wants.
+    """
+
+    key: str
+    title: TitleBlock
+    draw: Callable
+    aspect: float = 0.55
+    stem: str = ""
+
+
+@dataclass(frozen=True)
+class Section:
+    key: str
+    heading: str
+    paragraphs: tuple[str, ...]
+    figure: FigureBlock | None
+    tables: tuple[Table, ...]
+    title: TitleBlock | None = None
+
+
+@dataclass(frozen=True)
+class Report:
+    """Everything a report shows, formatted."""
+
+    title: str
+    stem: str
+    title_block: TitleBlock
+    url: str
+    reproduce_note: str
+    provenance: Table
+    settings: Table
+    sections: tuple[Section, ...]
+    method: tuple[str, ...]
+    equations: tuple[Equation, ...]
+    thesis: str
+
+
+def level_db(x) -> np.ndarray:
+    """``20 log10 |x|`` with magnitudes floored at 1e-30 (the dashboard's dB conversion)."""
+    return 20.0 * np.log10(np.maximum(np.abs(np.asarray(x)), 1e-30))
+
+
+def _fixed(x: float, digits: int) -> str:
+    """``x`` with ``digits`` decimals, never ``-0.00``."""
+    v = round(float(x), digits)
+    return f"{v + 0.0:.{digits}f}"
+
+
+def _db(x: float) -> str:
+    return f"{_fixed(x, 2)} dB"
+
+
+def _hz(x: float) -> str:
+    return f"{_fixed(x, 1)} Hz"
+
+
+def _pct(x: float) -> str:
+    return f"{_fixed(x, 1)} %"
+
+
+def _setting_text(name, value) -> str:
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if name == "rounds":
+        return f"{value:,}"
+    if isinstance(value, float):
+        return f"{value:g}"
+    return str(value)
+
+
+def _settings_table(snap: Snapshot) -> Table:
+    rows = tuple(
+        (name, SETTING_KEYS[name][1], _setting_text(name, v)) for name, v in snap.settings.items()
+    )
+    return Table("Settings of the page", ("setting", "meaning", "value"), rows)
+
+
+def _provenance_table(snap: Snapshot) -> Table:
+    p = snap.provenance
+    rows = []
+    for d in (p.tire, p.chassis):
+        rows.append(
+            (
+                d.role,
+                "reference (shipped model)" if d.is_reference else f"uploaded file '{d.name}'",
+                d.digest or "-",
+            )
+        )
+    for note in p.notes:
+        rows.append(("note", note, ""))
+    rows.append(("fbs_core", f"version {fbs_core.__version__}", ""))
+    return Table("Data in use", ("model", "source", "digest"), tuple(rows))
+
+
+def _peak_row(label: str, freq, v, h) -> tuple[str, ...]:
+    lv = level_db(v)
+    i = int(np.argmax(lv))
+    return (label, _db(lv[i]), _hz(freq[i]), f"{h.speed_at(freq[i]):.1f} km/h")
+
+
+def _coupled_section(snap: Snapshot) -> Section:
+    dof = snap.response_dof
+    s, h = snap.settings, snap.harmonic
+    rows = []
+    ref = snap.reference.sel(outputs=dof, inputs="patch") if snap.reference else None
+    tr = snap.truncated.sel(outputs=dof, inputs="patch") if snap.truncated else None
+    if ref is not None:
+        rows.append(_peak_row("all tire modes (reference)", ref.freq, ref.data[:, 0, 0], h))
+    if tr is not None:
+        rows.append(_peak_row(f"N = {s['n_modes']} modes", tr.freq, tr.data[:, 0, 0], h))
+    tables = [
+        Table(
+            f"Peak level at {dof} ({figures.level_unit(dof)})",
+            ("response", "peak level", "at frequency", "vehicle speed"),
+            tuple(rows),
+        )
+    ]
+    if ref is not None and tr is not None and np.array_equal(ref.freq, tr.freq):
+        lr, lt = level_db(ref.data[:, 0, 0]), level_db(tr.data[:, 0, 0])
+        i = int(np.argmax(lr))
+        d = lt - lr
+        j = int(np.argmax(np.abs(d)))
+        tables.append(
+            Table(
+                f"N = {s['n_modes']} against all modes",
+                ("quantity", "value", "at frequency"),
+                (
+                    ("level difference at the reference peak", _db(d[i]), _hz(ref.freq[i])),
+                    ("largest level difference", _db(d[j]), _hz(ref.freq[j])),
+                ),
+            )
+        )
+    fig = FigureBlock(
+        "coupled-response",
+        title_block(snap, "coupled-response"),
+        figures.draw_coupled(snap),
+        stem=file_stem(snap, "coupled-response"),
+    )
+    para = (
+        f"Velocity v_e* at {dof} per metre of road amplitude along the harmonic's speed line "
+        f"(eq. 4.1, {coupling_description(s['coupling'])}), with all tire modes and with the "
+        f"first {s['n_modes']} modes.",
+    )
+    return Section("coupled-response", "Coupled response", para, fig, tuple(tables))
+
+
+def _truncation_section(snap: Snapshot) -> Section:
+    m, s = snap.truncation, snap.settings
+    dof = snap.map_dof
+    err = 100 * (m.max_error if dof is None else m.dof_error(dof))
+    thr, fmax = s["threshold"], s["f_max"]
+    n_sugg = int(m.suggest(thr / 100, fmax, dof))
+    sel = m.centres <= fmax + 1e-9
+    rows = []
+    for i, n in enumerate(m.n_modes):
+        if sel.any():
+            k = int(np.argmax(np.where(sel, err[i], -np.inf)))
+            worst, at = err[i, k], m.centres[k]
+            mark = "below" if worst < thr else "at or above"
+        else:
+            worst, at, mark = np.nan, np.nan, "-"
+        notes = [t for t, ok in (("chosen", n == s["n_modes"]), ("suggested", n == n_sugg)) if ok]
+        rows.append(
+            (str(int(n)), _pct(worst), _hz(at), mark, ", ".join(notes)),
+        )
+    what = f"{dof}" if dof else "the maximum over the 6 bushing DOFs"
+    para = (
+        f"Floating-band error of eq. 5.1 ({m.width:g} Hz band, {m.step:g} Hz steps) of "
+        f"{what} for N retained modes against all {m.n_modes_total} modes. Blue: below the "
+        f"{thr:g} % threshold (darker is larger); red, hatched: at or above it; black line: "
+        f"the {thr:g} % contour. Suggested N = {n_sugg}: the smallest N from which the error "
+        f"stays below {thr:g} % at all centres up to {fmax:g} Hz (thesis table 5.1).",
+    )
+    table = Table(
+        f"Largest error up to {fmax:g} Hz for each N ({what})",
+        ("N", "largest error", "at centre", f"vs {thr:g} %", ""),
+        tuple(rows),
+    )
+    fig = FigureBlock(
+        "truncation-map",
+        title_block(snap, "truncation-map"),
+        figures.draw_truncation(snap, n_sugg),
+        aspect=0.62,
+        stem=file_stem(snap, "truncation-map"),
+    )
+    return Section("truncation-map", "Truncation error map", para, fig, (table,))
+
+
+def _suggested_section(snap: Snapshot) -> Section:
+    sm = snap.suggested
+    rows = []
+    for k, n, ef, (lo, hi) in zip(
+        sm.harmonics, sm.n_modes, sm.eigenfrequency, sm.freq_range, strict=True
+    ):
+        rows.append(
+            (
+                str(k),
+                f"{lo:.1f}-{hi:.1f} Hz",
+                str(int(n)),
+                "-" if not np.isfinite(ef) else f"{ef:.1f} Hz",
+            )
+        )
+    what = sm.dof or "maximum over the 6 bushing DOFs"
+    para = (
+        f"Smallest N from which the eq. 5.1 error stays below {sm.threshold * 100:g} % at all "
+        f"centres up to {sm.f_max:g} Hz ({what}), and the highest eigenfrequency among those "
+        f"modes at {sm.speed:g} km/h (thesis table 5.1).",
+    )
+    table = Table(
+        "Suggested number of modes",
+        ("harmonic", "band", "suggested N", f"highest eigenfreq. at {sm.speed:g} km/h"),
+        tuple(rows),
+    )
+    tb = title_block(snap, "suggested-modes")
+    return Section("suggested-modes", "Suggested number of modes", para, None, (table,), tb)
+
+
+def _band_section(snap: Snapshot) -> Section:
+    b, s = snap.band, snap.settings
+    dof = snap.response_dof
+    j = b.dofs.index(dof)
+    w = s["percentile"]
+    q = [float(x) for x in b.q]
+    lo, hi = (100 - w) / 2, (100 + w) / 2
+    ref = level_db(b.reference[:, j])
+    i = int(np.argmax(ref))
+    rnd = level_db(b.round(s["single_round"])[:, j])
+    width = level_db(b.upper[:, j]) - level_db(b.lower[:, j])
+    k = int(np.argmax(width))
+    conv = np.asarray(b.convergence.step_change_db, float)
+    f_i = _hz(b.freq[i])
+    rows = (
+        ("unpolluted reference", _db(ref[i])),
+        ("minimum over the rounds", _db(level_db(b.lower[i, j]))),
+        ("maximum over the rounds", _db(level_db(b.upper[i, j]))),
+        (f"{lo:g} % percentile", _db(level_db(b.percentiles[q.index(lo), i, j]))),
+        (f"{hi:g} % percentile", _db(level_db(b.percentiles[q.index(hi), i, j]))),
+        (f"round #{s['single_round']}", _db(rnd[i])),
+    )
+    extra = (
+        ("widest corridor (max - min)", _db(width[k]), _hz(b.freq[k])),
+        (
+            "last change of a band edge",
+            _db(conv[-1]) if conv.size else "-",
+            f"rounds {int(b.convergence.rounds[-2]):,} to {int(b.convergence.rounds[-1]):,}"
+            if conv.size
+            else "",
+        ),
+    )
+    para = (
+        f"Each element of the subsystem FRFs scaled by a factor uniform in "
+        f"[1 - p, 1 + p], p = {s['noise']:g} %, the response recomputed R = {s['rounds']:,} "
+        f"times (eqs. 5.2-5.4). Shaded: minimum to maximum over the rounds and the {w} % "
+        f"central band ({lo:g}-{hi:g} % percentiles); dark line: the unpolluted reference; "
+        f"orange: round #{s['single_round']}. A large last change of a band edge means R is "
+        "too small.",
+    )
+    tables = (
+        Table(f"Levels at the reference peak, {f_i}", ("curve", "level"), rows),
+        Table("Corridor", ("quantity", "value", "where"), extra),
+    )
+    fig = FigureBlock(
+        "scatter-band",
+        title_block(snap, "scatter-band"),
+        figures.draw_band(snap),
+        stem=file_stem(snap, "scatter-band"),
+    )
+    return Section("scatter-band", "Noise scatter band", para, fig, tables)
+
+
+def _eigen_section(snap: Snapshot) -> Section:
+    e, n = snap.eigen, snap.settings["n_modes"]
+    hit = np.flatnonzero(e.n_modes == n)
+    rows = []
+    if hit.size:
+        for v, row in zip(e.speeds, e.frequency, strict=True):
+            rows.append((f"{v:g} km/h", _hz(row[hit[0]])))
+    para = (
+        f"Highest eigenfrequency among the first N modes (N/2 +/- pairs, lowest first); "
+        f"chosen N = {n}.",
+    )
+    fig = FigureBlock(
+        "eigenfrequency",
+        title_block(snap, "eigenfrequency"),
+        figures.draw_eigen(snap),
+        aspect=0.5,
+        stem=file_stem(snap, "eigenfrequency"),
+    )
+    table = Table(
+        f"Highest retained eigenfrequency at N = {n}", ("speed", "frequency"), tuple(rows)
+    )
+    return Section("eigenfrequency", "Eigenfrequency vs number of modes", para, fig, (table,))
+
+
+def report_content(snap: Snapshot) -> Report:
+    """The formatted content of the report of a snapshot (all results it holds)."""
+    sections = []
+    if snap.reference is not None or snap.truncated is not None:
+        sections.append(_coupled_section(snap))
+    if snap.truncation is not None:
+        sections.append(_truncation_section(snap))
+    if snap.suggested is not None:
+        sections.append(_suggested_section(snap))
+    if snap.band is not None:
+        sections.append(_band_section(snap))
+    if snap.eigen is not None:
+        sections.append(_eigen_section(snap))
+    s = snap.settings
+    if snap.provenance.is_reference:
+        note = "The link reproduces this page with the shipped reference models."
+    else:
+        files = ", ".join(f"'{d.name}'" for d in snap.provenance.uploads)
+        note = (
+            f"The link reproduces this page only after uploading the same file(s) {files} "
+            "(check the digests above): without them it shows the reference models."
+        )
+    title = (
+        f"tire-fbs report: {harmonic_description(s['harmonic']).split(':')[0]}, "
+        f"{snap.response_dof}, N = {s['n_modes']}, {s['coupling']}"
+    )
+    return Report(
+        title=title,
+        stem=file_stem(snap, "report"),
+        title_block=title_block(snap, "report"),
+        url=snap.url,
+        reproduce_note=note,
+        provenance=_provenance_table(snap),
+        settings=_settings_table(snap),
+        sections=tuple(sections),
+        method=METHOD_PARAGRAPHS,
+        equations=EQUATIONS,
+        thesis=THESIS,
+    )
+
+
+def plot_file(snap: Snapshot, view: str, fmt: str = "png") -> tuple[str, bytes]:
+    """``(file name, bytes)`` of one plot of the report with its title block on top.
+
+    ``view`` is one of the report's plots (``coupled-response``, ``truncation-map``,
+    ``scatter-band``, ``eigenfrequency``) whose result the snapshot holds; ``fmt`` is
+    ``png``, ``svg`` or ``pdf``.
+
+    Raises
+    ------
+    ReportError
+        For a view the snapshot has no plot of, naming those it has.
+    """
+    blocks = {sec.figure.key: sec.figure for sec in report_content(snap).sections if sec.figure}
+    if view not in blocks:
+        raise ReportError(
+            f"no {view!r} plot in this snapshot; plots: {', '.join(blocks) or 'none'}"
+        )
+    fig = figures.standalone(blocks[view])
+    return f"{blocks[view].stem}.{fmt}", figures.render(fig, fmt)

@@ -1,0 +1,285 @@
+"""Static plots of a snapshot with matplotlib (no browser, no pyplot state).
+
+Each ``draw_*`` returns ``draw(fig, rect)``, which adds its axes inside
+``rect = (left, bottom, width, height)`` (figure fraction) with the legend below the axes,
+outside the data. :func:`standalone` puts a title block above one plot (a saved image says
+what it shows); :func:`render` writes a figure as SVG, PNG or PDF bytes.
+
+Figures are built from :class:`matplotlib.figure.Figure` directly (no pyplot, so no global
+figure registry); rendering takes a lock because the SVG/PDF font settings are read from
+matplotlib's global rcParams.
+"""
+
+from __future__ import annotations
+
+import io
+import threading
+
+import matplotlib
+import numpy as np
+from matplotlib import patheffects
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+from .colormap import LINE_STYLES, ErrorColorScale, threshold_contour
+from .snapshot import Snapshot
+from .titles import TitleBlock
+
+__all__ = [
+    "COLORS",
+    "level_unit",
+    "draw_coupled",
+    "draw_truncation",
+    "draw_band",
+    "draw_eigen",
+    "draw_title_block",
+    "standalone",
+    "render",
+]
+
+COLORS = {
+    "reference": "#1f2937",
+    "truncated": "#d9480f",
+    "band": "#a5d8ff",
+    "percentile": "#4dabf7",
+    "round": "#e8590c",
+}
+_SPEED_COLORS = ("#74c0fc", "#1c7ed6", "#0b3d91")
+_RENDER_LOCK = threading.Lock()
+#: Font sizes (pt) of tick labels, axis labels and legends.
+TICK_PT, LABEL_PT, LEGEND_PT = 9.0, 10.0, 9.0
+_DASH = {"solid": "-", "dashed": (0, (6, 3)), "dotted": (0, (1.5, 2.5))}
+
+
+def level_unit(dof: str) -> str:
+    """Unit of a bushing velocity level per road amplitude (``bushing:rz`` -> rad/s)."""
+    d = dof.split(":")[-1]
+    return "dB re 1 (rad/s)/m" if d.startswith("r") else "dB re 1 (m/s)/m"
+
+
+def _db(x) -> np.ndarray:
+    return 20.0 * np.log10(np.maximum(np.abs(np.asarray(x)), 1e-30))
+
+
+def _axes(fig: Figure, rect, legend_rows: int = 1, right: float = 0.0):
+    """Axes inside ``rect`` leaving room for tick labels and a legend below."""
+    left, bottom, width, height = rect
+    h_in = fig.get_figheight() * height
+    w_in = fig.get_figwidth() * width
+    pad_l, pad_r = 0.75 / w_in, (0.1 + right) / w_in
+    pad_b = (0.55 + 0.24 * legend_rows) / h_in
+    pad_t = 0.08 / h_in
+    ax = fig.add_axes(
+        (
+            left + pad_l * width,
+            bottom + pad_b * height,
+            width * (1 - pad_l - pad_r),
+            height * (1 - pad_b - pad_t),
+        )
+    )
+    ax.tick_params(labelsize=TICK_PT)
+    ax.grid(True, color="#dee2e6", linewidth=0.6)
+    return ax
+
+
+def _legend_below(ax, handles, rect, ncol: int = 3):
+    """The legend under the axes, at the bottom of the plot's region (outside the data)."""
+    left, bottom, width, _ = rect
+    ax.figure.legend(
+        handles=handles,
+        loc="lower center",
+        bbox_to_anchor=(left + width / 2, bottom + 0.02 / ax.figure.get_figheight()),
+        bbox_transform=ax.figure.transFigure,
+        ncol=ncol,
+        fontsize=LEGEND_PT,
+        frameon=False,
+        handlelength=2.6,
+    )
+
+
+def _labels(ax, x: str, y: str):
+    ax.set_xlabel(x, fontsize=LABEL_PT)
+    ax.set_ylabel(y, fontsize=LABEL_PT)
+
+
+def draw_coupled(snap: Snapshot):
+    """Coupled response v_e* (eq. 4.1) in dB: all modes and N modes."""
+    dof, n = snap.response_dof, snap.settings["n_modes"]
+
+    def draw(fig, rect):
+        ax = _axes(fig, rect)
+        handles = []
+        for frf, label, color, style in (
+            (snap.reference, "all tire modes (reference)", COLORS["reference"], "-"),
+            (snap.truncated, f"N = {n} modes", COLORS["truncated"], "--"),
+        ):
+            if frf is None:
+                continue
+            sel = frf.sel(outputs=dof, inputs="patch")
+            (ln,) = ax.plot(
+                sel.freq, _db(sel.data[:, 0, 0]), style, color=color, lw=1.6, label=label
+            )
+            handles.append(ln)
+        _labels(ax, "Frequency (Hz)", f"Level at {dof} ({level_unit(dof)})")
+        _legend_below(ax, handles, rect, ncol=2)
+
+    return draw
+
+
+def _halo_line(ax, draw, style_key: str, **kw):
+    color, dash, width, halo = LINE_STYLES[style_key]
+    effects = [patheffects.Stroke(linewidth=width + 2.5, foreground=halo), patheffects.Normal()]
+    return draw(color=color, linestyle=_DASH[dash], linewidth=width, path_effects=effects, **kw)
+
+
+def draw_truncation(snap: Snapshot, n_suggested: int | None = None):
+    """Error map (eq. 5.1) with the threshold scale, contour, chosen and suggested N."""
+    m, s = snap.truncation, snap.settings
+    dof = snap.map_dof
+    err = 100 * np.asarray(m.max_error if dof is None else m.dof_error(dof), float)
+    thr, fmax = float(s["threshold"]), float(s["f_max"])
+    scale = ErrorColorScale(thr)
+
+    def draw(fig, rect):
+        ax = _axes(fig, rect, legend_rows=2, right=0.9)
+        ax.grid(False)
+        cmap, norm = scale.matplotlib()
+        x, y = np.asarray(m.centres, float), np.asarray(m.n_modes, float)
+        mesh = ax.pcolormesh(
+            x, y, np.ma.masked_invalid(err), cmap=cmap, norm=norm, shading="nearest"
+        )
+        mesh.set_rasterized(True)  # one image instead of a path per cell (SVG/PDF size)
+        above = scale.at_or_above(err)
+        if above.any():
+            hatch = np.ma.masked_where(~above, np.ones_like(err))
+            hatched = ax.pcolor(
+                x,
+                y,
+                hatch,
+                shading="nearest",
+                facecolor="none",
+                edgecolor=(1, 1, 1, 0.55),
+                hatch="///",
+                linewidth=0.0,
+            )
+            hatched.set_rasterized(True)
+        handles = [Patch(facecolor=scale.above, edgecolor="white", hatch="///")]
+        handles[0].set_label(f"error >= {thr:g} %")
+        for line in threshold_contour(x, y, err, thr):
+            xy = (line[:, 0], line[:, 1])
+            _halo_line(ax, lambda xy=xy, **kw: ax.plot(*xy, **kw), "threshold contour")
+        handles.append(_legend_line("threshold contour", f"{thr:g} % contour"))
+        _halo_line(ax, lambda **kw: ax.axhline(s["n_modes"], **kw), "chosen N")
+        handles.append(_legend_line("chosen N", f"chosen N = {s['n_modes']}"))
+        if n_suggested:
+            _halo_line(ax, lambda **kw: ax.axhline(n_suggested, **kw), "suggested N")
+            handles.append(_legend_line("suggested N", f"suggested N = {n_suggested}"))
+        if x[0] <= fmax <= x[-1]:
+            _halo_line(ax, lambda **kw: ax.axvline(fmax, **kw), "f_max")
+            handles.append(_legend_line("f_max", f"f_max = {fmax:g} Hz"))
+        if s.get("n_axis") == "log":
+            ax.set_yscale("log")
+        ax.set_xlim(x[0] - 0.5 * (x[1] - x[0]), x[-1] + 0.5 * (x[1] - x[0]))
+        _labels(ax, "Centre frequency (Hz)", "Retained modes N")
+        cb = fig.colorbar(mesh, ax=ax, pad=0.02, fraction=0.05, extend="max")
+        cb.set_label(f"Error (%), red: >= {thr:g} %", fontsize=LABEL_PT)
+        cb.set_ticks(np.linspace(0.0, thr, 5))
+        cb.ax.tick_params(labelsize=TICK_PT)
+        _legend_below(ax, handles, rect, ncol=3)
+
+    return draw
+
+
+def _legend_line(key: str, label: str) -> Line2D:
+    color, dash, width, halo = LINE_STYLES[key]
+    effects = [patheffects.Stroke(linewidth=width + 2.5, foreground=halo), patheffects.Normal()]
+    return Line2D(
+        [], [], color=color, linestyle=_DASH[dash], linewidth=width, path_effects=effects,
+        label=label,
+    )  # fmt: skip
+
+
+def draw_band(snap: Snapshot):
+    """Scatter band: min-max corridor, central percentile band, reference, one round."""
+    b, s = snap.band, snap.settings
+    dof = snap.response_dof
+    j = b.dofs.index(dof)
+    w = s["percentile"]
+    q = [float(v) for v in b.q]
+    lo, hi = (100 - w) / 2, (100 + w) / 2
+
+    def draw(fig, rect):
+        ax = _axes(fig, rect, legend_rows=2)
+        f = np.asarray(b.freq, float)
+        h = [
+            ax.fill_between(
+                f, _db(b.lower[:, j]), _db(b.upper[:, j]), color=COLORS["band"], lw=0,
+                label=f"min-max over R = {s['rounds']:,} rounds",
+            ),
+            ax.fill_between(
+                f, _db(b.percentiles[q.index(lo), :, j]), _db(b.percentiles[q.index(hi), :, j]),
+                color=COLORS["percentile"], lw=0, label=f"{w} % central band ({lo:g}-{hi:g} %)",
+            ),
+        ]  # fmt: skip
+        (r,) = ax.plot(f, _db(b.reference[:, j]), color=COLORS["reference"], lw=1.6)
+        r.set_label("unpolluted reference")
+        (one,) = ax.plot(f, _db(b.round(s["single_round"])[:, j]), color=COLORS["round"], lw=0.9)
+        one.set_label(f"round #{s['single_round']}")
+        _labels(ax, "Frequency (Hz)", f"Level at {dof} ({level_unit(dof)})")
+        _legend_below(ax, [*h, r, one], rect, ncol=2)
+
+    return draw
+
+
+def draw_eigen(snap: Snapshot):
+    """Highest retained eigenfrequency versus N at the operating speeds (fig. 5.8)."""
+    e, n = snap.eigen, snap.settings["n_modes"]
+
+    def draw(fig, rect):
+        ax = _axes(fig, rect)
+        handles = []
+        for v, row, c in zip(e.speeds, e.frequency, _SPEED_COLORS, strict=False):
+            (ln,) = ax.plot(e.n_modes, row, color=c, lw=1.6, label=f"{v:g} km/h")
+            handles.append(ln)
+        handles.append(ax.axvline(n, color=COLORS["round"], lw=1.5, label=f"chosen N = {n}"))
+        _labels(ax, "Retained modes N", "Highest retained eigenfrequency (Hz)")
+        _legend_below(ax, handles, rect, ncol=4)
+
+    return draw
+
+
+def draw_title_block(fig: Figure, tb: TitleBlock, top: float, left: float = 0.03) -> float:
+    """Write a title block from ``top`` (figure fraction) down; returns the bottom."""
+    h_in = fig.get_figheight()
+    y = top
+    for k, line in enumerate((tb.what, *tb.lines)):
+        size = 11.0 if k == 0 else 8.5
+        y -= (size * 1.45 / 72) / h_in
+        fig.text(left, y, line, fontsize=size, weight="bold" if k == 0 else "normal")
+    return y - 0.06 / h_in
+
+
+def standalone(block, width_in: float = 9.0, title: bool = True) -> Figure:
+    """One plot as its own figure, with its title block above it when ``title``."""
+    lines = 1 + len(block.title.lines) if title else 0
+    tb_in = (11.0 * 1.45 + 8.5 * 1.45 * (lines - 1)) / 72 + 0.15 if title else 0.0
+    plot_in = width_in * block.aspect
+    fig = Figure(figsize=(width_in, plot_in + tb_in))
+    bottom = plot_in / (plot_in + tb_in)
+    if title:
+        draw_title_block(fig, block.title, 1.0)
+    block.draw(fig, (0.0, 0.0, 1.0, bottom))
+    return fig
+
+
+def render(fig: Figure, fmt: str, dpi: float = 110) -> bytes:
+    """The figure as ``svg``, ``png`` or ``pdf`` bytes (glyphs as paths in SVG, fonts
+    embedded as TrueType in PDF, so text extracts and nothing is fetched)."""
+    if fmt not in ("svg", "png", "pdf"):
+        raise ValueError(f"unknown figure format {fmt!r}; allowed: svg, png, pdf")
+    buf = io.BytesIO()
+    meta = {"svg": {"Date": None}, "png": {}, "pdf": {"CreationDate": None}}[fmt]
+    with _RENDER_LOCK, matplotlib.rc_context({"svg.fonttype": "path", "pdf.fonttype": 42}):
+        fig.savefig(buf, format=fmt, dpi=dpi, metadata=meta)
+    return buf.getvalue()

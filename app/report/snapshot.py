@@ -1,0 +1,362 @@
+"""A plain snapshot of one dashboard state: what a report, a title block or a file name shows.
+
+The snapshot holds no Panel or param objects: the settings as a plain dict, where the data
+came from (the shipped reference models or uploaded files with their digests), the computed
+results as the core library's immutable objects (:class:`fbs_core.FRF`,
+:class:`fbs_core.TruncationMap`, :class:`fbs_core.SuggestedModes`,
+:class:`fbs_core.ScatterBand`, :class:`fbs_core.ModeFrequencies`), the page URL that
+reproduces the state and the time it was taken. Everything in :mod:`app.report` is a pure
+function of it.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import fbs_core
+from fbs_core.errors import FBSError
+
+__all__ = [
+    "ReportError",
+    "DataFile",
+    "Provenance",
+    "Snapshot",
+    "SETTING_KEYS",
+    "DIRECTIONS",
+    "COUPLINGS",
+    "NOISE_TARGETS",
+    "MAP_MODES",
+    "N_AXES",
+]
+
+#: Bushing DOF directions, hub couplings, noise targets, map modes and N-axis scales
+#: accepted in the settings (the dashboard's choices).
+DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+COUPLINGS = ("6dof", "5dof")
+NOISE_TARGETS = ("both", "tire", "vehicle")
+MAP_MODES = ("selected DOF", "max over 6 DOFs")
+N_AXES = ("linear", "log")
+
+#: Settings a snapshot may hold: name -> (type, meaning). The first four are required.
+SETTING_KEYS: dict[str, tuple[type, str]] = {
+    "harmonic": (int, "harmonic case 1-7"),
+    "n_modes": (int, "retained tire modes N"),
+    "dof": (str, "response DOF direction at the bushing"),
+    "coupling": (str, "hub coupling"),
+    "threshold": (float, "error threshold in %"),
+    "f_max": (float, "upper frequency of the suggested N in Hz"),
+    "map_mode": (str, "error map of the selected DOF or the maximum over 6 DOFs"),
+    "n_axis": (str, "scale of the N axis of the error map"),
+    "noise": (float, "noise level p in %"),
+    "target": (str, "subsystem(s) with noise"),
+    "frequency_dependent": (bool, "new scaling matrix at every line"),
+    "rounds": (int, "Monte-Carlo rounds R"),
+    "seed": (int, "random seed"),
+    "single_round": (int, "index of the single round drawn"),
+    "percentile": (int, "width of the central percentile band in %"),
+}
+_REQUIRED = ("harmonic", "n_modes", "dof", "coupling")
+_CHOICES = {
+    "dof": DIRECTIONS,
+    "coupling": COUPLINGS,
+    "target": NOISE_TARGETS,
+    "map_mode": MAP_MODES,
+    "n_axis": N_AXES,
+}
+#: Settings each result needs to be described.
+_NEEDS = {
+    "truncation": ("threshold", "f_max", "map_mode"),
+    "suggested": ("threshold", "f_max", "map_mode"),
+    "band": (
+        "noise",
+        "target",
+        "frequency_dependent",
+        "rounds",
+        "seed",
+        "single_round",
+        "percentile",
+    ),
+}
+
+
+class ReportError(FBSError):
+    """A snapshot that cannot be reported: missing or invalid settings, mismatched results."""
+
+
+@dataclass(frozen=True)
+class DataFile:
+    """One model of the snapshot: the shipped reference (``name=None``) or an uploaded file.
+
+    Attributes
+    ----------
+    role : {"tire", "chassis"}
+    name : str or None
+        File name as uploaded; None for the shipped reference model.
+    digest : str or None
+        Digest of the uploaded bytes and import settings (identifies the data).
+    """
+
+    role: str
+    name: str | None = None
+    digest: str | None = None
+
+    def __post_init__(self):
+        if self.role not in ("tire", "chassis"):
+            raise ReportError(f"unknown data role {self.role!r}; allowed: tire, chassis")
+        if self.name is not None and not str(self.name).strip():
+            raise ReportError(f"the uploaded {self.role} file needs a name")
+
+    @property
+    def is_reference(self) -> bool:
+        return self.name is None
+
+    def describe(self) -> str:
+        """``"reference tire (shipped model)"`` or ``"uploaded chassis 'x.uff' (digest ...)"``."""
+        if self.is_reference:
+            return f"reference {self.role} (shipped model)"
+        dig = f", digest {self.digest}" if self.digest else ""
+        return f"uploaded {self.role} '{self.name}'{dig}"
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """Where the models of a snapshot came from.
+
+    Attributes
+    ----------
+    tire, chassis : DataFile
+    notes : tuple of str
+        What the import did (unit conversions, interpolation), one note per entry.
+    """
+
+    tire: DataFile = field(default_factory=lambda: DataFile("tire"))
+    chassis: DataFile = field(default_factory=lambda: DataFile("chassis"))
+    notes: tuple[str, ...] = ()
+
+    def __post_init__(self):
+        if self.tire.role != "tire" or self.chassis.role != "chassis":
+            raise ReportError("Provenance takes DataFile('tire', ...) and DataFile('chassis', ...)")
+        object.__setattr__(self, "notes", tuple(str(n) for n in self.notes))
+
+    @property
+    def is_reference(self) -> bool:
+        """True when both models are the shipped reference."""
+        return self.tire.is_reference and self.chassis.is_reference
+
+    @property
+    def uploads(self) -> tuple[DataFile, ...]:
+        return tuple(d for d in (self.tire, self.chassis) if not d.is_reference)
+
+    def describe(self) -> str:
+        """One line naming the data in use."""
+        if self.is_reference:
+            return "reference tire and chassis (shipped models)"
+        return "; ".join(d.describe() for d in (self.tire, self.chassis))
+
+
+def _check_setting(name: str, value):
+    typ, meaning = SETTING_KEYS[name]
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise ReportError(f"setting {name!r} ({meaning}) must be True or False, got {value!r}")
+        return value
+    if typ is int:
+        if isinstance(value, bool) or not float(value).is_integer():
+            raise ReportError(f"setting {name!r} ({meaning}) must be an integer, got {value!r}")
+        value = int(value)
+    elif typ is float:
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise ReportError(
+                f"setting {name!r} ({meaning}) must be a number, got {value!r}"
+            ) from None
+    else:
+        value = str(value)
+    if name in _CHOICES and value not in _CHOICES[name]:
+        raise ReportError(
+            f"setting {name!r} ({meaning}) is {value!r}; allowed: {', '.join(_CHOICES[name])}"
+        )
+    if name == "harmonic" and not 1 <= value <= 7:
+        raise ReportError(f"setting 'harmonic' is {value}; allowed: 1, 2, 3, 4, 5, 6, 7")
+    if name in ("n_modes", "rounds", "percentile") and value < 1:
+        raise ReportError(f"setting {name!r} ({meaning}) must be >= 1, got {value}")
+    if name in ("threshold", "f_max") and not value > 0:
+        raise ReportError(f"setting {name!r} ({meaning}) must be > 0, got {value}")
+    if name in ("noise", "seed", "single_round") and not value >= 0:
+        raise ReportError(f"setting {name!r} ({meaning}) must be >= 0, got {value}")
+    return value
+
+
+def normalise_settings(settings: Mapping) -> Mapping:
+    """Checked, typed, read-only copy of ``settings`` (keys of :data:`SETTING_KEYS`).
+
+    Raises
+    ------
+    ReportError
+        For an unknown key (naming the allowed ones), a missing required key or a value
+        of the wrong type or outside its choices.
+    """
+    unknown = sorted(set(settings) - set(SETTING_KEYS))
+    if unknown:
+        raise ReportError(
+            f"unknown setting(s) {', '.join(map(repr, unknown))}; allowed: "
+            + ", ".join(SETTING_KEYS)
+        )
+    missing = [k for k in _REQUIRED if k not in settings]
+    if missing:
+        raise ReportError(f"missing setting(s): {', '.join(missing)}")
+    out = {k: _check_setting(k, settings[k]) for k in SETTING_KEYS if k in settings}
+    out.setdefault("n_axis", "linear")
+    return MappingProxyType(out)
+
+
+@dataclass(frozen=True, eq=False)
+class Snapshot:
+    """Everything one report shows, as plain data.
+
+    Attributes
+    ----------
+    settings : Mapping
+        The dashboard settings (keys of :data:`SETTING_KEYS`; harmonic, n_modes, dof and
+        coupling required; the others required by the results given).
+    provenance : Provenance
+        Reference models or uploaded files (names and digests).
+    url : str
+        The page URL that reproduces the state (``""`` if unknown).
+    created : datetime.datetime
+        When the snapshot was taken (timezone-aware; naive is taken as UTC).
+    reference, truncated : fbs_core.FRF, optional
+        Coupled bushing response (eq. 4.1) with all tire modes and with ``n_modes`` modes:
+        outputs ``bushing:x`` ... ``bushing:rz``, input ``patch``.
+    truncation : fbs_core.TruncationMap, optional
+        Error map of the harmonic (eq. 5.1).
+    suggested : fbs_core.SuggestedModes, optional
+        Suggested number of modes (thesis table 5.1).
+    band : fbs_core.ScatterBand, optional
+        Monte-Carlo scatter band (eqs. 5.2-5.4).
+    eigen : fbs_core.ModeFrequencies, optional
+        Highest retained eigenfrequency versus N (thesis fig. 5.8).
+    n_modes_total : int, optional
+        Modes of the tire (default from the truncation map).
+    """
+
+    settings: Mapping
+    provenance: Provenance = field(default_factory=Provenance)
+    url: str = ""
+    created: _dt.datetime = field(default_factory=lambda: _dt.datetime.now(_dt.UTC))
+    reference: fbs_core.FRF | None = None
+    truncated: fbs_core.FRF | None = None
+    truncation: fbs_core.TruncationMap | None = None
+    suggested: fbs_core.SuggestedModes | None = None
+    band: fbs_core.ScatterBand | None = None
+    eigen: fbs_core.ModeFrequencies | None = None
+    n_modes_total: int | None = None
+
+    def __post_init__(self):
+        s = normalise_settings(self.settings)
+        object.__setattr__(self, "settings", s)
+        if not isinstance(self.provenance, Provenance):
+            raise ReportError(f"provenance must be a Provenance, got {type(self.provenance)}")
+        if not isinstance(self.created, _dt.datetime):
+            raise ReportError(f"created must be a datetime, got {self.created!r}")
+        if self.created.tzinfo is None:
+            object.__setattr__(self, "created", self.created.replace(tzinfo=_dt.UTC))
+        url = str(self.url or "")
+        if url and not url.startswith(("http://", "https://")):
+            raise ReportError(f"url must be an http(s) address of the page, got {url!r}")
+        if any(c in url for c in "\"'<> \n"):
+            raise ReportError("url must not contain quotes, angle brackets or spaces")
+        object.__setattr__(self, "url", url)
+        for name, cls in (
+            ("reference", fbs_core.FRF),
+            ("truncated", fbs_core.FRF),
+            ("truncation", fbs_core.TruncationMap),
+            ("suggested", fbs_core.SuggestedModes),
+            ("band", fbs_core.ScatterBand),
+            ("eigen", fbs_core.ModeFrequencies),
+        ):
+            v = getattr(self, name)
+            if v is not None and not isinstance(v, cls):
+                raise ReportError(f"{name} must be a {cls.__name__}, got {type(v).__name__}")
+        for name, keys in _NEEDS.items():
+            if getattr(self, name) is not None:
+                missing = [k for k in keys if k not in s]
+                if missing:
+                    raise ReportError(
+                        f"the {name} result needs the setting(s) {', '.join(missing)}"
+                    )
+        self._check_results(s)
+        if self.n_modes_total is None and self.truncation is not None:
+            object.__setattr__(self, "n_modes_total", self.truncation.n_modes_total)
+
+    def _check_results(self, s):
+        dof = f"bushing:{s['dof']}"
+        for name in ("reference", "truncated"):
+            frf = getattr(self, name)
+            if frf is not None and dof not in frf.outputs:
+                raise ReportError(
+                    f"the {name} response has no output {dof!r}; outputs: {', '.join(frf.outputs)}"
+                )
+        k = s["harmonic"]
+        for name in ("truncation", "band"):
+            res = getattr(self, name)
+            if res is not None and res.harmonic not in (None, k):
+                raise ReportError(f"the {name} result is of harmonic {res.harmonic}, not {k}")
+            if res is not None and dof not in res.dofs:
+                raise ReportError(
+                    f"the {name} result has no response DOF {dof!r}; DOFs: {', '.join(res.dofs)}"
+                )
+        if self.band is not None:
+            w = s["percentile"]
+            q = {float(x) for x in self.band.q}
+            if (100 - w) / 2 not in q or (100 + w) / 2 not in q:
+                raise ReportError(
+                    f"the band holds the percentiles {sorted(q)}, not the "
+                    f"{(100 - w) / 2:g} and {(100 + w) / 2:g} % of a {w} % central band"
+                )
+            b = self.band
+            given = (b.noise * 100, b.target, b.frequency_dependent, b.rounds, b.seed)
+            said = (s["noise"], s["target"], s["frequency_dependent"], s["rounds"], s["seed"])
+            if not (abs(given[0] - said[0]) <= 1e-9 * max(1.0, said[0]) and given[1:] == said[1:]):
+                raise ReportError(
+                    "the band was computed with noise, target, frequency dependence, rounds, "
+                    f"seed = {given}, the settings say {said}"
+                )
+            if not 0 <= s["single_round"] < self.band.rounds:
+                raise ReportError(
+                    f"single_round {s['single_round']} is not a round of the band "
+                    f"(0..{self.band.rounds - 1})"
+                )
+
+        if self.suggested is not None:
+            sm = self.suggested
+            if not (
+                abs(sm.threshold * 100 - s["threshold"]) <= 1e-9 * s["threshold"]
+                and sm.f_max == s["f_max"]
+                and sm.dof == self.map_dof
+            ):
+                raise ReportError(
+                    f"the suggested modes were read at threshold {sm.threshold * 100:g} %, "
+                    f"f_max {sm.f_max:g} Hz, DOF {sm.dof}; the settings say "
+                    f"{s['threshold']:g} %, {s['f_max']:g} Hz, DOF {self.map_dof}"
+                )
+
+    @property
+    def harmonic(self) -> fbs_core.Harmonic:
+        return fbs_core.harmonic(self.settings["harmonic"])
+
+    @property
+    def response_dof(self) -> str:
+        """``"bushing:z"`` etc."""
+        return f"bushing:{self.settings['dof']}"
+
+    @property
+    def map_dof(self) -> str | None:
+        """DOF of the error map and the suggested modes (None: maximum over the 6 DOFs)."""
+        if self.settings.get("map_mode", MAP_MODES[0]) == MAP_MODES[0]:
+            return self.response_dof
+        return None

@@ -1,0 +1,243 @@
+"""Title blocks and file names of plots, images, CSV files and reports (pure functions).
+
+Every plot, saved image, CSV and report of a dashboard state says what it shows: the
+quantity, the harmonic with its road wavelength, speed range and frequency band, the
+response DOF, the retained modes N, the hub coupling, the noise settings where noise is
+applied, the data in use (reference models or uploaded file names), the date and the page
+URL that reproduces it. The file name says the same in short.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import fbs_core
+
+from .snapshot import ReportError, Snapshot
+
+__all__ = [
+    "VIEWS",
+    "TitleBlock",
+    "harmonic_description",
+    "coupling_description",
+    "modes_description",
+    "noise_description",
+    "title_block",
+    "file_stem",
+]
+
+#: The things that carry a title block: view key -> what it shows.
+VIEWS: dict[str, str] = {
+    "report": "tire-fbs report",
+    "coupled-response": "Coupled bushing response v_e* (eq. 4.1): all tire modes and N modes",
+    "truncation-map": "Truncation error (eq. 5.1, floating band) over centre frequency and N",
+    "suggested-modes": "Suggested number of tire modes (thesis table 5.1)",
+    "scatter-band": "Noise scatter band of v_e* (eqs. 5.2-5.4)",
+    "eigenfrequency": "Highest retained eigenfrequency vs N (thesis fig. 5.8)",
+    "uncoupled": "Uncoupled subsystems: free hub velocity Y_ja^A F_a and chassis mobility",
+}
+
+_NOISE_EQ = {"tire": "5.2", "vehicle": "5.3", "both": "5.4"}
+_NOISE_WHERE = {"tire": "the tire", "vehicle": "the vehicle", "both": "tire and vehicle"}
+
+
+@dataclass(frozen=True)
+class TitleBlock:
+    """What a plot shows, as a heading and detail lines.
+
+    Attributes
+    ----------
+    what : str
+        The heading (quantity and equation).
+    lines : tuple of str
+        Harmonic, case, noise, data, date and link lines (only those that apply).
+    """
+
+    what: str
+    lines: tuple[str, ...]
+
+    @property
+    def text(self) -> str:
+        """Heading and lines, one per line."""
+        return "\n".join((self.what, *self.lines))
+
+
+def harmonic_description(k) -> str:
+    """``"Harmonic 4: road wavelength 0.2395 m, 30-120 km/h, band 34.8-139.2 Hz"``.
+
+    From :func:`fbs_core.harmonic` (thesis fig. 4.4, table 5.1).
+
+    Raises
+    ------
+    fbs_core.harmonics.HarmonicError
+        For anything but 1..7.
+    """
+    h = fbs_core.harmonic(k)
+    lo, hi = h.freq_range
+    v0, v1 = h.speed_range
+    return (
+        f"Harmonic {h.k}: road wavelength {h.wavelength:g} m, {v0:g}-{v1:g} km/h, "
+        f"band {lo:.1f}-{hi:.1f} Hz"
+    )
+
+
+def coupling_description(coupling: str) -> str:
+    """Plain words for the hub coupling option."""
+    if coupling == "6dof":
+        return "6-DOF hub coupling (braked wheel)"
+    if coupling == "5dof":
+        return "5-DOF hub coupling (wheel spin ry released)"
+    raise ReportError(f"unknown coupling {coupling!r}; allowed: 6dof, 5dof")
+
+
+def modes_description(n_modes: int, n_total: int | None = None) -> str:
+    """``"N = 60 of 400 tire modes"``; ``"all 400 tire modes"`` when N reaches the total."""
+    n = int(n_modes)
+    if n_total is not None and n >= n_total:
+        return f"N = all {int(n_total)} tire modes"
+    of = f" of {int(n_total)}" if n_total is not None else ""
+    return f"N = {n}{of} tire modes"
+
+
+def noise_description(settings) -> str:
+    """The noise settings in one line (thesis eqs. 5.2-5.4)."""
+    s = settings
+    target = s["target"]
+    how = "new scaling matrix at every line" if s["frequency_dependent"] else "one per round"
+    return (
+        f"Noise p = {s['noise']:g} % in {_NOISE_WHERE[target]} (eq. {_NOISE_EQ[target]}), "
+        f"{how}, R = {s['rounds']:,} rounds, seed {s['seed']}, "
+        f"{s['percentile']} % central band, round #{s['single_round']}"
+    )
+
+
+def _dof_text(snap: Snapshot, view: str) -> str:
+    if view in ("truncation-map", "suggested-modes"):
+        d = snap.map_dof
+        return f"DOF {d}" if d is not None else "DOF: maximum over the 6 bushing DOFs"
+    if view == "uncoupled":
+        return f"DOF hub:{snap.settings['dof']} (tire) and {snap.response_dof} (chassis)"
+    return f"DOF {snap.response_dof}"
+
+
+def _date_text(snap: Snapshot) -> str:
+    t = snap.created.astimezone(snap.created.tzinfo)
+    return f"{t:%Y-%m-%d %H:%M} {t.tzname() or 'UTC'}"
+
+
+#: The parts of each view's title block, in order (those of the report are optional).
+_PARTS: dict[str, tuple[str, ...]] = {
+    "report": ("harmonic", "dof", "modes", "threshold", "coupling", "noise"),
+    "coupled-response": ("harmonic", "dof", "modes", "coupling"),
+    "truncation-map": ("harmonic", "dof", "chosen", "threshold", "coupling"),
+    "suggested-modes": ("all-harmonics", "dof", "threshold", "coupling"),
+    "scatter-band": ("harmonic", "dof", "modes", "coupling", "noise"),
+    "eigenfrequency": ("chosen",),
+    "uncoupled": ("harmonic", "dof", "modes"),
+}
+
+
+def _part(snap: Snapshot, view: str, part: str) -> str | None:
+    s = snap.settings
+    if part == "harmonic":
+        return harmonic_description(s["harmonic"])
+    if part == "all-harmonics":
+        return "All seven harmonics, 30-120 km/h"
+    if part == "dof":
+        return _dof_text(snap, view)
+    if part in ("modes", "chosen"):
+        text = modes_description(s["n_modes"], snap.n_modes_total)
+        return "chosen " + text if part == "chosen" else text
+    if part == "coupling":
+        return coupling_description(s["coupling"])
+    need = ("threshold", "f_max") if part == "threshold" else ("noise", "target", "rounds")
+    missing = [k for k in need if k not in s]
+    if missing:
+        if view == "report":
+            return None
+        raise ReportError(f"the {view} title needs the setting(s) {', '.join(missing)}")
+    if part == "threshold":
+        return f"threshold {s['threshold']:g} % up to f_max {s['f_max']:g} Hz"
+    return noise_description(s)
+
+
+def title_block(snap: Snapshot, view: str) -> TitleBlock:
+    """The title block of a view (key of :data:`VIEWS`) for a snapshot.
+
+    Lines: the harmonic (wavelength, speeds, band); DOF, N, threshold and coupling in one
+    line; the noise settings (scatter band and report); the data in use; date and version;
+    the reproducing link.
+
+    Raises
+    ------
+    ReportError
+        For an unknown view, naming the allowed ones; for a view whose settings the
+        snapshot lacks (e.g. the scatter band without noise settings).
+    """
+    if view not in VIEWS:
+        raise ReportError(f"unknown view {view!r}; allowed: {', '.join(VIEWS)}")
+    parts = {p: _part(snap, view, p) for p in _PARTS[view]}
+    lines = [parts.pop(p) for p in ("harmonic", "all-harmonics") if p in parts]
+    noise = parts.pop("noise", None)
+    case = [v for v in parts.values() if v]
+    if case:
+        lines.append(" | ".join(case))
+    if noise:
+        lines.append(noise)
+    lines.append("Data: " + snap.provenance.describe())
+    lines.append(f"{_date_text(snap)} | tire-fbs {fbs_core.__version__}")
+    if snap.url:
+        lines.append(snap.url)
+    what = VIEWS[view]
+    if view == "truncation-map" and snap.map_dof is None:
+        what = "Truncation error (eq. 5.1), maximum over the 6 bushing DOFs (thesis fig. 5.6)"
+    return TitleBlock(what, tuple(lines))
+
+
+def _num(x: float) -> str:
+    return f"{x:g}".replace("+", "")
+
+
+def _safe(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9.-]+", "-", text).strip("-.")
+
+
+def file_stem(snap: Snapshot, view: str = "report") -> str:
+    """File name without extension that says what a view shows.
+
+    ``tire-fbs_h4_bushing-z_N60_6dof_2026-12-01`` for the report,
+    ``tire-fbs_scatter-band_h4_bushing-z_N60_6dof_p10-both_R10000_2026-12-01`` for the band;
+    ``_upload`` before the date when uploaded data are in use. Only ``[A-Za-z0-9._-]``.
+
+    Raises
+    ------
+    ReportError
+        For an unknown view.
+    """
+    if view not in VIEWS:
+        raise ReportError(f"unknown view {view!r}; allowed: {', '.join(VIEWS)}")
+    s = snap.settings
+    dof = snap.map_dof if view in ("truncation-map", "suggested-modes") else snap.response_dof
+    dof_part = dof.replace(":", "-") if dof else "bushing-max6"
+    parts = ["tire-fbs"] if view == "report" else ["tire-fbs", view]
+    if view == "suggested-modes":
+        parts += [f"thr{_num(s['threshold'])}", f"fmax{_num(s['f_max'])}", dof_part]
+    elif view == "eigenfrequency":
+        parts += [f"N{s['n_modes']}"]
+    elif view == "truncation-map":
+        parts += [f"h{s['harmonic']}", dof_part, f"thr{_num(s['threshold'])}"]
+    elif view == "uncoupled":
+        parts += [f"h{s['harmonic']}", f"hub-{s['dof']}", f"N{s['n_modes']}"]
+    else:
+        parts += [f"h{s['harmonic']}", dof_part, f"N{s['n_modes']}"]
+    if view not in ("eigenfrequency", "uncoupled"):
+        parts.append(s["coupling"])
+    if view == "scatter-band":
+        parts += [f"p{_num(s['noise'])}-{s['target']}", f"R{s['rounds']}"]
+        if s["frequency_dependent"]:
+            parts.append("fdep")
+    if not snap.provenance.is_reference:
+        parts.append("upload")
+    parts.append(f"{snap.created:%Y-%m-%d}")
+    return "_".join(_safe(p) for p in parts)
