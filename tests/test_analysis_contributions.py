@@ -16,7 +16,7 @@ from fbs_core import FRF, assemble, bushing_response, harmonic, reference_chassi
 from fbs_core.analysis import bushing_contributions, interface_contributions
 from fbs_core.chassis import BUSHING, SPINDLE
 from fbs_core.errors import DOFError, FrequencyGridError
-from fbs_core.prediction import COUPLINGS
+from fbs_core.prediction import coupled_dofs
 
 
 def test_chain_interface_force_is_the_spring_force():
@@ -98,7 +98,7 @@ SPEED = 60.0
 def _assembled(k: int, coupling: str, freq_key: tuple):
     tire, ch = reference_tire(), reference_chassis()
     ts, cs = tire.system(SPEED), ch.system()
-    joined = [(f"tire/{d}", f"chassis/spindle:{d.split(':')[1]}") for d in COUPLINGS[coupling]]
+    joined = [(f"tire/{d}", f"chassis/spindle:{d.split(':')[1]}") for d in coupled_dofs(coupling)]
     S = assemble({"tire": ts, "chassis": cs}, joined)
     pos = {d: i for i, d in enumerate(S.dofs)}
     load = np.zeros(S.n, complex)
@@ -107,7 +107,7 @@ def _assembled(k: int, coupling: str, freq_key: tuple):
     # the chassis' displacements, its spindle DOFs merged into the hub where coupled
     cpos = []
     for d in cs.dofs:
-        merged = d.startswith("spindle:") and f"hub:{d.split(':')[1]}" in COUPLINGS[coupling]
+        merged = d.startswith("spindle:") and f"hub:{d.split(':')[1]}" in coupled_dofs(coupling)
         cpos.append(pos[f"tire/hub:{d.split(':')[1]}"] if merged else pos[f"chassis/{d}"])
     xE = X.data[:, cpos, 0]
     g = np.stack(
@@ -122,7 +122,7 @@ def _assembled(k: int, coupling: str, freq_key: tuple):
 def test_tire_chassis_contributions_match_assembled_system(coupling):
     f = np.linspace(8.0, 300.0, 12)
     c = bushing_contributions(2, None, f, coupling, speed_kmh=SPEED)
-    assert c.outputs == BUSHING and c.interface == COUPLINGS[coupling]
+    assert c.outputs == BUSHING and c.interface == coupled_dofs(coupling)
     vb, g = _assembled(2, coupling, tuple(f))
     scale = np.linalg.norm(vb, axis=1)[:, None]
     assert np.max(np.abs(c.terms.sum(-1) - vb) / scale) < 1e-6

@@ -14,7 +14,7 @@ from fbs_core import assemble, bushing_response, harmonic, reference_chassis, re
 from fbs_core.analysis import speed_map
 from fbs_core.chassis import BUSHING
 from fbs_core.errors import DOFError, FBSError
-from fbs_core.prediction import COUPLINGS
+from fbs_core.prediction import coupled_dofs
 from fbs_core.tire import ModeCountError, OperatingPointError
 
 
@@ -52,7 +52,7 @@ def test_row_at_an_operating_point_equals_the_assembled_system():
     f = np.array([12.0, 55.0, 140.0, 333.0])
     m = speed_map(5, speeds=[60.0, v], freq=f)
     ts, cs = tire.system(v), ch.system()
-    joined = [(f"tire/{d}", f"chassis/spindle:{d.split(':')[1]}") for d in COUPLINGS["6dof"]]
+    joined = [(f"tire/{d}", f"chassis/spindle:{d.split(':')[1]}") for d in coupled_dofs("6dof")]
     S = assemble({"tire": ts, "chassis": cs}, joined)
     pos = {d: i for i, d in enumerate(S.dofs)}
     load = np.zeros(S.n, complex)

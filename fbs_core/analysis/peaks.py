@@ -265,7 +265,9 @@ def system_modes_near(system: SecondOrderSystem, freq_hz: float, n: int = 4) -> 
         lu = spla.splu((A - sigma * B).tocsc())
         op = spla.LinearOperator((N, N), matvec=lambda z: lu.solve(B @ z), dtype=complex)
         k = min(max(3 * n, 8), N - 2)
-        mu = spla.eigs(op, k=k, which="LM", v0=np.ones(N, complex), return_eigenvectors=False)
+        mu = spla.eigs(
+            op, k=k, which="LM", v0=np.ones(N, complex), tol=1e-10, return_eigenvectors=False
+        )
         lam = sigma + 1.0 / mu
     lam = lam[lam.imag > 0]
     order = np.argsort(np.abs(lam.imag / (2 * np.pi) - freq_hz), kind="stable")
@@ -349,9 +351,18 @@ def coupled_modes_near(
     Returns
     -------
     tuple of Mode
+        Cached for the reference models (the same peak asked again costs nothing).
     """
+    if tire is None and chassis is None:
+        coupled_dofs(coupling)
+        return _reference_modes(float(freq_hz), float(speed_kmh), coupling, int(n))
     s = coupled_system(speed_kmh, coupling, tire=tire, chassis=chassis)
     return system_modes_near(s, freq_hz, n)
+
+
+@functools.lru_cache(maxsize=256)
+def _reference_modes(freq_hz: float, speed_kmh: float, coupling: str, n: int):
+    return system_modes_near(_reference_system(speed_kmh, coupling), freq_hz, n)
 
 
 def peak_labels(
