@@ -1,11 +1,17 @@
 """Container entrypoint: deployment settings from environment variables -> ``panel serve``.
 
-The image's exec-form ENTRYPOINT runs this script, which validates the ``FBS_*`` variables,
-builds the ``panel serve`` command line and replaces itself with it (``os.execv``), so the
-server is PID 1 and receives ``docker stop``'s SIGTERM. Arguments given after the image name
-in ``docker run`` are appended to the ``panel serve`` command line. ``--healthcheck`` instead
-probes the server's ``/liveness`` endpoint (the image's HEALTHCHECK); ``--print-command``
-prints the command line without running it (secrets masked).
+The image's exec-form ENTRYPOINT runs this script, which validates the ``FBS_*`` variables
+and builds the arguments of ``panel serve``. It then replaces itself (``os.execve``, same
+PID: the server is PID 1 and receives ``docker stop``'s SIGTERM) with a Python that runs
+``panel serve`` in-process through ``docker/fbs_server.py`` (cheap ``/liveness``, throttled
+logins, prompt shutdown). Secrets (the cookie secret, the basic-auth users) are handed over
+in an unlinked temporary file whose descriptor the new process reads and closes; they are
+removed from the new process's environment and are never on its command line, so ``ps``,
+``docker top`` and ``/proc/<pid>/environ`` do not show them, and child processes do not
+inherit them. Arguments given after the image name in ``docker run`` are appended to the
+``panel serve`` arguments. ``--healthcheck`` instead probes the server's ``/liveness``
+endpoint (the image's HEALTHCHECK); ``--print-command`` prints the arguments without
+running the server.
 
 Variables (all optional; the table with examples is in docs/deployment.md):
 
@@ -17,14 +23,18 @@ Variables (all optional; the table with examples is in docs/deployment.md):
     Worker threads for session callbacks (``--num-threads``), integer >= 1, default 4.
 ``FBS_BASIC_AUTH``
     Turns on Panel's basic authentication (login form): ``user:password`` entries separated
-    by commas or newlines. The passwords are written to a private file, never onto the
-    command line.
+    by commas or newlines. The users stay in the server's memory: never on a command line,
+    in a file or in the server's environment.
 ``FBS_BASIC_AUTH_FILE``
     Same, from a mounted JSON file ``{"user": "password", ...}`` (e.g. a Docker secret).
-``FBS_COOKIE_SECRET``
-    Secret (>= 32 characters) that signs the login cookies (``--cookie-secret``). With
-    authentication on and no secret, a random one is made at start: logins then end when the
-    container restarts. ``PANEL_COOKIE_SECRET`` is accepted as well.
+``FBS_LOGIN_MAX_FAILURES``
+    Failed logins of one client within 5 minutes after which it is refused (HTTP 429) until
+    they age out, default 10; from the 4th failure on each answer is delayed.
+``FBS_COOKIE_SECRET``, ``FBS_COOKIE_SECRET_FILE``
+    Secret (>= 32 characters) that signs the login cookies, or the path of a file holding
+    it (e.g. a Docker secret). With authentication on and no secret, a random one is made at
+    start: logins then end when the container restarts. ``PANEL_COOKIE_SECRET`` is accepted
+    as well.
 ``PANEL_OAUTH_PROVIDER``, ``PANEL_OAUTH_KEY``, ``PANEL_OAUTH_SECRET``, ...
     Read by Panel itself: OAuth login instead of basic authentication.
 ``FBS_PREFIX``
@@ -51,6 +61,7 @@ import secrets
 import sys
 import tempfile
 import urllib.request
+from dataclasses import dataclass, field
 from pathlib import Path
 
 DEFAULT_PORT = 5006
@@ -58,10 +69,31 @@ LOG_LEVELS = ("debug", "info", "warning", "error", "critical")
 TRUE = ("1", "true", "yes", "on")
 FALSE = ("", "0", "false", "no", "off")
 MIN_SECRET_LEN = 32
+#: Variables holding secrets: read here, handed to the server privately, removed from the
+#: server's environment.
+SECRET_VARS = (
+    "FBS_BASIC_AUTH",
+    "FBS_COOKIE_SECRET",
+    "PANEL_COOKIE_SECRET",
+    "BOKEH_COOKIE_SECRET",
+)
+#: Internal option: the server stage, reading its private settings from a descriptor.
+SERVE_FD = "--serve-fd"
+HERE = Path(__file__).resolve().parent
 
 
 class SettingError(ValueError):
     """A deployment environment variable has a value that cannot be used."""
+
+
+@dataclass
+class Launch:
+    """What the server process gets: public arguments and private settings."""
+
+    args: list[str]  # arguments of ``panel serve`` (no secrets)
+    private: dict = field(default_factory=dict)  # cookie_secret, basic_auth
+    options: dict = field(default_factory=dict)  # fbs_server.serve options
+    warnings: list[str] = field(default_factory=list)
 
 
 def _flag(env: dict[str, str], name: str) -> bool:
@@ -73,7 +105,7 @@ def _flag(env: dict[str, str], name: str) -> bool:
     raise SettingError(f"{name}={env[name]!r}: allowed values are {', '.join(TRUE + FALSE[1:])}")
 
 
-#: Default largest websocket message in MB (see build_command).
+#: Default largest websocket message in MB (see build_launch).
 WEBSOCKET_MAX_MESSAGE_MB = 200
 
 
@@ -135,13 +167,21 @@ def _check_users_file(path: str) -> None:
         )
 
 
-def _write_users(users: dict[str, str]) -> str:
-    folder = tempfile.mkdtemp(prefix="fbs-auth-")  # mode 0700
-    path = os.path.join(folder, "users.json")
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-    with os.fdopen(fd, "w", encoding="utf-8") as f:
-        json.dump(users, f)
-    return path
+def _cookie_secret(env: dict[str, str]) -> str:
+    """The cookie secret from FBS_COOKIE_SECRET(_FILE) or PANEL_COOKIE_SECRET, or ""."""
+    given = [n for n in ("FBS_COOKIE_SECRET", "FBS_COOKIE_SECRET_FILE", "PANEL_COOKIE_SECRET")]
+    given = [n for n in given if env.get(n)]
+    if len(given) > 1:
+        raise SettingError(f"set one of {', '.join(given)}, not several")
+    if env.get("FBS_COOKIE_SECRET_FILE"):
+        path = env["FBS_COOKIE_SECRET_FILE"]
+        try:
+            with open(path, encoding="utf-8") as f:
+                secret = f.read().strip()
+        except OSError as exc:
+            raise SettingError(f"FBS_COOKIE_SECRET_FILE={path!r} cannot be read: {exc}") from exc
+        return secret
+    return env.get("FBS_COOKIE_SECRET") or env.get("PANEL_COOKIE_SECRET") or ""
 
 
 def default_app() -> str:
@@ -152,8 +192,8 @@ def default_app() -> str:
     return str(Path(next(iter(spec.submodule_search_locations))) / "main.py")
 
 
-def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], list[str]]:
-    """Command line of ``panel serve`` and the warnings to print, from the environment.
+def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
+    """Arguments of ``panel serve``, private settings and warnings, from the environment.
 
     Raises
     ------
@@ -166,21 +206,12 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
         raise SettingError(f"FBS_APP: the Panel script {app!r} does not exist")
     port = _positive_int(env, "FBS_PORT", DEFAULT_PORT)
     address = env.get("FBS_ADDRESS", "0.0.0.0").strip() or "0.0.0.0"
-    cmd = [
-        str(Path(sys.executable).with_name("panel")),
-        "serve",
-        app,
-        "--address",
-        address,
-        "--port",
-        str(port),
-        "--liveness",
-    ]
+    args = [app, "--address", address, "--port", str(port)]
     threads = _positive_int(env, "FBS_NUM_THREADS", 4)
     if env.get("PANEL_NUM_THREADS"):
         warnings.append("PANEL_NUM_THREADS is set and wins over FBS_NUM_THREADS")
     else:
-        cmd += ["--num-threads", str(threads)]
+        args += ["--num-threads", str(threads)]
 
     if "PANEL_BASIC_AUTH" in env:
         raise SettingError(
@@ -189,59 +220,57 @@ def build_command(env: dict[str, str], extra: list[str]) -> tuple[list[str], lis
         )
     if env.get("FBS_BASIC_AUTH") and env.get("FBS_BASIC_AUTH_FILE"):
         raise SettingError("set FBS_BASIC_AUTH or FBS_BASIC_AUTH_FILE, not both")
-    users_file = None
+    private: dict = {}
     if env.get("FBS_BASIC_AUTH_FILE"):
-        users_file = env["FBS_BASIC_AUTH_FILE"]
-        _check_users_file(users_file)
+        _check_users_file(env["FBS_BASIC_AUTH_FILE"])
+        private["basic_auth"] = env["FBS_BASIC_AUTH_FILE"]
     elif env.get("FBS_BASIC_AUTH"):
-        users_file = _write_users(parse_users(env["FBS_BASIC_AUTH"]))
+        private["basic_auth"] = parse_users(env["FBS_BASIC_AUTH"])
     oauth = bool(env.get("PANEL_OAUTH_PROVIDER"))
-    if users_file and oauth:
+    if private and oauth:
         raise SettingError(
             "basic authentication (FBS_BASIC_AUTH*) and PANEL_OAUTH_PROVIDER "
             "exclude each other: choose one"
         )
-    if users_file:
-        cmd += [f"--basic-auth={users_file}"]
+    options = {
+        "login_max_failures": _positive_int(env, "FBS_LOGIN_MAX_FAILURES", 10),
+    }
 
-    secret = env.get("FBS_COOKIE_SECRET", "")
-    if secret and env.get("PANEL_COOKIE_SECRET"):
-        raise SettingError("set FBS_COOKIE_SECRET or PANEL_COOKIE_SECRET, not both")
-    secret = secret or env.get("PANEL_COOKIE_SECRET", "")
+    secret = _cookie_secret(env)
     if secret and len(secret) < MIN_SECRET_LEN:
         raise SettingError(
             f"the cookie secret must have at least {MIN_SECRET_LEN} characters "
             f"(has {len(secret)}); make one with "
             "python3 -c 'import secrets; print(secrets.token_urlsafe(32))'"
         )
-    if not secret and (users_file or oauth):
+    if not secret and (private or oauth):
         secret = secrets.token_urlsafe(32)
         warnings.append("no FBS_COOKIE_SECRET: made a random one, logins end at restart")
-    if secret and not env.get("PANEL_COOKIE_SECRET"):
-        # one argument "--opt=value": a value beginning with "-" (token_urlsafe makes one in
-        # 64) would otherwise be taken by panel serve's parser for an option
-        cmd += [f"--cookie-secret={secret}"]
+    if secret:
+        private["cookie_secret"] = secret
 
     prefix = env.get("FBS_PREFIX", "").strip("/")
     if prefix:
-        cmd += [f"--prefix={prefix}"]
+        args += [f"--prefix={prefix}"]
     if _flag(env, "FBS_USE_XHEADERS"):
-        cmd += ["--use-xheaders"]
+        args += ["--use-xheaders"]
     # an uploaded file travels base64-encoded in one message: 200 MB carries files up to
     # 150 MB, so a file above fbs_core's 100 MiB limit gets its clear refusal instead of a
     # closed websocket (Bokeh's default of 20 MB would cut files above 15 MB)
     size = _positive_int(env, "FBS_WEBSOCKET_MAX_MESSAGE_MB", WEBSOCKET_MAX_MESSAGE_MB)
-    cmd += ["--websocket-max-message-size", str(size * 1024 * 1024)]
+    args += ["--websocket-max-message-size", str(size * 1024 * 1024)]
     level = env.get("FBS_LOG_LEVEL", "info").strip().lower()
     if level not in LOG_LEVELS:
         raise SettingError(f"FBS_LOG_LEVEL={level!r}: allowed values are {', '.join(LOG_LEVELS)}")
-    cmd += ["--log-level", level]
-    return cmd + list(extra), warnings
-
-
-def masked(cmd: list[str]) -> list[str]:
-    """The command line with the value of ``--cookie-secret`` hidden."""
-    return ["--cookie-secret=***" if arg.startswith("--cookie-secret=") else arg for arg in cmd]
+    args += ["--log-level", level]
+    for arg in extra:
+        if arg.split("=", 1)[0] in ("--cookie-secret", "--basic-auth", "--oauth-secret"):
+            raise SettingError(
+                f"{arg.split('=', 1)[0]} on the command line is visible to every user of the "
+                "host (ps, docker top): use FBS_COOKIE_SECRET(_FILE), FBS_BASIC_AUTH(_FILE) "
+                "or PANEL_OAUTH_SECRET"
+            )
+    return Launch(args + list(extra), private, options, warnings)
 
 
 def healthcheck(env: dict[str, str]) -> int:
@@ -258,22 +287,54 @@ def healthcheck(env: dict[str, str]) -> int:
     return 0 if ok else 1
 
 
+def exec_server(launch: Launch, env: dict[str, str]) -> None:
+    """Replace this process by the server stage; secrets travel in an unlinked file."""
+    blob = json.dumps({"private": launch.private, "options": launch.options}).encode()
+    with tempfile.TemporaryFile() as f:  # no name on disk; closed by the server once read
+        f.write(blob)
+        f.flush()
+        fd = os.dup(f.fileno())
+    os.lseek(fd, 0, os.SEEK_SET)
+    os.set_inheritable(fd, True)
+    clean = {k: v for k, v in env.items() if k not in SECRET_VARS}
+    argv = [sys.executable, str(Path(__file__).resolve()), SERVE_FD, str(fd), "--", *launch.args]
+    os.execve(sys.executable, argv, clean)
+
+
+def run_server(argv: list[str]) -> int:
+    """The server stage: ``--serve-fd FD -- ARGS`` (started by :func:`exec_server`)."""
+    fd = int(argv[1])
+    with os.fdopen(fd, "rb") as f:
+        settings = json.loads(f.read() or b"{}")
+    sys.path.insert(0, str(HERE))
+    import fbs_server
+
+    return fbs_server.serve(argv[3:], settings.get("private", {}), settings.get("options", {}))
+
+
 def main(argv: list[str]) -> int:
     env = dict(os.environ)
     if argv[:1] == ["--healthcheck"]:
         return healthcheck(env)
+    if argv[:1] == [SERVE_FD] and argv[2:3] == ["--"]:
+        return run_server(argv)
     dry = argv[:1] == ["--print-command"]
     try:
-        cmd, warnings = build_command(env, argv[1:] if dry else argv)
+        launch = build_launch(env, argv[1:] if dry else argv)
     except SettingError as exc:
         print(f"tire-fbs: configuration error: {exc}", file=sys.stderr)
         return 2
-    for w in warnings:
+    for w in launch.warnings:
         print(f"tire-fbs: warning: {w}", file=sys.stderr)
-    print("tire-fbs: " + " ".join(masked(cmd)), file=sys.stderr, flush=True)
+    private = ", ".join(sorted(launch.private)) or "none"
+    print(
+        "tire-fbs: panel serve " + " ".join(launch.args) + f"  (private settings: {private})",
+        file=sys.stderr,
+        flush=True,
+    )
     if dry:
         return 0
-    os.execv(cmd[0], cmd)
+    exec_server(launch, env)
     return 0  # not reached
 
 

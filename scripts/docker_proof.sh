@@ -13,7 +13,9 @@
 #     that the app document can be created (/liveness?endpoint=/main) and runs the browser
 #     smoke test (docker/smoke_test.py: page renders, a slider change updates a plot);
 #  6. runs a second container with basic authentication on (FBS_BASIC_AUTH): without
-#     credentials only the login form, after logging in the same smoke test passes;
+#     credentials only the login form, after logging in the same smoke test passes; the
+#     cookie secret and the password appear neither in `docker top` nor in the environment
+#     of the server process, and `docker stop` ends the container within its grace period;
 #  7. stops everything it started, by container ID and PID (dockerd only if it started it),
 #     also on failure or interruption, and prints the timings.
 #
@@ -189,23 +191,46 @@ proof_open() {
     timed "start -> healthy (no auth)" wait_healthy "$cid"
     timed "app document (/liveness?endpoint=/main)" check_app_document "$port"
     timed "browser smoke test (no auth)" "$PY" docker/smoke_test.py "http://127.0.0.1:$port/"
-    docker stop -t 20 "$cid" >/dev/null
-    log "stopped container ${cid:0:12}"
+    timed "docker stop after use (no auth)" stop_promptly "$cid"
+}
+
+check_no_secrets() {  # check_no_secrets CID SECRET...: not in docker top, not in PID 1's env
+    local cid=$1 s
+    shift
+    local top env
+    top=$(docker top "$cid" -eo pid,args)
+    env=$(docker exec "$cid" cat /proc/1/environ | tr '\0' '\n')
+    for s in "$@"; do
+        if grep -qF -- "$s" <<<"$top"; then fail "a secret is visible in docker top"; fi
+        if grep -qF -- "$s" <<<"$env"; then fail "a secret is in the server's environment"; fi
+    done
+    log "no secret in docker top or /proc/1/environ:"
+    sed 's/^/    /' <<<"$top"
+}
+
+stop_promptly() {  # stop_promptly CID: docker stop must not need its kill after 10 s
+    local cid=$1 t0=$SECONDS
+    docker stop -t 10 "$cid" >/dev/null
+    local took=$((SECONDS - t0)) code
+    code=$(docker inspect -f '{{.State.ExitCode}}' "$cid")
+    log "stopped container ${cid:0:12} in ${took} s (exit code $code)"
+    if ((took >= 10)) || [[ "$code" == 137 ]]; then fail "the server did not end on SIGTERM"; fi
 }
 
 proof_auth() {
-    local port cid password
+    local port cid password secret
     port=$(free_port)
     password=$("$PY" -c 'import secrets; print(secrets.token_urlsafe(12))')
+    secret=$("$PY" -c 'import secrets; print(secrets.token_urlsafe(32))')
     cid=$(run_container "$port" -e "FBS_BASIC_AUTH=reviewer:$password" \
-        -e "FBS_COOKIE_SECRET=$("$PY" -c 'import secrets; print(secrets.token_urlsafe(32))')")
+        -e "FBS_COOKIE_SECRET=$secret")
     containers+=("$cid")
     log "container ${cid:0:12} with basic auth on 127.0.0.1:$port"
     timed "start -> healthy (basic auth)" wait_healthy "$cid"
     timed "browser smoke test (login first)" "$PY" docker/smoke_test.py \
         "http://127.0.0.1:$port/" --expect-login --user reviewer "--password=$password"
-    docker stop -t 20 "$cid" >/dev/null
-    log "stopped container ${cid:0:12}"
+    check_no_secrets "$cid" "$password" "$secret"
+    timed "docker stop after use (basic auth)" stop_promptly "$cid"
 }
 
 timed "install tools (apt-get when missing)" install_tools

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Start the dashboard on the shipped reference data (the README's "start the dashboard on a
 # fresh machine" command). Creates .venv if missing, installs the project if fbs_core is not
-# importable, then runs `panel serve app/main.py` and prints the URL.
+# importable, then runs `panel serve app/main.py` through the container's entrypoint
+# (docker/entrypoint.py: cheap /liveness, throttled logins, prompt exit on Ctrl-C) and prints
+# the URL. The FBS_* variables of docs/deployment.md apply (e.g. FBS_BASIC_AUTH for a login).
 #
 # Environment: PORT (5006), ADDRESS (localhost; 0.0.0.0 to listen on all interfaces),
 # NUM_THREADS (4: one session's long computation does not block the others),
@@ -43,6 +45,6 @@ echo "== warming up (reference models, truncation maps, default scatter band) ..
 # 150 MB, so a file above fbs_core's 100 MiB limit is refused with a message (Bokeh's
 # default of 20 MB would close the connection on files above 15 MB)
 WS_MAX_MB=${WS_MAX_MB:-200}
-exec .venv/bin/panel serve app/main.py --port "$PORT" --address "$ADDRESS" \
-  --num-threads "$NUM_THREADS" --websocket-max-message-size $((WS_MAX_MB * 1024 * 1024)) \
-  --warm "${SHOW_ARG[@]}" "$@"
+FBS_APP=app/main.py FBS_PORT=$PORT FBS_ADDRESS=$ADDRESS FBS_NUM_THREADS=$NUM_THREADS \
+  FBS_WEBSOCKET_MAX_MESSAGE_MB=$WS_MAX_MB \
+  exec .venv/bin/python docker/entrypoint.py --warm "${SHOW_ARG[@]}" "$@"

@@ -1,0 +1,186 @@
+"""Start the deployment's server (``docker/entrypoint.py``) on a free port and talk to it.
+
+Shared by ``tests/test_auth.py`` and ``tests/test_server_*.py``: the server runs as a
+subprocess exactly as in the container (the entrypoint with ``FBS_*`` variables), serving a
+small Panel script, and is checked from outside like a browser or an attacker would.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import json
+import os
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+ENTRYPOINT = ROOT / "docker" / "entrypoint.py"
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(condition, timeout_s: float, interval_s: float = 0.05, what: str = "condition"):
+    """Poll ``condition()`` until it returns a true value (returned) or the time is up."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"{what} not reached within {timeout_s:.0f} s")
+        time.sleep(interval_s)
+
+
+class Server:
+    """The entrypoint serving ``app_text`` as ``/<name>`` on 127.0.0.1, log in ``folder``."""
+
+    def __init__(self, folder: Path, app_text: str, env: dict[str, str], name: str = "fbsapp"):
+        self.folder = Path(folder)
+        self.app = self.folder / f"{name}.py"
+        self.app.write_text(app_text)
+        self.name = name
+        self.port = free_port()
+        self.base = f"http://127.0.0.1:{self.port}"
+        full_env = {
+            **os.environ,
+            "FBS_APP": str(self.app),
+            "FBS_PORT": str(self.port),
+            "FBS_ADDRESS": "127.0.0.1",
+            "FBS_NUM_THREADS": "2",
+            "BOKEH_ALLOW_WS_ORIGIN": f"127.0.0.1:{self.port}",
+            **env,
+        }
+        self.log_path = self.folder / f"server-{self.port}.log"
+        self._log = open(self.log_path, "w")  # noqa: SIM115 (closed in stop)
+        self.proc = subprocess.Popen(
+            [sys.executable, str(ENTRYPOINT)],
+            env=full_env,
+            stdout=self._log,
+            stderr=subprocess.STDOUT,
+        )
+
+    def log(self) -> str:
+        return self.log_path.read_text()
+
+    def started(self, timeout_s: float = 60) -> Server:
+        """Wait until ``/liveness`` answers; raises with the log if the server ends first."""
+
+        def up():
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"the server exited ({self.proc.returncode}):\n{self.log()}")
+            try:
+                with urllib.request.urlopen(self.base + "/liveness", timeout=2) as r:
+                    return r.status == 200
+            except OSError:
+                return False
+
+        wait_for(up, timeout_s, 0.1, "server start")
+        return self
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(15)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self._log.close()
+
+
+class NoRedirect(urllib.request.HTTPRedirectHandler):
+    def redirect_request(self, *args, **kwargs):
+        return None
+
+
+def get(opener, url, data=None, headers=None):
+    """(status, headers, body) of a request, without following redirects by default."""
+    req = urllib.request.Request(url, data=data, headers=headers or {})
+    try:
+        with opener.open(req, timeout=60) as r:
+            return r.status, r.headers, r.read().decode()
+    except urllib.error.HTTPError as e:
+        return e.code, e.headers, e.read().decode()
+
+
+def run_async(coro):
+    """Run ``coro`` to completion on a fresh event loop in its own thread.
+
+    ``asyncio.run`` refuses to start inside a running loop, and pytest-playwright's sync API
+    leaves one running in a worker that has already run browser tests.
+    """
+    with concurrent.futures.ThreadPoolExecutor(max_workers=1) as pool:
+        return pool.submit(asyncio.run, coro).result()
+
+
+async def websocket_session(
+    port: int,
+    app: str,
+    cookie: str | None,
+    token: str | None = None,
+    origin: str | None = None,
+) -> tuple[str, str]:
+    """Open the app's Bokeh websocket as bokehjs does, then pull the document.
+
+    Returns the type of the server's first message and the pulled document's content.
+    Bokeh messages are three frames: header, metadata, content.
+    """
+    from bokeh.util.token import generate_jwt_token, generate_session_id
+    from tornado.httpclient import HTTPRequest
+    from tornado.websocket import websocket_connect
+
+    headers = {"Origin": origin or f"http://127.0.0.1:{port}"}
+    if cookie:
+        headers["Cookie"] = cookie
+    token = token or generate_jwt_token(generate_session_id(), signed=False)
+    request = HTTPRequest(f"ws://127.0.0.1:{port}/{app}/ws", headers=headers)
+    conn = await websocket_connect(request, subprotocols=["bokeh", token])
+
+    async def frames(n):
+        return [await asyncio.wait_for(conn.read_message(), 20) for _ in range(n)]
+
+    try:
+        first = json.loads((await frames(3))[0])["msgtype"]
+        for frame in (json.dumps({"msgid": "t1", "msgtype": "PULL-DOC-REQ"}), "{}", "{}"):
+            await conn.write_message(frame)
+        while True:
+            header, _, content = await frames(3)
+            if json.loads(header)["msgtype"] == "PULL-DOC-REPLY":
+                return first, content
+    finally:
+        conn.close()
+
+
+def process_tree(pid: int) -> list[int]:
+    """``pid`` and all its descendants (from /proc)."""
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        out.append(p)
+        try:
+            for tid in os.listdir(f"/proc/{p}/task"):
+                with open(f"/proc/{p}/task/{tid}/children") as f:
+                    todo += [int(c) for c in f.read().split()]
+        except OSError:
+            continue
+    return out
+
+
+def running(pid: int) -> bool:
+    """True while ``pid`` exists and is not a zombie."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            state = f.read().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"

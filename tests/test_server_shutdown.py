@@ -1,0 +1,75 @@
+"""The server ends promptly on SIGTERM, whatever work is running or queued (issue 20, 9).
+
+``docker stop`` sends SIGTERM and kills the container 10 s later. The dashboard runs long
+computations (Monte-Carlo bands) on worker threads, and Python waits at exit for every
+worker thread of a ``concurrent.futures`` pool to finish its queue: after heavy use the
+server took 36-39 s to exit. Here a served page queues a minute of work on the event
+loop's executor (as the scatter band does, ``asyncio.to_thread``) and on Panel's thread
+pool, and starts a child process (as the file-parser sandbox does); once that work runs,
+SIGTERM must end the server within docker's grace period and leave no child behind.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import time
+import urllib.request
+
+import pytest
+from server_util import Server, get, running, wait_for
+
+#: docker stop's default grace period (s).
+DOCKER_STOP_GRACE_S = 10.0
+
+APP = """
+import asyncio, os, subprocess, sys, time
+from pathlib import Path
+import panel as pn
+
+here = Path(__file__).parent
+
+def busy(name):
+    (here / f"busy-{name}-{os.getpid()}-{time.monotonic_ns()}").touch()
+    end = time.monotonic() + 60
+    while time.monotonic() < end:
+        sum(range(10_000))
+
+ctx = pn.state.curdoc.session_context
+if ctx is not None and ctx.server_context is not None:  # a served page, not the start-up proof
+    loop = asyncio.get_event_loop()
+    for k in range(8):  # more than the executor's threads: some are queued
+        loop.run_in_executor(None, busy, f"loop{k}")
+        pn.state.execute(lambda k=k: busy(f"panel{k}"), schedule="thread")
+    child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    (here / "child.pid").write_text(str(child.pid))
+pn.Column("# busy page", pn.widgets.IntSlider(name="k", value=2)).servable()
+"""
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_stop_signal_ends_a_busy_server_promptly(tmp_path, sig):
+    srv = Server(tmp_path, APP, {"FBS_NUM_THREADS": "2"}, name="busy").started()
+    child = None
+    try:
+        opener = urllib.request.build_opener()
+        status, _, body = get(opener, srv.base + "/busy")
+        assert status == 200 and "render_items" in body
+        pid_file = tmp_path / "child.pid"
+        child = int(wait_for(pid_file.exists, 60, what="child started") and pid_file.read_text())
+        wait_for(lambda: len(list(tmp_path.glob("busy-*"))) >= 2, 60, what="work running")
+        t0 = time.monotonic()
+        srv.proc.send_signal(sig)
+        try:
+            srv.proc.wait(DOCKER_STOP_GRACE_S)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"the server did not end within {DOCKER_STOP_GRACE_S:.0f} s of {sig!r}")
+        print(f"{sig.name}: ended after {time.monotonic() - t0:.2f} s")
+        wait_for(lambda: not running(child), 5, what="the child process ended")
+        assert "stopping the server" in srv.log()
+    finally:
+        srv.stop()
+        if child is not None and running(child):
+            import os
+
+            os.kill(child, signal.SIGKILL)
