@@ -113,3 +113,23 @@ def test_contour_refuses_bad_grids():
         threshold_contour([1, 1, 2], [1, 2], np.zeros((2, 3)), 1.0)
     with pytest.raises(ReportError, match="expected \\(n_y, n_x\\) = \\(2, 3\\)"):
         threshold_contour([1, 2, 3], [1, 2], np.zeros((3, 2)), 1.0)
+
+
+def test_log_rows_put_each_count_where_a_log_axis_shows_it():
+    from app.report.colormap import log_rows
+
+    n = np.arange(10.0, 400.0, 10.0)
+    err = np.repeat(n[:, None], 3, axis=1)  # each row holds its own N
+    low, high, img = log_rows(n, err, 512)
+    assert (low, high) == (5.0, 395.0)
+    # row i covers [e_i, e_i+1] of a log-uniform partition: its value is the N whose cell
+    # [N - 5, N + 5] holds the row's geometric centre
+    edges = np.exp(np.linspace(np.log(5.0), np.log(395.0), 513))
+    mid = np.sqrt(edges[:-1] * edges[1:])
+    expected = 10.0 * np.clip(np.round(mid / 10.0), 1, 39)
+    np.testing.assert_array_equal(img[:, 0], expected)
+    # low counts get more rows than high ones (a log axis spreads them)
+    rows_per_n = {v: int(np.sum(img[:, 0] == v)) for v in (10.0, 390.0)}
+    assert rows_per_n[10.0] > 10 * rows_per_n[390.0] > 0
+    with pytest.raises(ReportError, match="uniformly spaced"):
+        log_rows([10, 20, 40], np.zeros((3, 2)))

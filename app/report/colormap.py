@@ -212,3 +212,50 @@ def contour_columns(lines: list[np.ndarray]) -> dict[str, list[list[float]]]:
         "xs": [ln[:, 0].tolist() for ln in lines],
         "ys": [ln[:, 1].tolist() for ln in lines],
     }
+
+
+def log_rows(n_modes, error, n_rows: int = 256) -> tuple[float, float, np.ndarray]:
+    """The map's rows resampled for a logarithmic N axis (an image is stretched linearly
+    between its edges on screen, so its rows must be uniform in log N).
+
+    Row ``i`` of the result is the map row whose cell ``[N - dN/2, N + dN/2]`` holds the
+    centre of the log-uniform row ``i`` between the outer cell edges.
+
+    Parameters
+    ----------
+    n_modes : array_like, shape (n_N,)
+        Ascending, uniformly spaced retained-mode counts.
+    error : array_like, shape (n_N, n_c)
+    n_rows : int
+        Rows of the resampled image.
+
+    Returns
+    -------
+    low, high : float
+        The outer cell edges (the image spans ``[low, high]`` on the N axis).
+    image : ndarray, shape (n_rows, n_c)
+
+    Raises
+    ------
+    ReportError
+        For counts that are not ascending and uniform, a first cell edge at or below 0, or
+        an error of another shape.
+    """
+    n = np.asarray(n_modes, float)
+    z = np.asarray(error, float)
+    if n.ndim != 1 or n.size < 2 or np.any(np.diff(n) <= 0):
+        raise ReportError("n_modes must be ascending with at least 2 counts")
+    step = np.diff(n)
+    if not np.allclose(step, step[0]):
+        raise ReportError("n_modes must be uniformly spaced (e.g. 10, 20, ..., 390)")
+    if z.ndim != 2 or z.shape[0] != n.size:
+        raise ReportError(f"error has shape {z.shape}, expected ({n.size}, n_c)")
+    if n_rows < n.size:
+        raise ReportError(f"n_rows must be at least the number of counts ({n.size})")
+    low, high = n[0] - step[0] / 2, n[-1] + step[0] / 2
+    if low <= 0:
+        raise ReportError(f"the first cell edge {low:g} must be > 0 on a log axis")
+    edges = np.geomspace(low, high, n_rows + 1)
+    centres = np.sqrt(edges[:-1] * edges[1:])
+    idx = np.clip(np.floor((centres - low) / step[0]).astype(int), 0, n.size - 1)
+    return float(low), float(high), z[idx]

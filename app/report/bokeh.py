@@ -1,0 +1,158 @@
+"""Bokeh side of the title blocks, the presentation style and the readable error map.
+
+Helpers the live views call on their figures (built once, then only properties assigned):
+
+- :class:`TitleBlockModels`: the title block as Bokeh ``Title`` models above the plot, so the
+  toolbar's saved PNG carries it too, and the save tool's file name;
+- :func:`style_figure`: type sizes of the normal and the presentation view and legends
+  outside the data;
+- :class:`ErrorMapLayers`: the threshold colour scale, the threshold contour and legend
+  entries for the lines of the truncation error map.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from bokeh.models import ColumnDataSource, Legend, LegendItem, SaveTool, Title
+
+from .colormap import LINE_STYLES, ErrorColorScale, contour_columns, threshold_contour
+from .titles import TitleBlock
+
+__all__ = ["STYLES", "TitleBlockModels", "style_figure", "ErrorMapLayers"]
+
+#: Type sizes of the normal and the presentation view (the projector needs tick labels of
+#: at least 14 px and legends of at least 12 pt).
+STYLES: dict[str, dict[str, str]] = {
+    "normal": {
+        "tick": "12px",
+        "axis": "13px",
+        "title": "13px",
+        "detail": "11px",
+        "legend": "10pt",
+    },
+    "present": {
+        "tick": "16px",
+        "axis": "17px",
+        "title": "18px",
+        "detail": "14px",
+        "legend": "13pt",
+    },
+}
+#: Lines of a title block (heading + harmonic, case, noise, data, date, link).
+TITLE_LINES = 7
+
+
+class TitleBlockModels:
+    """A title block drawn as Bokeh ``Title`` models above a figure (saved with it).
+
+    Built once per figure; :meth:`update` only assigns the titles' text (and the save
+    tool's file name), so a change costs a few property patches.
+    """
+
+    def __init__(self, fig, lines: int = TITLE_LINES):
+        self.fig = fig
+        # Bokeh stacks the "above" panels from the plot outwards: add the last line first
+        self.titles = [Title(text="", text_font_size="11px") for _ in range(lines - 1)]
+        for t in reversed(self.titles):
+            fig.add_layout(t, "above")
+        self.heading = Title(text="", text_font_size="13px", text_font_style="bold")
+        fig.add_layout(self.heading, "above")
+
+    def update(self, tb: TitleBlock, stem: str | None = None) -> None:
+        """Show ``tb`` (lines beyond the models' count are joined into the last one)."""
+        lines = list(tb.lines)
+        n = len(self.titles)
+        if len(lines) > n:
+            lines = lines[: n - 1] + [" | ".join(lines[n - 1 :])]
+        lines += [""] * (n - len(lines))
+        if self.heading.text != tb.what:
+            self.heading.text = tb.what
+        for t, text in zip(self.titles, lines, strict=True):
+            if t.text != text:
+                t.text = text
+            visible = bool(text)
+            if t.visible != visible:
+                t.visible = visible
+        if stem is not None:
+            for tool in self.fig.select(type=SaveTool):
+                if tool.filename != stem:
+                    tool.filename = stem
+
+    def style(self, mode: str) -> None:
+        s = STYLES[mode]
+        self.heading.text_font_size = s["title"]
+        for t in self.titles:
+            t.text_font_size = s["detail"]
+
+
+def style_figure(fig, mode: str = "normal", legend_side: str = "right") -> None:
+    """Type sizes of ``mode`` (``"normal"`` or ``"present"``) and legends outside the data.
+
+    Raises
+    ------
+    ValueError
+        For an unknown mode or side.
+    """
+    if mode not in STYLES:
+        raise ValueError(f"unknown style {mode!r}; allowed: {', '.join(STYLES)}")
+    if legend_side not in ("right", "below", "left", "above"):
+        raise ValueError(f"unknown legend side {legend_side!r}; allowed: right, below")
+    s = STYLES[mode]
+    for ax in (*fig.xaxis, *fig.yaxis):
+        ax.major_label_text_font_size = s["tick"]
+        ax.axis_label_text_font_size = s["axis"]
+    fig.title.text_font_size = s["title"]
+    for leg in list(fig.legend):
+        leg.label_text_font_size = s["legend"]
+        if leg in fig.center:
+            fig.center = [r for r in fig.center if r is not leg]
+            leg.location = "top_left" if legend_side in ("right", "left") else "center"
+            if legend_side in ("below", "above"):
+                leg.orientation = "horizontal"
+            fig.add_layout(leg, legend_side)
+
+
+class ErrorMapLayers:
+    """Colour scale split at the threshold, threshold contour and the lines' legend.
+
+    Parameters
+    ----------
+    fig : bokeh figure
+        The error map's figure (its image glyph takes :attr:`mapper`).
+    threshold : float
+        Initial threshold in percent.
+    """
+
+    def __init__(self, fig, threshold: float):
+        self.scale = ErrorColorScale(float(threshold))
+        self.mapper = self.scale.bokeh_mapper(name="truncation.mapper")
+        self.contour = ColumnDataSource({"xs": [], "ys": []}, name="truncation.contour")
+        color, dash, width, halo = LINE_STYLES["threshold contour"]
+        fig.multi_line(
+            "xs", "ys", source=self.contour, line_color=halo, line_width=width + 2.5
+        )  # the halo under the line
+        self.contour_line = fig.multi_line(
+            "xs", "ys", source=self.contour, line_color=color, line_width=width, line_dash=dash
+        )
+        self.fig = fig
+
+    def update(self, centres, n_modes, error_pct, threshold: float) -> None:
+        """New threshold and map: the mapper's cap and the contour polylines."""
+        thr = float(threshold)
+        if thr != self.scale.threshold:
+            self.scale = ErrorColorScale(thr)
+        if self.mapper.high != self.scale.cap:
+            self.mapper.high = self.scale.cap
+        lines = threshold_contour(centres, n_modes, np.asarray(error_pct, float), thr)
+        self.contour.data = contour_columns(lines)
+
+    def legend(self, items: list[tuple[str, object]], side: str = "below") -> Legend:
+        """A legend outside the map: ``(label, renderer)`` pairs, the contour first."""
+        leg = Legend(
+            items=[LegendItem(label=lab, renderers=[r]) for lab, r in items],
+            orientation="horizontal",
+            location="center",
+            name="truncation.legend",
+        )
+        self.fig.add_layout(leg, side)
+        return leg
