@@ -129,3 +129,66 @@ def _frf_for_refusal():
     from fbs_core import FRF
 
     return FRF([1.0, 2.0], np.ones((2, 1, 1)), ["hub:z"], ["hub:z"], "mobility")
+
+
+# -- crafted tire files (issue 20.8): never opened in this process, only domain errors ----
+def _crafted(tmp_path, edit):
+    import h5py
+
+    from fbs_core.tire import storage
+
+    p = storage.save_tire_model(small_tire(), tmp_path / "t.h5")
+    with h5py.File(p, "r+") as h:
+        edit(h)
+    return p.read_bytes()
+
+
+def _deep_json(depth=100_000):
+    return "[" * depth + "]" * depth
+
+
+@pytest.mark.parametrize(
+    "edit,match",
+    [
+        # metadata that made h5py / json raise RecursionError, TypeError, AttributeError
+        (lambda h: h.attrs.__setitem__("meta", _deep_json()), "not valid JSON"),
+        (lambda h: h.attrs.__setitem__("meta", "[1, 2]"), "must be a JSON object"),
+        (lambda h: h.attrs.__setitem__("format_version", np.array([1, 2])), "format_version"),
+        (lambda h: h.attrs.__setitem__("format_version", "one"), "format_version"),
+        (
+            lambda h: (h.__delitem__("hub_dofs"), h.create_dataset("hub_dofs", data=np.arange(6))),
+            "hub_dofs",
+        ),
+        (
+            lambda h: (
+                h["parameters"].attrs.__setitem__("orders", "abc")
+                if "parameters" in h
+                else h.create_group("parameters").attrs.__setitem__("x", "abc")
+            ),
+            "parameters",
+        ),
+        (
+            lambda h: (h.__delitem__("poles"), h.create_dataset("poles", data=np.ones((2, 3)))),
+            "tire model",
+        ),
+    ],
+)
+def test_crafted_tire_files_end_in_domain_errors(tmp_path, edit, match):
+    raw = _crafted(tmp_path, edit)
+    with pytest.raises(DataFormatError, match=match):
+        load_tire_model(raw, filename="crafted.h5")
+
+
+def test_the_uploaded_tire_file_is_never_opened_in_this_process(tmp_path, monkeypatch):
+    import h5py
+
+    from fbs_core.tire import storage
+
+    raw = storage.save_tire_model(small_tire(), tmp_path / "t.h5").read_bytes()
+
+    def refuse(*a, **k):
+        raise AssertionError("h5py.File opened in the server process")
+
+    monkeypatch.setattr(h5py, "File", refuse)
+    model = load_tire_model(raw, filename="upload.h5").model
+    np.testing.assert_array_equal(model.poles, small_tire().poles)

@@ -283,3 +283,46 @@ def _uff_with_164(tmp_path, length_factor, force_factor, num_label="NONE", den_l
 def test_uff_dataset_164_unit_systems(tmp_path, lf, ff, trans, rot):
     r = load_frf(_uff_with_164(tmp_path, lf, ff), quantity="accelerance")
     np.testing.assert_allclose(r.frf.data[0].diagonal(), [trans, rot], rtol=1e-6)
+
+
+def test_uff_labels_with_superscripts_and_latin1(tmp_path):
+    # record 9 holds the whole FRF unit written with a superscript two, Latin-1 encoded
+    p = _uff_with_164(tmp_path, 1.0, 1.0, num_label="(1/kN)*(mm/s2)")
+    raw = p.read_bytes().replace(b"(1/kN)*(mm/s2)", "(1/kN)*(mm/s²)".encode("latin-1") + b" ")
+    r = load_frf(raw, filename="latin1.uff")
+    assert r.frf.quantity == "accelerance"
+    # z/z: mm/(s² kN); rz/rz in the same unit system: rad/(s² kN mm) = 1 rad/(s² N m)
+    np.testing.assert_allclose(r.frf.data[0].diagonal(), [1e-3 / 1e3, 1 / (1e3 * 1e-3)], rtol=1e-12)
+
+
+def test_the_dashboard_upload_summary_shows_the_units_it_understood():
+    """A chassis FRF in mm/(s kN): the summary says how the label was read and the SI
+    units of the entries, and the chassis in use is the SI one (x 1e-6)."""
+    from app.datasource import DataSource
+
+    grid = np.arange(13.0, 422.01, 0.5)
+    Y = fc.reference_chassis().mobility(grid)
+    # a CSV as another program would write it: every entry in mm and kN
+    fac = np.array(
+        [
+            [
+                (1e3 if o.split(":")[1] in "xyz" else 1.0)
+                * 1e3
+                * (1e-3 if i.split(":")[1] in ("rx", "ry", "rz") else 1.0)
+                for i in Y.inputs
+            ]
+            for o in Y.outputs
+        ]
+    )
+    # value in mm/(s kN) = SI value x (mm per m) x (N per kN); moments: kN mm = N m
+    mm_kn = Y.replace(data=Y.data * fac[None])
+    raw = _csv_with_units(mm_kn, "mm/(s kN)")
+    ds = DataSource()
+    assert ds.load_chassis(raw, "chassis_mm_kN.csv"), ds.error
+    s = ds.chassis_summary
+    assert "units 'mm/(s kN)' read as mobility, mm, kN, s, rad" in s
+    assert "units (SI): m/(N s) | m/(N m s) | rad/(N s) | rad/(N m s)" in s
+    f = fc.harmonic(3).frequencies()
+    np.testing.assert_allclose(
+        ds.models.chassis.mobility(f).data, fc.reference_chassis().mobility(f).data, rtol=1e-12
+    )

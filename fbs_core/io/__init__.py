@@ -149,7 +149,7 @@ def load_frf(
     max_bytes : int
         Size limit of the file (default 100 MiB).
     timeout : float
-        Seconds the MATLAB / HDF5 parser may take.
+        Seconds the parser (every format runs in the sandbox process) may take.
 
     Returns
     -------
@@ -189,7 +189,7 @@ def load_frf(
     if fmt == "uff":
         from .uff import read_uff
 
-        frf, notes, meta = read_uff(src, nodes=nodes, quantity=quantity, freq=freq)
+        frf, notes, meta = read_uff(src, nodes=nodes, quantity=quantity, freq=freq, timeout=timeout)
     elif fmt == "mat":
         from .matlab import read_mat
 
@@ -197,7 +197,7 @@ def load_frf(
     elif fmt == "csv":
         from .csv import read_csv
 
-        frf, notes, meta = read_csv(src, nodes=nodes, quantity=quantity)
+        frf, notes, meta = read_csv(src, nodes=nodes, quantity=quantity, timeout=timeout)
     else:
         from .hdf5 import read_hdf5
 

@@ -9,6 +9,7 @@ blow-up (``RLIMIT_AS``) ends in :class:`~fbs_core.errors.DataFormatError` here.
 from __future__ import annotations
 
 import atexit
+import json
 import os
 import select
 import struct
@@ -22,12 +23,17 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFormatError
-from ._worker import decode
+from ._worker import array_specs
 
-__all__ = ["parse_isolated", "DEFAULT_TIMEOUT"]
+__all__ = ["parse_isolated", "DEFAULT_TIMEOUT", "MAX_RESULT_BYTES"]
 
 #: Seconds a single file may take to parse.
 DEFAULT_TIMEOUT = 30.0
+
+#: Largest total size of the arrays one file may yield (256 MiB): far more than the
+#: dashboard can show (a 12 x 6 mobility at 100,000 lines is 115 MB), far less than the
+#: memory a hostile file could otherwise claim in the server process.
+MAX_RESULT_BYTES = 256 << 20
 
 _U64 = struct.Struct("<Q")
 _WORKER = Path(__file__).with_name("_worker.py")
@@ -61,37 +67,72 @@ class _Worker:
             self.proc.wait()
         self.proc = None
 
-    def _read(self, fd: int, n: int, deadline: float) -> bytes:
-        buf = bytearray()
-        while len(buf) < n:
+    def _read(self, fd: int, n: int, deadline: float, into: memoryview | None = None):
+        """``n`` bytes from the pipe, as bytes or straight into ``into``."""
+        buf = bytearray() if into is None else into
+        got = 0
+        while got < n:
             left = deadline - time.monotonic()
             if left <= 0:
                 raise TimeoutError
             ready, _, _ = select.select([fd], [], [], left)
             if ready:
-                chunk = os.read(fd, min(n - len(buf), 1 << 20))
+                chunk = os.read(fd, min(n - got, 1 << 20))
                 if not chunk:
                     raise EOFError
-                buf += chunk
-        return bytes(buf)
+                if into is None:
+                    buf += chunk
+                else:
+                    into[got : got + len(chunk)] = chunk
+                got += len(chunk)
+        return bytes(buf) if into is None else None
 
-    def request(self, kind: str, raw: bytes, timeout: float, mem_bytes: int) -> tuple[int, bytes]:
+    def request(self, kind: str, raw: bytes, timeout: float, mem_bytes: int, limit: int):
+        """Send one file; returns ``(0, (meta, arrays))`` or ``(status, message bytes)``.
+
+        The arrays are read from the pipe straight into arrays allocated here (one copy
+        of the data in this process); a reply larger than ``limit`` or not matching its
+        own header stops the worker instead of being read.
+        """
         with self.lock:
             proc = self._start()
             head = kind.ljust(8).encode() + b"".join(
-                _U64.pack(v) for v in (int(timeout * 1000), int(mem_bytes), len(raw))
+                _U64.pack(v) for v in (int(timeout * 1000), int(mem_bytes), int(limit), len(raw))
             )
             try:
-                proc.stdin.write(head + raw)
+                proc.stdin.write(head)
+                proc.stdin.write(raw)
                 proc.stdin.flush()
                 # the worker enforces ``timeout`` itself; allow for its start-up on top
                 deadline = time.monotonic() + timeout + 60.0
                 fd = proc.stdout.fileno()
                 status, n = (_U64.unpack(self._read(fd, 8, deadline))[0] for _ in range(2))
-                return status, self._read(fd, n, deadline)
+                if status != 0:
+                    if n > 1 << 20:
+                        raise ValueError("message too long")
+                    return status, self._read(fd, n, deadline)
+                if n > limit + (64 << 20):
+                    raise ValueError(f"reply of {n} bytes")
+                (hlen,) = _U64.unpack(self._read(fd, 8, deadline))
+                if hlen > min(n, 64 << 20):
+                    raise ValueError("header too long")
+                meta = json.loads(self._read(fd, hlen, deadline).decode())
+                specs = array_specs(meta)
+                sizes = [dt.itemsize * int(np.prod(shape, dtype=np.int64)) for dt, shape in specs]
+                if 8 + hlen + sum(sizes) != n or sum(sizes) > limit:
+                    raise ValueError("reply does not match its header")
+                arrays = []
+                for (dt, shape), size in zip(specs, sizes, strict=True):
+                    a = np.empty(shape, dt)
+                    self._read(fd, size, deadline, memoryview(a.reshape(-1).view(np.uint8)))
+                    arrays.append(a)
+                return 0, (meta, arrays)
             except (OSError, EOFError, TimeoutError):
                 self.stop()
                 return 2, b"the parser process stopped unexpectedly"
+            except (ValueError, TypeError, KeyError, AttributeError, OverflowError) as e:
+                self.stop()  # the stream is out of step: never reuse this worker
+                return 2, f"unreadable parser reply ({e})".encode()
 
 
 _worker = _Worker()
@@ -114,12 +155,13 @@ def parse_isolated(
     *,
     timeout: float = DEFAULT_TIMEOUT,
     mem_bytes: int | None = None,
+    max_result_bytes: int | None = None,
 ) -> tuple[dict, list[np.ndarray]]:
-    """Parse ``raw`` with handler ``kind`` ("mat5" or "hdf5") in the sandbox.
+    """Parse ``raw`` with handler ``kind`` ("mat5", "hdf5", "uff" or "csv") in the sandbox.
 
     Parameters
     ----------
-    kind : {"mat5", "hdf5"}
+    kind : {"mat5", "hdf5", "uff", "csv"}
     raw : bytes
         File content.
     what : str
@@ -127,7 +169,12 @@ def parse_isolated(
     timeout : float
         Seconds before the parser is killed.
     mem_bytes : int, optional
-        Extra address space the parser may use; default ``max(1 GiB, 20 x len(raw))``.
+        Extra address space the parser may use; default ``1 GiB + 4 x len(raw)``.
+    max_result_bytes : int, optional
+        Largest total size of the arrays that may come back (default
+        :data:`MAX_RESULT_BYTES`); the parsers check the sizes a file announces before
+        reading its data, so a small compressed file cannot make the server allocate
+        gigabytes.
 
     Returns
     -------
@@ -139,16 +186,15 @@ def parse_isolated(
     Raises
     ------
     DataFormatError
-        If the file cannot be parsed, crashes the parser or takes too long.
+        If the file cannot be parsed, crashes the parser, takes too long or holds more
+        numbers than allowed.
     """
     if mem_bytes is None:
-        mem_bytes = max(1 << 30, 20 * len(raw))
-    status, payload = _worker.request(kind, bytes(raw), float(timeout), int(mem_bytes))
+        mem_bytes = (1 << 30) + 4 * len(raw)
+    limit = MAX_RESULT_BYTES if max_result_bytes is None else int(max_result_bytes)
+    status, payload = _worker.request(kind, raw, float(timeout), int(mem_bytes), limit)
     if status == 0:
-        try:
-            return decode(payload)
-        except Exception as e:  # a compromised parser could send anything
-            raise DataFormatError(f"{what}: unreadable parser reply ({e})") from None
+        return payload
     msg = payload.decode("utf-8", "replace")
     if status == 1:
         raise DataFormatError(f"{what} cannot be read: {msg}")

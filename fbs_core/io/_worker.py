@@ -10,13 +10,19 @@ so the calling process never dies with the parser.
 
 Protocol on stdin / stdout (all integers unsigned 64-bit little endian):
 
-- request: ``kind`` (8 ASCII bytes, ``"mat5    "`` or ``"hdf5    "``), ``timeout_ms``,
-  ``mem_bytes``, ``n``, then ``n`` bytes of file content;
+- request: ``kind`` (8 ASCII bytes: ``mat5``, ``hdf5``, ``uff`` or ``csv``, space padded),
+  ``timeout_ms``, ``mem_bytes``, ``max_reply`` (largest total size of the arrays that may
+  come back), ``n``, then ``n`` bytes of file content;
 - reply: ``status`` (0 ok, 1 refused, 2 crash, 3 timeout, 4 library error), ``n``, then ``n``
   bytes: for status 0 an encoded dump (see :func:`encode`), else a UTF-8 message.
 
-A dump is a JSON header (length-prefixed) followed by ``.npy`` blobs written with
-``allow_pickle=False``; nothing in this protocol is ever unpickled.
+A dump is a JSON header (length-prefixed) that lists the dtype and shape of every array,
+followed by the arrays' raw bytes; only numeric dtypes are accepted, nothing is ever
+unpickled, and the receiver reads the bytes straight into arrays it allocated
+(:func:`fbs_core.io._sandbox.parse_isolated`), one copy.
+
+The text formats (UFF, CSV) are parsed by :mod:`fbs_core.io._textparse`, loaded by path
+(it imports only numpy and the standard library).
 """
 
 from __future__ import annotations
@@ -48,25 +54,37 @@ class ParseError(Exception):
 
 # -- encoding ------------------------------------------------------------------------
 def encode(meta: dict, arrays: list[np.ndarray]) -> bytes:
-    """JSON header + npy blobs; the header lists the byte length of every blob."""
-    blobs = []
+    """JSON header (with dtype and shape of every array) + the arrays' raw bytes."""
+    arrays = [np.ascontiguousarray(a) for a in arrays]
     for a in arrays:
-        b = io.BytesIO()
-        np.save(b, np.ascontiguousarray(a), allow_pickle=False)
-        blobs.append(b.getvalue())
-    meta = dict(meta, _blob_sizes=[len(b) for b in blobs])
+        if a.dtype.kind not in _NUMERIC_KINDS or a.dtype.hasobject:
+            raise ParseError(f"unsupported array type {a.dtype}")
+    meta = dict(meta, _arrays=[{"dtype": a.dtype.str, "shape": list(a.shape)} for a in arrays])
     head = json.dumps(meta).encode()
-    return _U64.pack(len(head)) + head + b"".join(blobs)
+    return _U64.pack(len(head)) + head + b"".join(a.tobytes() for a in arrays)
+
+
+def array_specs(meta: dict) -> list[tuple[np.dtype, tuple[int, ...]]]:
+    """Checked dtypes and shapes of the arrays announced by a dump's header."""
+    specs = []
+    for e in meta.pop("_arrays"):
+        dt = np.dtype(str(e["dtype"]))
+        shape = tuple(int(x) for x in e["shape"])
+        if dt.kind not in _NUMERIC_KINDS or dt.hasobject or any(x < 0 for x in shape):
+            raise ValueError(f"unsupported array {e!r}")
+        specs.append((dt, shape))
+    return specs
 
 
 def decode(payload: bytes) -> tuple[dict, list[np.ndarray]]:
-    """Inverse of :func:`encode` (``allow_pickle=False``)."""
+    """Inverse of :func:`encode`."""
     (n,) = _U64.unpack_from(payload, 0)
     meta = json.loads(payload[8 : 8 + n].decode())
     pos = 8 + n
     arrays = []
-    for size in meta.pop("_blob_sizes"):
-        arrays.append(np.load(io.BytesIO(payload[pos : pos + size]), allow_pickle=False))
+    for dt, shape in array_specs(meta):
+        size = dt.itemsize * int(np.prod(shape, dtype=np.int64))
+        arrays.append(np.frombuffer(payload, dt, size // dt.itemsize, pos).reshape(shape).copy())
         pos += size
     return meta, arrays
 
@@ -121,11 +139,21 @@ def _strings(a) -> list[str]:
     raise ParseError("expected characters")
 
 
-def parse_mat5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
+def _too_big(limit: int) -> ParseError:
+    return ParseError(
+        f"the file holds more than {limit / 2**20:.0f} MiB of numbers, more than this tool "
+        "accepts from one file"
+    )
+
+
+def parse_mat5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
     import scipy.io
 
     info = scipy.io.whosmat(io.BytesIO(raw))
     variables, arrays = {}, []
+    # announced sizes first (8 bytes per element), before anything is decompressed
+    if sum(8 * int(np.prod(shape, dtype=np.int64)) for _, shape, _ in info) > limit:
+        raise _too_big(limit)
     for name, _shape, cls in info:
         if cls not in _MAT_NUMERIC | {"char", "cell"}:
             raise ParseError(
@@ -142,6 +170,8 @@ def parse_mat5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
         variable_names=names,
         verify_compressed_data_integrity=True,
     )
+    if sum(v.nbytes for v in data.values() if isinstance(v, np.ndarray)) > limit:
+        raise _too_big(limit)
     for name in names:
         v = data.get(name)
         if not isinstance(v, np.ndarray) or type(v) is not np.ndarray:
@@ -168,10 +198,11 @@ def _complex_fields(dt):
     return None
 
 
-def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
+def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
     import h5py
 
     datasets, groups, arrays = {}, {}, []
+    total = [0]
     with h5py.File(io.BytesIO(raw), "r") as f:
         errors: list[Exception] = []
 
@@ -222,6 +253,9 @@ def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
             if obj.is_virtual or obj.external:
                 raise ParseError(f"dataset {path!r} stores its data in other files; refused")
             dt = obj.dtype
+            total[0] += int(obj.size or 0) * max(dt.itemsize, 8)
+            if total[0] > limit:  # announced size, checked before the data are read
+                raise _too_big(limit)
             entry = {"attrs": attrs_of(obj), "shape": list(obj.shape)}
             if h5py.check_string_dtype(dt) is not None:
                 a = obj[()]
@@ -258,7 +292,31 @@ def parse_hdf5(raw: bytes) -> tuple[dict, list[np.ndarray]]:
     return {"format": "hdf5", "datasets": datasets, "groups": groups}, arrays
 
 
-HANDLERS = {"mat5": parse_mat5, "hdf5": parse_hdf5}
+_TEXT = []
+
+
+def _textparse():
+    """:mod:`fbs_core.io._textparse`, loaded by path (never through ``fbs_core``)."""
+    if not _TEXT:
+        import importlib.util
+
+        path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_textparse.py")
+        spec = importlib.util.spec_from_file_location("_fbs_textparse", path)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        _TEXT.append(mod)
+    return _TEXT[0]
+
+
+def parse_uff(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
+    return _textparse().parse_uff(raw, max_values=limit // 16)
+
+
+def parse_csv(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
+    return _textparse().parse_csv(raw, max_values=limit // 8)
+
+
+HANDLERS = {"mat5": parse_mat5, "hdf5": parse_hdf5, "uff": parse_uff, "csv": parse_csv}
 
 
 # -- process plumbing ------------------------------------------------------------------
@@ -284,29 +342,38 @@ def _limit_memory(mem_bytes: int) -> None:
         pass
 
 
-def _child(kind: str, raw: bytes, mem_bytes: int, w: int) -> None:
+def _child(kind: str, raw: bytes, mem_bytes: int, limit: int, w: int) -> None:
     _limit_memory(mem_bytes)
     try:
-        meta, arrays = HANDLERS[kind](raw)
+        meta, arrays = HANDLERS[kind](raw, limit)
+        if sum(a.nbytes for a in arrays) > limit:
+            raise _too_big(limit)
         status, payload = 0, encode(meta, arrays)
     except ParseError as e:
         status, payload = 1, str(e).encode()
     except MemoryError:
         status, payload = 1, b"the file needs more memory to parse than allowed"
+    except RecursionError:
+        status, payload = 4, b"RecursionError: the file is nested too deeply"
     except Exception as e:  # any failure of the third-party parser
-        msg = f"{type(e).__name__}: {e}"[:300]
-        status, payload = 4, msg.encode("utf-8", "replace")
+        if type(e).__name__ == "ParseError":  # the text parsers' refusals
+            status, payload = 1, str(e)[:2000].encode("utf-8", "replace")
+        else:
+            msg = f"{type(e).__name__}: {e}"[:300]
+            status, payload = 4, msg.encode("utf-8", "replace")
     with os.fdopen(w, "wb") as out:
         out.write(_U64.pack(status) + _U64.pack(len(payload)) + payload)
 
 
-def _serve_one(kind: str, raw: bytes, timeout: float, mem_bytes: int) -> tuple[int, bytes]:
+def _serve_one(
+    kind: str, raw: bytes, timeout: float, mem_bytes: int, limit: int
+) -> tuple[int, bytes]:
     r, w = os.pipe()
     pid = os.fork()
     if pid == 0:  # pragma: no cover - runs in the forked child
         os.close(r)
         try:
-            _child(kind, raw, mem_bytes, w)
+            _child(kind, raw, mem_bytes, limit, w)
         finally:
             os._exit(0)
     os.close(w)
@@ -345,6 +412,8 @@ def main() -> None:
     import h5py  # noqa: F401  (preload, so forks are fast)
     import scipy.io  # noqa: F401
 
+    _textparse()
+
     # the protocol owns the original stdout; anything a library prints goes nowhere
     stdout = os.fdopen(os.dup(1), "wb")
     os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
@@ -352,14 +421,16 @@ def main() -> None:
     while True:
         try:
             kind = _read_exact(stdin, 8).decode().strip()
-            timeout_ms, mem_bytes, n = (_U64.unpack(_read_exact(stdin, 8))[0] for _ in range(3))
+            timeout_ms, mem_bytes, limit, n = (
+                _U64.unpack(_read_exact(stdin, 8))[0] for _ in range(4)
+            )
             raw = _read_exact(stdin, n)
         except EOFError:
             return
         if kind not in HANDLERS:
             status, payload = 1, f"unknown request {kind!r}".encode()
         else:
-            status, payload = _serve_one(kind, raw, timeout_ms / 1000.0, mem_bytes)
+            status, payload = _serve_one(kind, raw, timeout_ms / 1000.0, mem_bytes, limit)
         stdout.write(_U64.pack(status) + _U64.pack(len(payload)) + payload)
         stdout.flush()
 

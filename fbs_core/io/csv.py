@@ -29,6 +29,7 @@ import numpy as np
 
 from ..errors import DataFormatError
 from ..frf import FRF
+from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import (
     Source,
     frequency_from_units,
@@ -61,9 +62,17 @@ def _split_pair(text: str, where: str) -> tuple[str, str]:
 
 
 def read_csv(
-    src: Source, *, nodes: Mapping | None = None, quantity: str | None = None
+    src: Source,
+    *,
+    nodes: Mapping | None = None,
+    quantity: str | None = None,
+    timeout: float = DEFAULT_TIMEOUT,
 ) -> tuple[FRF, list[str], dict]:
     """Read an FRF from CSV in the documented layout.
+
+    The numbers are parsed in the sandbox process (:func:`._textparse.parse_csv`, under
+    its time and memory limits); this process receives the header lines and one float
+    array.
 
     Raises
     ------
@@ -71,27 +80,14 @@ def read_csv(
         Naming the line and column of the problem.
     """
     name = src.name
-    try:
-        text = src.raw.decode("utf-8-sig")
-    except UnicodeDecodeError as e:
-        raise DataFormatError(f"{name!r} is not UTF-8 text (byte {e.start})") from None
-    if "\x00" in text:
-        raise DataFormatError(f"{name!r} contains NUL bytes; not a text file")
-    lines = text.splitlines()
+    parsed, (a,) = parse_isolated("csv", src.raw, f"CSV file {name!r}", timeout=timeout)
     meta: dict[str, str] = {}
-    k = 0
-    while k < len(lines) and (not lines[k].strip() or lines[k].lstrip().startswith("#")):
-        body = lines[k].lstrip()[1:].strip()
+    for body in parsed["comments"]:
         if ":" in body:
             key, _, val = body.partition(":")
             meta[key.strip().lower()] = val.strip()
-        k += 1
-    if k >= len(lines):
-        raise DataFormatError(f"{name!r} has no header row (after the '#' lines)")
-    header_line = lines[k]
-    delim = max((",", ";", "\t"), key=header_line.count)
-    rows = list(_csv.reader(lines[k:], delimiter=delim))
-    header = [h.strip() for h in rows[0]]
+    k = int(parsed["header_line"]) - 1
+    header = [str(h).strip() for h in parsed["header"]]
     m = _FREQ.match(header[0]) if header else None
     if not m:
         raise DataFormatError(
@@ -135,24 +131,8 @@ def read_csv(
     if layout and layout != got:
         raise DataFormatError(f"{name!r}: header says layout {layout!r} but columns are {got}")
 
-    values = []
-    for r, row in enumerate(rows[1:], start=k + 2):
-        if not row or all(not x.strip() for x in row):
-            continue
-        if len(row) != len(header):
-            raise DataFormatError(
-                f"{name!r} line {r}: {len(row)} fields, the header has {len(header)}"
-            )
-        try:
-            values.append([float(x) for x in row])
-        except ValueError:
-            c = next(j for j, x in enumerate(row) if not _is_float(x))
-            raise DataFormatError(
-                f"{name!r} line {r} column {c + 1}: {row[c]!r} is not a number"
-            ) from None
-    if not values:
+    if a.shape[0] == 0:
         raise DataFormatError(f"{name!r} has no data rows")
-    a = np.array(values)
     if not np.all(np.isfinite(a)):
         r, c = np.argwhere(~np.isfinite(a))[0]
         raise DataFormatError(
@@ -218,14 +198,6 @@ def read_csv(
         if k not in ("quantity", "units", "layout", "phase_unit", "freq_unit", "kinds")
     }
     return frf, notes, extra
-
-
-def _is_float(x: str) -> bool:
-    try:
-        float(x)
-        return True
-    except ValueError:
-        return False
 
 
 def _header(metadata: Mapping | None, title: str) -> list[str]:

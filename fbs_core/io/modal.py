@@ -23,8 +23,6 @@ MATLAB variable layout (``docs/file-formats.md``; the arrays of
 from __future__ import annotations
 
 import json
-import tempfile
-from pathlib import Path
 
 import numpy as np
 
@@ -133,36 +131,44 @@ def write_tire_mat(model, *, version: str = "5") -> bytes:
 def read_tire_native(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
     """Read a tire model in the project's format (``fbs_core.tire.storage``, HDF5).
 
-    The file is first parsed completely in the sandbox (every dataset and attribute,
-    refusing links and external storage, checking values are finite); only a file
-    that passed is handed to the owner's reader
-    :func:`fbs_core.tire.storage.load_tire_model`, from a private temporary copy.
+    The file is parsed completely in the sandbox (every dataset and attribute, refusing
+    links and external storage); the model is then built from that parsed content by
+    :func:`fbs_core.tire.storage.tire_from_content`. The uploaded file is never opened
+    in this process.
 
     Raises
     ------
     DataFormatError
-        For damaged files, another format or version, non-finite values.
+        For damaged files, another format or version, non-finite values, and any
+        inconsistency of the content (never a bare TypeError or the like).
     """
     from ..tire import storage
 
     what = f"tire model {src.name!r}"
     meta, arrays = parse_isolated("hdf5", src.raw, what, timeout=timeout)
-    fmt = meta["groups"].get("/", {}).get("format")
-    if fmt != storage.FORMAT:
-        raise DataFormatError(
-            f"{what} is not a {storage.FORMAT!r} file (its format attribute is {fmt!r}); "
-            "tire models are read from that format or from MATLAB (.mat)"
-        )
-    for path, e in meta["datasets"].items():
-        if "array" in e:
-            check_finite(arrays[e["array"]], f"{what} dataset {path}")
-    with tempfile.TemporaryDirectory(prefix="fbs_tire_") as d:
-        p = Path(d) / "upload.h5"
-        p.write_bytes(src.raw)
-        try:
-            model = storage.load_tire_model(p)
-        except FBSError as e:
-            raise type(e)(str(e).replace(str(p), repr(src.name))) from None
-        except (KeyError, ValueError, TypeError, OSError) as e:
-            raise DataFormatError(f"{what}: {e}".replace(str(p), repr(src.name))) from None
-    return model
+    try:
+        groups, datasets = meta["groups"], meta["datasets"]
+        root = groups.get("/", {})
+        fmt = root.get("format")
+        if fmt != storage.FORMAT:
+            raise DataFormatError(
+                f"{what} is not a {storage.FORMAT!r} file (its format attribute is {fmt!r}); "
+                "tire models are read from that format or from MATLAB (.mat)"
+            )
+        data = {}
+        for path, e in datasets.items():
+            name = path.lstrip("/")
+            if "/" in name:
+                continue  # datasets inside groups are not part of version 1
+            if "array" in e:
+                data[name] = check_finite(arrays[e["array"]], f"{what} dataset {path}")
+            elif "strings" in e:
+                data[name] = list(e["strings"])
+        params = groups.get("/parameters")
+        return storage.tire_from_content(root, data, params, what)
+    except FBSError as e:
+        if what in str(e):
+            raise
+        raise type(e)(f"{what}: {e}") from None
+    except (KeyError, ValueError, TypeError, AttributeError, IndexError, RecursionError) as e:
+        raise DataFormatError(f"{what}: inconsistent content ({type(e).__name__}: {e})") from None

@@ -12,6 +12,7 @@ system. Abscissa values are single precision in the format (E13.5).
 
 from __future__ import annotations
 
+import functools
 import math
 import tempfile
 import time
@@ -25,6 +26,7 @@ from ..dofs import DIRECTIONS, parse_label
 from ..errors import DataFormatError, DOFError, FBSError, FrequencyGridError, QuantityError
 from ..frf import FRF
 from ..units import response_unit
+from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import (
     Source,
     Units,
@@ -75,27 +77,26 @@ _REQUIRED = (
 )
 
 
-def _read_sets(src: Source) -> list[dict]:
-    import pyuff
-
-    with tempfile.TemporaryDirectory(prefix="fbs_uff_") as d:
-        path = Path(d) / "upload.uff"
-        path.write_bytes(src.raw)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                uff = pyuff.UFF(str(path))
-                n = uff.get_n_sets()
-                sets = uff.read_sets() if n else []
-        except Exception as e:
-            raise DataFormatError(f"{src.name!r} is not a readable Universal File: {e}") from None
-    if isinstance(sets, dict):
-        sets = [sets]
+def _read_sets(src: Source, timeout: float) -> tuple[list[dict], dict]:
+    """All datasets of the file, parsed in the sandbox (:func:`._textparse.parse_uff`):
+    dataset 58 as pyuff-style dictionaries with ``x`` and ``data`` arrays."""
+    meta, arrays = parse_isolated("uff", src.raw, f"Universal File {src.name!r}", timeout=timeout)
+    sets = []
+    for s in meta["sets"]:
+        if s.get("type") == 58:
+            y = arrays[s["data"]]
+            if "x" in s:
+                x = arrays[s["x"]]
+            else:
+                x = s["abscissa_min"] + np.arange(y.size) * s["abscissa_inc"]
+            s = dict(s, x=x, data=y)
+        sets.append(s)
     if not sets:
+        extra = f" ({meta['empty']} empty ones)" if meta.get("empty") else ""
         raise DataFormatError(
-            f"{src.name!r} contains no UFF datasets (blocks between '    -1' lines)"
+            f"{src.name!r} contains no UFF datasets{extra} (blocks between '    -1' lines)"
         )
-    return sets
+    return sets, meta.get("contents", {})
 
 
 def _dof(node, code, ent, what: str, nodes: Mapping | None, ent_names: dict) -> tuple[str, int]:
@@ -172,6 +173,11 @@ def _quantity_of(s: dict, what: str) -> str | None:
     )
 
 
+@functools.lru_cache(maxsize=256)
+def _parse_units_cached(label: str):
+    return parse_units(label)
+
+
 def _units_label(s: dict) -> str:
     """The FRF units of a record: record 9's label, over record 10's (the excitation)
     unless record 9 already is a whole FRF unit such as ``m/s/N``."""
@@ -182,7 +188,7 @@ def _units_label(s: dict) -> str:
     if not den or den.upper() == "NONE":
         return num
     try:
-        u = parse_units(num)
+        u = _parse_units_cached(num)
     except QuantityError:
         return num
     if u is not None and u.kinds is not None and u.kinds[1] != "generalised":
@@ -191,7 +197,12 @@ def _units_label(s: dict) -> str:
 
 
 def read_uff(
-    src: Source, *, nodes: Mapping | None = None, quantity: str | None = None, freq=None
+    src: Source,
+    *,
+    nodes: Mapping | None = None,
+    quantity: str | None = None,
+    freq=None,
+    timeout: float = DEFAULT_TIMEOUT,
 ) -> tuple[FRF, list[str], dict]:
     """Read the FRF records (dataset 58, function type 4) of a Universal File.
 
@@ -229,7 +240,7 @@ def read_uff(
                 f"nodes maps UFF node numbers to names, e.g. {{1: 'spindle', 2: 'bushing'}}; "
                 f"got keys {', '.join(map(repr, bad[:4]))}"
             )
-    sets = _read_sets(src)
+    sets, contents = _read_sets(src, timeout)
     notes: list[str] = []
     units164 = [s for s in sets if s.get("type") == 164]
     f58 = [s for s in sets if s.get("type") == 58]
@@ -253,10 +264,9 @@ def read_uff(
         )
         notes.append(f"skipped {len(f58) - len(frf_sets)} non-FRF records ({', '.join(kinds)})")
     if not frf_sets:
+        held = ", ".join(f"{n} {what}" for what, n in contents.items()) or "nothing"
         raise DataFormatError(
-            f"{src.name!r} holds no FRF records (dataset 58 with function type 4); "
-            f"found {len(f58)} dataset-58 records and dataset types "
-            f"{sorted({int(s.get('type', -1)) for s in sets})}"
+            f"{src.name!r} holds no FRF records (dataset 58 with function type 4); it holds {held}"
         )
     ent_names = {} if nodes else _entity_names(frf_sets)
 

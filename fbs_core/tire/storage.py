@@ -19,6 +19,7 @@ Every dataset carries ``unit`` and ``description`` attributes. No pickles.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
 
@@ -36,6 +37,7 @@ __all__ = [
     "DATA_FILE",
     "save_tire_model",
     "load_tire_model",
+    "tire_from_content",
     "reference_tire",
 ]
 
@@ -119,37 +121,103 @@ def load_tire_model(path) -> TireModel:
         raise DataFormatError(f"no modal tire file at {path}")
     try:
         with h5py.File(path, "r") as f:
-            fmt = f.attrs.get("format")
-            ver = int(f.attrs.get("format_version", -1))
-            if fmt != FORMAT:
-                raise DataFormatError(f"{path} is not a {FORMAT!r} file (format={fmt!r})")
-            if ver != FORMAT_VERSION:
-                raise DataFormatError(
-                    f"{path} has format_version {ver}; this code reads {FORMAT_VERSION}"
-                )
-            missing = [k for k in (*_DATASETS, "hub_dofs") if k not in f]
-            if missing:
-                raise DataFormatError(f"{path} lacks dataset(s) {missing}")
-            data = {k: f[k][()] for k in _DATASETS}
-            hub = tuple(s.decode() if isinstance(s, bytes) else str(s) for s in f["hub_dofs"][()])
-            params = None
-            if "parameters" in f:
-                attrs = {k: v for k, v in f["parameters"].attrs.items() if k != "description"}
-                params = TireParameters.from_dict(
-                    {k: (v.tolist() if k == "orders" else float(v)) for k, v in attrs.items()}
-                )
-            meta = json.loads(f.attrs.get("meta", "{}"))
+            root = dict(f.attrs.items())
+            data = {k: f[k][()] for k in f if isinstance(f[k], h5py.Dataset)}
+            params = dict(f["parameters"].attrs.items()) if "parameters" in f else None
     except OSError as e:
         raise DataFormatError(f"cannot read {path} as HDF5: {e}") from e
+    return tire_from_content(root, data, params, str(path))
+
+
+def _text(v) -> str:
+    if isinstance(v, bytes):
+        return v.decode("utf-8", "replace")
+    if isinstance(v, np.ndarray) and v.shape == ():
+        return _text(v.item())
+    return str(v)
+
+
+def tire_from_content(
+    root: Mapping, data: Mapping, parameters: Mapping | None = None, where: str = "tire model"
+) -> TireModel:
+    """Build a :class:`TireModel` from already-read content of a ``tire-fbs/modal-tire`` file.
+
+    No file is opened here: the importer (:func:`fbs_core.io.load_tire_model`) passes
+    what the sandbox parsed, :func:`load_tire_model` what h5py read.
+
+    Parameters
+    ----------
+    root : mapping
+        Attributes of the root group (``format``, ``format_version``, ``meta``).
+    data : mapping
+        Dataset name (without ``/``) -> array; ``hub_dofs`` an array or list of str.
+        Datasets not needed are ignored (later versions may add optional ones).
+    parameters : mapping, optional
+        Attributes of the ``/parameters`` group.
+    where : str
+        How to name the file in messages.
+
+    Raises
+    ------
+    DataFormatError
+        For another format or version, missing or inconsistent data.
+    """
+    fmt = root.get("format")
+    fmt = _text(fmt) if fmt is not None else None
+    if fmt != FORMAT:
+        raise DataFormatError(f"{where} is not a {FORMAT!r} file (format={fmt!r})")
+    raw_ver = root.get("format_version", -1)
+    try:
+        ver = int(np.asarray(raw_ver).item())
+        shown = str(ver)
+    except (TypeError, ValueError):
+        ver, shown = -1, repr(raw_ver)[:40]
+    if ver != FORMAT_VERSION:
+        raise DataFormatError(
+            f"{where} has format_version {shown}; this code reads {FORMAT_VERSION}"
+        )
+    missing = [k for k in (*_DATASETS, "hub_dofs") if k not in data]
+    if missing:
+        raise DataFormatError(f"{where} lacks dataset(s) {missing}")
+    arrays = {}
+    for k in _DATASETS:
+        a = np.asarray(data[k])
+        if a.dtype.kind not in "biufc":
+            raise DataFormatError(f"{where}: dataset {k!r} must be numeric, got {a.dtype}")
+        arrays[k] = a
+    hub_raw = data["hub_dofs"]
+    if isinstance(hub_raw, np.ndarray):
+        hub_raw = hub_raw.ravel().tolist()
+    if not isinstance(hub_raw, list | tuple):
+        raise DataFormatError(f"{where}: hub_dofs must be 6 DOF labels")
+    hub = tuple(_text(x) for x in hub_raw)
     if hub != HUB_DOFS:
-        raise DataFormatError(f"hub_dofs must be {list(HUB_DOFS)}, got {list(hub)}")
+        raise DataFormatError(f"hub_dofs must be {list(HUB_DOFS)}, got {list(hub)[:6]}")
+    params = None
+    if parameters is not None:
+        attrs = {k: v for k, v in parameters.items() if k != "description"}
+        try:
+            params = TireParameters.from_dict(
+                {
+                    k: (np.asarray(v).tolist() if k == "orders" else float(np.asarray(v)))
+                    for k, v in attrs.items()
+                }
+            )
+        except (TypeError, ValueError, KeyError) as e:
+            raise DataFormatError(f"{where}: invalid /parameters: {e}") from None
+    try:
+        meta = json.loads(_text(root.get("meta", "{}")))
+    except (ValueError, RecursionError):
+        raise DataFormatError(f"{where}: the 'meta' attribute is not valid JSON") from None
+    if not isinstance(meta, dict):
+        raise DataFormatError(f"{where}: the 'meta' attribute must be a JSON object")
     return TireModel(
-        data["speeds"],
-        data["poles"],
-        data["psi"],
-        data["chi"],
-        data["wavelengths"],
-        data["participation"],
+        arrays["speeds"],
+        arrays["poles"],
+        arrays["psi"],
+        arrays["chi"],
+        arrays["wavelengths"],
+        arrays["participation"],
         params=params,
         meta=meta,
         hub_dofs=hub,
