@@ -6,6 +6,8 @@ Prints, for the code of the working tree it is run from:
   and the ratio to the 10k file (2.0 and 4.0 for a linear reader);
 * UFF files of 1k / 2k / 4k dataset-58 records: the same;
 * a 2.8 MB UFF file of ``-1`` lines (refused; the time it takes);
+* a ~300 KB compressed MAT file of 300 MB of zeros (refused by the sandbox's bound on
+  what may come back): time and the calling process' peak memory;
 * a ~100 MiB CSV (12 outputs x 6 inputs, re-im): parse time and the peak resident
   memory of the process that called ``load_frf`` (the server), in a fresh interpreter,
   next to its memory after the imports.
@@ -103,6 +105,45 @@ def big_csv(path: Path, target_bytes: int = 100 * 2**20 - 4096) -> None:
             k += 1
 
 
+_MAKE_BOMB = r"""
+import sys, numpy as np, scipy.io
+scipy.io.savemat(sys.argv[1], {"H": np.zeros(37_500_000), "freq": np.arange(2.0)},
+                 do_compression=True)
+"""
+
+_BOMB = r"""
+import json, resource, sys, time
+from fbs_core.errors import FBSError
+from fbs_core.io import load_frf
+import fbs_core.io.matlab
+raw = open(sys.argv[1], "rb").read()
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+t0 = time.perf_counter()
+try:
+    load_frf(raw, filename="bomb.mat")
+    msg = "accepted?!"
+except FBSError as e:
+    msg = str(e)
+t = time.perf_counter() - t0
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print(json.dumps(dict(size=len(raw), t=t, base=base, peak=peak, msg=msg[:110])))
+"""
+
+
+def bomb(d: str) -> None:
+    """A small compressed MAT file of 300 MB of zeros (issue 20.4)."""
+    p = Path(d) / "bomb.mat"
+    subprocess.run([sys.executable, "-c", _MAKE_BOMB, str(p)], check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", _BOMB, str(p)], capture_output=True, text=True, check=True
+    )
+    r = json.loads(out.stdout.strip().splitlines()[-1])
+    print(
+        f"MAT of {r['size'] / 1e3:.0f} KB holding 300 MB of zeros: {r['t']:.2f} s, calling "
+        f"process peak RSS {r['peak']:.0f} MB ({r['base']:.0f} MB before): {r['msg']}"
+    )
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
     scaling(
@@ -128,6 +169,7 @@ def main() -> None:
     if quick:
         return
     with tempfile.TemporaryDirectory() as d:
+        bomb(d)
         p = Path(d) / "big.csv"
         big_csv(p)
         out = subprocess.run(
