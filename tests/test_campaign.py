@@ -233,6 +233,11 @@ def test_truncation_cases_5dof_and_a_chassis_variant_from_a_file(tmp_path):
         np.testing.assert_allclose(got.error, m.error, rtol=1e-12, atol=1e-15)
         assert got.suggested.tolist() == [[m.suggest(0.1, 40.0)], [m.suggest(0.2, 40.0)]]
         np.testing.assert_allclose(got.map.response, m.response, rtol=1e-12, atol=0)
+    # the model file changed under the same variant name: refused, the file is kept
+    fbs_core.save_frf(chassis_frf.replace(data=chassis_frf.data * 1.01), tmp_path / "chassis.h5")
+    with pytest.raises(CampaignError, match="changed model"):
+        run_campaign(load_campaign(tmp_path / "tr.toml"))
+    assert open_campaign(tmp_path / "tr.h5").band(bc.name).upper.tolist() == direct.upper.tolist()
 
 
 def test_cli_summary_and_errors(tmp_path, capsys):

@@ -220,9 +220,16 @@ def _model_units(campaign: Campaign, store: CampaignStore, done: set[str]) -> No
     for kind, variants in (("tire", campaign.tires), ("chassis", campaign.chassis)):
         for name, src in variants.items():
             unit = f"models/{kind}/{name}"
-            if unit in done:
-                continue
             sha = "" if src == "reference" else file_sha256(src)
+            if unit in done:
+                old = store.unit_attrs(unit) or {}
+                if (str(old.get("source")), str(old.get("sha256"))) != (src, sha):
+                    raise CampaignError(
+                        f"{store.output} was computed with {kind} variant {name!r} from "
+                        f"{old.get('source')} (sha256 {str(old.get('sha256'))[:12]}...), now "
+                        f"{src} ({sha[:12] or '-'}): a changed model needs a new output file"
+                    )
+                continue
             store.write_unit(unit, {}, {"source": src, "sha256": sha})
 
 

@@ -229,6 +229,16 @@ class CampaignStore:
             self.parts.rmdir()
         return n
 
+    def unit_attrs(self, path: str) -> dict | None:
+        """Attributes of a stored unit (result file or parts), None when absent."""
+        import h5py
+
+        for p in self.files():
+            with h5py.File(p, "r") as h:
+                if path in h:
+                    return {k: v for k, v in h[path].attrs.items()}
+        return None
+
     # -- checks ------------------------------------------------------------------------------
     def case_digests(self) -> dict[str, str]:
         """``case name -> settings digest`` of the cases already in the file or parts."""
