@@ -120,13 +120,13 @@ def main(argv=None) -> None:
         t0 = time.perf_counter()
         if cfg == "in-process":
             cluster = LocalCluster(
-                n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+                n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
             )
             n, threads = 1, None
         else:
             n = int(cfg)
             cluster = LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
             )
             threads = 1
         with cluster, Client(cluster) as client:

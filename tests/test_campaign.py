@@ -74,7 +74,7 @@ def test_band_same_in_one_block_in_8_blocks_on_2_worker_processes_and_scatter_ba
     assert run_campaign(one).status == "complete"  # in-process LocalCluster, one block
     with (
         LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
         ) as cluster,
         Client(cluster) as client,
     ):

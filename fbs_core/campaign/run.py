@@ -173,11 +173,11 @@ def make_client(scheduler: str | None = None, workers: int | None = None):
             n_workers=int(workers),
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",
         )
     else:
         cluster = LocalCluster(
-            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
         )
     return Client(cluster), cluster
 
@@ -317,23 +317,29 @@ def _write(store: CampaignStore, campaign: Campaign, t: Task, res) -> None:
 
 
 class Progress:
-    """Text progress bar: tasks done/total, rounds per second, time left (to a stream)."""
+    """Text progress bar: tasks done/total, rounds per second, time left (to a stream).
 
-    def __init__(self, total: int, rounds_total: float, stream=None, every: float = 0.5):
+    The time left is projected from the work (rounds x lines) done and left, not from the
+    rounds: a round of a harmonic with many lines costs more than one with few.
+    """
+
+    def __init__(self, total: int, work_total: float, stream=None, every: float = 0.5):
         import sys
 
-        self.total, self.rounds_total = total, rounds_total
+        self.total, self.work_total = total, work_total
         self.stream = sys.stderr if stream is None else stream
         self.every = every
         self.t0 = time.perf_counter()
         self.last = 0.0
         self.done = 0
         self.rounds = 0.0
+        self.work = 0.0
 
     def line(self) -> str:
         dt = time.perf_counter() - self.t0
         rate = self.rounds / dt if dt > 0 else 0.0
-        left = (self.rounds_total - self.rounds) / rate if rate > 0 else float("nan")
+        wrate = self.work / dt if dt > 0 else 0.0
+        left = (self.work_total - self.work) / wrate if wrate > 0 else float("nan")
         frac = self.done / self.total if self.total else 1.0
         bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
         eta = "--:--" if not np.isfinite(left) else time.strftime("%H:%M:%S", time.gmtime(left))
@@ -342,9 +348,12 @@ class Progress:
             f"elapsed {time.strftime('%H:%M:%S', time.gmtime(dt))}  left {eta}"
         )
 
-    def update(self, tasks: int = 1, rounds: float = 0.0, force: bool = False) -> None:
+    def update(
+        self, tasks: int = 1, rounds: float = 0.0, work: float = 0.0, force: bool = False
+    ) -> None:
         self.done += tasks
         self.rounds += rounds
+        self.work += work
         now = time.perf_counter()
         if force or now - self.last >= self.every or self.done == self.total:
             self.last = now
@@ -405,7 +414,7 @@ def run_campaign(
     _model_units(campaign, store, done)
     tasks, n_skipped = plan(campaign, done)
     todo = [t for t in tasks if t.unit not in done]
-    bar = Progress(len(todo), sum(t.rounds for t in todo)) if progress is True else None
+    bar = Progress(len(todo), sum(t.work for t in todo)) if progress is True else None
     t_start = time.perf_counter()
     started = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
     report = RunReport(str(out_path), "complete", len(tasks), n_skipped, 0, 0.0, 0.0)
@@ -506,7 +515,7 @@ def run_campaign(
                     report.tasks_done += 1
                     report.rounds_done += t.rounds
                     if bar:
-                        bar.update(1, t.rounds)
+                        bar.update(1, t.rounds, t.work)
                     elif callable(progress):
                         progress(report.tasks_done, len(todo), report.rounds_done)
                     if (stop is not None and stop.is_set()) or (
