@@ -198,9 +198,11 @@ def test_case_1_hub_response_peaks_near_17_and_38_hz():
         a = v[:, HUB_DOFS.index(dof)]
         peaks = local_peaks(f, a)
         assert np.any(np.abs(peaks - 38.0) < 2.5), (dof, peaks)
-    # the road wave is symmetric across the width: no lateral, camber or steer response
-    lat = v[:, [HUB_DOFS.index(d) for d in ("hub:y", "hub:rx", "hub:rz")]]
-    assert lat.max() < 1e-8 * z.max()
+    # camber, toe and their lateral force give a physical lateral response (issue 14:
+    # it was numerical noise, -210 dB, on the symmetric tire); camber projects about
+    # sin(1.5 deg) of the vertical motion onto y
+    y = v[:, HUB_DOFS.index("hub:y")]
+    assert 0.01 * z.max() < y.max() < 0.1 * z.max()
 
 
 def test_short_wavelengths_excite_higher_orders():

@@ -21,8 +21,13 @@ __all__ = ["TireParameters", "FAMILIES", "DEFAULT_PARAMETERS"]
 #: ``ip`` in-plane inextensible ring (u, w = -du/dtheta); ``op`` out-of-plane
 #: (lateral) ring v with plane cross-sections; ``w1`` cross-section tilt
 #: (w linear across the width); ``w2`` ... ``w6`` width-wise bending families
-#: (w ~ Legendre P_m(2y/b)), after Kropp (1989).
+#: (w ~ cos(m pi (y/b + 1/2)), the free-edge strip shapes), after Kropp (1989).
 FAMILIES: tuple[str, ...] = ("ip", "op", "w1", "w2", "w3", "w4", "w5", "w6")
+
+#: Parameters that may be negative (alignment angles in rad, conicity per unit load),
+#: limited to |value| <= ANGLE_LIMIT (small-angle alignment of a road wheel).
+SIGNED: tuple[str, ...] = ("camber", "toe", "mu_y0")
+ANGLE_LIMIT = 0.2
 
 
 @dataclass(frozen=True)
@@ -66,6 +71,27 @@ class TireParameters:
         gives the longitudinal part of the patch load).
     zeta : float
         Modal damping ratio of the non-rotating tire.
+    camber : float
+        Camber angle of the wheel in rad (ISO 8855, the left rear wheel of the
+        reference chassis: negative = top of the wheel inclined towards the
+        vehicle). The wheel plane is rotated by ``-camber`` about the vehicle x
+        axis: the road normal and the road wave are no longer in the wheel plane,
+        the static contact pressure varies across the width, and the camber
+        thrust varies with the wheel load (``camber_thrust``).
+    toe : float
+        Toe-in angle of the wheel in rad (positive: the front of the left wheel
+        turned towards the vehicle). The wheel plane is rotated by ``-toe`` about
+        the vehicle z axis; the slip angle it imposes gives a lateral force that
+        varies with the wheel load (``cornering_load``).
+    cornering_load : float
+        Load sensitivity of the cornering stiffness, ``d K_ya / d F_z`` at
+        ``F_z0``, per rad.
+    camber_thrust : float
+        Camber stiffness per unit load, ``K_yg / F_z``, per rad.
+    mu_y0 : float
+        Conicity and ply-steer lateral force per unit load at zero slip and
+        camber, ``F_y0 / F_z`` (vehicle y; its sign depends on the tire and its
+        mounting side).
     orders : tuple of int
         Highest circumferential order kept in each family of :data:`FAMILIES`
         (-1 drops the family).
@@ -93,6 +119,21 @@ class TireParameters:
     k_cz: float = 4.0e5
     F_z0: float = 4000.0
     zeta: float = 0.04
+    # rear-wheel alignment: static camber -1.5 deg, toe-in 10' per wheel, the middle of
+    # the usual passenger-car rear axle settings (camber -1 deg to -2 deg, toe-in 5' to
+    # 15' per wheel: Reimpell, Betzler & Stoll, The Automotive Chassis, 2nd ed. 2001,
+    # sec. 3.5-3.6; Heissing & Ersoy, Chassis Handbook, 2011, sec. 3.3)
+    camber: float = float(np.deg2rad(-1.5))
+    toe: float = float(np.deg2rad(10.0 / 60.0))
+    # Magic Formula 205/60R15, F_z0 = 4000 N (Pacejka, Tire and Vehicle Dynamics, 2nd ed.
+    # 2006, table A3.1: PKY1 = -14.95, PKY2 = 2.13): K_ya = PKY1 F_z0 sin(2 atan(F_z /
+    # (PKY2 F_z0))) = 46 kN/rad, whose slope at F_z0 is 7.35 per rad
+    cornering_load: float = 7.35
+    # camber stiffness of a radial passenger-car tire ~ 0.1 K_ya ~ F_z per rad
+    # (Pacejka 2006, sec. 3.2 and table A3.1; Gillespie, Fundamentals of Vehicle
+    # Dynamics, 1992, ch. 10: camber stiffness about 1/10 of the cornering stiffness)
+    camber_thrust: float = 1.0
+    mu_y0: float = 0.0
     orders: tuple[int, ...] = (16, 6, 14, 14, 12, 11, 10, 10)
 
     def __post_init__(self):
@@ -105,6 +146,13 @@ class TireParameters:
             if f.name == "orders":
                 continue
             v = getattr(self, f.name)
+            if f.name in SIGNED:
+                if not np.isfinite(v) or abs(v) > ANGLE_LIMIT:
+                    raise DataFormatError(
+                        f"tire parameter {f.name} must be finite with |{f.name}| <= "
+                        f"{ANGLE_LIMIT}, got {v}"
+                    )
+                continue
             if not np.isfinite(v) or v < 0:
                 raise DataFormatError(f"tire parameter {f.name} must be finite and >= 0, got {v}")
 

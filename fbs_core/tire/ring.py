@@ -62,6 +62,8 @@ __all__ = [
     "belt_labels",
     "omega_of_speed",
     "ring_closed_form",
+    "wheel_rotation",
+    "lateral_load_coefficient",
 ]
 
 #: Hub DOF labels in vehicle coordinates.
@@ -279,14 +281,55 @@ def _operators(params: TireParameters):
     thp = np.repeat(th_c, yc.size)[:, None]
     dx = Fc["w"] * np.cos(thp) - Fc["u"] * np.sin(thp)
     dz = -Fc["w"] * np.sin(thp) - Fc["u"] * np.cos(thp)
+    dw = (dx, Fc["v"], dz)  # wheel-axes components of the belt displacement in the patch
+    Q = wheel_rotation(params)
+    dv = [sum(Q[i, j] * dw[j] for j in range(3)) for i in range(3)]  # road (vehicle) axes
     area = params.L_c * params.b_c
     Kc = (
-        params.k_cx * _gram(dx, wc) + params.k_cy * _gram(Fc["v"], wc) + params.k_cz * _gram(dz, wc)
+        params.k_cx * _gram(dv[0], wc)
+        + params.k_cy * _gram(dv[1], wc)
+        + params.k_cz * _gram(dv[2], wc)
     ) / area
     K0[6:, 6:] += Kc
-    x_patch = -R * (thp[:, 0] - np.pi / 2)  # forward coordinate in the patch
-    contact = (x_patch, wc, dx, dz)
+    x_patch = -R * (thp[:, 0] - np.pi / 2)  # forward coordinate in the patch (wheel axes)
+    y_patch = np.tile(yc * params.b_c / 2, th_c.size)
+    contact = (x_patch, y_patch, wc, dw)
     return M, K0, A, Kw2, contact
+
+
+def wheel_rotation(params: TireParameters = DEFAULT_PARAMETERS) -> np.ndarray:
+    """Wheel axes in vehicle axes (columns), shape (3, 3), from camber and toe.
+
+    ``Q = R_z(-toe) R_x(-camber)`` for the left wheel of the reference chassis
+    (ISO 8855 camber, negative with the top of the wheel towards the vehicle;
+    toe-in positive with its front towards the vehicle). A vector with wheel
+    components ``a_w`` has vehicle components ``Q a_w`` (thesis section 4.1.2,
+    the transformation of the tire model to the vehicle's coordinates).
+    """
+    c, s = np.cos(-params.camber), np.sin(-params.camber)
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    c, s = np.cos(-params.toe), np.sin(-params.toe)
+    rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    return rz @ rx
+
+
+def lateral_load_coefficient(params: TireParameters = DEFAULT_PARAMETERS) -> float:
+    """Lateral force per unit wheel load ``mu_y = dF_y / dF_z`` (vehicle y) at zero speed
+    change: conicity and ply steer ``mu_y0``, the toe-in slip angle times the load
+    sensitivity of the cornering stiffness, and the camber thrust (Pacejka 2006,
+    sec. 3.2: ``F_y = K_ya(F_z) alpha + K_yg(F_z) gamma + S_Vy``)."""
+    p = params
+    return p.mu_y0 - p.cornering_load * p.toe + p.camber_thrust * p.camber
+
+
+def _to_vehicle(a: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """Congruence ``T^T a T`` with ``T = diag(Q^T, Q^T, I)``: hub DOFs in vehicle axes."""
+    T6 = np.zeros((6, 6))
+    T6[:3, :3] = T6[3:, 3:] = Q.T
+    out = np.array(a, dtype=float, copy=True)
+    out[:6, :] = T6.T @ out[:6, :]
+    out[:, :6] = out[:, :6] @ T6
+    return out
 
 
 def _sym(a):
@@ -319,7 +362,9 @@ def system_matrices(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETER
     G[3, 5] -= Om * params.I_rim_p
     G[5, 3] += Om * params.I_rim_p
     K = _sym(K0 + Om**2 * Kw2)
-    return _sym(M), _damping(params), G, K
+    Q = wheel_rotation(params)
+    M, D, G, K = (_to_vehicle(a, Q) for a in (M, _damping(params), G, K))
+    return _sym(M), _sym(D), 0.5 * (G - G.T), _sym(K)
 
 
 def build_tire_system(
@@ -348,22 +393,33 @@ def patch_load(wavelength: float, params: TireParameters = DEFAULT_PARAMETERS) -
     """Load vector of a unit road wave rolled under the patch, shape (n_dof,).
 
     The road profile ``h(x) = exp(j 2 pi x / lambda)`` (1 m amplitude, x forward
-    from the patch centre) is enforced through the vertical contact springs
-    (traction ``k_cz / (L_c b_c) h``), and the static contact pressure
-    ``F_z0 / (L_c b_c)`` acting normal to the inclined road adds the
-    longitudinal traction ``-p0 dh/dx``. The patch is space fixed, so the load
-    depends on the wavelength only; it oscillates at ``f = v / lambda``.
+    along the vehicle from the patch centre) is enforced through the vertical
+    contact springs (traction ``k_cz / (L_c b_c) h``), and the static contact
+    pressure ``p0 = F_z0 / (L_c b_c)`` acting normal to the inclined road adds the
+    longitudinal traction ``-p0 dh/dx``. With camber the pressure varies across
+    the width (the lower shoulder carries more), and the lateral force of toe,
+    camber and conicity follows the vertical traction,
+    ``q_y = mu_y q_z`` (:func:`lateral_load_coefficient`). Tractions are in
+    vehicle axes and act on the belt through :func:`wheel_rotation`. The patch is
+    space fixed, so the load depends on the wavelength only; it oscillates at
+    ``f = v / lambda``.
     Units: N per metre of road amplitude.
     """
     M, *_, contact = _operators(params)
-    x, wc, dx, dz = contact
+    x, y, wc, dw = contact
+    Q = wheel_rotation(params)
     k = 2 * np.pi / wavelength
-    h = np.exp(1j * k * x)
+    h = np.exp(1j * k * (Q[0, 0] * x + Q[0, 1] * y))  # road wave along the vehicle x axis
     area = params.L_c * params.b_c
     qz = params.k_cz / area * h
-    qx = -params.F_z0 / area * 1j * k * h
+    # static pressure: a cambered wheel presses its lower shoulder harder into the road
+    tilt = params.k_cz * (Q[2, 0] * x + Q[2, 1] * y) / params.F_z0 if params.F_z0 > 0 else 0.0
+    p0 = params.F_z0 / area * np.clip(1.0 - tilt, 0.0, None)
+    qv = (-p0 * 1j * k * h, lateral_load_coefficient(params) * qz, qz)  # vehicle axes
     f = np.zeros(M.shape[0], complex)
-    f[6:] = (wc * qz) @ dz + (wc * qx) @ dx
+    for j in range(3):  # wheel component j of the traction, on the wheel component j of d
+        qw = sum(Q[i, j] * qv[i] for i in range(3))
+        f[6:] += (wc * qw) @ dw[j]
     return f
 
 
