@@ -1,0 +1,207 @@
+"""The thesis' landmarks next to this tire's, with each physics addition switched off.
+
+The thesis (Rosholm & Westers 2018) reports a handful of numbers about its
+(proprietary) tire and the coupled tire + chassis: the hub peaks of the free tire
+(section 4.1.2, figs. 4.6-4.7), the shapes of the case-1 bushing response (figs.
+4.8-4.9), the suggested number of modes per harmonic case (table 5.1) and the 150
+modes of fig. 5.3 (case 5, bushing z, 160 Hz). :func:`landmarks` measures the same
+numbers on a tire model; :func:`landmark_table` does so for the reference tire and
+for variants of it with one physics addition switched off, so that the mechanism
+behind each difference is measured, not assumed (``scripts/print_landmarks.py``,
+``docs/tire-model.md``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from .params import DEFAULT_PARAMETERS, TireParameters
+
+__all__ = [
+    "THESIS",
+    "VARIANTS",
+    "Landmarks",
+    "LandmarkTable",
+    "landmarks",
+    "landmark_table",
+]
+
+#: The thesis' landmarks (section 4.1.2, figs. 4.6-4.9, table 5.1, fig. 5.3).
+THESIS: dict = {
+    "hub_peaks_hz": "17, 38",
+    "bushing_z_peaks_hz": "14, 38",
+    "bushing_translation_largest": "z",
+    "bushing_rotation_largest": "rx (broad peak at 37 Hz); ry highest before and after",
+    "bushing_rz": "weak up to 45 Hz",
+    "table_5_1_130": (40, 40, 50, 60, 70, 70, 60),
+    "table_5_1_160": (40, 40, 50, 60, 270, 340, 130),
+    "fig_5_3_case5_z_160": 150,
+}
+
+#: Variants of the reference tire, each with one physics addition switched off.
+VARIANTS: dict[str, dict] = {
+    "no asymmetry": {"camber": 0.0, "toe": 0.0, "mu_y0": 0.0},
+}
+
+_DOFS = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def _peaks(f, a, floor=0.1):
+    """Local maxima of ``a`` above ``floor`` times its maximum."""
+    i = np.flatnonzero((a[1:-1] > a[:-2]) & (a[1:-1] >= a[2:])) + 1
+    return tuple(float(x) for x in f[i[a[i] >= floor * a.max()]])
+
+
+@dataclass(frozen=True)
+class Landmarks:
+    """The thesis' landmarks measured on one tire model (coupled to the reference chassis).
+
+    Attributes
+    ----------
+    hub_peaks : dict
+        Peaks (Hz) of the free hub velocity for the case-1 patch load, per hub DOF.
+    bushing_peaks : dict
+        Peaks (Hz) of the case-1 bushing velocity (6-DOF coupling), per bushing DOF.
+    bushing_level_db : dict
+        Maximum of the case-1 bushing velocity per DOF in dB re 1 m/s (translations)
+        or 1 rad/s (rotations) per metre of road amplitude.
+    table_130, table_160 : tuple of int
+        Suggested modes (20 % threshold, maximum over the bushing DOFs), cases 1-7.
+    case5_z_160 : int
+        Suggested modes for case 5, bushing z only, up to 160 Hz (fig. 5.3).
+    """
+
+    hub_peaks: dict
+    bushing_peaks: dict
+    bushing_level_db: dict
+    table_130: tuple
+    table_160: tuple
+    case5_z_160: int
+
+    def rows(self) -> list[tuple[str, str]]:
+        """``(landmark, value)`` rows in the order of :data:`THESIS`."""
+        lv = self.bushing_level_db
+        tr = max(("x", "y", "z"), key=lambda d: lv[d])
+        rot = max(("rx", "ry", "rz"), key=lambda d: lv[d])
+
+        def fmt(p):
+            return ", ".join(f"{x:.1f}" for x in p) if p else "-"
+
+        return [
+            ("hub_peaks_hz", f"z {fmt(self.hub_peaks['z'])}; x {fmt(self.hub_peaks['x'])}"),
+            ("bushing_z_peaks_hz", fmt(self.bushing_peaks["z"])),
+            (
+                "bushing_translation_largest",
+                f"{tr} ({', '.join(f'{d} {lv[d]:.0f}' for d in ('x', 'y', 'z'))} dB)",
+            ),
+            (
+                "bushing_rotation_largest",
+                f"{rot} ({', '.join(f'{d} {lv[d]:.0f}' for d in ('rx', 'ry', 'rz'))} dB); "
+                f"rx peaks {fmt(self.bushing_peaks['rx'])}",
+            ),
+            ("bushing_rz", f"{lv['rz'] - lv[rot]:+.0f} dB re {rot}"),
+            ("table_5_1_130", ", ".join(str(n) for n in self.table_130)),
+            ("table_5_1_160", ", ".join(str(n) for n in self.table_160)),
+            ("fig_5_3_case5_z_160", str(self.case5_z_160)),
+        ]
+
+
+def landmarks(tire=None, chassis=None) -> Landmarks:
+    """Measure the thesis' landmarks on ``tire`` (default: the shipped reference tire).
+
+    Parameters
+    ----------
+    tire : TireModel, optional
+    chassis : ChassisModel, optional
+        Default: the reference chassis.
+
+    Returns
+    -------
+    Landmarks
+    """
+    from .. import reference_tire
+    from ..prediction import bushing_response
+    from ..studies import suggest_modes
+
+    tire = reference_tire() if tire is None else tire
+    f = np.arange(13.0, 51.5, 0.25)
+    v = np.abs(tire.patch_response(f, 1).data[:, :, 0])
+    # a DOF 160 dB below the largest carries round-off only (a symmetric tire's y, rx, rz)
+    hub = {
+        d: _peaks(f, v[:, k], 0.3) if v[:, k].max() > 1e-8 * v.max() else ()
+        for k, d in enumerate(_DOFS)
+    }
+    r = bushing_response(1, tire=tire, chassis=chassis)
+    vb = np.abs(r.data[:, :, 0])
+    names = [o.split(":")[1] for o in r.outputs]
+    bpk = {d: _peaks(r.freq, vb[:, k], 0.1) for k, d in enumerate(names)}
+    lv = {d: float(20 * np.log10(vb[:, k].max())) for k, d in enumerate(names)}
+    s160 = suggest_modes(0.2, 160.0, tire=tire, chassis=chassis)
+    s130 = suggest_modes(0.2, 130.0, maps=s160.maps, tire=tire)
+    z5 = suggest_modes(0.2, 160.0, maps=s160.maps[4:5], dof="bushing:z", tire=tire)
+    return Landmarks(
+        hub,
+        bpk,
+        lv,
+        tuple(int(n) for n in s130.n_modes),
+        tuple(int(n) for n in s160.n_modes),
+        int(z5.n_modes[0]),
+    )
+
+
+@dataclass(frozen=True)
+class LandmarkTable:
+    """The thesis' landmarks, the reference tire's, and each variant's.
+
+    Attributes
+    ----------
+    keys : tuple of str
+        Landmark keys (of :data:`THESIS`).
+    thesis : tuple of str
+    columns : dict
+        Column name (``"reference"`` and the :data:`VARIANTS` names) -> tuple of str,
+        one value per key.
+    measured : dict
+        Column name -> :class:`Landmarks`.
+    """
+
+    keys: tuple
+    thesis: tuple
+    columns: dict
+    measured: dict
+
+    def text(self) -> str:
+        """Plain-text table, one landmark per block of lines."""
+        lines = []
+        for i, k in enumerate(self.keys):
+            lines.append(f"{k}")
+            lines.append(f"    {'thesis':<14s} {self.thesis[i]}")
+            for name, col in self.columns.items():
+                lines.append(f"    {name:<14s} {col[i]}")
+        return "\n".join(lines)
+
+
+def landmark_table(
+    params: TireParameters = DEFAULT_PARAMETERS, variants=None, chassis=None
+) -> LandmarkTable:
+    """Landmarks of the tire built from ``params`` and of its :data:`VARIANTS`.
+
+    Each variant is rebuilt from physics (``build_modal_model``, about 1-2 s each)
+    with one addition switched off.
+    """
+    from .build import build_modal_model
+
+    variants = VARIANTS if variants is None else variants
+    cols = {"reference": params} | {
+        name: dataclasses.replace(params, **kw) for name, kw in variants.items()
+    }
+    measured = {name: landmarks(build_modal_model(p), chassis) for name, p in cols.items()}
+    keys = tuple(THESIS)
+    thesis = tuple(
+        ", ".join(str(x) for x in v) if isinstance(v, tuple) else str(v) for v in THESIS.values()
+    )
+    columns = {name: tuple(v for _, v in m.rows()) for name, m in measured.items()}
+    return LandmarkTable(keys, thesis, columns, measured)
