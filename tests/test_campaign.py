@@ -164,6 +164,7 @@ def test_stopped_and_killed_runs_leave_a_consistent_file_and_resume(tmp_path):
     assert rep.status == "stopped" and rep.tasks_done == 3
     part = open_campaign(camp.output)
     assert sum(c.lines_done for c in part.cases) < sum(c.n_lines for c in part.cases)
+    assert "0 of 2 cases complete" in part.summary()  # planned from the stored campaign file
     with pytest.raises(CampaignError, match="not complete"):
         part.band(part.cases[0].name)
     # a killed run: a finished task's part file, and a write cut short before its rename
@@ -245,7 +246,7 @@ def test_cli_summary_and_errors(tmp_path, capsys):
     camp.write_text(_toml(tmp_path / "c.h5", rounds=50))
     assert cli(["run", str(camp), "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "complete: 1 tasks done" in out and "1 of 1 cases complete" in out
+    assert "complete: 1 tasks done" in out and "1 of 1 cases complete, 0 partial" in out
     assert cli(["summary", str(tmp_path / "c.h5")]) == 0
     assert "h1 noise 10 % both" in capsys.readouterr().out
     assert cli(["summary", str(tmp_path / "none.h5")]) == 2

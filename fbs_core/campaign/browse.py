@@ -310,11 +310,29 @@ class CampaignResult:
             m,
         )
 
+    def planned(self) -> tuple[str, ...] | None:
+        """Names of all the cases of the campaign file stored in the result (None when it
+        cannot be read back, e.g. a model file of it has moved)."""
+        from .spec import parse_campaign
+
+        try:
+            return tuple(c.name for c in parse_campaign(self.campaign_toml, self.path.parent).cases)
+        except CampaignError:
+            return None
+
     def summary(self) -> str:
         """One line per case (status, settings, band width or suggested modes)."""
         name = self.attrs.get("campaign_name", self.path.stem)
         done = sum(c.complete for c in self.cases)
-        out = [f"campaign {name!r}: {done} of {len(self.cases)} cases complete ({self.path})"]
+        planned = self.planned()
+        total = (
+            len(self.cases) if planned is None else len(set(planned) | {c.name for c in self.cases})
+        )
+        partial = sum(0 < c.lines_done < c.n_lines for c in self.cases)
+        out = [
+            f"campaign {name!r}: {done} of {total} cases complete, {partial} partial, "
+            f"{total - len(self.cases)} not started ({self.path})"
+        ]
         if self.runs:
             r = self.runs[-1]
             out.append(
