@@ -292,3 +292,20 @@ def test_ctrl_c_stops_cleanly_and_the_same_command_resumes(tmp_path):
     assert r.returncode == 0, r.stderr
     assert f"{n_mid} done before" in r.stdout
     assert all(c.complete for c in open_campaign(tmp_path / "k.h5").cases)
+
+
+def test_progress_bar_shows_done_total_rate_and_time_left_from_the_work():
+    import io
+
+    from fbs_core.campaign.run import Progress
+
+    out = io.StringIO()
+    bar = Progress(4, 100.0, stream=out, every=0.0)
+    bar.t0 -= 10.0  # 10 s ago
+    # a cheap task: half the rounds but a quarter of the work (few lines)
+    bar.update(1, rounds=50.0, work=25.0)
+    line = out.getvalue()
+    assert "1/4 tasks" in line and "5 rounds/s" in line
+    left = line.split("left ")[1].strip()
+    h, m, s = (int(x) for x in left.split(":"))
+    assert 29 <= 3600 * h + 60 * m + s <= 31  # 75 work units left at 2.5 per second
