@@ -536,7 +536,7 @@ def run_campaign(
         report.seconds = time.perf_counter() - t_start
         if todo:
             store.write_unit(
-                f"runs/{started.replace(':', '')}_{os.getpid()}",
+                f"runs/{started.replace(':', '')}_{uuid.uuid4().hex[:8]}",
                 {},
                 {
                     "started": started,
