@@ -157,8 +157,9 @@ class ErrorColorScale:
         """``(cmap, norm)`` for matplotlib: the same steps, :attr:`above` as the over colour."""
         from matplotlib.colors import BoundaryNorm, ListedColormap
 
-        cmap = ListedColormap(list(self.palette))
-        cmap = cmap.with_extremes(over=self.above, under=self.palette[0], bad="#ffffff")
+        cmap = ListedColormap(list(self.palette)).with_extremes(
+            over=self.above, under=self.palette[0], bad="#ffffff"
+        )
         bounds = np.linspace(0.0, self.threshold, len(self.palette) + 1)
         return cmap, BoundaryNorm(bounds, cmap.N)
 

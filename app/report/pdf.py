@@ -31,7 +31,7 @@ class _Pages:
 
     def __init__(self, pdf: PdfPages, footer: str):
         self.pdf, self.footer = pdf, footer
-        self.fig = None
+        self.fig: Figure | None = None
         self.y = 0.0  # inches from the top
         self.page = 0
 
