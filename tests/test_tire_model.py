@@ -130,7 +130,8 @@ def test_truncation_keeps_pairs_lowest_first(tire):
 
 def test_eigenfrequencies(tire):
     f = tire.eigenfrequencies(80.0)
-    np.testing.assert_allclose(f, np.sort(tire.poles[3, 0::2].imag) / (2 * np.pi))
+    pos = tire.poles[3, 0::2].imag
+    np.testing.assert_allclose(f, np.sort(pos[pos > 0]) / (2 * np.pi))  # not the slip states
     assert f[0] > 0
 
 

@@ -4,6 +4,7 @@ the supplier-style modal model (``model``, ``build``) and its file format
 """
 
 from .build import OPERATING_POINTS, build_modal_model
+from .landmarks import landmark_table
 from .model import ModeCountError, OperatingPointError, TireModel
 from .modes import ComplexModes, ModalError, complex_modes, track_modes
 from .params import DEFAULT_PARAMETERS, FAMILIES, TireParameters
@@ -25,6 +26,7 @@ __all__ = [
     "build_modal_model",
     "build_tire_system",
     "complex_modes",
+    "landmark_table",
     "load_tire_model",
     "patch_load",
     "reference_tire",

@@ -44,6 +44,8 @@ THESIS: dict = {
 #: Variants of the reference tire, each with one physics addition switched off.
 VARIANTS: dict[str, dict] = {
     "no asymmetry": {"camber": 0.0, "toe": 0.0, "mu_y0": 0.0},
+    # tread sticking to the road; the last family gets its order 10 back (400 modes)
+    "no slip": {"slip_zones": 0, "orders": (16, 6, 14, 14, 12, 11, 10, 10)},
 }
 
 _DOFS = ("x", "y", "z", "rx", "ry", "rz")

@@ -106,12 +106,13 @@ class TireModel:
             raise DataFormatError(
                 f"participation has shape {part.shape}, expected {(n_s, lam.size, n_m)}"
             )
-        if not np.allclose(poles[:, 1::2], np.conj(poles[:, 0::2])) or np.any(
-            poles[:, 0::2].imag <= 0
-        ):
+        a, b = poles[:, 0::2], poles[:, 1::2]
+        first_order = (a.imag == 0) & (b.imag == 0)  # two real poles (e.g. tread slip)
+        if not np.all(first_order | (np.isclose(b, np.conj(a)) & (a.imag > 0))):
             raise DataFormatError(
                 "poles must come in conjugate pairs [r, conj(r), ...] with the member of "
-                "positive eigenfrequency first"
+                "positive eigenfrequency first, or in pairs of two real poles (first-order "
+                "modes)"
             )
         for name, val in (
             ("speeds", sp),

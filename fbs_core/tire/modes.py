@@ -18,7 +18,9 @@ systems", 1966; Brinkmeier et al., J. Sound Vib. 309, 2008), and the mobility is
 Modes are returned in conjugate pairs, ``[r_1, conj(r_1), r_2, conj(r_2), ...]``,
 the member with positive eigenfrequency first, pairs sorted by eigenfrequency,
 so that keeping the first ``N`` modes keeps ``N / 2`` pairs, lowest first
-(thesis section 5.1).
+(thesis section 5.1). DOFs without mass (first-order states such as the slip of
+the tread) give real poles; they are returned in pairs of two real poles ahead
+of the conjugate pairs.
 """
 
 from __future__ import annotations
@@ -63,7 +65,8 @@ class ComplexModes:
     def damping_ratios(self) -> np.ndarray:
         """``-Re(lambda) / |lambda|`` of the positive members, shape (n,)."""
         p = self.poles[0::2]
-        return -p.real / np.abs(p)
+        a = np.abs(p)
+        return np.where(a > 0, -p.real / np.where(a > 0, a, 1.0), 1.0)  # zero pole: 1
 
     def take(self, idx) -> ComplexModes:
         """The pairs ``idx`` (indices of positive members, 0..n-1), as a new object."""
@@ -78,7 +81,8 @@ def complex_modes(M, C, K) -> ComplexModes:
     Parameters
     ----------
     M, C, K : array_like, shape (n, n)
-        Mass, damping plus gyroscopic, stiffness. Real; ``M`` invertible.
+        Mass, damping plus gyroscopic, stiffness. Real; ``M`` invertible, or zero
+        rows and columns for first-order DOFs whose block of ``C`` is invertible.
 
     Returns
     -------
@@ -93,6 +97,9 @@ def complex_modes(M, C, K) -> ComplexModes:
     """
     M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
     n = M.shape[0]
+    massless = ~np.any(M != 0, axis=0) & ~np.any(M != 0, axis=1)
+    if np.any(massless):
+        return _descriptor_modes(M, C, K, massless)
     Minv = np.linalg.inv(M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
     lam, vr = sla.eig(A)
@@ -123,6 +130,81 @@ def complex_modes(M, C, K) -> ComplexModes:
     P[:, 0::2], P[:, 1::2] = psi, np.conj(psi)
     X[:, 0::2], X[:, 1::2] = chi, np.conj(chi)
     return ComplexModes(poles, P, X)
+
+
+def _descriptor_modes(M, C, K, massless) -> ComplexModes:
+    """Modes of a system with massless (first-order) DOFs, e.g. tread slip states.
+
+    State ``z = [x; v_m]`` (all displacements, velocities of the DOFs with mass):
+    ``E z' = A z + B f`` with rows ``x_m' = v_m``, ``C_ss x_s' + C_sm v_m + K_s x = f_s``
+    and ``M_mm v_m' + C_ms x_s' + C_mm v_m + K_m x = f_m``. With right eigenvectors
+    ``V`` of ``E^-1 A`` and ``W = V^-1``: ``psi_r = V[x, r]``,
+    ``chi_r^T = (W E^-1 B)[r]``, so that ``H(s) = sum_r psi_r chi_r^T / (s - lambda_r)``
+    (``a_r = 1``). Real poles (first-order modes) come in pairs of two real members,
+    ahead of the conjugate pairs (eigenfrequency 0).
+    """
+    n = M.shape[0]
+    mi = np.flatnonzero(~massless)
+    si = np.flatnonzero(massless)
+    nm = mi.size
+    N = n + nm
+    E = np.zeros((N, N))
+    A = np.zeros((N, N))
+    B = np.zeros((N, n))
+    E[mi, mi] = 1.0  # x_m' = v_m
+    A[mi, n + np.arange(nm)] = 1.0
+    E[np.ix_(si, si)] = C[np.ix_(si, si)]
+    A[si, :n] = -K[si]
+    A[np.ix_(si, n + np.arange(nm))] = -C[np.ix_(si, mi)]
+    B[si, si] = 1.0
+    E[np.ix_(n + np.arange(nm), si)] = C[np.ix_(mi, si)]
+    E[np.ix_(n + np.arange(nm), n + np.arange(nm))] = M[np.ix_(mi, mi)]
+    A[n + np.arange(nm), :n] = -K[mi]
+    A[np.ix_(n + np.arange(nm), n + np.arange(nm))] = -C[np.ix_(mi, mi)]
+    B[n + np.arange(nm), mi] = 1.0
+    EinvB = np.linalg.solve(E, B)
+    lam, vr = sla.eig(np.linalg.solve(E, A))
+    tol = 1e-9 * np.abs(lam).max()
+    pos = np.flatnonzero(lam.imag > tol)
+    real = np.flatnonzero(np.abs(lam.imag) <= tol)
+    if real.size % 2 or pos.size * 2 + real.size != N:
+        raise ModalError(
+            f"expected conjugate pairs and an even number of real poles, found {pos.size} "
+            f"pairs and {real.size} real poles"
+        )
+    real = real[np.argsort(-lam[real].real)]  # slowest first
+    lam = np.where(np.abs(lam.imag) <= tol, lam.real + 0j, lam)
+    k = np.argmax(np.abs(vr[:n]), axis=0)
+    ph = vr[k, np.arange(N)]
+    vr = vr * (np.abs(ph) / ph)[None, :]
+    vr = vr / np.linalg.norm(vr[:n], axis=0)[None, :]
+    W = np.linalg.solve(vr, np.eye(N))
+    # zero poles (free sliding: motions without stiffness) are exactly 0 and their
+    # shapes a basis of the null space, made unique by unit entries in its first DOFs
+    zero = real[np.abs(lam[real]) <= tol]
+    if zero.size:
+        lam[zero] = 0.0
+        rows = np.arange(zero.size)
+        blk = vr[np.ix_(rows, zero)]
+        if np.linalg.cond(blk) > 1e8:
+            rows = sla.qr(vr[:n, zero].T, pivoting=True)[2][: zero.size]
+            blk = vr[np.ix_(rows, zero)]
+        T = np.linalg.inv(blk)
+        vr[:, zero] = vr[:, zero] @ T
+        W[zero] = np.linalg.solve(T, W[zero])
+    X = (W @ EinvB).T  # (n, N): chi_r as columns
+    pos = pos[np.argsort(lam[pos].imag)]
+    n_pairs = pos.size + real.size // 2
+    poles = np.empty(2 * n_pairs, complex)
+    P = np.empty((n, 2 * n_pairs), complex)
+    Q = np.empty((n, 2 * n_pairs), complex)
+    nr = real.size
+    poles[:nr] = lam[real]
+    P[:, :nr], Q[:, :nr] = vr[:n, real], X[:, real]
+    poles[nr::2], poles[nr + 1 :: 2] = lam[pos], np.conj(lam[pos])
+    P[:, nr::2], P[:, nr + 1 :: 2] = vr[:n, pos], np.conj(vr[:n, pos])
+    Q[:, nr::2], Q[:, nr + 1 :: 2] = X[:, pos], np.conj(X[:, pos])
+    return ComplexModes(poles, P, Q)
 
 
 def receptance(s, modes: ComplexModes, out_idx=None, in_idx=None, n_modes=None) -> np.ndarray:

@@ -88,6 +88,18 @@ class TireParameters:
         ``F_z0``, per rad.
     camber_thrust : float
         Camber stiffness per unit load, ``K_yg / F_z``, per rad.
+    C_kappa, C_alpha : float
+        Longitudinal slip stiffness (N) and cornering stiffness (N/rad) at ``F_z0``.
+        With the contact stiffness they set the relaxation lengths of the tread in
+        the patch, ``sigma_x = C_kappa / k_cx``, ``sigma_y = C_alpha / k_cy``.
+    v_low : float
+        Speed in m/s below which the slip damping ``C / v`` is held at ``C / v_low``
+        (Magic Formula's low-speed limit VXLOW), so that the tire standing still has
+        finite matrices.
+    slip_zones : int
+        Number of zones along the patch whose tread slips as one (each zone adds a
+        longitudinal and a lateral first-order slip state); 0: the tread sticks to the
+        road (tangential contact springs to the ground).
     mu_y0 : float
         Conicity and ply-steer lateral force per unit load at zero slip and
         camber, ``F_y0 / F_z`` (vehicle y; its sign depends on the tire and its
@@ -134,16 +146,29 @@ class TireParameters:
     # Dynamics, 1992, ch. 10: camber stiffness about 1/10 of the cornering stiffness)
     camber_thrust: float = 1.0
     mu_y0: float = 0.0
-    orders: tuple[int, ...] = (16, 6, 14, 14, 12, 11, 10, 10)
+    # Magic Formula 205/60R15 (Pacejka 2006, table A3.1): C_kappa = PKX1 F_z0 with
+    # PKX1 = 21.69; C_alpha = K_ya(F_z0) = 14.95 F_z0 sin(2 atan(1 / 2.13)) = 46 kN/rad.
+    # Relaxation lengths of the tread: 87e3 / 6e5 = 0.145 m, 46e3 / 2e5 = 0.23 m, of the
+    # order of the patch length, as in the brush model (Pacejka 2006, sec. 7.2)
+    C_kappa: float = 86.8e3
+    C_alpha: float = 46.0e3
+    v_low: float = 1.0
+    slip_zones: int = 2
+    # the last family keeps orders up to 9 so that 198 DOFs with mass and 4 slip states
+    # give 400 complex modes, as the thesis' model (orders up to 10 without slip)
+    orders: tuple[int, ...] = (16, 6, 14, 14, 12, 11, 10, 9)
 
     def __post_init__(self):
         object.__setattr__(self, "orders", tuple(int(n) for n in self.orders))
+        if float(self.slip_zones) != int(self.slip_zones) or not 0 <= self.slip_zones <= 8:
+            raise DataFormatError(f"slip_zones must be an integer 0..8, got {self.slip_zones}")
+        object.__setattr__(self, "slip_zones", int(self.slip_zones))
         if len(self.orders) != len(FAMILIES):
             raise DataFormatError(
                 f"orders must give one entry per family {FAMILIES}, got {self.orders}"
             )
         for f in fields(self):
-            if f.name == "orders":
+            if f.name in ("orders", "slip_zones"):
                 continue
             v = getattr(self, f.name)
             if f.name in SIGNED:
@@ -166,6 +191,11 @@ class TireParameters:
         """Number of belt generalised coordinates."""
         return sum(2 * n + 1 for n in self.orders if n >= 0)
 
+    @property
+    def n_slip(self) -> int:
+        """Number of first-order slip states (longitudinal and lateral per zone)."""
+        return 2 * self.slip_zones
+
     def to_dict(self) -> dict:
         d = asdict(self)
         d["orders"] = list(self.orders)
@@ -179,7 +209,14 @@ class TireParameters:
             raise DataFormatError(
                 f"unknown tire parameter(s) {sorted(unknown)}; known: {sorted(known)}"
             )
-        kw = {k: (tuple(int(x) for x in v) if k == "orders" else float(v)) for k, v in d.items()}
+        kw = {
+            k: (
+                tuple(int(x) for x in v)
+                if k == "orders"
+                else (int(v) if k == "slip_zones" else float(v))
+            )
+            for k, v in d.items()
+        }
         return cls(**kw)
 
 

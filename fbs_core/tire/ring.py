@@ -64,6 +64,8 @@ __all__ = [
     "ring_closed_form",
     "wheel_rotation",
     "lateral_load_coefficient",
+    "slip_damping",
+    "slip_labels",
 ]
 
 #: Hub DOF labels in vehicle coordinates.
@@ -106,6 +108,12 @@ def belt_labels(params: TireParameters = DEFAULT_PARAMETERS) -> tuple[str, ...]:
         f"belt.{FAMILIES[f]}.n{n:02d}" + ("" if n == 0 else "cs"[k])
         for f, n, k in zip(b.fam, b.n, b.kind, strict=True)
     )
+
+
+def slip_labels(params: TireParameters = DEFAULT_PARAMETERS) -> tuple[str, ...]:
+    """Labels of the first-order slip states of the tread zones, e.g. ``"slip.z0.x"``
+    (zone 0 at the front of the patch; x longitudinal, y lateral, road axes)."""
+    return tuple(f"slip.z{z}.{d}" for z in range(params.slip_zones) for d in "xy")
 
 
 def _trig(n, kind, theta, d):
@@ -271,8 +279,15 @@ def _operators(params: TireParameters):
             rel = np.hstack([-rim, belt])
             K0 += 0.5 * k * _gram(rel, wth)
 
-    # contact patch: space-fixed springs at the bottom (theta = pi/2)
-    xg, wx = legendre.leggauss(48)
+    # contact patch: space-fixed springs at the bottom (theta = pi/2), in zones along the
+    # patch (composite Gauss rule); with slip, the tread of each zone slips as one
+    nz = max(params.slip_zones, 1)
+    xz, wz = legendre.leggauss(max(48 // nz, 16))
+    edges = np.linspace(-1.0, 1.0, nz + 1)
+    lo, hi = edges[:-1, None], edges[1:, None]
+    xg = (0.5 * (lo + hi) + 0.5 * (hi - lo) * xz).ravel()  # zone 0 at theta < pi/2: front
+    wx = (0.5 * (hi - lo) * wz).ravel()
+    zone_of = np.repeat(np.arange(nz), xz.size)
     half = params.L_c / 2 / R
     th_c = np.pi / 2 + half * xg
     yc, wyc = legendre.leggauss(16)
@@ -285,15 +300,22 @@ def _operators(params: TireParameters):
     Q = wheel_rotation(params)
     dv = [sum(Q[i, j] * dw[j] for j in range(3)) for i in range(3)]  # road (vehicle) axes
     area = params.L_c * params.b_c
-    Kc = (
-        params.k_cx * _gram(dv[0], wc)
-        + params.k_cy * _gram(dv[1], wc)
-        + params.k_cz * _gram(dv[2], wc)
-    ) / area
+    ns = params.n_slip
+    Kc = np.zeros((nb + ns, nb + ns))
+    zp = np.repeat(zone_of, yc.size)  # zone of every patch point
+    for i, k in ((0, params.k_cx), (1, params.k_cy), (2, params.k_cz)):
+        d = np.hstack([dv[i], np.zeros((dv[i].shape[0], ns))])
+        if i < 2 and ns:  # tangential: spring between the belt and its zone's slipping tread
+            d[np.arange(zp.size), nb + 2 * zp + i] = -1.0
+        Kc += k / area * _gram(d, wc)
+    n_all = 6 + nb + ns
+    M, K0, A, Kw2 = (np.pad(a, (0, ns)) for a in (M, K0, A, Kw2))
+    assert M.shape == (n_all, n_all)
     K0[6:, 6:] += Kc
     x_patch = -R * (thp[:, 0] - np.pi / 2)  # forward coordinate in the patch (wheel axes)
     y_patch = np.tile(yc * params.b_c / 2, th_c.size)
-    contact = (x_patch, y_patch, wc, dw)
+    zone_area = np.bincount(zp, weights=wc, minlength=nz)
+    contact = (x_patch, y_patch, wc, dw, zone_area)
     return M, K0, A, Kw2, contact
 
 
@@ -344,9 +366,29 @@ def _damping(params: TireParameters) -> np.ndarray:
     modes ``Phi`` of the non-rotating tire standing on the road.
     """
     M, K0, *_ = _operators(params)
-    w2, phi = sla.eigh(_sym(K0), _sym(M))
-    MP = M @ phi
-    return _sym(MP @ np.diag(2 * params.zeta * np.sqrt(np.maximum(w2, 0.0))) @ MP.T)
+    m = M.shape[0] - params.n_slip  # DOFs with mass; the tread sticks (slip states held)
+    w2, phi = sla.eigh(_sym(K0[:m, :m]), _sym(M[:m, :m]))
+    MP = M[:m, :m] @ phi
+    D = np.zeros_like(M)
+    D[:m, :m] = _sym(MP @ np.diag(2 * params.zeta * np.sqrt(np.maximum(w2, 0.0))) @ MP.T)
+    return D
+
+
+def slip_damping(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS) -> np.ndarray:
+    """Slip dampers of the tread zones, ``C_kappa / v`` and ``C_alpha / v`` shared by area.
+
+    Returns the diagonal, shape (n_slip,), in N s/m: longitudinal and lateral per zone.
+    A tread zone of stiffness ``k`` in series with its slip damper ``c`` relaxes with the
+    time constant ``c / k = sigma / v``, the first-order relaxation-length model of the
+    contact (Pacejka 2006, sec. 7.2; reference-models.md 2.3); below ``v_low`` the
+    damper is held at ``C / v_low``.
+    """
+    if not params.slip_zones:
+        return np.zeros(0)
+    *_, contact = _operators(params)
+    share = contact[4] / contact[4].sum()
+    v = max(abs(float(speed_kmh)) / 3.6, params.v_low)
+    return np.column_stack([params.C_kappa / v * share, params.C_alpha / v * share]).ravel()
 
 
 def system_matrices(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS):
@@ -362,8 +404,12 @@ def system_matrices(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETER
     G[3, 5] -= Om * params.I_rim_p
     G[5, 3] += Om * params.I_rim_p
     K = _sym(K0 + Om**2 * Kw2)
+    D = _damping(params).copy()
+    ns = params.n_slip
+    if ns:
+        D[-ns:, -ns:] += np.diag(slip_damping(speed_kmh, params))
     Q = wheel_rotation(params)
-    M, D, G, K = (_to_vehicle(a, Q) for a in (M, _damping(params), G, K))
+    M, D, G, K = (_to_vehicle(a, Q) for a in (M, D, G, K))
     return _sym(M), _sym(D), 0.5 * (G - G.T), _sym(K)
 
 
@@ -386,7 +432,7 @@ def build_tire_system(
         (:func:`belt_labels`).
     """
     M, D, G, K = system_matrices(speed_kmh, params)
-    return SecondOrderSystem(M, D + G, K, HUB_DOFS + belt_labels(params))
+    return SecondOrderSystem(M, D + G, K, HUB_DOFS + belt_labels(params) + slip_labels(params))
 
 
 def patch_load(wavelength: float, params: TireParameters = DEFAULT_PARAMETERS) -> np.ndarray:
@@ -406,7 +452,7 @@ def patch_load(wavelength: float, params: TireParameters = DEFAULT_PARAMETERS) -
     Units: N per metre of road amplitude.
     """
     M, *_, contact = _operators(params)
-    x, y, wc, dw = contact
+    x, y, wc, dw, _ = contact
     Q = wheel_rotation(params)
     k = 2 * np.pi / wavelength
     h = np.exp(1j * k * (Q[0, 0] * x + Q[0, 1] * y))  # road wave along the vehicle x axis
@@ -419,7 +465,7 @@ def patch_load(wavelength: float, params: TireParameters = DEFAULT_PARAMETERS) -
     f = np.zeros(M.shape[0], complex)
     for j in range(3):  # wheel component j of the traction, on the wheel component j of d
         qw = sum(Q[i, j] * qv[i] for i in range(3))
-        f[6:] += (wc * qw) @ dw[j]
+        f[6 : 6 + dw[j].shape[1]] += (wc * qw) @ dw[j]
     return f
 
 
