@@ -326,3 +326,51 @@ def test_the_dashboard_upload_summary_shows_the_units_it_understood():
     np.testing.assert_allclose(
         ds.models.chassis.mobility(f).data, fc.reference_chassis().mobility(f).data, rtol=1e-12
     )
+
+
+# -- CSV: every column carries its entry's own unit --------------------------------------
+def _mixed():
+    """Bushing translation and rotation per metre of road: two different units."""
+    return fc.FRF(F, np.ones((3, 2, 1)), ["bushing:z", "bushing:rx"], ["patch"])
+
+
+def test_csv_columns_name_each_entry_s_unit():
+    """One unit line cannot describe (m/s)/m and (rad/s)/m at once: each column says its own."""
+    header = next(
+        ln for ln in save_frf(_mixed(), format="csv").decode().splitlines() if ln.startswith("freq")
+    )
+    assert "Re(bushing:z / patch) [(m/s)/m]" in header
+    assert "Im(bushing:rx / patch) [(rad/s)/m]" in header
+
+
+def test_csv_column_units_convert_when_there_is_no_unit_line():
+    """mm/s and mrad/s per metre of road: both entries x1e-3 (independent: 1 mm = 1e-3 m,
+    1 mrad = 1e-3 rad)."""
+    text = save_frf(_mixed(), format="csv").decode()
+    text = text.replace("# units: (m/s)/m\n", "")
+    text = text.replace("[(m/s)/m]", "[(mm/s)/m]").replace("[(rad/s)/m]", "[(mrad/s)/m]")
+    r = load_frf(text.encode(), filename="m.csv")
+    np.testing.assert_allclose(r.frf.data, 1e-3 * np.ones((3, 2, 1)), rtol=1e-15)
+    assert r.frf.quantity == "mobility"
+
+
+def test_csv_column_unit_of_the_wrong_kind_is_refused():
+    """A rotation column labelled in metres contradicts itself: an error names the pair."""
+    text = save_frf(_mixed(), format="csv").decode().replace("[(rad/s)/m]", "[(m/s)/m]")
+    with pytest.raises(fc.DataFormatError, match=r"bushing:rx / patch.*rotation"):
+        load_frf(text.encode(), filename="k.csv")
+
+
+def test_csv_column_unit_not_understood_is_quoted():
+    text = save_frf(_mixed(), format="csv").decode().replace("[(rad/s)/m]", "[furlong]")
+    with pytest.raises(fc.DataFormatError, match="'furlong'"):
+        load_frf(text.encode(), filename="q.csv")
+
+
+def test_csv_unit_line_governs_and_a_differing_column_scale_is_noted():
+    """The issue's edit (unit line changed by hand to kN): the line governs, x1e-3, and the
+    notes say the columns stated another scale."""
+    text = save_frf(_one(), format="csv").decode().replace("# units: m/(N s)", "# units: m/s/kN")
+    r = load_frf(text.encode(), filename="e.csv")
+    assert r.frf.data[0, 0, 0] == pytest.approx(1e-3, rel=1e-15)
+    assert any("governs" in n for n in r.notes)

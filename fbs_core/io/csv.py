@@ -6,7 +6,7 @@ FRF layout (``docs/file-formats.md``)::
     # quantity: mobility
     # units: m/(N s)
     # layout: re-im
-    freq [Hz],Re(bushing:z / spindle:x),Im(bushing:z / spindle:x),...
+    freq [Hz],Re(bushing:z / spindle:x) [m/(N s)],Im(bushing:z / spindle:x) [m/(N s)],...
     0.5,1.25e-05,-3.5e-06,...
 
 Header lines start with ``#`` and hold ``key: value`` pairs: ``quantity``
@@ -14,8 +14,13 @@ Header lines start with ``#`` and hold ``key: value`` pairs: ``quantity``
 ``mag-phase``), ``phase_unit`` (``deg`` or ``rad``), ``freq_unit`` (``Hz``,
 ``rad/s``); other keys are kept as metadata. Then one header row: the frequency
 column first, then two columns per output/input pair, ``Re(out / in)`` and
-``Im(out / in)`` (or ``Mag(...)`` and ``Phase(...)``), in any order. Comma,
-semicolon or tab separated; UTF-8.
+``Im(out / in)`` (or ``Mag(...)`` and ``Phase(...)``), in any order, each optionally
+followed by the entry's unit in brackets (``[(rad/s)/m]``; the writer always gives it,
+since one FRF can mix translations and rotations, forces, moments and road inputs). A
+column unit is checked against the entry's kind (a rotation in m is refused); the
+``units`` line, where present, governs the scale (a difference is noted on import);
+without a ``units`` line the column units convert the data. Comma, semicolon or tab separated;
+UTF-8.
 """
 
 from __future__ import annotations
@@ -47,7 +52,9 @@ from .checks import (
 
 __all__ = ["read_csv", "write_csv", "write_csv_tables"]
 
-_COL = re.compile(r"^\s*(re|im|mag|abs|phase|ph)\s*[\(\[]\s*(.+?)\s*[\)\]]\s*$", re.I)
+_COL = re.compile(
+    r"^\s*(re|im|mag|abs|phase|ph)\s*[\(\[]\s*(.+?)\s*[\)\]]\s*(?:\[\s*([^\]]*?)\s*\])?\s*$", re.I
+)
 _FREQ = re.compile(r"^\s*(freq|frequency|f)\s*(?:[\[\(]\s*([^\]\)]*)\s*[\]\)])?\s*$", re.I)
 
 
@@ -100,6 +107,7 @@ def read_csv(
     if phase_unit not in ("deg", "rad"):
         raise DataFormatError(f"{name!r}: phase_unit {phase_unit!r}; allowed: deg, rad")
     cols: dict[tuple[str, str], dict[str, int]] = {}
+    col_units: dict[tuple[str, str], str] = {}  # optional "[unit]" after a column name
     for c, h in enumerate(header[1:], start=1):
         mm = _COL.match(h)
         if not mm:
@@ -115,6 +123,12 @@ def read_csv(
         if part in cols.setdefault(key, {}):
             raise DataFormatError(f"{name!r}: column {h!r} appears twice")
         cols[key][part] = c
+        if mm.group(3) and part in ("re", "im", "mag"):
+            if col_units.setdefault(key, mm.group(3)) != mm.group(3):
+                raise DataFormatError(
+                    f"{name!r}: the columns of {o} / {i} give two units, "
+                    f"{col_units[key]!r} and {mm.group(3)!r}"
+                )
     if not cols:
         raise DataFormatError(f"{name!r} has a frequency column but no FRF columns")
     kinds = {frozenset(v) for v in cols.values()}
@@ -151,12 +165,15 @@ def read_csv(
             labels[key] = (rename_node(lab, nodes), sign)
         return labels[key]
 
+    entry_units: dict[tuple[str, str], str] = {}
     for (o, i), v in cols.items():
         (lo, so), (li, si) = norm_label(o, "output"), norm_label(i, "input")
         key = (lo, li)
         if key in norm:
             raise DataFormatError(f"{name!r}: two column pairs for {key[0]} / {key[1]}")
         norm[key] = (v, so * si)
+        if (o, i) in col_units:
+            entry_units[key] = col_units[(o, i)]
     outputs = list(dict.fromkeys(o for o, _ in norm))
     inputs = list(dict.fromkeys(i for _, i in norm))
     n_missing, missing = missing_pairs(outputs, inputs, norm)
@@ -184,20 +201,87 @@ def read_csv(
     units = parse_units(meta.get("units"))
     if meta.get("units") and units is None:
         notes.append(f"units {meta['units']!r} not understood; not checked")
+    if not meta.get("units") and entry_units:
+        # no unit line: the columns' own units say it (all of them, or it is ambiguous)
+        if len(entry_units) != len(norm):
+            raise DataFormatError(
+                f"{name!r}: {len(entry_units)} of {len(norm)} output/input pairs give a "
+                "unit after their column name and there is no '# units:' line; give every "
+                "pair its unit, or the unit line"
+            )
+    declared = units
+    if not meta.get("units") and entry_units:
+        declared = _parse_column_unit(next(iter(entry_units.items())), name)
     q = reconcile_quantity(
-        meta.get("quantity") or None, units, quantity, repr(name), meta.get("units")
+        meta.get("quantity") or None, declared, quantity, repr(name), meta.get("units")
     )
     frf = FRF(freq, data, outputs, inputs, q, kinds=parse_kinds(meta.get("kinds"), repr(name)))
     notes += units_note(units)
-    if units is not None and not units.is_si:
-        frf = frf.replace(data=frf.data * si_factors(units, outputs, inputs, frf.kinds, q)[None])
-        notes.append(f"converted from {units.label} to SI ({frf.unit()})")
+    factors = None
+    if units is not None:
+        factors = si_factors(units, outputs, inputs, frf.kinds, q)
+    if entry_units:
+        factors, differ = _column_factors(entry_units, factors, frf, q, o_pos, i_pos, name)
+        if differ:
+            notes.append(
+                f"the unit line {meta['units']!r} governs; {len(differ)} column pairs state "
+                f"another scale, e.g. {differ[0]}"
+            )
+        else:
+            notes.append(f"units of {len(entry_units)} column pairs checked")
+    if factors is not None and not np.all(factors == 1.0):
+        frf = frf.replace(data=frf.data * factors[None])
+        came = units.label if units is not None else "the column units"
+        notes.append(f"converted from {came} to SI ({frf.unit()})")
     extra = {
         k: v
         for k, v in meta.items()
         if k not in ("quantity", "units", "layout", "phase_unit", "freq_unit", "kinds")
     }
     return frf, notes, extra
+
+
+def _parse_column_unit(item: tuple[tuple[str, str], str], name: str):
+    (o, i), text = item
+    u = parse_units(text)
+    if u is None or u.quantity is None:
+        raise DataFormatError(
+            f"{name!r}: the unit {text!r} after the columns of {o} / {i} is not understood "
+            "as an FRF unit (known: m mm cm um in ft / N kN mN lbf / s ms / rad deg / g, "
+            "e.g. '(m/s)/m', 'rad/(N m s)', 'mm/(s N)')"
+        )
+    return u
+
+
+def _column_factors(entry_units, factors, frf: FRF, q: str, o_pos, i_pos, name: str):
+    """SI factors from the unit written after each column name, checked against the kind
+    of each entry (a rotation is not in m). Where the file has a unit line, that line
+    governs the scale (a file whose unit line was edited by hand reads as the line says);
+    the pairs whose column unit gives another scale are returned for the import notes."""
+    from ..units import input_kind, output_kind
+
+    out = np.ones((len(o_pos), len(i_pos))) if factors is None else factors.copy()
+    differ: list[str] = []
+    for (o, i), text in entry_units.items():
+        u = _parse_column_unit(((o, i), text), name)
+        ok, ik = output_kind(o, frf.kinds), input_kind(i, frf.kinds)
+        if u.kinds is not None and u.kinds != (ok, ik):
+            raise DataFormatError(
+                f"{name!r}: the unit {text!r} of {o} / {i} is that of a {u.kinds[0]} per "
+                f"{u.kinds[1]}, but {o} is a {ok} and {i} a {ik}"
+            )
+        if u.quantity != q:
+            raise DataFormatError(
+                f"{name!r}: the unit {text!r} of {o} / {i} is that of a {u.quantity}, the "
+                f"file holds a {q}"
+            )
+        f = u.factor(ok, ik, q)
+        a, b = o_pos[o], i_pos[i]
+        if factors is None:
+            out[a, b] = f
+        elif not np.isclose(f, factors[a, b], rtol=1e-9, atol=0.0):
+            differ.append(f"{o} / {i} [{text}]")
+    return out, differ
 
 
 def _header(metadata: Mapping | None, title: str) -> list[str]:
@@ -242,9 +326,11 @@ def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
     if frf.kinds:
         lines.append(f"# kinds: {kinds_text(frf.kinds)}")
     cols = ["freq [Hz]"]
-    for o in frf.outputs:
-        for i in frf.inputs:
-            cols += [f"Re({o} / {i})", f"Im({o} / {i})"]
+    units = frf.units  # every entry's own SI unit, written after its column name
+    for a, o in enumerate(frf.outputs):
+        for b, i in enumerate(frf.inputs):
+            u = units[a, b]
+            cols += [f"Re({o} / {i}) [{u}]", f"Im({o} / {i}) [{u}]"]
     lines.append(",".join(cols))
     d = frf.data.reshape(frf.freq.size, -1)
     block = np.empty((frf.freq.size, 1 + 2 * d.shape[1]))
