@@ -161,14 +161,16 @@ def _load_model_classes() -> None:
 _APP_URLS: dict[str, str] = {}
 
 
-def websocket_url(url: str) -> str:
+def websocket_url(url: str, headers: dict | None = None) -> str:
     """The Bokeh websocket endpoint of an app URL (``http://h:p/app`` -> ``ws://h:p/app/ws``).
 
     A server root that redirects to its app (``panel serve`` of one script: ``/`` ->
-    ``/main``) is followed first, as a browser would.
+    ``/main``) is followed first, as a browser would (sending ``headers``, e.g. a login
+    cookie).
     """
     if url not in _APP_URLS:
-        with urllib.request.urlopen(url, timeout=60) as r:
+        req = urllib.request.Request(url, headers=headers or {})
+        with urllib.request.urlopen(req, timeout=60) as r:
             _APP_URLS[url] = r.geturl()
     parts = urllib.parse.urlsplit(_APP_URLS[url])
     scheme = {"http": "ws", "https": "wss"}.get(parts.scheme, parts.scheme)
@@ -212,9 +214,13 @@ class BokehSession:
     sessions' patches does not count its own backlog as the server's.
     """
 
-    def __init__(self, *, max_message_mb: int = 200):
+    def __init__(
+        self, *, max_message_mb: int = 200, headers: dict | None = None, token: str | None = None
+    ):
         _load_model_classes()
         self._max_bytes = max_message_mb * 2**20
+        self._headers = dict(headers or {})  # e.g. Cookie (a login), Origin
+        self._token = token  # of a session the server made for a page (else a new session)
         self.errors: list[str] = []
         self.doc = None
         self._ws = self._sock = None
@@ -234,14 +240,17 @@ class BokehSession:
         from bokeh.protocol import Protocol
         from bokeh.protocol.receiver import Receiver
         from bokeh.util.token import generate_jwt_token, generate_session_id
+        from tornado.httpclient import HTTPRequest
         from tornado.websocket import websocket_connect
 
         self._protocol = Protocol()
         self._receiver = Receiver(self._protocol)
-        token = generate_jwt_token(generate_session_id())
+        token = self._token or generate_jwt_token(generate_session_id())
         self._ws = await asyncio.wait_for(
             websocket_connect(
-                websocket_url(url), subprotocols=["bokeh", token], max_message_size=self._max_bytes
+                HTTPRequest(websocket_url(url, self._headers), headers=self._headers),
+                subprotocols=["bokeh", token],
+                max_message_size=self._max_bytes,
             ),
             timeout_s,
         )
