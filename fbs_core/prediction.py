@@ -23,6 +23,8 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from .chassis import BUSHING, SPINDLE, ChassisModel, reference_chassis
 from .coupling import couple_response
@@ -31,7 +33,7 @@ from .errors import FBSError
 from .frf import FRF, check_grid
 from .harmonics import Harmonic, harmonic
 
-__all__ = ["bushing_response", "coupled_dofs", "COUPLINGS", "HUB"]
+__all__ = ["bushing_response", "direct_bushing_response", "coupled_dofs", "COUPLINGS", "HUB"]
 
 #: Hub DOF labels of the tire, in vehicle coordinates.
 HUB: tuple[str, ...] = node_labels("hub")
@@ -109,6 +111,98 @@ def _compute(tire, chassis: ChassisModel, h: Harmonic, f, n_modes, coupling, spe
         interface=_interface(),
         couple=coupled_dofs(coupling),
     )
+
+
+def _assembled_index(tire_dofs, chassis_dofs, coupled):
+    """Primal assembly by index maps: global index of every tire and chassis DOF.
+
+    Chassis ``spindle:d`` is merged into tire ``hub:d`` for every coupled ``hub:d``
+    (the same DOF merging as :func:`fbs_core.direct.assemble`).
+    """
+    n_a = len(tire_dofs)
+    g_e, nxt = [], n_a
+    for d in chassis_dofs:
+        node, _, direction = d.partition(":")
+        hub = f"hub:{direction}"
+        if node == "spindle" and hub in coupled:
+            g_e.append(tire_dofs.index(hub))
+        else:
+            g_e.append(nxt)
+            nxt += 1
+    return np.arange(n_a), np.array(g_e), nxt
+
+
+def direct_bushing_response(
+    harmonic_case,
+    freq=None,
+    coupling: str = "6dof",
+    *,
+    speed_kmh: float | None = None,
+    tire=None,
+    chassis: ChassisModel | None = None,
+) -> FRF:
+    """Ground truth of :func:`bushing_response`: the assembled matrices solved line by line.
+
+    At every line the tire's own matrices at the exact speed of that line,
+    ``v = 3.6 f lambda`` (``tire.system(v)``: ``M``, ``C = D + G(v)``, ``K(v)``;
+    thesis section 4.1.2), are joined to the chassis' FE matrices at the coupled
+    hub DOFs (primal assembly, as :func:`fbs_core.direct.assemble`) and the
+    dynamic stiffness ``K - omega^2 M + j omega C`` (eq. 2.2) is solved for the
+    physical patch load ``tire.patch_load(v, lambda)``. No modes, no
+    interpolation between operating points, no FBS: what the modal model and
+    eq. 4.1 approximate. Needs a tire with physical parameters.
+
+    Parameters
+    ----------
+    harmonic_case : int or Harmonic
+    freq : array_like, optional
+        Lines in Hz inside the harmonic's band; default ``harmonic.frequencies()``.
+    coupling : {"6dof", "5dof"}
+    speed_kmh : float, optional
+        Keyword only: one fixed speed instead of the harmonic line.
+    tire, chassis : optional
+        Keyword only; default the reference models.
+
+    Returns
+    -------
+    FRF
+        Outputs ``bushing:x`` ... ``bushing:rz``, input ``patch`` (mobility, per
+        metre of road amplitude), like :func:`bushing_response`.
+    """
+    h = harmonic(harmonic_case)
+    coupled = coupled_dofs(coupling)
+    f = h.frequencies() if freq is None else check_grid(freq)
+    speeds = h.speed_at(f) if speed_kmh is None else np.full(f.size, float(speed_kmh))
+    speeds = np.atleast_1d(speeds)
+    if tire is None:
+        from . import reference_tire
+
+        tire = reference_tire()
+    chassis = reference_chassis() if chassis is None else chassis
+    cs = chassis.system()
+    Ze_parts = [sp.csc_matrix(a) for a in (cs.K, cs.M, cs.C)]
+    keep = [list(cs.dofs).index(d) for d in SPINDLE + BUSHING]  # 12 chassis DOFs kept
+    out = np.empty((f.size, len(BUSHING), 1), complex)
+    load = tire.patch_load(float(speeds[0]), h.wavelength)  # space-fixed: speed independent
+    ia = ie = None
+    for i, (fi, v) in enumerate(zip(f, speeds, strict=True)):
+        ts = tire.system(float(v))
+        if ia is None:
+            ia, ie, n = _assembled_index(list(ts.dofs), SPINDLE + BUSHING, coupled)
+        w = 2 * np.pi * fi
+        # block elimination of the chassis' inner DOFs (exact: Gaussian elimination of
+        # the assembled matrix in another order): Z_E condensed onto spindle + bushing
+        Ze = (Ze_parts[0] - w**2 * Ze_parts[1] + 1j * w * Ze_parts[2]).tocsc()
+        rhs = np.zeros((cs.n, len(keep)), complex)
+        rhs[keep, np.arange(len(keep))] = 1.0
+        S = np.linalg.inv(spla.splu(Ze).solve(rhs)[keep])
+        Z = np.zeros((n, n), complex)
+        Z[np.ix_(ia, ia)] += ts.K - w**2 * ts.M + 1j * w * ts.C
+        Z[np.ix_(ie, ie)] += S
+        b = np.zeros(n, complex)
+        b[ia] = load
+        out[i, :, 0] = 1j * w * np.linalg.solve(Z, b)[ie[len(SPINDLE) :]]
+    return FRF(f, out, BUSHING, ["patch"], "mobility")
 
 
 def bushing_response(

@@ -139,7 +139,9 @@ def test_other_grid_needs_an_explicit_interpolation(chassis_frf):
 # -- the tire upload -------------------------------------------------------------------------
 def test_tire_upload_shows_modes_and_operating_points(tmp_path):
     ds = DataSource()
-    assert ds.load_tire(_tire_bytes(tmp_path, _sub_tire(n_modes=200)), "supplier.h5"), ds.error
+    # every 8th of the reference tire's operating points: 20, 40, ..., 120 km/h
+    sub = _sub_tire(n_modes=200, speeds=slice(None, None, 8))
+    assert ds.load_tire(_tire_bytes(tmp_path, sub), "supplier.h5"), ds.error
     assert ds.models.tire.n_modes == 200 and ds.models.chassis is None
     s = ds.tire_summary
     assert "200 complex modes" in s and "20, 40, 60, 80, 100, 120 km/h" in s
@@ -149,7 +151,8 @@ def test_tire_upload_shows_modes_and_operating_points(tmp_path):
 def test_tire_without_the_harmonics_operating_points_is_refused(tmp_path):
     ds = DataSource()
     # operating points from 60 km/h: the harmonics need 30 km/h
-    assert not ds.load_tire(_tire_bytes(tmp_path, _sub_tire(speeds=slice(2, None))), "t.h5")
+    sub = _sub_tire(speeds=fbs_core.reference_tire().speeds >= 60.0)
+    assert not ds.load_tire(_tire_bytes(tmp_path, sub), "t.h5")
     assert "outside the operating points" in ds.error and "harmonic 1" in ds.error
     assert ds.models is REFERENCE
 
@@ -310,9 +313,11 @@ def test_truncated_tire_upload_is_the_reference_with_fewer_modes(tmp_path):
     mob = MobilityView(case=state.case).data()
     ref100 = compute.mobility_data(1, 100, "z", "6dof")
     ref200 = compute.mobility_data(1, 200, "z", "6dof")
-    # the first 100 modes are the reference's; "all modes" of this tire are its 200
-    np.testing.assert_allclose(mob["truncated"], ref100["truncated"], rtol=1e-9)
-    np.testing.assert_allclose(mob["reference"], ref200["truncated"], rtol=1e-9)
+    # the first 100 modes are the reference's; "all modes" of this tire are its 200 (the
+    # reference keeps the 100 lowest pairs of each operating point and interpolates its
+    # clusters of close modes whole, so a cut of the stored modes differs slightly)
+    np.testing.assert_allclose(mob["truncated"], ref100["truncated"], rtol=1e-3)
+    np.testing.assert_allclose(mob["reference"], ref200["truncated"], rtol=1e-3)
     m = TruncationView(case=state.case, truncation=state.truncation).data()
     assert m["n_modes"].tolist() == list(range(10, 200, 10))
     e = EigenView(case=state.case).data()

@@ -8,13 +8,15 @@ of each harmonic case, ``p_r = chi_r^T f_patch``. From these it synthesises
 * the hub mobility ``Y_jj^A(omega) = j omega sum_r psi_r chi_r^T / (j omega - lambda_r)``,
 * the free hub velocity ``Y_ja^A F_a = j omega sum_r psi_r p_r / (j omega - lambda_r)``,
 
-keeping the first ``N`` modes (``N / 2`` conjugate pairs, lowest first; thesis
-section 5.1). Along a harmonic line the speed is ``v = f lambda``; between two
-operating points the poles and the residues (``psi_r chi_r^T`` and
-``psi_r p_r``, which do not depend on how the shapes are scaled) are
-interpolated linearly in speed (thesis section 4.1.2). Modes are tracked across
-operating points before storing (:func:`.modes.track_modes`), so that mode ``r``
-is the same mode at every speed.
+keeping the first ``N`` modes (``N / 2`` conjugate pairs of lowest eigenfrequency
+at the nearest operating point; thesis section 5.1). Along a harmonic line every
+line has its own speed ``v = f lambda`` (thesis section 4.1.2); between the
+operating points the poles and the residues (``psi_r chi_r^T`` and ``psi_r p_r``,
+which do not depend on how the shapes are scaled) are interpolated in speed,
+cubic on the four nearest points, and clusters of close modes (veering pairs of
+the gyroscopic tire) through their characteristic polynomial and moments
+(:mod:`.interp`). Modes are tracked across operating points before storing
+(:func:`.modes.track_modes`), so that mode ``r`` is the same mode at every speed.
 """
 
 from __future__ import annotations
@@ -27,11 +29,20 @@ from ..direct import SecondOrderSystem
 from ..errors import DataFormatError, FBSError
 from ..frf import FRF, check_grid
 from ..harmonics import Harmonic, harmonic
+from . import interp
+from .interp import cluster_at, cluster_ends, cluster_sum, find_clusters, lagrange_weights
 from .params import TireParameters
 from .ring import HUB_DOFS, build_tire_system
 from .ring import patch_load as _patch_load
 
-__all__ = ["TireModel", "OperatingPointError", "ModeCountError"]
+__all__ = ["TireModel", "OperatingPointError", "ModeCountError", "INTERPOLATIONS"]
+
+#: Interpolation schemes between operating points.
+INTERPOLATIONS = ("cubic", "cluster", "linear")
+
+
+#: Lines per block of the modal sums (bounds the memory of the per-mode terms).
+_CHUNK = 48
 
 
 class OperatingPointError(FBSError):
@@ -73,6 +84,13 @@ class TireModel:
         Free-form provenance (source, format version, ...).
     hub_dofs : tuple of str
         Labels of the 6 hub DOFs, ``hub:x`` ... ``hub:rz`` in vehicle coordinates.
+    interpolation : {"cubic", "cluster", "linear"}
+        Between operating points (:mod:`.interp`): ``"cubic"`` (default) cubic
+        Lagrange in speed on the four nearest operating points (linear in the
+        first and last interval), with clusters of close modes interpolated
+        through their characteristic polynomial and moments; ``"cluster"`` the
+        same with linear weights; ``"linear"`` plain linear weights on every
+        pole and residue (thesis section 4.1.2, for comparison).
     """
 
     speeds: np.ndarray
@@ -84,8 +102,14 @@ class TireModel:
     params: TireParameters | None = None
     meta: dict = field(default_factory=dict)
     hub_dofs: tuple[str, ...] = HUB_DOFS
+    interpolation: str = "cubic"
 
     def __post_init__(self):
+        if self.interpolation not in INTERPOLATIONS:
+            raise FBSError(
+                f"unknown interpolation {self.interpolation!r}; allowed: "
+                f"{', '.join(map(repr, INTERPOLATIONS))}"
+            )
         sp = np.asarray(self.speeds, float)
         n_s = sp.size
         if sp.ndim != 1 or n_s < 2 or np.any(np.diff(sp) <= 0):
@@ -127,7 +151,30 @@ class TireModel:
         # residues, invariant to the scaling of the shapes: (n_s, n_m, 6 * 6 + 6 * n_h)
         R = np.einsum("smi,smj->smij", self.psi, self.chi).reshape(n_s, n_m, 36)
         Q = np.einsum("smi,shm->smhi", self.psi, part).reshape(n_s, n_m, 6 * lam.size)
-        object.__setattr__(self, "_Z", np.concatenate([R, Q], axis=2))
+        Z = np.concatenate([R, Q], axis=2)
+        Z.setflags(write=False)
+        object.__setattr__(self, "_Z", Z)
+        clusters, nodes = [], []
+        for k in range(n_s - 1):
+            nd = slice(k, k + 2)
+            if self.interpolation == "cubic" and 1 <= k <= n_s - 3:
+                nd = slice(k - 1, k + 3)  # centred stencil; end intervals stay linear
+            nodes.append(nd)
+            groups = []
+            if self.interpolation != "linear":
+                moving = interp.residue_change(Z[k, 0::2], Z[k + 1, 0::2]) > interp.TAU
+                groups = find_clusters(poles[k, 0::2], poles[k + 1, 0::2], moving=moving)
+            e = (k - nd.start, k + 1 - nd.start)
+            groups = [2 * g + par for g in groups for par in (0, 1)]
+            clusters.append(tuple(cluster_ends(groups, poles[nd], Z[nd], e)))
+        object.__setattr__(self, "_clusters", tuple(clusters))
+        object.__setattr__(self, "_nodes", tuple(nodes))
+        # truncation order at every operating point: pairs by eigenfrequency there
+        pairs = np.argsort(poles[:, 0::2].imag, axis=1, kind="stable")
+        order = np.stack([2 * pairs, 2 * pairs + 1], axis=-1).reshape(n_s, -1)
+        order.setflags(write=False)
+        object.__setattr__(self, "_order", order)
+        object.__setattr__(self, "_plans", {})  # cache of truncation plans (see _plan)
 
     # -- basic information -----------------------------------------------------------
     @property
@@ -149,10 +196,29 @@ class TireModel:
         t = np.clip((v - self.speeds[k]) / (self.speeds[k + 1] - self.speeds[k]), 0.0, 1.0)
         return k, t
 
+    def _poles_at(self, k: int, t: np.ndarray) -> np.ndarray:
+        """Poles ``(n_l, n_m)`` in interval ``k`` at fractions ``t``, stored order; within a
+        cluster the roots go to the members in the order of their interpolated poles."""
+        nd = self._nodes[k]
+        v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
+        w = lagrange_weights(self.speeds[nd], v)
+        lam = w @ self.poles[nd]
+        rows = np.arange(w.shape[0])[:, None, None]
+        for cl in self._clusters[k]:
+            p, _ = cluster_at(cl, w, np.arange(0))
+            perm = np.argsort(np.abs(lam[:, cl.members].imag), axis=-1)
+            lam[rows, np.take_along_axis(cl.members[None], perm, axis=-1)] = p
+        return lam
+
     def poles_at(self, speed_kmh: float) -> np.ndarray:
-        """Poles interpolated linearly in speed, shape (n_m,)."""
+        """Poles at ``speed_kmh``, shape (n_m,), in the stored (tracked) order.
+
+        Linear in speed between the operating points, except for clusters of
+        close modes (:mod:`.interp`), whose poles are the roots of the
+        interpolated characteristic polynomial.
+        """
         k, t = self._weights(speed_kmh)
-        return (1 - t[0]) * self.poles[k[0]] + t[0] * self.poles[k[0] + 1]
+        return self._poles_at(int(k[0]), t[:1])[0]
 
     def eigenfrequencies(self, speed_kmh: float) -> np.ndarray:
         """Positive eigenfrequencies ``Im(lambda) / 2 pi`` in Hz at ``speed_kmh``, sorted.
@@ -191,31 +257,103 @@ class TireModel:
         return int(i[0])
 
     # -- modal synthesis -------------------------------------------------------------
+    def _total(self, k: int, t, s, cols) -> np.ndarray:
+        """Receptance sum over all modes at lines of interval ``k``: linear part by
+        matrix products, every cluster by its rational form (no roots needed)."""
+        nd = self._nodes[k]
+        v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
+        w = lagrange_weights(self.speeds[nd], v)
+        T = 1.0 / (s[:, None] - w @ self.poles[nd])  # (n_l, n_m)
+        for cl in self._clusters[k]:
+            T[:, cl.members.ravel()] = 0.0
+        Zn = self._Z[nd]  # (n_nodes, n_m, n_res), a view
+        tot = sum(w[:, i, None] * (T @ Zn[i]) for i in range(Zn.shape[0]))[:, cols]
+        for cl in self._clusters[k]:
+            tot = tot + cluster_sum(cl, w, s, cols)
+        return tot
+
     def _sums(self, freq, speeds, n_list, h_index) -> tuple[np.ndarray, np.ndarray]:
-        """Cumulative modal sums: mobility (n_N, n_f, 6, 6) and patch velocity (n_N, n_f, 6)."""
+        """Cumulative modal sums: mobility (n_N, n_f, 6, 6) and patch velocity (n_N, n_f, 6).
+
+        The modes are interpolated to every line's speed. The ``N`` retained modes
+        are the ``N / 2`` pairs of lowest eigenfrequency at the nearest operating
+        point (thesis section 5.1: "the first 50 positive eigenfrequencies"; exact
+        at the operating points, where the modes are delivered).
+        """
         f = np.asarray(freq, float)
         k, t = self._weights(speeds)
         s = 2j * np.pi * f
-        if h_index is None:
-            Z = self._Z[:, :, :36]
-        else:
-            Z = self._Z[:, :, np.r_[np.arange(36), 36 + 6 * h_index + np.arange(6)]]
+        cols = np.arange(36)
+        if h_index is not None:
+            cols = np.r_[cols, 36 + 6 * h_index + np.arange(6)]
+        n_list = list(n_list)
+        only_all = n_list == [self.n_modes]
         edges = np.r_[0, n_list]
-        out = np.zeros((len(n_list), f.size, Z.shape[2]), complex)
+        out = np.zeros((len(n_list), f.size, cols.size), complex)
         for kk in np.unique(k):
-            idx = np.flatnonzero(k == kk)
-            tt = t[idx][:, None]
-            lam = (1 - tt) * self.poles[kk][None, :] + tt * self.poles[kk + 1][None, :]
-            T = 1.0 / (s[idx, None] - lam)  # (n_lines, n_modes)
-            Ta, Tb = T * (1 - tt), T * tt
-            for b in range(len(n_list)):
-                sl = slice(edges[b], edges[b + 1])
-                # (n_lines, n_block) @ (n_block, n_res)
-                out[b, idx] = Ta[:, sl] @ Z[kk, sl] + Tb[:, sl] @ Z[kk + 1, sl]
+            lines = np.flatnonzero(k == kk)
+            if only_all:
+                for idx in np.array_split(lines, max(1, int(np.ceil(lines.size / _CHUNK)))):
+                    out[0, idx] = self._total(int(kk), t[idx], s[idx], cols)
+                continue
+            for near in (0, 1):  # lines nearer the lower / upper operating point
+                sel = lines[(t[lines] >= 0.5) == bool(near)]
+                for idx in np.array_split(sel, max(1, int(np.ceil(sel.size / _CHUNK)))):
+                    if idx.size:
+                        out[:, idx] = self._blocks(int(kk), near, t[idx], s[idx], cols, edges)
         out = np.cumsum(out, axis=0) * s[None, :, None]  # mobility = j omega H
         Y = out[:, :, :36].reshape(len(n_list), f.size, 6, 6)
         v = out[:, :, 36:] if h_index is not None else None
         return Y, v
+
+    def _plan(self, k: int, near: int, edges):
+        """Truncation order at operating point ``k + near`` and, per cluster batch, the
+        clusters inside one block of ``edges`` and those split by a block edge (with
+        their members ranked at that point). Cached: it depends on the counts only."""
+        key = (k, near, tuple(int(e) for e in edges))
+        hit = self._plans.get(key)
+        if hit is not None:
+            return hit
+        order = self._order[k + near]
+        rank = np.empty_like(order)
+        rank[order] = np.arange(order.size)
+        block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
+        plan = []
+        for cl in self._clusters[k]:
+            b = block[cl.members]
+            whole = np.all(b == b[:, :1], axis=1)  # cluster inside one block
+            w_sub = interp.subset(cl, whole) if whole.any() else None
+            s_sub = interp.subset(cl, ~whole) if (~whole).any() else None
+            # the lowest root goes to the member ranked lowest at the operating point
+            s_mem = None
+            if s_sub is not None:
+                s_mem = np.take_along_axis(s_sub.members, np.argsort(rank[s_sub.members], 1), 1)
+            plan.append((cl.members.ravel(), w_sub, s_sub, s_mem))
+        if len(self._plans) > 4 * len(self._clusters):
+            self._plans.clear()
+        self._plans[key] = (order, plan)
+        return order, plan
+
+    def _blocks(self, k: int, near: int, t, s, cols, edges) -> np.ndarray:
+        """Receptance sums over the blocks of retained modes ``edges`` (n_N, n_l, n_cols),
+        modes ranked at operating point ``k + near``."""
+        order, plan = self._plan(k, near, edges)
+        nd = self._nodes[k]
+        v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
+        w = lagrange_weights(self.speeds[nd], v)
+        Zn = self._Z[nd]
+        T = 1.0 / (s[:, None] - w @ self.poles[nd])  # (n_l, n_m)
+        Zl = (w @ Zn.reshape(Zn.shape[0], -1)).reshape(t.size, *Zn.shape[1:])
+        C = T[:, :, None] * Zl[:, :, cols]  # (n_l, n_m, n_cols)
+        for members, whole, split, split_members in plan:
+            C[:, members] = 0.0
+            if whole is not None:  # the cluster's sum, in the slot of its first member
+                C[:, whole.members[:, 0]] = cluster_sum(whole, w, s, cols, per_cluster=True)
+            if split is not None:  # split by a block edge: every member on its own
+                p, r = cluster_at(split, w, cols)  # roots by frequency, lowest first
+                C[:, split_members] = r / (s[:, None, None, None] - p[..., None])
+        kept = order[: edges[-1]]  # modes beyond the largest count are left out
+        return np.moveaxis(np.add.reduceat(C[:, kept], edges[:-1], axis=1), 1, 0)
 
     def hub_mobility(self, freq, speed_kmh: float, n_modes: int | None = None) -> FRF:
         """Hub mobility ``Y_jj^A`` (6 x 6) at a fixed speed, from the first ``n_modes`` modes.
