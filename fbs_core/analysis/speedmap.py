@@ -91,6 +91,11 @@ def _tire_at_speeds(tire, h: Harmonic, f: np.ndarray, speeds: np.ndarray, n: int
             f"the tire model has no patch participation for wavelength {h.wavelength:g} m "
             f"({h.name}); stored: {', '.join(f'{w:g}' for w in tire.wavelengths)} m"
         )
+    if hasattr(tire, "synthesis"):  # the model's own interpolation between its points
+        ff = np.tile(f, speeds.size)
+        vv = np.repeat(speeds, f.size)
+        Y, vj = tire.synthesis(ff, vv, int(hi[0]), None if n >= tire.n_modes else n)
+        return Y.reshape(speeds.size, f.size, 6, 6), vj.reshape(speeds.size, f.size, 6)
     Z = _residues(tire, int(hi[0]))[:, :n]
     op = tire.speeds
     k = np.clip(np.searchsorted(op, speeds, side="right") - 1, 0, op.size - 2)

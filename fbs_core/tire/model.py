@@ -355,6 +355,30 @@ class TireModel:
         kept = order[: edges[-1]]  # modes beyond the largest count are left out
         return np.moveaxis(np.add.reduceat(C[:, kept], edges[:-1], axis=1), 1, 0)
 
+    def synthesis(self, freq, speeds, harmonic_index: int | None = None, n_modes=None):
+        """Hub mobility and free hub velocity line by line, each line at its own speed.
+
+        Parameters
+        ----------
+        freq, speeds : array_like, shape (n,)
+            Frequency (Hz) and vehicle speed (km/h) of every line; any order.
+        harmonic_index : int, optional
+            Index into :attr:`wavelengths` of the patch load; None: mobility only.
+        n_modes : int, optional
+            Even count of retained modes (lowest pairs of the nearest operating point).
+
+        Returns
+        -------
+        Y : ndarray, shape (n, 6, 6)
+        v : ndarray, shape (n, 6) or None
+        """
+        f = np.asarray(freq, float).ravel()
+        sp = np.asarray(speeds, float).ravel()
+        if f.shape != sp.shape:
+            raise FBSError(f"freq and speeds must have one length, got {f.size} and {sp.size}")
+        Y, v = self._sums(f, sp, [self._check_n(n_modes)], harmonic_index)
+        return Y[0], (None if v is None else v[0])
+
     def hub_mobility(self, freq, speed_kmh: float, n_modes: int | None = None) -> FRF:
         """Hub mobility ``Y_jj^A`` (6 x 6) at a fixed speed, from the first ``n_modes`` modes.
 
