@@ -129,7 +129,7 @@ def test_order_lines_and_crossings_on_the_reference_tire():
     assert len(cr) > 20
     for c in cr[::7]:  # the line meets the branch: check against the model itself
         f_branch = tire.poles_at(c.speed_kmh)[0::2][c.branch].imag / (2 * np.pi)
-        assert f_branch == pytest.approx(c.freq, rel=1e-3)  # cubic model, linear crossing
+        assert f_branch == pytest.approx(c.freq, rel=5e-3)  # cubic model, linear crossing
         assert c.freq == pytest.approx(c.speed_kmh / 3.6 / HARMONICS[c.harmonic - 1].wavelength)
         assert 30 - 1e-9 <= c.speed_kmh <= 120 + 1e-9
     assert len(cb.crossings(in_band=False)) >= len(cr)
