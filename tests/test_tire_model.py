@@ -273,3 +273,16 @@ def test_file_format_attributes_and_errors(tmp_path, tire):
     text.write_text("not hdf5")
     with pytest.raises(DataFormatError, match="cannot read"):
         load_tire_model(text)
+
+
+def test_harmonic_case_keyword_is_deprecated(tire):
+    f = harmonic(2).frequencies(4.0)
+    new = tire.patch_response(f, harmonic=2).data
+    with pytest.warns(DeprecationWarning, match="harmonic_case is deprecated"):
+        old = tire.patch_response(f, harmonic_case=2).data
+    np.testing.assert_array_equal(old, new)
+    with pytest.warns(DeprecationWarning):
+        Y, _ = tire.truncations(f, harmonic_case=2, n_modes_list=[20])
+    np.testing.assert_array_equal(Y, tire.truncations(f, 2, [20])[0])
+    with pytest.raises(FBSError, match="not both"), pytest.warns(DeprecationWarning):
+        tire.patch_response(f, 2, harmonic_case=2)

@@ -21,6 +21,7 @@ the gyroscopic tire) through their characteristic polynomial and moments
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,7 +29,8 @@ import numpy as np
 from ..direct import SecondOrderSystem
 from ..errors import DataFormatError, FBSError
 from ..frf import FRF, check_grid
-from ..harmonics import Harmonic, harmonic
+from ..harmonics import Harmonic
+from ..harmonics import harmonic as _harmonic
 from . import interp
 from .interp import cluster_at, cluster_ends, cluster_sum, find_clusters, lagrange_weights
 from .params import TireParameters
@@ -51,6 +53,22 @@ class OperatingPointError(FBSError):
 
 class ModeCountError(FBSError):
     """A number of retained modes that is not an even count in the allowed range."""
+
+
+def _renamed(harmonic, harmonic_case):
+    """The keyword ``harmonic_case`` was renamed ``harmonic`` (kept for one release)."""
+    if harmonic_case is not None:
+        warnings.warn(
+            "the keyword harmonic_case is deprecated; use harmonic",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        if harmonic is not None:
+            raise FBSError("give harmonic or harmonic_case (deprecated), not both")
+        return harmonic_case
+    if harmonic is None:
+        raise FBSError("harmonic is required: a case 1..7 or a Harmonic")
+    return harmonic
 
 
 def _ro(a) -> np.ndarray:
@@ -402,7 +420,13 @@ class TireModel:
         return FRF(f, Y[0], self.hub_dofs, self.hub_dofs, "mobility")
 
     def patch_response(
-        self, freq, harmonic_case, n_modes: int | None = None, speed_kmh: float | None = None
+        self,
+        freq,
+        harmonic=None,
+        n_modes: int | None = None,
+        speed_kmh: float | None = None,
+        *,
+        harmonic_case=None,
     ) -> FRF:
         """Free hub velocity ``Y_ja^A F_a`` for the patch load of a harmonic case.
 
@@ -410,8 +434,8 @@ class TireModel:
         ----------
         freq : array_like, shape (n_freq,)
             Frequencies in Hz inside the harmonic's band.
-        harmonic_case : int or Harmonic
-            Case 1..7.
+        harmonic : int or Harmonic
+            Case 1..7 (``harmonic_case=`` is the deprecated name).
         n_modes : int, optional
             Even number of complex modes kept; ``None`` keeps all.
         speed_kmh : float, optional
@@ -423,7 +447,7 @@ class TireModel:
         FRF
             Outputs ``hub:*``, one input ``patch`` (per metre of road amplitude).
         """
-        h = harmonic(harmonic_case)
+        h = _harmonic(_renamed(harmonic, harmonic_case))
         f = check_grid(freq)
         n = self._check_n(n_modes)
         hi = self._harmonic_index(h)
@@ -431,7 +455,9 @@ class TireModel:
         _, vj = self._sums(f, np.atleast_1d(v), [n], hi)
         return FRF(f, vj[0][:, :, None], self.hub_dofs, ["patch"], "mobility")
 
-    def truncations(self, freq, harmonic_case, n_modes_list) -> tuple[np.ndarray, np.ndarray]:
+    def truncations(
+        self, freq, harmonic=None, n_modes_list=None, *, harmonic_case=None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Hub mobility and free hub velocity along a harmonic line for many truncations.
 
         Cumulative modal sums give every truncation for the price of one full
@@ -441,7 +467,8 @@ class TireModel:
         ----------
         freq : array_like, shape (n_freq,)
             Frequencies in Hz inside the harmonic's band.
-        harmonic_case : int or Harmonic
+        harmonic : int or Harmonic
+            Case 1..7 (``harmonic_case=`` is the deprecated name).
         n_modes_list : sequence of int
             Increasing even mode counts, each 10..n_modes.
 
@@ -450,8 +477,10 @@ class TireModel:
         Yjj : ndarray, shape (n_N, n_freq, 6, 6)
         vj : ndarray, shape (n_N, n_freq, 6)
         """
-        h = harmonic(harmonic_case)
+        h = _harmonic(_renamed(harmonic, harmonic_case))
         f = check_grid(freq)
+        if n_modes_list is None:
+            raise ModeCountError("n_modes_list is required (increasing even mode counts)")
         ns = [
             self._check_n(int(n)) if isinstance(n, int | np.integer) else self._check_n(n)
             for n in n_modes_list

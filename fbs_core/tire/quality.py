@@ -101,7 +101,7 @@ class SpeedRangeWarning(UserWarning):
     """A harmonic band needs vehicle speeds outside the model's operating points."""
 
 
-def speed_coverage(tire, harmonic_case) -> tuple[float, float]:
+def speed_coverage(tire, harmonic) -> tuple[float, float]:
     """Part of a harmonic's band that the model's operating points cover, in Hz.
 
     Warns :class:`SpeedRangeWarning` when the band ``v = 3.6 f lambda`` over the
@@ -114,9 +114,9 @@ def speed_coverage(tire, harmonic_case) -> tuple[float, float]:
     (f_lo, f_hi) : tuple of float
         Covered band in Hz (``f_lo > f_hi`` when nothing is covered).
     """
-    from ..harmonics import harmonic
+    from ..harmonics import harmonic as _harmonic
 
-    h = harmonic(harmonic_case)
+    h = _harmonic(harmonic)
     lo, hi = h.freq_range
     s0, s1 = float(tire.speeds[0]), float(tire.speeds[-1])
     c_lo = max(lo, s0 / 3.6 / h.wavelength)
