@@ -11,7 +11,7 @@ import pytest
 
 from fbs_core import assemble, bushing_response, harmonic, reference_chassis, reference_tire
 from fbs_core.chassis import BUSHING
-from fbs_core.prediction import COUPLINGS, direct_bushing_response
+from fbs_core.prediction import coupled_dofs, direct_bushing_response
 from fbs_core.tire import TireModel, complex_modes, track_modes
 from fbs_core.tire.quality import level_errors
 
@@ -41,7 +41,7 @@ def test_direct_truth_equals_primal_assembly():
             v = h.speed_at(fi)
             ts = tire.system(v)
             joined = [
-                (f"tire/{x}", f"chassis/spindle:{x.split(':')[1]}") for x in COUPLINGS[coupling]
+                (f"tire/{x}", f"chassis/spindle:{x.split(':')[1]}") for x in coupled_dofs(coupling)
             ]
             S = assemble({"tire": ts, "chassis": ch.system()}, joined)
             pos = {x: j for j, x in enumerate(S.dofs)}
