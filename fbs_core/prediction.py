@@ -73,20 +73,22 @@ def _interface() -> list[tuple[str, str]]:
     return [(f"hub:{d}", f"spindle:{d}") for d in DIRECTIONS]
 
 
-def _tire_frfs(tire, h: Harmonic, f: np.ndarray, n_modes, speed_kmh):
+def _tire_frfs(tire, h: Harmonic, f: np.ndarray, n_modes, speed_kmh, residual=False):
     """Y_jj^A and Y_ja^A F_a as FRFs (along the harmonic line, or at a fixed speed)."""
+    kw = {"residual": True} if residual else {}
     if speed_kmh is None:
-        Yjj, vj = tire.truncations(f, h, [tire.n_modes if n_modes is None else n_modes])
+        n = [tire.n_modes if n_modes is None else n_modes]
+        Yjj, vj = tire.truncations(f, h, n, **kw)
         Y_A = FRF(f, Yjj[0], HUB, HUB, "mobility")
         v_A = FRF(f, vj[0][:, :, None], HUB, ["patch"], "mobility")
     else:
-        Y_A = tire.hub_mobility(f, speed_kmh, n_modes)
-        v_A = tire.patch_response(f, h, n_modes, speed_kmh=speed_kmh)
+        Y_A = tire.hub_mobility(f, speed_kmh, n_modes, **kw)
+        v_A = tire.patch_response(f, h, n_modes, speed_kmh=speed_kmh, **kw)
     return Y_A, v_A
 
 
 @functools.lru_cache(maxsize=64)
-def _cached(k: int, n_modes, fbytes: bytes, coupling: str, speed_kmh) -> FRF:
+def _cached(k: int, n_modes, fbytes: bytes, coupling: str, speed_kmh, residual=False) -> FRF:
     from . import reference_tire  # the tire package registers it at import
 
     return _compute(
@@ -97,11 +99,14 @@ def _cached(k: int, n_modes, fbytes: bytes, coupling: str, speed_kmh) -> FRF:
         n_modes,
         coupling,
         speed_kmh,
+        residual,
     )
 
 
-def _compute(tire, chassis: ChassisModel, h: Harmonic, f, n_modes, coupling, speed_kmh):
-    Y_A, v_A = _tire_frfs(tire, h, f, n_modes, speed_kmh)
+def _compute(
+    tire, chassis: ChassisModel, h: Harmonic, f, n_modes, coupling, speed_kmh, residual=False
+):
+    Y_A, v_A = _tire_frfs(tire, h, f, n_modes, speed_kmh, residual)
     Y_E = chassis.mobility(f, outputs=SPINDLE + BUSHING, inputs=SPINDLE)
     return couple_response(
         Y_E.sel(outputs=BUSHING),
@@ -214,6 +219,7 @@ def bushing_response(
     speed_kmh: float | None = None,
     tire=None,
     chassis: ChassisModel | None = None,
+    residual: bool = False,
 ) -> FRF:
     """Velocity at the chosen bushing for the patch load of a harmonic case (eq. 4.1).
 
@@ -237,6 +243,9 @@ def bushing_response(
         Keyword only; default ``fbs_core.reference_tire()``.
     chassis : ChassisModel, optional
         Keyword only; default :func:`fbs_core.reference_chassis`.
+    residual : bool
+        Keyword only: compensate the tire modes left out by ``n_modes`` with their
+        quasi-static part (upper residual flexibility, docs/tire-model.md).
 
     Returns
     -------
@@ -261,7 +270,7 @@ def bushing_response(
     if speed_kmh is not None:
         speed_kmh = float(speed_kmh)
     if tire is None and chassis is None and h in _HARMONIC_SET:
-        return _cached(h.k, n_modes, f.tobytes(), coupling, speed_kmh)
+        return _cached(h.k, n_modes, f.tobytes(), coupling, speed_kmh, bool(residual))
     if tire is None:
         from . import reference_tire
 
@@ -274,6 +283,7 @@ def bushing_response(
         n_modes,
         coupling,
         speed_kmh,
+        bool(residual),
     )
 
 

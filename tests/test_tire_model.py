@@ -253,7 +253,7 @@ def test_shipped_file_is_reproducible(tmp_path):
 
 def test_file_format_attributes_and_errors(tmp_path, tire):
     with h5py.File(DATA_FILE, "r") as f:
-        assert f.attrs["format"] == "tire-fbs/modal-tire" and f.attrs["format_version"] == 1
+        assert f.attrs["format"] == "tire-fbs/modal-tire" and f.attrs["format_version"] == 2
         assert f["poles"].attrs["unit"] == "rad/s"
         assert f["speeds"].attrs["unit"] == "km/h"
         assert [s.decode() for s in f["hub_dofs"][()]] == list(HUB_DOFS)

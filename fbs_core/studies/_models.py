@@ -116,9 +116,22 @@ def chassis_arrays(chassis, freq: np.ndarray, dirs: Sequence[str]):
     return np.ascontiguousarray(YjjE), np.ascontiguousarray(YejE), tuple(resp)
 
 
-def tire_arrays(tire, freq: np.ndarray, h, n_modes_list, dirs: Sequence[str]):
-    """``(Y_jj^A (n_N, n_f, n_c, n_c), v_j (n_N, n_f, n_c))`` in the coupled directions."""
-    YjjA, vj = tire.truncations(freq, h, list(n_modes_list))
+def tire_arrays(tire, freq: np.ndarray, h, n_modes_list, dirs: Sequence[str], residual=False):
+    """``(Y_jj^A (n_N, n_f, n_c, n_c), v_j (n_N, n_f, n_c))`` in the coupled directions.
+
+    ``residual``: the tire compensates the modes left out (``truncations(...,
+    residual=True)``; a tire model without that keyword raises :class:`FBSError`).
+    """
+    if residual:
+        try:
+            YjjA, vj = tire.truncations(freq, h, list(n_modes_list), residual=True)
+        except TypeError as e:
+            raise FBSError(
+                f"tire model {type(tire).__name__} has no residual compensation "
+                "(truncations(..., residual=True))"
+            ) from e
+    else:
+        YjjA, vj = tire.truncations(freq, h, list(n_modes_list))
     YjjA = np.asarray(YjjA)
     vj = np.asarray(vj)
     n = len(n_modes_list)

@@ -259,6 +259,7 @@ def truncation_map(
     tire=None,
     chassis=None,
     coupling="6dof",
+    residual: bool = False,
 ) -> TruncationMap:
     """Truncation error map of one harmonic (thesis figs. 5.3, 5.6, 5.7).
 
@@ -277,6 +278,9 @@ def truncation_map(
         FRF on ``freq`` (inputs ``spindle:*``).
     coupling : {"6dof", "5dof"} or sequence of directions
         Coupled hub directions.
+    residual : bool
+        Compensate the modes left out of every truncation by their quasi-static part
+        (upper residual flexibility); the reference stays the all-modes response.
 
     Returns
     -------
@@ -302,7 +306,9 @@ def truncation_map(
         )
     YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
     has_all = n[-1] == n_total  # the reference is then the last truncation itself
-    YjjA, vj = _models.tire_arrays(tire, f, h, list(n) + ([] if has_all else [n_total]), dirs)
+    YjjA, vj = _models.tire_arrays(
+        tire, f, h, list(n) + ([] if has_all else [n_total]), dirs, residual
+    )
     k = n.size
     return truncation_map_arrays(
         f,
@@ -448,6 +454,7 @@ def suggest_modes(
     tire=None,
     chassis=None,
     coupling="6dof",
+    residual: bool = False,
 ) -> SuggestedModes:
     """Suggested number of tire modes for every harmonic (thesis table 5.1).
 
@@ -465,8 +472,8 @@ def suggest_modes(
     maps : sequence of TruncationMap, optional
         Precomputed maps (one per harmonic, e.g. ``result.maps`` of an earlier call),
         so that several thresholds or ``f_max`` cost no new coupling.
-    n_modes, df, width, step, edges, tire, chassis, coupling
-        Passed to :func:`truncation_map`.
+    n_modes, df, width, step, edges, tire, chassis, coupling, residual
+        Passed to :func:`truncation_map` (``residual``: with residual compensation).
 
     Returns
     -------
@@ -485,6 +492,7 @@ def suggest_modes(
                 tire=tire,
                 chassis=chassis,
                 coupling=coupling,
+                residual=residual,
             )
             for k in harmonics
         )

@@ -102,6 +102,11 @@ class TireModel:
         Free-form provenance (source, format version, ...).
     hub_dofs : tuple of str
         Labels of the 6 hub DOFs, ``hub:x`` ... ``hub:rz`` in vehicle coordinates.
+    residual : ndarray, shape (n_s, 36 + 6 n_h), optional
+        Upper residual flexibility of modes *not* in the model (a supplier's
+        truncated delivery, :meth:`truncated`): receptance ``-sum R_r / lambda_r`` of
+        the hub mobility (6 x 6, row major) and of the hub velocity per wavelength;
+        used by the syntheses with ``residual=True``.
     interpolation : {"cubic", "cluster", "linear"}
         Between operating points (:mod:`.interp`): ``"cubic"`` (default) cubic
         Lagrange in speed on the four nearest operating points (linear in the
@@ -121,6 +126,7 @@ class TireModel:
     meta: dict = field(default_factory=dict)
     hub_dofs: tuple[str, ...] = HUB_DOFS
     interpolation: str = "cubic"
+    residual: np.ndarray | None = None
 
     def __post_init__(self):
         if self.interpolation not in INTERPOLATIONS:
@@ -166,6 +172,14 @@ class TireModel:
         ):
             object.__setattr__(self, name, _ro(np.asarray(val)))
         object.__setattr__(self, "hub_dofs", tuple(self.hub_dofs))
+        if self.residual is not None:
+            res = np.asarray(self.residual, complex)
+            if res.shape != (n_s, 36 + 6 * lam.size):
+                raise DataFormatError(
+                    f"residual has shape {res.shape}, expected {(n_s, 36 + 6 * lam.size)} "
+                    "(hub mobility 6 x 6 and the hub velocity of every wavelength)"
+                )
+            object.__setattr__(self, "residual", _ro(res))
         # residues, invariant to the scaling of the shapes: (n_s, n_m, 6 * 6 + 6 * n_h)
         R = np.einsum("smi,smj->smij", self.psi, self.chi).reshape(n_s, n_m, 36)
         Q = np.einsum("smi,shm->smhi", self.psi, part).reshape(n_s, n_m, 6 * lam.size)
@@ -290,13 +304,17 @@ class TireModel:
             tot = tot + cluster_sum(cl, w, s, cols)
         return tot
 
-    def _sums(self, freq, speeds, n_list, h_index) -> tuple[np.ndarray, np.ndarray]:
+    def _sums(
+        self, freq, speeds, n_list, h_index, residual: bool = False
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Cumulative modal sums: mobility (n_N, n_f, 6, 6) and patch velocity (n_N, n_f, 6).
 
         The modes are interpolated to every line's speed. The ``N`` retained modes
         are the ``N / 2`` pairs of lowest eigenfrequency at the nearest operating
         point (thesis section 5.1: "the first 50 positive eigenfrequencies"; exact
-        at the operating points, where the modes are delivered).
+        at the operating points, where the modes are delivered). With ``residual``
+        every mode left out of a truncation still enters with its quasi-static
+        part ``R_r / (-lambda_r)`` (upper residual flexibility, docs/tire-model.md).
         """
         f = np.asarray(freq, float)
         k, t = self._weights(speeds)
@@ -308,6 +326,11 @@ class TireModel:
         only_all = n_list == [self.n_modes]
         edges = np.r_[0, n_list]
         out = np.zeros((len(n_list), f.size, cols.size), complex)
+        want = bool(residual)
+        residual = want and not only_all
+        if residual:
+            sta = np.zeros_like(out)  # static parts of the blocks
+            tot = np.zeros((f.size, cols.size), complex)  # static part of all modes
         for kk in np.unique(k):
             lines = np.flatnonzero(k == kk)
             if only_all:
@@ -317,9 +340,29 @@ class TireModel:
             for near in (0, 1):  # lines nearer the lower / upper operating point
                 sel = lines[(t[lines] >= 0.5) == bool(near)]
                 for idx in np.array_split(sel, max(1, int(np.ceil(sel.size / _CHUNK)))):
-                    if idx.size:
+                    if not idx.size:
+                        continue
+                    if residual:
+                        out[:, idx], sta[:, idx] = self._blocks(
+                            int(kk), near, t[idx], s[idx], cols, edges, static=True
+                        )
+                        if edges[-1] == self.n_modes:  # every mode is in a block
+                            tot[idx] = sta[:, idx].sum(axis=0)
+                        else:  # the static part of the modes beyond the last count too
+                            tot[idx] = self._total(int(kk), t[idx], np.zeros(idx.size), cols)
+                    else:
                         out[:, idx] = self._blocks(int(kk), near, t[idx], s[idx], cols, edges)
-        out = np.cumsum(out, axis=0) * s[None, :, None]  # mobility = j omega H
+        out = np.cumsum(out, axis=0)
+        if residual:  # + the quasi-static part of the modes left out
+            out += tot[None] - np.cumsum(sta, axis=0)
+        if want and self.residual is not None:  # + that of the modes not delivered
+            for kk in np.unique(k):
+                idx = np.flatnonzero(k == kk)
+                nd = self._nodes[kk]
+                v = self.speeds[kk] + t[idx] * (self.speeds[kk + 1] - self.speeds[kk])
+                w = lagrange_weights(self.speeds[nd], v)
+                out[:, idx] += (w @ self.residual[nd][:, cols])[None]
+        out *= s[None, :, None]  # mobility = j omega H
         Y = out[:, :, :36].reshape(len(n_list), f.size, 6, 6)
         v = out[:, :, 36:] if h_index is not None else None
         return Y, v
@@ -352,26 +395,39 @@ class TireModel:
         self._plans[key] = (order, plan)
         return order, plan
 
-    def _blocks(self, k: int, near: int, t, s, cols, edges) -> np.ndarray:
+    def _blocks(self, k: int, near: int, t, s, cols, edges, static: bool = False):
         """Receptance sums over the blocks of retained modes ``edges`` (n_N, n_l, n_cols),
-        modes ranked at operating point ``k + near``."""
+        modes ranked at operating point ``k + near``; with ``static`` also the sums of
+        their quasi-static parts ``R_r / (-lambda_r)`` (same shape)."""
         order, plan = self._plan(k, near, edges)
         nd = self._nodes[k]
         v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
         w = lagrange_weights(self.speeds[nd], v)
         Zn = self._Z[nd]
-        T = 1.0 / (s[:, None] - w @ self.poles[nd])  # (n_l, n_m)
-        Zl = (w @ Zn.reshape(Zn.shape[0], -1)).reshape(t.size, *Zn.shape[1:])
-        C = T[:, :, None] * Zl[:, :, cols]  # (n_l, n_m, n_cols)
+        lam = w @ self.poles[nd]
+        T = 1.0 / (s[:, None] - lam)  # (n_l, n_m)
+        Zl = (w @ Zn.reshape(Zn.shape[0], -1)).reshape(t.size, *Zn.shape[1:])[:, :, cols]
+        C = T[:, :, None] * Zl  # (n_l, n_m, n_cols)
+        C0 = -Zl / lam[:, :, None] if static else None
+        zero = np.zeros_like(s)
         for members, whole, split, split_members in plan:
             C[:, members] = 0.0
+            if static:
+                C0[:, members] = 0.0
             if whole is not None:  # the cluster's sum, in the slot of its first member
                 C[:, whole.members[:, 0]] = cluster_sum(whole, w, s, cols, per_cluster=True)
+                if static:
+                    C0[:, whole.members[:, 0]] = cluster_sum(whole, w, zero, cols, per_cluster=True)
             if split is not None:  # split by a block edge: every member on its own
                 p, r = cluster_at(split, w, cols)  # roots by frequency, lowest first
                 C[:, split_members] = r / (s[:, None, None, None] - p[..., None])
+                if static:
+                    C0[:, split_members] = -r / p[..., None]
         kept = order[: edges[-1]]  # modes beyond the largest count are left out
-        return np.moveaxis(np.add.reduceat(C[:, kept], edges[:-1], axis=1), 1, 0)
+        dyn = np.moveaxis(np.add.reduceat(C[:, kept], edges[:-1], axis=1), 1, 0)
+        if not static:
+            return dyn
+        return dyn, np.moveaxis(np.add.reduceat(C0[:, kept], edges[:-1], axis=1), 1, 0)
 
     def synthesis(self, freq, speeds, harmonic_index: int | None = None, n_modes=None):
         """Hub mobility and free hub velocity line by line, each line at its own speed.
@@ -397,7 +453,39 @@ class TireModel:
         Y, v = self._sums(f, sp, [self._check_n(n_modes)], harmonic_index)
         return Y[0], (None if v is None else v[0])
 
-    def hub_mobility(self, freq, speed_kmh: float, n_modes: int | None = None) -> FRF:
+    def truncated(self, n_modes: int) -> TireModel:
+        """The first ``n_modes`` stored modes plus the residual of all the others.
+
+        What a supplier with the full modal set delivers to save size: per operating
+        point the upper residual flexibility ``-sum_(r > N) R_r / lambda_r`` of the
+        modes left out (hub mobility and patch residues, added to any residual this
+        model already carries). Synthesis with ``residual=True`` uses it.
+
+        Parameters
+        ----------
+        n_modes : int
+            Even count of stored modes kept (in the stored, speed-averaged order).
+        """
+        n = self._check_n(n_modes)
+        rest = -(self._Z[:, n:] / self.poles[:, n:, None]).sum(axis=1)
+        res = rest if self.residual is None else rest + self.residual
+        return TireModel(
+            self.speeds,
+            self.poles[:, :n],
+            self.psi[:, :n],
+            self.chi[:, :n],
+            self.wavelengths,
+            self.participation[:, :, :n],
+            params=self.params,
+            meta={**self.meta, "truncated_from": int(self.n_modes)},
+            hub_dofs=self.hub_dofs,
+            interpolation=self.interpolation,
+            residual=res,
+        )
+
+    def hub_mobility(
+        self, freq, speed_kmh: float, n_modes: int | None = None, *, residual: bool = False
+    ) -> FRF:
         """Hub mobility ``Y_jj^A`` (6 x 6) at a fixed speed, from the first ``n_modes`` modes.
 
         Parameters
@@ -408,6 +496,9 @@ class TireModel:
             Vehicle speed within the operating points.
         n_modes : int, optional
             Even number of complex modes, 10..n_modes; ``None`` keeps all.
+        residual : bool
+            Keyword only: add the quasi-static part ``R_r / (-lambda_r)`` of every mode
+            left out (upper residual flexibility; docs/tire-model.md).
 
         Returns
         -------
@@ -416,7 +507,7 @@ class TireModel:
         """
         f = check_grid(freq)
         n = self._check_n(n_modes)
-        Y, _ = self._sums(f, np.full(f.size, float(speed_kmh)), [n], None)
+        Y, _ = self._sums(f, np.full(f.size, float(speed_kmh)), [n], None, residual)
         return FRF(f, Y[0], self.hub_dofs, self.hub_dofs, "mobility")
 
     def patch_response(
@@ -426,6 +517,7 @@ class TireModel:
         n_modes: int | None = None,
         speed_kmh: float | None = None,
         *,
+        residual: bool = False,
         harmonic_case=None,
     ) -> FRF:
         """Free hub velocity ``Y_ja^A F_a`` for the patch load of a harmonic case.
@@ -441,6 +533,8 @@ class TireModel:
         speed_kmh : float, optional
             Evaluate at this fixed speed instead of along the line ``v = f lambda``
             (then any positive frequencies are allowed).
+        residual : bool
+            Keyword only: compensate the modes left out by their quasi-static part.
 
         Returns
         -------
@@ -452,11 +546,11 @@ class TireModel:
         n = self._check_n(n_modes)
         hi = self._harmonic_index(h)
         v = h.speed_at(f) if speed_kmh is None else np.full(f.size, float(speed_kmh))
-        _, vj = self._sums(f, np.atleast_1d(v), [n], hi)
+        _, vj = self._sums(f, np.atleast_1d(v), [n], hi, residual)
         return FRF(f, vj[0][:, :, None], self.hub_dofs, ["patch"], "mobility")
 
     def truncations(
-        self, freq, harmonic=None, n_modes_list=None, *, harmonic_case=None
+        self, freq, harmonic=None, n_modes_list=None, *, residual: bool = False, harmonic_case=None
     ) -> tuple[np.ndarray, np.ndarray]:
         """Hub mobility and free hub velocity along a harmonic line for many truncations.
 
@@ -471,6 +565,9 @@ class TireModel:
             Case 1..7 (``harmonic_case=`` is the deprecated name).
         n_modes_list : sequence of int
             Increasing even mode counts, each 10..n_modes.
+        residual : bool
+            Keyword only: compensate the modes left out of every truncation by their
+            quasi-static part ``R_r / (-lambda_r)`` (upper residual flexibility).
 
         Returns
         -------
@@ -487,7 +584,7 @@ class TireModel:
         ]
         if not ns or np.any(np.diff(ns) <= 0):
             raise ModeCountError(f"n_modes_list must be non-empty and increasing, got {ns}")
-        return self._sums(f, h.speed_at(f), ns, self._harmonic_index(h))
+        return self._sums(f, h.speed_at(f), ns, self._harmonic_index(h), residual)
 
     # -- physical model --------------------------------------------------------------
     def _need_params(self) -> TireParameters:

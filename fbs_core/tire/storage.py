@@ -1,4 +1,5 @@
-"""HDF5 file format of a modal tire model (format ``tire-fbs/modal-tire``, version 1).
+"""HDF5 file format of a modal tire model (format ``tire-fbs/modal-tire``, version 2;
+version 1 files, without the optional residual, still load).
 
 The layout, described for suppliers in ``docs/tire-model.md``::
 
@@ -10,6 +11,8 @@ The layout, described for suppliers in ``docs/tire-model.md``::
     /hub_dofs              (6,)              str  hub:x ... hub:rz (vehicle axes)
     /wavelengths           (n_h,)            float64  m
     /participation         (n_s, n_h, n_m)   complex128 chi_r^T f_patch
+    /residual              (n_s, 36 + 6 n_h) complex128 optional (format 2): residual
+                           flexibility of the modes not in the file
     /parameters            group, attrs: the physical parameters (optional)
 
 Complex data use h5py's native compound type with fields ``r`` and ``i``.
@@ -34,6 +37,7 @@ from .ring import HUB_DOFS
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
+    "READABLE_VERSIONS",
     "DATA_FILE",
     "save_tire_model",
     "load_tire_model",
@@ -42,7 +46,9 @@ __all__ = [
 ]
 
 FORMAT = "tire-fbs/modal-tire"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+#: Versions this code reads: 1 (no residual), 2 (optional /residual).
+READABLE_VERSIONS = (1, 2)
 
 #: The shipped reference model.
 DATA_FILE = Path(__file__).resolve().parents[2] / "data" / "reference_tire.h5"
@@ -75,7 +81,7 @@ _DATASETS = {
 
 
 def save_tire_model(model: TireModel, path, description: str = "") -> Path:
-    """Write a :class:`TireModel` to HDF5 (format version 1).
+    """Write a :class:`TireModel` to HDF5 (format version 2).
 
     Returns
     -------
@@ -99,6 +105,14 @@ def save_tire_model(model: TireModel, path, description: str = "") -> Path:
             "hub DOF labels, vehicle coordinates ISO 8855: x forward, "
             "y left, z up; rotations about these axes"
         )
+        if model.residual is not None:
+            ds = f.create_dataset("residual", data=np.asarray(model.residual))
+            ds.attrs["unit"] = "m/N (receptance; rad, N m as for the hub DOFs), per m of road"
+            ds.attrs["description"] = (
+                "optional (format 2): upper residual flexibility of the modes not in the "
+                "file, -sum R_r / lambda_r per speed; columns: hub receptance 6 x 6 row "
+                "major, then the 6 hub responses to the patch load of every wavelength"
+            )
         if model.params is not None:
             g = f.create_group("parameters")
             g.attrs["description"] = "physical parameters (SI units), fbs_core.tire.TireParameters"
@@ -172,9 +186,10 @@ def tire_from_content(
         shown = str(ver)
     except (TypeError, ValueError):
         ver, shown = -1, repr(raw_ver)[:40]
-    if ver != FORMAT_VERSION:
+    if ver not in READABLE_VERSIONS:
         raise DataFormatError(
-            f"{where} has format_version {shown}; this code reads {FORMAT_VERSION}"
+            f"{where} has format_version {shown}; this code reads "
+            f"{', '.join(map(str, READABLE_VERSIONS))}"
         )
     missing = [k for k in (*_DATASETS, "hub_dofs") if k not in data]
     if missing:
@@ -211,6 +226,11 @@ def tire_from_content(
         raise DataFormatError(f"{where}: the 'meta' attribute is not valid JSON") from None
     if not isinstance(meta, dict):
         raise DataFormatError(f"{where}: the 'meta' attribute must be a JSON object")
+    residual = None
+    if ver >= 2 and "residual" in data:
+        residual = np.asarray(data["residual"])
+        if residual.dtype.kind not in "biufc":
+            raise DataFormatError(f"{where}: dataset 'residual' must be numeric")
     return TireModel(
         arrays["speeds"],
         arrays["poles"],
@@ -221,6 +241,7 @@ def tire_from_content(
         params=params,
         meta=meta,
         hub_dofs=hub,
+        residual=residual,
     )
 
 
