@@ -408,7 +408,9 @@ class TireModel:
         T = 1.0 / (s[:, None] - lam)  # (n_l, n_m)
         Zl = (w @ Zn.reshape(Zn.shape[0], -1)).reshape(t.size, *Zn.shape[1:])[:, :, cols]
         C = T[:, :, None] * Zl  # (n_l, n_m, n_cols)
-        C0 = -Zl / lam[:, :, None] if static else None
+        if static:  # -R / lambda; a zero pole (free sliding) has no static part: 0
+            inv = np.divide(-1.0, lam, out=np.zeros_like(lam), where=lam != 0)
+            C0 = Zl * inv[:, :, None]
         zero = np.zeros_like(s)
         for members, whole, split, split_members in plan:
             C[:, members] = 0.0
@@ -467,7 +469,9 @@ class TireModel:
             Even count of stored modes kept (in the stored, speed-averaged order).
         """
         n = self._check_n(n_modes)
-        rest = -(self._Z[:, n:] / self.poles[:, n:, None]).sum(axis=1)
+        p = self.poles[:, n:]
+        inv = np.divide(-1.0, p, out=np.zeros_like(p), where=p != 0)  # zero poles: none
+        rest = (self._Z[:, n:] * inv[:, :, None]).sum(axis=1)
         res = rest if self.residual is None else rest + self.residual
         return TireModel(
             self.speeds,
