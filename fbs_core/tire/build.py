@@ -21,7 +21,7 @@ __all__ = ["OPERATING_POINTS", "build_modal_model"]
 
 #: Operating points of the shipped modal model in km/h: every 2.5 km/h from 20 to 120
 #: (the thesis' supplier model had 20, 40, ..., 120; section 4.1.2). Finer points keep
-#: the interpolated prediction within 0.3 dB of the physics near the peaks
+#: the interpolated prediction within 0.4 dB of the physics near the peaks
 #: (docs/tire-model.md, bench/bench_speed_fidelity.py).
 OPERATING_POINTS: tuple[float, ...] = tuple(20.0 + 2.5 * i for i in range(41))
 
