@@ -44,9 +44,12 @@ Two criteria (``method=``):
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 from scipy.optimize import linear_sum_assignment
 
 from ..errors import FBSError
@@ -66,7 +69,9 @@ __all__ = [
 DIRECTIONS_OF_TRAVEL = ("forward", "backward", "standing")
 
 
-def classify_branches(speeds, freq, tol_hz: float = 0.5, tol_rel: float = 0.01):
+def classify_branches(
+    speeds: npt.ArrayLike, freq: npt.ArrayLike, tol_hz: float = 0.5, tol_rel: float = 0.01
+) -> tuple[tuple[str, ...], np.ndarray]:
     """Forward / backward / standing label of each branch from its mean ``df/dv``.
 
     Parameters
@@ -105,7 +110,7 @@ def classify_branches(speeds, freq, tol_hz: float = 0.5, tol_rel: float = 0.01):
     return tuple(str(x) for x in labels), a
 
 
-def travelling_index(psi, dofs) -> np.ndarray:
+def travelling_index(psi: np.ndarray, dofs: Sequence[str]) -> np.ndarray:
     """Travelling-wave index of mode shapes: -1 forward, +1 backward, 0 standing.
 
     ``tau = sum_pairs 2 Im(conj(a_c) a_s) / sum_pairs (|a_c|^2 + |a_s|^2)`` over the
@@ -143,7 +148,7 @@ def travelling_index(psi, dofs) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=8)
-def _shape_index(tire) -> np.ndarray:
+def _shape_index(tire: Any) -> np.ndarray:
     """Travelling index of every tracked mode pair at every operating point, (n_s, n_b)."""
     from ..tire import complex_modes
 
@@ -160,7 +165,7 @@ def _shape_index(tire) -> np.ndarray:
     return out
 
 
-def harmonic_lines(speeds, wavelengths=None) -> np.ndarray:
+def harmonic_lines(speeds: npt.ArrayLike, wavelengths: npt.ArrayLike | None = None) -> np.ndarray:
     """Order lines ``f = v / lambda`` (v in m/s) of the harmonic cases, shape (n_v, n_h).
 
     Parameters
@@ -171,7 +176,7 @@ def harmonic_lines(speeds, wavelengths=None) -> np.ndarray:
         Road wavelengths in m; default the seven cases (thesis table 5.1).
     """
     lam = np.array([h.wavelength for h in HARMONICS] if wavelengths is None else wavelengths)
-    return np.asarray(speeds, float)[:, None] / 3.6 / lam[None, :]
+    return np.asarray(np.asarray(speeds, float)[:, None] / 3.6 / lam[None, :], float)
 
 
 @dataclass(frozen=True)
@@ -284,7 +289,7 @@ class Campbell:
         uniq = {(c.harmonic, c.branch, round(c.speed_kmh, 9)): c for c in out}
         return tuple(sorted(uniq.values(), key=lambda c: (c.harmonic, c.speed_kmh, c.branch)))
 
-    def export_mapping(self) -> dict:
+    def export_mapping(self) -> dict[str, Any]:
         """The data as a mapping for :func:`fbs_core.io.export_result` (arrays with axes)."""
         return {
             "freq": (("speed_kmh", "branch"), self.freq),
@@ -307,8 +312,8 @@ METHODS = ("slope", "shape")
 
 
 def campbell(
-    tire=None,
-    speeds=None,
+    tire: Any = None,
+    speeds: npt.ArrayLike | None = None,
     fmax: float = 450.0,
     n_modes: int | None = None,
     method: str = "slope",
@@ -386,7 +391,10 @@ def campbell(
     if method == "shape":
         tire.system(float(tire.speeds[0]))  # DataFormatError without parameters
         tau = _shape_index(tire)[:, keep].mean(axis=0)
-        labels = np.where(tau < -0.2, "forward", np.where(tau > 0.2, "backward", "standing"))
+        labels = tuple(
+            str(x)
+            for x in np.where(tau < -0.2, "forward", np.where(tau > 0.2, "backward", "standing"))
+        )
     hk = np.array([h.k for h in HARMONICS])
     lam = np.array([h.wavelength for h in HARMONICS])
     lo = np.array([h.speed_range[0] for h in HARMONICS])

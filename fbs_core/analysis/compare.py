@@ -13,6 +13,7 @@ difference of their errors on the same mode counts, centre frequencies and DOFs.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -49,7 +50,7 @@ class LevelDifference:
         d = np.abs(self.db[np.isfinite(self.db)])
         return float(d.max()) if d.size else 0.0
 
-    def export_mapping(self) -> dict:
+    def export_mapping(self) -> dict[str, Any]:
         """Arrays with axes for :func:`fbs_core.io.export_result`."""
         dims = ("freq", "output", "input")
         return {
@@ -136,7 +137,7 @@ class MapDifference:
     diff: np.ndarray
     max_diff: np.ndarray
 
-    def export_mapping(self) -> dict:
+    def export_mapping(self) -> dict[str, Any]:
         """Arrays with axes for :func:`fbs_core.io.export_result`."""
         dims = ("n_modes", "centre", "dof")
         return {
@@ -146,7 +147,7 @@ class MapDifference:
         }
 
 
-def truncation_map_difference(a, b) -> MapDifference:
+def truncation_map_difference(a: Any, b: Any) -> MapDifference:
     """Difference map of two truncation maps (:func:`fbs_core.truncation_map` results).
 
     Parameters

@@ -16,9 +16,12 @@ force and has no term.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from .. import kernels
 from ..chassis import BUSHING, SPINDLE, ChassisModel, reference_chassis
@@ -37,7 +40,9 @@ __all__ = [
 ]
 
 
-def contribution_kernel(Yej, YjjA, YjjE, vj, **solve_kw):
+def contribution_kernel(
+    Yej: np.ndarray, YjjA: np.ndarray, YjjE: np.ndarray, vj: np.ndarray, **solve_kw: Any
+) -> tuple[np.ndarray, np.ndarray]:
     """Interface forces and the per-DOF terms of eq. 4.1 (pure arrays).
 
     ``g = (Y_jj^A + Y_jj^E)^-1 v_j`` and ``T[..., e, k] = Y_ej[..., e, k] g[..., k]``
@@ -99,7 +104,7 @@ class Contributions:
     forces: np.ndarray
     quantity: str = "mobility"
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name in ("freq", "terms", "forces"):
             a = np.array(getattr(self, name), copy=True)
             a.setflags(write=False)
@@ -148,7 +153,7 @@ class Contributions:
         i = index_of(self.outputs, output, "response DOF")[0]
         return FRF(self.freq, self.terms[:, i : i + 1, :], [output], self.interface, self.quantity)
 
-    def export_mapping(self) -> dict:
+    def export_mapping(self) -> dict[str, Any]:
         """Arrays with axes for :func:`fbs_core.io.export_result`: the complex terms, the
         total and the interface forces."""
         return {
@@ -167,7 +172,7 @@ class Contributions:
         """``20 log10 |term| / ref`` of every term at one response, shape ``(n_f, n_j)``."""
         i = index_of(self.outputs, output, "response DOF")[0]
         with np.errstate(divide="ignore"):
-            return 20 * np.log10(np.abs(self.terms[:, i, :]) / ref)
+            return np.asarray(20 * np.log10(np.abs(self.terms[:, i, :]) / ref), float)
 
     def dominant(self, output: str) -> tuple[str, ...]:
         """Interface DOF with the largest term magnitude at every line for one response."""
@@ -197,8 +202,8 @@ def interface_contributions(
     Y_jj_E: FRF,
     v_j: FRF,
     *,
-    interface=None,
-    couple=None,
+    interface: Any = None,
+    couple: str | Sequence[str] | None = None,
     rcond: float | None = None,
     max_cond: float | None = kernels.MAX_COND,
 ) -> Contributions:
@@ -261,13 +266,13 @@ def interface_contributions(
 
 
 def bushing_contributions(
-    harmonic_case,
+    harmonic_case: Any,
     n_modes: int | None = None,
-    freq=None,
+    freq: npt.ArrayLike | None = None,
     coupling: str = "6dof",
     *,
     speed_kmh: float | None = None,
-    tire=None,
+    tire: Any = None,
     chassis: ChassisModel | None = None,
 ) -> Contributions:
     """Contributions of the hub forces to the bushing response of a harmonic case.
@@ -306,7 +311,7 @@ def bushing_contributions(
     """
     h = harmonic(harmonic_case)
     dofs = coupled_dofs(coupling)
-    f = h.frequencies() if freq is None else check_grid(freq)
+    f = h.frequencies() if freq is None else check_grid(np.asarray(freq))
     if tire is None:
         from .. import reference_tire
 

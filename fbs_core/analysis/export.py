@@ -9,6 +9,7 @@ metadata.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +21,7 @@ from .views import Bode, Delta
 __all__ = ["export_mapping", "to_csv"]
 
 
-def export_mapping(dataset) -> dict:
+def export_mapping(dataset: Any) -> dict[str, Any]:
     """Arrays with axes (and coordinates, metadata) of an analysis dataset.
 
     Parameters
@@ -41,7 +42,7 @@ def export_mapping(dataset) -> dict:
     if isinstance(dataset, FRF):
         return {"frf": dataset}
     if hasattr(dataset, "export_mapping"):
-        return dataset.export_mapping()
+        return dict(dataset.export_mapping())
     if isinstance(dataset, Bode):
         dims = ("freq", "output", "input")
         return {
@@ -88,7 +89,7 @@ def export_mapping(dataset) -> dict:
     )
 
 
-def to_csv(dataset, provenance: Mapping | None = None) -> bytes:
+def to_csv(dataset: Any, provenance: Mapping[str, Any] | None = None) -> bytes:
     """CSV text of an analysis dataset with its provenance as metadata lines.
 
     Parameters
@@ -110,4 +111,4 @@ def to_csv(dataset, provenance: Mapping | None = None) -> bytes:
     meta.update(dict(provenance or {}))
     kind = "Peaks" if isinstance(dataset, list | tuple) else type(dataset).__name__
     meta.setdefault("dataset", kind)
-    return export_result(mapping, format="csv", metadata=meta)
+    return bytes(export_result(mapping, format="csv", metadata=meta))

@@ -31,8 +31,10 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -57,7 +59,7 @@ __all__ = [
 ]
 
 
-def parabolic_vertex(x, y) -> tuple[float, float]:
+def parabolic_vertex(x: npt.ArrayLike, y: npt.ArrayLike) -> tuple[float, float]:
     """Vertex of the parabola through three points ``(x_i, y_i)`` (any spacing).
 
     Parameters
@@ -71,8 +73,8 @@ def parabolic_vertex(x, y) -> tuple[float, float]:
         The vertex, clipped to ``[x[0], x[2]]``; the middle point where the three
         points are collinear.
     """
-    x0, x1, x2 = (float(v) for v in x)
-    y0, y1, y2 = (float(v) for v in y)
+    x0, x1, x2 = (float(v) for v in np.asarray(x, float))
+    y0, y1, y2 = (float(v) for v in np.asarray(y, float))
     d01 = (y1 - y0) / (x1 - x0)
     d12 = (y2 - y1) / (x2 - x1)
     a = (d12 - d01) / (x2 - x0)  # second divided difference
@@ -88,7 +90,7 @@ def parabolic_vertex(x, y) -> tuple[float, float]:
 METHODS = ("inverse_power", "db")
 
 
-def _refine(x, lv, method):
+def _refine(x: np.ndarray, lv: np.ndarray, method: str) -> tuple[float, float]:
     """Vertex (frequency, level dB) of the three points by the chosen parabola."""
     if method == "db":
         return parabolic_vertex(x, lv)
@@ -100,8 +102,8 @@ def _refine(x, lv, method):
 
 
 def find_peaks_db(
-    freq,
-    level,
+    freq: npt.ArrayLike,
+    level: npt.ArrayLike,
     prominence_db: float = 3.0,
     max_peaks: int | None = None,
     method: str = "inverse_power",
@@ -214,7 +216,7 @@ class Peak:
         return s
 
 
-def _first_order(system: SecondOrderSystem):
+def _first_order(system: SecondOrderSystem) -> tuple[Any, Any]:
     """``A z = lambda B z`` with ``z = [x; lambda x]``: A = [[0, I], [-K, -C]], B = diag(I, M)."""
     n = system.n
     eye = sp.identity(n, format="csc", dtype=complex)
@@ -281,13 +283,13 @@ def _reference_system(speed_kmh: float, coupling: str) -> SecondOrderSystem:
     return _assemble(reference_tire(), reference_chassis(), speed_kmh, coupling)
 
 
-def _assemble(tire, chassis, speed_kmh: float, coupling: str) -> SecondOrderSystem:
+def _assemble(tire: Any, chassis: Any, speed_kmh: float, coupling: str) -> SecondOrderSystem:
     joined = [(f"tire/{d}", f"chassis/spindle:{d.split(':')[1]}") for d in coupled_dofs(coupling)]
     return assemble({"tire": tire.system(speed_kmh), "chassis": chassis.system()}, joined)
 
 
 def coupled_system(
-    speed_kmh: float, coupling: str = "6dof", *, tire=None, chassis=None
+    speed_kmh: float, coupling: str = "6dof", *, tire: Any = None, chassis: Any = None
 ) -> SecondOrderSystem:
     """The assembled tire + chassis system at ``speed_kmh`` (primal assembly at the hub).
 
@@ -331,8 +333,8 @@ def coupled_modes_near(
     coupling: str = "6dof",
     n: int = 3,
     *,
-    tire=None,
-    chassis=None,
+    tire: Any = None,
+    chassis: Any = None,
 ) -> tuple[Mode, ...]:
     """Modes of the coupled tire + chassis nearest ``freq_hz`` at ``speed_kmh``.
 
@@ -361,7 +363,7 @@ def coupled_modes_near(
 
 
 @functools.lru_cache(maxsize=256)
-def _reference_modes(freq_hz: float, speed_kmh: float, coupling: str, n: int):
+def _reference_modes(freq_hz: float, speed_kmh: float, coupling: str, n: int) -> tuple[Mode, ...]:
     return system_modes_near(_reference_system(speed_kmh, coupling), freq_hz, n)
 
 
@@ -374,12 +376,12 @@ def peak_labels(
     max_peaks: int | None = 8,
     method: str = "inverse_power",
     ref: float = 1.0,
-    harmonic=None,
+    harmonic: Any = None,
     speed_kmh: float | None = None,
     coupling: str = "6dof",
     n_nearby: int = 0,
-    tire=None,
-    chassis=None,
+    tire: Any = None,
+    chassis: Any = None,
 ) -> tuple[Peak, ...]:
     """Automatic peak labels of one FRF element, optionally with the coupled modes nearby.
 
@@ -436,8 +438,8 @@ def peak_labels(
         elif h is not None:
             lo, hi = h.freq_range
             v = float(3.6 * min(max(f0, lo), hi) * h.wavelength)
-        modes = ()
-        if n_nearby:
+        modes: tuple[Mode, ...] = ()
+        if n_nearby and v is not None:
             modes = coupled_modes_near(f0, v, coupling, n_nearby, tire=tire, chassis=chassis)
         out.append(Peak(float(f0), float(l0), int(i), float(p), v, modes))
     return tuple(out)

@@ -15,8 +15,9 @@ from __future__ import annotations
 import hashlib
 import json
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -33,7 +34,7 @@ FORMAT_VERSION = 1
 _MAX_JSON_CHARS = 200_000_000
 
 
-def _h(*parts) -> str:
+def _h(*parts: Any) -> str:
     m = hashlib.sha256()
     for p in parts:
         if isinstance(p, np.ndarray):
@@ -48,7 +49,7 @@ def _h(*parts) -> str:
     return "sha256:" + m.hexdigest()
 
 
-def digest(obj) -> str:
+def digest(obj: Any) -> str:
     """Content digest ``"sha256:<hex>"`` of a data source.
 
     Parameters
@@ -83,7 +84,7 @@ def digest(obj) -> str:
     )
 
 
-def _jsonable(v, where: str):
+def _jsonable(v: Any, where: str) -> Any:
     if isinstance(v, np.generic):
         v = v.item()
     if v is None or isinstance(v, bool | int | str):
@@ -101,7 +102,7 @@ def _jsonable(v, where: str):
     raise FBSError(f"{where} must be JSON-compatible (numbers, text, lists, dicts), got {v!r}")
 
 
-def _floats(a: np.ndarray) -> list:
+def _floats(a: np.ndarray) -> list[Any]:
     """Floats for JSON; NaN and infinities (not JSON numbers) as the text "nan", "inf"."""
     x = a.astype(float).ravel()
     out = x.tolist()
@@ -110,13 +111,13 @@ def _floats(a: np.ndarray) -> list:
     return out
 
 
-def _unfloats(v) -> np.ndarray:
+def _unfloats(v: Any) -> np.ndarray:
     return np.asarray([float(x) for x in v], float)
 
 
-def _array_json(a: np.ndarray) -> dict:
+def _array_json(a: np.ndarray) -> dict[str, Any]:
     a = np.asarray(a)
-    out = {"shape": list(a.shape)}
+    out: dict[str, Any] = {"shape": list(a.shape)}
     if a.dtype.kind == "c":
         out["re"] = _floats(a.real)
         out["im"] = _floats(a.imag)
@@ -129,7 +130,7 @@ def _array_json(a: np.ndarray) -> dict:
     return out
 
 
-def _array_from(d, where: str) -> np.ndarray:
+def _array_from(d: Any, where: str) -> np.ndarray:
     try:
         shape = tuple(int(n) for n in d["shape"])
         if "re" in d:
@@ -166,16 +167,16 @@ class PinnedState:
     """
 
     name: str
-    frfs: dict = field(default_factory=dict)
-    arrays: dict = field(default_factory=dict)
-    coords: dict = field(default_factory=dict)
-    settings: dict = field(default_factory=dict)
-    sources: dict = field(default_factory=dict)
+    frfs: dict[str, FRF] = field(default_factory=dict)
+    arrays: dict[str, tuple[tuple[str, ...], np.ndarray]] = field(default_factory=dict)
+    coords: dict[str, Any] = field(default_factory=dict)
+    settings: dict[str, Any] = field(default_factory=dict)
+    sources: dict[str, str] = field(default_factory=dict)
     created: str = ""
 
-    def provenance(self) -> dict:
+    def provenance(self) -> dict[str, Any]:
         """Name, settings, sources and creation time as one flat JSON-compatible dict."""
-        out = {"pin": self.name, "pinned": self.created}
+        out: dict[str, Any] = {"pin": self.name, "pinned": self.created}
         out.update({f"setting.{k}": v for k, v in self.settings.items()})
         out.update({f"source.{k}": v for k, v in self.sources.items()})
         return out
@@ -210,7 +211,7 @@ class PinnedState:
         return json.dumps(doc, allow_nan=False)
 
     @classmethod
-    def from_json(cls, text) -> PinnedState:
+    def from_json(cls, text: str | bytes | bytearray) -> PinnedState:
         """Read a pinned state written by :meth:`to_json` (plain JSON, nothing executed).
 
         Parameters
@@ -272,9 +273,9 @@ class PinnedState:
         except (KeyError, TypeError, AttributeError, ValueError) as err:
             raise DataFormatError(f"pinned state: malformed content ({err})") from None
 
-    def export_mapping(self) -> dict:
+    def export_mapping(self) -> dict[str, Any]:
         """The result as a mapping for :func:`fbs_core.io.export_result`."""
-        out: dict = dict(self.frfs)
+        out: dict[str, Any] = dict(self.frfs)
         out.update({k: (dims, v) for k, (dims, v) in self.arrays.items()})
         if self.coords:
             out["coords"] = {k: np.asarray(v) for k, v in self.coords.items()}
@@ -284,11 +285,15 @@ class PinnedState:
         """CSV text of the result with the provenance as ``# key: value`` metadata lines."""
         from ..io import export_result
 
-        return export_result(self.export_mapping(), format="csv", metadata=self.provenance())
+        out = export_result(self.export_mapping(), format="csv", metadata=self.provenance())
+        return bytes(out)
 
 
 def pin_state(
-    name: str, result, settings: Mapping | None = None, sources: Mapping | None = None
+    name: str,
+    result: Any,
+    settings: Mapping[str, Any] | None = None,
+    sources: Mapping[str, str] | None = None,
 ) -> PinnedState:
     """Pin a result with its provenance.
 
@@ -316,10 +321,11 @@ def pin_state(
     """
     if not isinstance(name, str) or not name.strip():
         raise FBSError(f"a pinned state needs a non-empty name, got {name!r}")
+    mapping: dict[str, Any]
     if isinstance(result, FRF):
         mapping = {"result": result}
     elif hasattr(result, "export_mapping"):
-        mapping = result.export_mapping()
+        mapping = dict(result.export_mapping())
     elif isinstance(result, Mapping):
         mapping = dict(result)
     else:
@@ -328,7 +334,8 @@ def pin_state(
         )
     coords = mapping.pop("coords", {}) or {}
     meta = mapping.pop("metadata", {}) or {}
-    frfs, arrays = {}, {}
+    frfs: dict[str, FRF] = {}
+    arrays: dict[str, tuple[tuple[str, ...], np.ndarray]] = {}
     for k, v in mapping.items():
         if isinstance(v, FRF):
             frfs[str(k)] = v
@@ -348,7 +355,9 @@ def pin_state(
     )
 
 
-def add_pin(pins, state: PinnedState, limit: int = MAX_PINS) -> tuple[PinnedState, ...]:
+def add_pin(
+    pins: Iterable[PinnedState], state: PinnedState, limit: int = MAX_PINS
+) -> tuple[PinnedState, ...]:
     """A new tuple of pins with ``state`` appended.
 
     Parameters
@@ -363,18 +372,18 @@ def add_pin(pins, state: PinnedState, limit: int = MAX_PINS) -> tuple[PinnedStat
     FBSError
         When the name is taken or ``limit`` pins exist (naming them).
     """
-    pins = tuple(pins)
-    names = [p.name for p in pins]
+    have = tuple(pins)
+    names = [p.name for p in have]
     if state.name in names:
         raise FBSError(f"a pinned state is already named {state.name!r}; pick another name")
-    if len(pins) >= limit:
+    if len(have) >= limit:
         raise FBSError(
             f"at most {limit} pinned states; unpin one of {', '.join(map(repr, names))} first"
         )
-    return pins + (state,)
+    return have + (state,)
 
 
-def remove_pin(pins, name: str) -> tuple[PinnedState, ...]:
+def remove_pin(pins: Iterable[PinnedState], name: str) -> tuple[PinnedState, ...]:
     """A new tuple of pins without the one named ``name``.
 
     Parameters
@@ -387,9 +396,9 @@ def remove_pin(pins, name: str) -> tuple[PinnedState, ...]:
     FBSError
         If no pin has that name.
     """
-    pins = tuple(pins)
-    if name not in [p.name for p in pins]:
+    have = tuple(pins)
+    if name not in [p.name for p in have]:
         raise FBSError(
-            f"no pinned state named {name!r}; pinned: {', '.join(p.name for p in pins) or 'none'}"
+            f"no pinned state named {name!r}; pinned: {', '.join(p.name for p in have) or 'none'}"
         )
-    return tuple(p for p in pins if p.name != name)
+    return tuple(p for p in have if p.name != name)

@@ -10,9 +10,11 @@ instead of jumping by 360 degrees.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import FrequencyGridError
 from ..frf import FRF
@@ -29,7 +31,7 @@ __all__ = [
 ]
 
 
-def level_db(h, ref: float = 1.0) -> np.ndarray:
+def level_db(h: npt.ArrayLike, ref: float = 1.0) -> np.ndarray:
     """``20 log10(|h| / ref)``; ``-inf`` where ``h == 0``.
 
     Parameters
@@ -39,10 +41,10 @@ def level_db(h, ref: float = 1.0) -> np.ndarray:
         Reference value of 0 dB (in the unit of ``h``).
     """
     with np.errstate(divide="ignore"):
-        return 20 * np.log10(np.abs(np.asarray(h)) / ref)
+        return np.asarray(20 * np.log10(np.abs(np.asarray(h)) / ref), float)
 
 
-def phase_deg(h, unwrap: bool = True, axis: int = 0) -> np.ndarray:
+def phase_deg(h: npt.ArrayLike, unwrap: bool = True, axis: int = 0) -> np.ndarray:
     """Phase of ``h`` in degrees, unwrapped along ``axis`` (frequency) by default.
 
     Parameters
@@ -57,7 +59,7 @@ def phase_deg(h, unwrap: bool = True, axis: int = 0) -> np.ndarray:
     p = np.angle(np.asarray(h))
     if unwrap:
         p = np.unwrap(p, axis=axis)
-    return np.degrees(p)
+    return np.asarray(np.degrees(p), float)
 
 
 @dataclass(frozen=True, eq=False)
@@ -133,7 +135,7 @@ def real_imag(frf: FRF) -> tuple[np.ndarray, np.ndarray]:
     return frf.data.real.copy(), frf.data.imag.copy()
 
 
-def interp_level(freq, level, f0: float) -> float:
+def interp_level(freq: npt.ArrayLike, level: npt.ArrayLike, f0: float) -> float:
     """Level (dB) at ``f0`` by linear interpolation between the two nearest lines.
 
     Parameters
@@ -237,7 +239,7 @@ def _element(frf: FRF, output: str | None, input: str | None) -> np.ndarray:
     """The complex values of one element, shape (n_f,)."""
     from ..errors import DOFError
 
-    def pick(labels, want, what):
+    def pick(labels: Sequence[str], want: str | None, what: str) -> int:
         if want is None:
             if len(labels) != 1:
                 raise DOFError(
