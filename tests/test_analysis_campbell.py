@@ -134,6 +134,9 @@ def test_order_lines_and_crossings_on_the_reference_tire():
         assert 30 - 1e-9 <= c.speed_kmh <= 120 + 1e-9
     assert len(cb.crossings(in_band=False)) >= len(cr)
     assert np.all(cb.freq.min(axis=0) <= 450.0)
+    assert np.all(cb.freq > 0) and np.all(np.isfinite(cb.damping))  # vibration modes only
+    real = np.flatnonzero(np.abs(tire.poles[0, 0::2].imag) == 0)
+    assert not set(real) & set(cb.branch.tolist())
     assert set(cb.direction) <= {"forward", "backward", "standing"}
     few = campbell(tire, n_modes=40)
     assert few.branch.max() < 20

@@ -211,7 +211,8 @@ class Campbell:
     speeds : ndarray, shape (n_v,)
         Speeds in km/h.
     branch : ndarray of int, shape (n_b,)
-        Index of each tracked mode pair in the model (0 = lowest).
+        Index of each tracked mode pair in the model (0 = lowest); pairs of real poles
+        (first-order states, no eigenfrequency) are left out.
     freq : ndarray, shape (n_v, n_b)
         Eigenfrequency of each branch in Hz.
     damping : ndarray, shape (n_v, n_b)
@@ -383,7 +384,10 @@ def campbell(
         raise FBSError(f"speeds must be >= 2 increasing values in km/h, got {v.tolist()}")
     poles = np.stack([tire.poles_at(s)[0::2][:nb] for s in v])  # raises OperatingPointError
     F = poles.imag / (2 * np.pi)
-    keep = np.flatnonzero(F.min(axis=0) <= fmax)
+    # vibration modes only: the first-order states of a tire with tread relaxation have
+    # real poles (stored in pairs ahead of the conjugate pairs) and no eigenfrequency
+    oscillatory = np.all(tire.poles[:, 0::2][:, :nb].imag > 0, axis=0) & np.all(F > 0, axis=0)
+    keep = np.flatnonzero(oscillatory & (F.min(axis=0) <= fmax))
     F = F[:, keep]
     op = tire.poles[:, 0::2][:, keep].imag / (2 * np.pi)
     labels, a = classify_branches(tire.speeds, op)
