@@ -34,9 +34,9 @@ Two criteria (``method=``):
   minus that, standing in between. It is exact for the ring (the gyroscopic split is
   odd in ``Omega`` and the ring's even part is small), but centrifugal softening and
   the veering of dense branches bias it in the full tire; the shape criterion does
-  not depend on the frequencies. On the reference tire the two agree on 88 % of the
+  not depend on the frequencies. On the reference tire the two agree on 86 % of the
   branches that shift by more than 10 Hz over 20-120 km/h; the shape criterion costs
-  one dense complex-mode solve per operating point (about a minute for the reference
+  one dense complex-mode solve per operating point (about 40 s for the reference
   tire on a loaded 2-core machine, then cached per model), the slope criterion
   milliseconds.
 """
