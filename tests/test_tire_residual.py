@@ -8,6 +8,7 @@ the reference tire; for the FRF-fitted residual also the direct solution.
 import numpy as np
 import pytest
 
+import fbs_core as fc
 from fbs_core import harmonic, reference_tire
 from fbs_core.studies import truncation_map
 from fbs_core.tire import TireModel, complex_modes, track_modes
@@ -154,3 +155,21 @@ def test_truncated_delivery_with_residual_is_stored_and_compensates(tmp_path):
             small.participation,
             residual=small.residual[:, :36],
         )
+
+
+@pytest.mark.parametrize("k", [5, 7])
+def test_one_mode_count_with_residuals_equals_its_row_of_the_whole_study(k):
+    """A single N with residuals (what bushing_response asks for) is the same sum as that
+    N's row when all counts are computed at once (the study's path), and finite: the
+    zero poles of the tread-slip states have no static part on either path."""
+    tire = fc.reference_tire()
+    f = fc.harmonic(k).frequencies()
+    counts = list(range(10, tire.n_modes + 1, 10))
+    Y_all, v_all = tire.truncations(f, k, counts, residual=True)
+    for n in (60, 200):
+        Y, v = tire.truncations(f, k, [n], residual=True)
+        assert np.all(np.isfinite(Y)) and np.all(np.isfinite(v))
+        row = counts.index(n)
+        np.testing.assert_allclose(Y[0], Y_all[row], rtol=0, atol=1e-11 * np.abs(Y_all[row]).max())
+        np.testing.assert_allclose(v[0], v_all[row], rtol=0, atol=1e-11 * np.abs(v_all[row]).max())
+    assert np.all(np.isfinite(fc.bushing_response(k, n_modes=60, residual=True).data))

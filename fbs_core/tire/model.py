@@ -343,13 +343,15 @@ class TireModel:
                     if not idx.size:
                         continue
                     if residual:
-                        out[:, idx], sta[:, idx] = self._blocks(
-                            int(kk), near, t[idx], s[idx], cols, edges, static=True
+                        # one more block up to all modes, so that the static part of
+                        # every mode (zero poles: none) comes from the same sums
+                        full = edges if edges[-1] == self.n_modes else np.r_[edges, self.n_modes]
+                        dyn, st = self._blocks(
+                            int(kk), near, t[idx], s[idx], cols, full, static=True
                         )
-                        if edges[-1] == self.n_modes:  # every mode is in a block
-                            tot[idx] = sta[:, idx].sum(axis=0)
-                        else:  # the static part of the modes beyond the last count too
-                            tot[idx] = self._total(int(kk), t[idx], np.zeros(idx.size), cols)
+                        nb = len(edges) - 1
+                        out[:, idx], sta[:, idx] = dyn[:nb], st[:nb]
+                        tot[idx] = st.sum(axis=0)
                     else:
                         out[:, idx] = self._blocks(int(kk), near, t[idx], s[idx], cols, edges)
         out = np.cumsum(out, axis=0)
