@@ -25,6 +25,7 @@ import numpy as np
 
 import fbs_core
 from fbs_core import studies
+from fbs_core.vocabulary import DB_FLOOR, DIRECTIONS, EIGEN_SPEEDS, magnitude_db, readonly
 
 __all__ = [
     "DB_FLOOR",
@@ -47,10 +48,6 @@ __all__ = [
     "version",
 ]
 
-#: Magnitudes are floored at this value before the dB conversion (no -inf at exact zeros).
-DB_FLOOR = 1e-30
-#: Operating speeds of the eigenfrequency plot (thesis fig. 5.8), km/h.
-EIGEN_SPEEDS = (20.0, 80.0, 120.0)
 #: Central percentile bands offered (width in %) and the percentile levels they need.
 PERCENTILE_BANDS = (50, 80, 90, 95, 99)
 Q_LEVELS = tuple(sorted({q for w in PERCENTILE_BANDS for q in ((100 - w) / 2, (100 + w) / 2)}))
@@ -100,7 +97,7 @@ def version() -> str:
 
 def db(x: np.ndarray) -> np.ndarray:
     """``20 log10 |x|`` (dB re 1 unit), magnitudes floored at :data:`DB_FLOOR`."""
-    return 20.0 * np.log10(np.maximum(np.abs(x), DB_FLOOR))
+    return magnitude_db(x)
 
 
 def level_unit(dof: str) -> str:
@@ -115,9 +112,7 @@ def level_unit(dof: str) -> str:
 @shared_cache(maxsize=8)
 def frequencies(harmonic: int) -> np.ndarray:
     """The analysis grid of a harmonic case in Hz (read-only)."""
-    f = np.array(fbs_core.harmonic(harmonic).frequencies(), dtype=float)
-    f.setflags(write=False)
-    return f
+    return readonly(fbs_core.harmonic(harmonic).frequencies(), float)
 
 
 def _key(models):
@@ -175,7 +170,7 @@ def _bushing_response(harmonic: int, n_modes: int | None, coupling: str, models=
         **_models_kw(models),
     )
     return np.stack(
-        [frf.sel(outputs=f"bushing:{d}").data[:, 0, 0] for d in ("x", "y", "z", "rx", "ry", "rz")],
+        [frf.sel(outputs=f"bushing:{d}").data[:, 0, 0] for d in DIRECTIONS],
         axis=1,
     )
 
@@ -188,7 +183,7 @@ def coupled_response(harmonic: int, n_modes: int | None, coupling: str, models=N
     """
     models = _key(models)
     m = error_map(harmonic, coupling, models)
-    order = [m.dofs.index(f"bushing:{d}") for d in ("x", "y", "z", "rx", "ry", "rz")]
+    order = [m.dofs.index(f"bushing:{d}") for d in DIRECTIONS]
     if n_modes is None or (m.n_modes_total is not None and n_modes >= m.n_modes_total):
         return m.reference[:, order]
     hit = np.flatnonzero(m.n_modes == int(n_modes))
@@ -198,7 +193,7 @@ def coupled_response(harmonic: int, n_modes: int | None, coupling: str, models=N
 
 
 def _dof_index(dof: str) -> int:
-    return ("x", "y", "z", "rx", "ry", "rz").index(dof)
+    return DIRECTIONS.index(dof)
 
 
 def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str, models=None) -> dict:

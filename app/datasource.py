@@ -11,17 +11,16 @@ the uploaded bytes and the import settings, so the cached computations of
 :mod:`app.compute` can key on it (two sessions that upload the same file share results;
 different uploads never do).
 
-Checks beyond those of :mod:`fbs_core.io` (every view must run on the models):
+The checks are the core's (every view must run on the models):
 
 - chassis: six spindle DOFs (inputs and outputs) and all six bushing outputs
   (``fbs_core.io.prepare_chassis`` / ``require_dofs``); lines on every harmonic's analysis
   grid, either present in the file or, only when the user ticks it, interpolated
-  (``FRF.interpolate``, linear in real and imaginary part, never extrapolated);
-- tire: hub DOFs ``hub:x`` ... ``hub:rz``, at least 20 complex modes, the patch
-  participation and operating points of all seven harmonic cases and the speeds of the
-  eigenfrequency view;
-- the pair: the interface matrix ``Y_jj^A + Y_jj^E`` (eq. 2.44) well conditioned on every
-  harmonic's grid (``fbs_core.io.interface_check``).
+  (:class:`fbs_core.FRFChassis`: linear in real and imaginary part, never extrapolated);
+- tire: :func:`fbs_core.io.checks.check_tire` (hub DOFs, at least 20 complex modes, the
+  operating points of all seven harmonic cases and of the eigenfrequency view);
+- the pair: :func:`fbs_core.io.checks.check_pair` (the interface matrix
+  ``Y_jj^A + Y_jj^E``, eq. 2.44, well conditioned on every harmonic's grid).
 
 A refused upload leaves the state as it was and says why in :attr:`DataSource.error`.
 """
@@ -31,13 +30,14 @@ from __future__ import annotations
 import hashlib
 import threading
 
-import numpy as np
 import param
 
-import fbs_core
+from fbs_core.chassis import FRFChassis
 from fbs_core.dofs import parse_label
-from fbs_core.errors import DOFError, FBSError, FrequencyGridError
-from fbs_core.frf import FRF
+from fbs_core.errors import DOFError, FBSError
+from fbs_core.harmonics import harmonic
+from fbs_core.io.checks import check_pair, check_tire
+from fbs_core.vocabulary import DIRECTIONS, EIGEN_SPEEDS, HARMONIC_CASES
 
 __all__ = [
     "CHASSIS_ACCEPT",
@@ -50,71 +50,12 @@ __all__ = [
     "REFERENCE",
 ]
 
-DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
-SPINDLE = tuple(f"spindle:{d}" for d in DIRECTIONS)
 BUSHING = tuple(f"bushing:{d}" for d in DIRECTIONS)
-HUB = tuple(f"hub:{d}" for d in DIRECTIONS)
 #: Harmonic cases every view may ask for.
-HARMONICS = tuple(range(1, 8))
-#: Speeds of the eigenfrequency view (thesis fig. 5.8), km/h.
-EIGEN_SPEEDS = (20.0, 80.0, 120.0)
-#: Smallest number of complex tire modes accepted (a truncation map needs N = 10 < total).
-MIN_TIRE_MODES = 20
+HARMONICS = HARMONIC_CASES
 #: File endings offered by the upload widgets.
 CHASSIS_ACCEPT = ".uff,.unv,.uf,.58,.mat,.csv,.txt,.h5,.hdf5,.hdf"
 TIRE_ACCEPT = ".h5,.hdf5,.hdf,.mat"
-
-
-def _grid(k: int) -> np.ndarray:
-    return np.asarray(fbs_core.harmonic(k).frequencies(), float)
-
-
-class FRFChassis:
-    """A chassis given by a measured or computed mobility FRF, used like ``ChassisModel``.
-
-    Parameters
-    ----------
-    frf : FRF
-        Mobility with inputs ``spindle:*`` and outputs ``spindle:*`` and ``bushing:*``
-        (as returned by :func:`fbs_core.io.prepare_chassis`).
-    interpolate : bool
-        Lines the file does not hold are interpolated with :meth:`FRF.interpolate`
-        (chosen explicitly by the user); otherwise such a request is refused.
-    """
-
-    def __init__(self, frf: FRF, interpolate: bool = False) -> None:
-        self.frf = frf
-        self.interpolate = bool(interpolate)
-
-    def __repr__(self) -> str:
-        return f"FRFChassis({self.frf!r}, interpolate={self.interpolate})"
-
-    def _on(self, freq: np.ndarray) -> FRF:
-        F = self.frf.freq
-        f = np.asarray(freq, float)
-        tol = 1e-9 * np.maximum(1.0, np.abs(f))
-        idx = np.clip(np.searchsorted(F, f - tol), 0, F.size - 1)
-        hit = np.abs(F[idx] - f) <= tol
-        if hit.all():
-            return self.frf.isel(freq=idx)
-        if self.interpolate:
-            return self.frf.interpolate(f)
-        miss = f[~hit]
-        raise FrequencyGridError(
-            f"the chassis FRF ({F.size} lines, {F[0]:g}-{F[-1]:g} Hz) has no line at "
-            f"{miss.size} of the {f.size} analysis frequencies {f[0]:g}-{f[-1]:g} Hz "
-            f"(first: {miss[0]:g} Hz); tick 'interpolate onto the analysis grid' to "
-            "interpolate it explicitly (linear in real and imaginary part)"
-        )
-
-    def mobility(self, freq, outputs=None, inputs=None, quantity: str = "mobility") -> FRF:
-        """The FRF on ``freq`` (Hz), same signature as ``ChassisModel.mobility``."""
-        Y = self._on(freq)
-        Y = Y.sel(
-            outputs=SPINDLE + BUSHING if outputs is None else list(outputs),
-            inputs=SPINDLE if inputs is None else list(inputs),
-        )
-        return Y if quantity == Y.quantity else Y.to(quantity)
 
 
 class Models:
@@ -216,58 +157,6 @@ def parse_node(text: str, role: str) -> tuple[str, int | None]:
             f"the {role} node must be one node name or number without a direction, got {t!r}"
         )
     return t, None
-
-
-def check_tire(tire) -> list[str]:
-    """Refuse a tire model some view cannot run on; returns notes.
-
-    Raises
-    ------
-    FBSError
-        Naming the missing hub DOFs, modes, wavelengths or operating points.
-    """
-    if tuple(tire.hub_dofs) != HUB:
-        raise FBSError(
-            f"the tire's hub DOFs must be {', '.join(HUB)}, got {', '.join(tire.hub_dofs)}"
-        )
-    if tire.n_modes < MIN_TIRE_MODES:
-        raise FBSError(
-            f"the tire model has {tire.n_modes} complex modes; the truncation study "
-            f"needs at least {MIN_TIRE_MODES}"
-        )
-    for k in HARMONICS:
-        f = _grid(k)
-        try:
-            tire.truncations(f[[0, -1]], fbs_core.harmonic(k), [tire.n_modes])
-        except FBSError as e:
-            raise type(e)(f"harmonic {k}: {e}") from None
-    for v in EIGEN_SPEEDS:
-        try:
-            tire.eigenfrequencies(v)
-        except FBSError as e:
-            raise type(e)(f"eigenfrequency view (fig. 5.8, {v:g} km/h): {e}") from None
-    notes = []
-    if tire.n_modes < 400:
-        notes.append(f"{tire.n_modes} complex modes: a chosen N above that uses all modes")
-    return notes
-
-
-def check_pair(tire, chassis) -> None:
-    """Every harmonic grid is available and the interface (eq. 2.44) is well conditioned."""
-    from fbs_core.io import interface_check
-
-    tire = fbs_core.reference_tire() if tire is None else tire
-    chassis = fbs_core.reference_chassis() if chassis is None else chassis
-    pairs = list(zip(HUB, SPINDLE, strict=True))
-    for k in HARMONICS:
-        f = _grid(k)
-        try:
-            Yjj = tire.truncations(f, fbs_core.harmonic(k), [tire.n_modes])[0][0]
-            YA = FRF(f, Yjj, HUB, HUB, "mobility")
-            YE = chassis.mobility(f, outputs=SPINDLE, inputs=SPINDLE)
-            interface_check(YA, YE, interface=pairs)
-        except FBSError as e:
-            raise type(e)(f"harmonic {k} ({f[0]:g}-{f[-1]:g} Hz): {e}") from None
 
 
 class DataSource(param.Parameterized):
@@ -390,8 +279,9 @@ class DataSource(param.Parameterized):
         chassis = FRFChassis(frf, interpolate=interpolate)
         used = []
         for k in HARMONICS:
-            Y = chassis._on(_grid(k))  # FrequencyGridError unless present / interpolated
-            used.append(not np.isin(Y.freq, frf.freq).all())
+            f = harmonic(k).frequencies()
+            chassis.on_grid(f)  # FrequencyGridError unless present / interpolated
+            used.append(chassis.needs_interpolation(f))
         if any(used):
             notes.append(
                 "interpolated onto the analysis grids of harmonics "

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import param
 
+from fbs_core.vocabulary import COUPLINGS, DIRECTIONS
+
 from .datasource import REFERENCE, DataSource, Models
 
 __all__ = [
@@ -24,11 +26,6 @@ __all__ = [
     "URL_KEYS",
 ]
 
-#: Bushing / hub DOF directions (vehicle coordinates, thesis fig. 4.5).
-DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
-#: Hub coupling options: all 6 hub DOFs (braked wheel, as in the thesis) or 5 with the spin
-#: DOF released (free-rolling wheel).
-COUPLINGS = ("6dof", "5dof")
 #: Where the Monte-Carlo noise is applied (thesis eqs. 5.2-5.4).
 NOISE_TARGETS = ("both", "tire", "vehicle")
 #: Retained-mode counts offered (thesis 5.1: 10 to 400 in steps of 10).

@@ -6,8 +6,9 @@ vibrations at the bushings", Chalmers MSc thesis (2018).
 
 from . import analysis as analysis
 from . import io as io
+from . import vocabulary as vocabulary
 from .analysis import bushing_contributions, campbell, peak_labels, speed_map
-from .chassis import ChassisModel, reference_chassis
+from .chassis import ChassisModel, FRFChassis, reference_chassis
 from .coupling import (
     couple_generalized,
     couple_impedance,
@@ -19,12 +20,18 @@ from .coupling import (
 from .direct import SecondOrderSystem, assemble
 from .dofs import DIRECTIONS, node_labels, parse_label
 from .errors import (
+    CouplingOptionError,
     DataFormatError,
     DOFError,
     FBSError,
     FrequencyGridError,
+    HarmonicError,
+    ModalError,
+    ModeCountError,
+    OperatingPointError,
     QuantityError,
     SingularInterfaceError,
+    StudyCancelled,
 )
 from .frf import FRF, QUANTITIES
 from .harmonics import HARMONICS, Harmonic, harmonic
@@ -43,6 +50,7 @@ from .studies import (
     truncation_map,
 )
 from .tire import TireModel, reference_tire
+from .vocabulary import COUPLINGS, EIGEN_SPEEDS, magnitude_db, readonly
 
 __version__ = "0.1.0"
 
@@ -67,6 +75,17 @@ __all__ = [
     "FrequencyGridError",
     "QuantityError",
     "SingularInterfaceError",
+    "CouplingOptionError",
+    "HarmonicError",
+    "ModalError",
+    "ModeCountError",
+    "OperatingPointError",
+    "StudyCancelled",
+    "COUPLINGS",
+    "EIGEN_SPEEDS",
+    "magnitude_db",
+    "readonly",
+    "FRFChassis",
     "harmonic",
     "reference_tire",
     "ChassisModel",

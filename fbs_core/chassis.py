@@ -35,7 +35,7 @@ import scipy.linalg as sla
 
 from .direct import SecondOrderSystem
 from .dofs import DIRECTIONS, index_of, node_labels
-from .errors import DataFormatError, QuantityError
+from .errors import DataFormatError, FrequencyGridError, QuantityError
 from .fe import FEModel, Material, Section, rigid_body_mass
 from .frf import FRF, QUANTITIES, check_grid
 
@@ -46,6 +46,8 @@ __all__ = [
     "carrier_mode_table",
     "modal_energy",
     "read_chassis_frf",
+    "FRFChassis",
+    "match_grid",
     "SPINDLE",
     "BUSHING",
 ]
@@ -370,3 +372,108 @@ def carrier_mode_table(chassis: ChassisModel, fmax: float = 100.0) -> dict[str, 
     e = modal_energy(chassis)
     keep = f < fmax
     return {d: float(f[keep][np.argmax(e[keep, k])]) for k, d in enumerate(DIRECTIONS)}
+
+
+def match_grid(available, wanted, rtol: float = 1e-9) -> np.ndarray | None:
+    """Positions of the ``wanted`` frequencies in the sorted grid ``available``.
+
+    A line matches when it lies within ``rtol * max(1, |f|)`` Hz of a wanted frequency
+    (grids read from files carry rounding in their last digits).
+
+    Parameters
+    ----------
+    available : array_like, shape (n,)
+        Increasing frequencies in Hz.
+    wanted : array_like, shape (m,)
+        Frequencies in Hz.
+
+    Returns
+    -------
+    ndarray of int, shape (m,), or None
+        ``None`` when some wanted frequency has no line.
+
+    Examples
+    --------
+    >>> match_grid([1.0, 2.0, 3.0], [3.0, 1.0 + 1e-12]).tolist()
+    [2, 0]
+    >>> match_grid([1.0, 2.0], [1.5]) is None
+    True
+    """
+    F = np.asarray(available, float)
+    f = np.asarray(wanted, float)
+    if F.size == 0:
+        return None if f.size else np.zeros(0, int)
+    tol = rtol * np.maximum(1.0, np.abs(f))
+    idx = np.clip(np.searchsorted(F, f - tol), 0, F.size - 1)
+    return idx if bool(np.all(np.abs(F[idx] - f) <= tol)) else None
+
+
+class FRFChassis:
+    """A chassis given by a measured or computed mobility FRF, used like :class:`ChassisModel`.
+
+    The FRF is used on its own lines; frequencies it does not hold are refused unless the
+    user chose ``interpolate=True`` (then :meth:`FRF.interpolate`: linear in real and
+    imaginary part, never extrapolated). No silent interpolation (docs/file-formats.md).
+
+    Parameters
+    ----------
+    frf : FRF
+        Mobility with inputs ``spindle:*`` and outputs ``spindle:*`` and ``bushing:*``
+        (as returned by :func:`fbs_core.io.prepare_chassis`).
+    interpolate : bool
+        Interpolate onto frequencies the FRF has no line at (an explicit choice).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fbs_core import FRF
+    >>> Y = FRF([1.0, 2.0], np.ones((2, 1, 1)), ["spindle:z"], ["spindle:z"], "mobility")
+    >>> FRFChassis(Y).mobility([2.0], ["spindle:z"], ["spindle:z"]).freq.tolist()
+    [2.0]
+    """
+
+    def __init__(self, frf: FRF, interpolate: bool = False) -> None:
+        self.frf = frf
+        self.interpolate = bool(interpolate)
+
+    def __repr__(self) -> str:
+        return f"FRFChassis({self.frf!r}, interpolate={self.interpolate})"
+
+    def needs_interpolation(self, freq) -> bool:
+        """True when some of ``freq`` (Hz) is not a line of the FRF."""
+        return match_grid(self.frf.freq, freq) is None
+
+    def on_grid(self, freq) -> FRF:
+        """The whole FRF on ``freq`` (Hz): its own lines, else interpolated if allowed.
+
+        Raises
+        ------
+        FrequencyGridError
+            When some frequency is not a line of the FRF and ``interpolate`` is False,
+            naming the first missing one and how to allow interpolation.
+        """
+        f = np.asarray(freq, float)
+        idx = match_grid(self.frf.freq, f)
+        if idx is not None:
+            return self.frf.isel(freq=idx)
+        if self.interpolate:
+            return self.frf.interpolate(f)
+        F = self.frf.freq
+        tol = 1e-9 * np.maximum(1.0, np.abs(f))
+        near = np.clip(np.searchsorted(F, f - tol), 0, F.size - 1)
+        miss = f[np.abs(F[near] - f) > tol]
+        raise FrequencyGridError(
+            f"the chassis FRF ({F.size} lines, {F[0]:g}-{F[-1]:g} Hz) has no line at "
+            f"{miss.size} of the {f.size} analysis frequencies {f[0]:g}-{f[-1]:g} Hz "
+            f"(first: {miss[0]:g} Hz); tick 'interpolate onto the analysis grid' to "
+            "interpolate it explicitly (linear in real and imaginary part)"
+        )
+
+    def mobility(self, freq, outputs=None, inputs=None, quantity: str = "mobility") -> FRF:
+        """The FRF on ``freq`` (Hz), same signature as :meth:`ChassisModel.mobility`."""
+        Y = self.on_grid(freq)
+        Y = Y.sel(
+            outputs=SPINDLE + BUSHING if outputs is None else list(outputs),
+            inputs=SPINDLE if inputs is None else list(inputs),
+        )
+        return Y if quantity == Y.quantity else Y.to(quantity)

@@ -16,6 +16,12 @@ __all__ = [
     "QuantityError",
     "SingularInterfaceError",
     "DataFormatError",
+    "HarmonicError",
+    "CouplingOptionError",
+    "OperatingPointError",
+    "ModeCountError",
+    "ModalError",
+    "StudyCancelled",
 ]
 
 
@@ -44,3 +50,31 @@ class SingularInterfaceError(FBSError, np.linalg.LinAlgError):
 
 class DataFormatError(FBSError):
     """A file or array that is not what it claims to be."""
+
+
+class HarmonicError(FBSError):
+    """An unknown harmonic excitation case."""
+
+
+class CouplingOptionError(FBSError):
+    """An unknown coupling option."""
+
+
+class OperatingPointError(FBSError):
+    """A speed outside the operating points of the modal model."""
+
+
+class ModeCountError(FBSError):
+    """A number of retained modes that is not an even count in the allowed range."""
+
+
+class ModalError(FBSError):
+    """A modal problem that violates the assumptions (e.g. overdamped modes)."""
+
+
+class StudyCancelled(Exception):  # noqa: N818  (a signal, not an error of the input)
+    """A long study stopped because its ``cancel`` callable returned True.
+
+    Not an :class:`FBSError`: nothing was wrong with the input; the caller asked to stop
+    (for example a dashboard session whose settings changed while the study ran).
+    """

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import FBSError, FrequencyGridError
+from .errors import FrequencyGridError, HarmonicError
 
 __all__ = ["Harmonic", "HarmonicError", "HARMONICS", "WAVELENGTHS", "SPEED_RANGE", "harmonic"]
 
@@ -28,10 +28,6 @@ WAVELENGTHS: tuple[float, ...] = (0.646, 0.499, 0.339, 0.2395, 0.166, 0.1156, 0.
 SPEED_RANGE: tuple[float, float] = (30.0, 120.0)
 
 _REL_TOL = 1e-9
-
-
-class HarmonicError(FBSError):
-    """An unknown harmonic excitation case."""
 
 
 @dataclass(frozen=True)

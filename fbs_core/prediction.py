@@ -21,6 +21,7 @@ wheel: no drive or brake torque passes the bearing).
 from __future__ import annotations
 
 import functools
+import warnings
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,24 +30,34 @@ import scipy.sparse.linalg as spla
 from .chassis import BUSHING, SPINDLE, ChassisModel, reference_chassis
 from .coupling import couple_response
 from .dofs import DIRECTIONS, node_labels
-from .errors import FBSError
+from .errors import CouplingOptionError
 from .frf import FRF, check_grid
-from .harmonics import Harmonic, harmonic
+from .harmonics import Harmonic
+from .harmonics import harmonic as _harmonic
+from .vocabulary import COUPLINGS as _COUPLING_NAMES
 
-__all__ = ["bushing_response", "direct_bushing_response", "coupled_dofs", "COUPLINGS", "HUB"]
+__all__ = ["bushing_response", "direct_bushing_response", "coupled_dofs", "COUPLED_DOFS", "HUB"]
 
 #: Hub DOF labels of the tire, in vehicle coordinates.
 HUB: tuple[str, ...] = node_labels("hub")
 
-#: Coupling options: the hub DOFs joined to the spindle.
-COUPLINGS: dict[str, tuple[str, ...]] = {
-    "6dof": HUB,
-    "5dof": tuple(d for d in HUB if d != "hub:ry"),
-}
+#: The hub DOFs joined to the spindle for each coupling option
+#: (:data:`fbs_core.vocabulary.COUPLINGS`).
+COUPLED_DOFS: dict[str, tuple[str, ...]] = dict(
+    zip(_COUPLING_NAMES, (HUB, tuple(d for d in HUB if d != "hub:ry")), strict=True)
+)
 
 
-class CouplingOptionError(FBSError):
-    """An unknown coupling option."""
+def __getattr__(name: str):
+    if name == "COUPLINGS":  # the old name of COUPLED_DOFS (one release)
+        warnings.warn(
+            "fbs_core.prediction.COUPLINGS is deprecated: the option names are "
+            "fbs_core.vocabulary.COUPLINGS, their hub DOFs fbs_core.prediction.COUPLED_DOFS",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return COUPLED_DOFS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def coupled_dofs(coupling: str) -> tuple[str, ...]:
@@ -61,12 +72,12 @@ def coupled_dofs(coupling: str) -> tuple[str, ...]:
     CouplingOptionError
         For any other value, naming the allowed ones.
     """
-    if not isinstance(coupling, str) or coupling not in COUPLINGS:
+    if not isinstance(coupling, str) or coupling not in COUPLED_DOFS:
         raise CouplingOptionError(
-            f"unknown coupling {coupling!r}; allowed: {', '.join(map(repr, COUPLINGS))} "
+            f"unknown coupling {coupling!r}; allowed: {', '.join(map(repr, _COUPLING_NAMES))} "
             "(all hub DOFs = braked wheel, or wheel spin hub:ry released = free rolling)"
         )
-    return COUPLINGS[coupling]
+    return COUPLED_DOFS[coupling]
 
 
 def _interface() -> list[tuple[str, str]]:
@@ -94,7 +105,7 @@ def _cached(k: int, n_modes, fbytes: bytes, coupling: str, speed_kmh, residual=F
     return _compute(
         reference_tire(),
         reference_chassis(),
-        harmonic(k),
+        _harmonic(k),
         np.frombuffer(fbytes, float),
         n_modes,
         coupling,
@@ -138,7 +149,7 @@ def _assembled_index(tire_dofs, chassis_dofs, coupled):
 
 
 def direct_bushing_response(
-    harmonic_case,
+    harmonic,
     freq=None,
     coupling: str = "6dof",
     *,
@@ -159,7 +170,7 @@ def direct_bushing_response(
 
     Parameters
     ----------
-    harmonic_case : int or Harmonic
+    harmonic : int or Harmonic
     freq : array_like, optional
         Lines in Hz inside the harmonic's band; default ``harmonic.frequencies()``.
     coupling : {"6dof", "5dof"}
@@ -174,7 +185,7 @@ def direct_bushing_response(
         Outputs ``bushing:x`` ... ``bushing:rz``, input ``patch`` (mobility, per
         metre of road amplitude), like :func:`bushing_response`.
     """
-    h = harmonic(harmonic_case)
+    h = _harmonic(harmonic)
     coupled = coupled_dofs(coupling)
     f = h.frequencies() if freq is None else check_grid(freq)
     speeds = h.speed_at(f) if speed_kmh is None else np.full(f.size, float(speed_kmh))
@@ -211,7 +222,7 @@ def direct_bushing_response(
 
 
 def bushing_response(
-    harmonic_case,
+    harmonic=None,
     n_modes: int | None = None,
     freq=None,
     coupling: str = "6dof",
@@ -220,12 +231,13 @@ def bushing_response(
     tire=None,
     chassis: ChassisModel | None = None,
     residual: bool = False,
+    harmonic_case=None,
 ) -> FRF:
     """Velocity at the chosen bushing for the patch load of a harmonic case (eq. 4.1).
 
     Parameters
     ----------
-    harmonic_case : int or Harmonic
+    harmonic : int or Harmonic
         Excitation case 1..7 (thesis fig. 4.4, table 5.1).
     n_modes : int, optional
         Number of complex tire modes kept (even, pairs lowest first); ``None``
@@ -246,6 +258,9 @@ def bushing_response(
     residual : bool
         Keyword only: compensate the tire modes left out by ``n_modes`` with their
         quasi-static part (upper residual flexibility, docs/tire-model.md).
+    harmonic_case : int or Harmonic, optional
+        Deprecated name of ``harmonic`` (a ``DeprecationWarning``; removed in the next
+        release).
 
     Returns
     -------
@@ -264,7 +279,7 @@ def bushing_response(
     >>> v.outputs[2], v.inputs                       # doctest: +SKIP
     ('bushing:z', ('patch',))
     """
-    h = harmonic(harmonic_case)
+    h = _harmonic(_renamed(harmonic, harmonic_case))
     coupled_dofs(coupling)
     f = h.frequencies() if freq is None else check_grid(freq)
     if speed_kmh is not None:
@@ -287,4 +302,20 @@ def bushing_response(
     )
 
 
-_HARMONIC_SET = {harmonic(k) for k in range(1, 8)}
+_HARMONIC_SET = {_harmonic(k) for k in range(1, 8)}
+
+
+def _renamed(harmonic, harmonic_case):
+    """The harmonic given under its name or its deprecated one (``harmonic_case``)."""
+    if harmonic_case is None:
+        if harmonic is None:
+            raise TypeError("bushing_response() missing the argument 'harmonic'")
+        return harmonic
+    warnings.warn(
+        "bushing_response(harmonic_case=...) is deprecated; use harmonic=...",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    if harmonic is not None:
+        raise TypeError("give 'harmonic' only (harmonic_case is its deprecated name)")
+    return harmonic_case

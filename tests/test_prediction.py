@@ -15,7 +15,7 @@ import pytest
 from fbs_core import assemble, bushing_response, harmonic, reference_chassis, reference_tire
 from fbs_core.chassis import BUSHING
 from fbs_core.errors import FBSError, FrequencyGridError
-from fbs_core.prediction import COUPLINGS, CouplingOptionError, coupled_dofs
+from fbs_core.prediction import COUPLED_DOFS, CouplingOptionError, coupled_dofs
 
 SPEED = 60.0  # km/h, one of the tire's operating points
 
@@ -26,7 +26,7 @@ def _direct(k: int, coupling: str, speed: float, freq_key: tuple) -> np.ndarray:
     tire, ch = reference_tire(), reference_chassis()
     h = harmonic(k)
     ts, cs = tire.system(speed), ch.system()
-    joined = [(f"tire/{d}", f"chassis/spindle:{d.split(':')[1]}") for d in COUPLINGS[coupling]]
+    joined = [(f"tire/{d}", f"chassis/spindle:{d.split(':')[1]}") for d in COUPLED_DOFS[coupling]]
     S = assemble({"tire": ts, "chassis": cs}, joined).to_dense()
     pos = {d: i for i, d in enumerate(S.dofs)}
     load = np.zeros(S.n, complex)

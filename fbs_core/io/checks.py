@@ -476,3 +476,106 @@ def describe(frf: FRF, operating_points: Sequence[float] | None = None) -> str:
     if operating_points is not None:
         lines.append("operating points: " + ", ".join(f"{v:g}" for v in operating_points) + " km/h")
     return "\n".join(lines)
+
+
+# -- checks of a model pair for the whole study (the dashboard's upload checks) ----------------
+#: Smallest number of complex tire modes accepted (a truncation map needs N = 10 < total).
+MIN_TIRE_MODES = 20
+
+
+def check_tire(tire) -> list[str]:
+    """Refuse a tire model that cannot run every study of the thesis; return notes.
+
+    The model must have the hub DOFs ``hub:x`` ... ``hub:rz``, at least
+    :data:`MIN_TIRE_MODES` complex modes, the patch participation and operating points of
+    all seven harmonic cases (thesis fig. 4.4) and the speeds of the eigenfrequency curves
+    (fig. 5.8, :data:`fbs_core.vocabulary.EIGEN_SPEEDS`).
+
+    Parameters
+    ----------
+    tire : TireModel
+        A modal tire model (e.g. from :func:`fbs_core.io.load_tire_model`).
+
+    Returns
+    -------
+    list of str
+        Notes for the user (fewer than 400 modes).
+
+    Raises
+    ------
+    FBSError
+        Naming the missing hub DOFs, modes, wavelengths or operating points and the
+        harmonic or speed that needs them.
+    """
+    from ..errors import FBSError
+    from ..harmonics import harmonic
+    from ..vocabulary import EIGEN_SPEEDS, HARMONIC_CASES
+
+    hub = tuple(f"hub:{d}" for d in DIRECTIONS)
+    if tuple(tire.hub_dofs) != hub:
+        raise FBSError(
+            f"the tire's hub DOFs must be {', '.join(hub)}, got {', '.join(tire.hub_dofs)}"
+        )
+    if tire.n_modes < MIN_TIRE_MODES:
+        raise FBSError(
+            f"the tire model has {tire.n_modes} complex modes; the truncation study "
+            f"needs at least {MIN_TIRE_MODES}"
+        )
+    for k in HARMONIC_CASES:
+        h = harmonic(k)
+        f = h.frequencies()
+        try:
+            tire.truncations(f[[0, -1]], h, [tire.n_modes])
+        except FBSError as e:
+            raise type(e)(f"harmonic {k}: {e}") from None
+    for v in EIGEN_SPEEDS:
+        try:
+            tire.eigenfrequencies(v)
+        except FBSError as e:
+            raise type(e)(f"eigenfrequency view (fig. 5.8, {v:g} km/h): {e}") from None
+    notes = []
+    if tire.n_modes < 400:
+        notes.append(f"{tire.n_modes} complex modes: a chosen N above that uses all modes")
+    return notes
+
+
+def check_pair(tire=None, chassis=None, max_cond: float = 1e8) -> None:
+    """The pair couples on every harmonic's grid: the chassis has (or may interpolate)
+    the lines and the interface ``Y_jj^A + Y_jj^E`` (eq. 2.44) is well conditioned.
+
+    Parameters
+    ----------
+    tire : TireModel, optional
+        Default :func:`fbs_core.reference_tire`.
+    chassis : ChassisModel or FRFChassis, optional
+        Default :func:`fbs_core.reference_chassis`.
+    max_cond : float
+        Largest condition number accepted (:func:`interface_check`).
+
+    Raises
+    ------
+    FrequencyGridError, SingularInterfaceError
+        Naming the harmonic and its frequency range.
+    """
+    from ..chassis import SPINDLE, reference_chassis
+    from ..errors import FBSError
+    from ..harmonics import harmonic
+    from ..vocabulary import HARMONIC_CASES
+
+    if tire is None:
+        from ..tire import reference_tire
+
+        tire = reference_tire()
+    chassis = reference_chassis() if chassis is None else chassis
+    hub = tuple(f"hub:{d}" for d in DIRECTIONS)
+    pairs = list(zip(hub, SPINDLE, strict=True))
+    for k in HARMONIC_CASES:
+        h = harmonic(k)
+        f = h.frequencies()
+        try:
+            Yjj = tire.truncations(f, h, [tire.n_modes])[0][0]
+            YA = FRF(f, Yjj, hub, hub, "mobility")
+            YE = chassis.mobility(f, outputs=SPINDLE, inputs=SPINDLE)
+            interface_check(YA, YE, interface=pairs, max_cond=max_cond)
+        except FBSError as e:
+            raise type(e)(f"harmonic {k} ({f[0]:g}-{f[-1]:g} Hz): {e}") from None

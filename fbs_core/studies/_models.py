@@ -23,8 +23,7 @@ import numpy as np
 from ..dofs import DIRECTIONS, parse_label
 from ..errors import DOFError, FBSError, FrequencyGridError
 from ..frf import FRF
-
-COUPLINGS = ("6dof", "5dof")
+from ..vocabulary import COUPLINGS
 
 
 def coupled_directions(coupling) -> tuple[str, ...]:

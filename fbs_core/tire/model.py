@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..direct import SecondOrderSystem
-from ..errors import DataFormatError, FBSError
+from ..errors import DataFormatError, FBSError, ModeCountError, OperatingPointError
 from ..frf import FRF, check_grid
 from ..harmonics import Harmonic
 from ..harmonics import harmonic as _harmonic
@@ -45,14 +45,6 @@ INTERPOLATIONS = ("cubic", "cluster", "linear")
 
 #: Lines per block of the modal sums (bounds the memory of the per-mode terms).
 _CHUNK = 48
-
-
-class OperatingPointError(FBSError):
-    """A speed outside the operating points of the modal model."""
-
-
-class ModeCountError(FBSError):
-    """A number of retained modes that is not an even count in the allowed range."""
 
 
 def _renamed(harmonic, harmonic_case):

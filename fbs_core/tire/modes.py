@@ -31,13 +31,9 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from ..errors import FBSError
+from ..errors import ModalError
 
 __all__ = ["ComplexModes", "ModalError", "complex_modes", "mac", "track_modes", "receptance"]
-
-
-class ModalError(FBSError):
-    """A modal problem that violates the assumptions (e.g. overdamped modes)."""
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,76 @@
+"""The words of the domain, written once: DOF directions, couplings, speeds, dB, read-only arrays.
+
+Every module of :mod:`fbs_core` and of the dashboard takes these from here instead of
+spelling them again.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
+
+from .dofs import DIRECTIONS
+
+__all__ = [
+    "COUPLINGS",
+    "DB_FLOOR",
+    "DIRECTIONS",
+    "EIGEN_SPEEDS",
+    "HARMONIC_CASES",
+    "magnitude_db",
+    "readonly",
+]
+
+#: Hub coupling options: ``"6dof"`` joins all six hub DOFs to the spindle (a braked
+#: wheel, as in the thesis); ``"5dof"`` releases the wheel spin ``hub:ry`` (free rolling).
+COUPLINGS: tuple[str, ...] = ("6dof", "5dof")
+
+#: Operating speeds of the eigenfrequency-versus-N curves (thesis fig. 5.8), km/h.
+EIGEN_SPEEDS: tuple[float, ...] = (20.0, 80.0, 120.0)
+
+#: The harmonic excitation cases of the thesis (fig. 4.4).
+HARMONIC_CASES: tuple[int, ...] = tuple(range(1, 8))
+
+#: Magnitudes are floored at this value before the dB conversion (no ``-inf`` at zeros).
+DB_FLOOR = 1e-30
+
+
+def readonly(a: ArrayLike, dtype: DTypeLike = None) -> np.ndarray:
+    """A read-only copy of ``a`` (results are immutable: nobody can change them in place).
+
+    Examples
+    --------
+    >>> r = readonly([1.0, 2.0])
+    >>> r.flags.writeable
+    False
+    """
+    out = np.array(a, dtype=dtype, copy=True)
+    out.setflags(write=False)
+    return out
+
+
+def magnitude_db(x: ArrayLike, ref: float = 1.0, floor: float | None = DB_FLOOR) -> np.ndarray:
+    """``20 log10(|x| / ref)`` in dB re ``ref``.
+
+    Parameters
+    ----------
+    x : array_like
+        Real or complex amplitudes (any shape).
+    ref : float
+        Reference amplitude of 0 dB.
+    floor : float or None
+        Magnitudes below ``floor * ref`` count as ``floor * ref`` (finite levels at exact
+        zeros); ``None`` keeps ``-inf`` there.
+
+    Examples
+    --------
+    >>> float(magnitude_db(10.0))
+    20.0
+    >>> float(magnitude_db(0.0))
+    -600.0
+    """
+    mag = np.abs(np.asarray(x)) / ref
+    if floor is not None:
+        mag = np.maximum(mag, floor)
+    with np.errstate(divide="ignore"):
+        return 20.0 * np.log10(mag)
