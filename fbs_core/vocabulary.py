@@ -38,6 +38,13 @@ DB_FLOOR = 1e-30
 def readonly(a: ArrayLike, dtype: DTypeLike = None) -> np.ndarray:
     """A read-only copy of ``a`` (results are immutable: nobody can change them in place).
 
+    Parameters
+    ----------
+    a : array_like
+        The values.
+    dtype : data-type, optional
+        Type of the copy (default: that of ``a``).
+
     Examples
     --------
     >>> r = readonly([1.0, 2.0])

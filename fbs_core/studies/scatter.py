@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataFormatError, FBSError, SingularInterfaceError
+from ..errors import DataFormatError, FBSError, SingularInterfaceError, StudyCancelled
 from ..frf import check_grid
 from . import _kernels, _models
 from ._rng import as_seed, seed_key
@@ -285,6 +285,7 @@ def scatter_band_arrays(
     percentiles=(5.0, 95.0),
     checkpoints=None,
     max_chunk_bytes: float = 64e6,
+    cancel=None,
 ) -> ScatterBand:
     """The scatter band from arrays (the kernel behind :func:`scatter_band`).
 
@@ -316,6 +317,10 @@ def scatter_band_arrays(
         Round counts at which the band edges are recorded (default 10, 20, 50, ...).
     max_chunk_bytes : float
         Working-memory bound of one chunk of lines (``8 R n_e`` bytes per line).
+    cancel : callable, optional
+        Called without arguments before each chunk of lines; when it returns True the
+        study stops with :class:`~fbs_core.errors.StudyCancelled` (a dashboard whose
+        settings changed). It may also wait (e.g. to take turns with other studies).
 
     Returns
     -------
@@ -323,6 +328,8 @@ def scatter_band_arrays(
 
     Raises
     ------
+    StudyCancelled
+        When ``cancel()`` returned True.
     FBSError
         For a bad noise level, target, round count, percentile or checkpoint.
     DataFormatError
@@ -379,6 +386,8 @@ def scatter_band_arrays(
     mag = np.empty((chunk, ne, rounds))
     rids = np.arange(rounds, dtype=np.int64)
     for l0 in range(0, nf, chunk):
+        if cancel is not None and cancel():
+            raise StudyCancelled(f"scatter band cancelled after {l0} of {nf} lines")
         l1 = min(nf, l0 + chunk)
         m = mag[: l1 - l0]
         with _LOCK:
@@ -442,6 +451,7 @@ def scatter_band(
     percentiles=(5.0, 95.0),
     checkpoints=None,
     max_chunk_bytes: float = 64e6,
+    cancel=None,
 ) -> ScatterBand:
     """Noise scatter band of the bushing response for one harmonic (thesis 5.2, eqs. 5.2-5.4).
 
@@ -458,7 +468,7 @@ def scatter_band(
     tire, chassis : optional
         Models (default the reference ones); ``chassis`` may be an FRF on ``freq``.
     coupling : {"6dof", "5dof"} or sequence of directions
-    percentiles, checkpoints, max_chunk_bytes
+    percentiles, checkpoints, max_chunk_bytes, cancel
         See :func:`scatter_band_arrays`.
 
     Returns
@@ -498,4 +508,5 @@ def scatter_band(
         percentiles=percentiles,
         checkpoints=checkpoints,
         max_chunk_bytes=max_chunk_bytes,
+        cancel=cancel,
     )

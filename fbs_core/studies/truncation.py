@@ -99,6 +99,25 @@ class TruncationMap:
             raise DOFError(f"unknown response DOF {dof!r}; available: {', '.join(self.dofs)}")
         return self.error[:, :, self.dofs.index(dof)]
 
+    def response_for(self, n_modes: int | None) -> np.ndarray | None:
+        """The coupled response with ``n_modes`` retained modes, if the map holds it.
+
+        Parameters
+        ----------
+        n_modes : int or None
+            Retained modes; ``None`` or a count of at least ``n_modes_total`` is the
+            all-modes reference.
+
+        Returns
+        -------
+        ndarray, shape (n_f, n_dof), or None
+            ``None`` when the map has no row for that count (compute it directly).
+        """
+        if n_modes is None or (self.n_modes_total is not None and n_modes >= self.n_modes_total):
+            return self.reference
+        hit = np.flatnonzero(self.n_modes == int(n_modes))
+        return self.response[hit[0]] if hit.size else None
+
     def suggest(self, threshold: float = 0.2, f_max: float = 160.0, dof: str | None = None):
         """Smallest retained-mode count from which the error stays below ``threshold``.
 

@@ -1,0 +1,34 @@
+"""A long scatter band can be stopped between its chunks of lines (``cancel=``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import fbs_core
+from fbs_core.errors import StudyCancelled
+
+
+def test_cancel_is_asked_before_every_chunk_and_stops_the_study():
+    f = fbs_core.harmonic(1).frequencies()
+    rounds = 400
+    per_line = 8 * 6 * rounds
+    chunk = 10  # lines per chunk
+    kw = dict(rounds=rounds, seed=3, max_chunk_bytes=per_line * chunk)
+    asked = []
+    band = fbs_core.scatter_band(1, cancel=lambda: asked.append(1) and False, **kw)
+    assert len(asked) == -(-f.size // chunk)  # one question per chunk
+    plain = fbs_core.scatter_band(1, **kw)
+    np.testing.assert_array_equal(band.upper, plain.upper)  # asking changes nothing
+    np.testing.assert_array_equal(band.percentiles, plain.percentiles)
+
+    calls = []
+
+    def stop_at_third():
+        calls.append(1)
+        return len(calls) == 3
+
+    with pytest.raises(StudyCancelled, match=f"after {2 * chunk} of {f.size} lines"):
+        fbs_core.scatter_band(1, cancel=stop_at_third, **kw)
+    assert len(calls) == 3  # nothing ran after the cancel
+    assert not issubclass(StudyCancelled, fbs_core.FBSError)  # not an input error
