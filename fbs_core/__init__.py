@@ -20,6 +20,7 @@ from .coupling import (
 from .direct import SecondOrderSystem, assemble
 from .dofs import DIRECTIONS, node_labels, parse_label
 from .errors import (
+    CampaignError,
     CouplingOptionError,
     DataFormatError,
     DOFError,
@@ -75,6 +76,7 @@ __all__ = [
     "FrequencyGridError",
     "QuantityError",
     "SingularInterfaceError",
+    "CampaignError",
     "CouplingOptionError",
     "HarmonicError",
     "ModalError",

@@ -21,6 +21,7 @@ __all__ = [
     "OperatingPointError",
     "ModeCountError",
     "ModalError",
+    "CampaignError",
     "StudyCancelled",
 ]
 
@@ -70,6 +71,10 @@ class ModeCountError(FBSError):
 
 class ModalError(FBSError):
     """A modal problem that violates the assumptions (e.g. overdamped modes)."""
+
+
+class CampaignError(FBSError):
+    """A campaign file or result file that cannot be used (bad key, value or mismatch)."""
 
 
 class StudyCancelled(Exception):  # noqa: N818  (a signal, not an error of the input)

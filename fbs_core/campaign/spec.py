@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FBSError
+from ..errors import CampaignError
 
 __all__ = [
     "CampaignError",
@@ -60,10 +60,6 @@ OUTPUTS = {
     "truncation": ("error", "suggested", "responses"),
 }
 _TOP = ("campaign", "models", "grid", "scatter", "truncation", "outputs", "execution")
-
-
-class CampaignError(FBSError):
-    """A campaign file or result file that cannot be used (bad key, value or mismatch)."""
 
 
 @dataclass(frozen=True)
