@@ -6,9 +6,14 @@ URL query (``?h=5&N=150&dof=z...``), so that a link reproduces the view.
 
 from __future__ import annotations
 
-import panel as pn
+import functools
 
+import panel as pn
+import param
+
+from app.bands import served
 from app.state import URL_KEYS, DashboardState
+from app.store import Results
 from app.views import (
     Controls,
     EigenView,
@@ -34,24 +39,46 @@ every view downloads its data as CSV; the URL holds the page state.
 """
 
 
-def sync_url(state: DashboardState) -> None:
-    """Keep the state in the URL query (only when served)."""
-    loc = pn.state.location
+def apply_valid(obj: param.Parameterized, values: dict) -> list[str]:
+    """Set every value its parameter accepts, one by one; return the names refused.
+
+    Panel applies a URL's values to a parameterized object in one update, which stops at
+    the first bad value (a shared link with ``h=9`` would lose the valid ``N=150`` after
+    it); this is its ``on_error`` fallback.
+    """
+    refused = []
+    for name, value in values.items():
+        try:
+            obj.param.update(**{name: value})
+        except Exception:  # param's ValueError/TypeError: out of range, wrong type
+            refused.append(name)
+    return refused
+
+
+def sync_url(state: DashboardState, location=None) -> None:
+    """Keep the state in the URL query (only when served, or with a given ``location``)."""
+    loc = pn.state.location if location is None else location
     if loc is None:
         return
     for group, keys in URL_KEYS.items():
-        loc.sync(getattr(state, group), keys)
+        obj = getattr(state, group)
+        loc.sync(obj, keys, on_error=functools.partial(apply_valid, obj))
 
 
-def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemplate:
-    """Build one session's page around ``state`` (a new default state if omitted)."""
-    state = state or DashboardState()
-    case, noise, trunc = state.case, state.noise, state.truncation
+def create_app(
+    state: DashboardState | None = None, results: Results | None = None
+) -> pn.template.BootstrapTemplate:
+    """Build one session's page around ``state`` (a new default state if omitted).
+
+    The page's :class:`~app.store.Results` computes everything it shows; when served, it
+    is closed with the session (its running band is cancelled).
+    """
+    results = results if results is not None else Results(state)
+    state = results.state
     sync_url(state)
     # one frequency axis range for all spectra of the session: zoom and pan are linked
     freq = frequency_range()
     modes = modes_range()  # the error map's N axis and the eigenfrequency plot's
-    scatter = ScatterBandView(case=case, noise=noise, x_range=freq)
 
     def card(title, view, height, **kw):
         return pn.Card(
@@ -67,22 +94,22 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
 
     # the uncoupled subsystems are built on first request (two plots less per page load)
     uncoupled = pn.Row(
-        visible=case.param.show_uncoupled,
+        visible=state.case.param.show_uncoupled,
         css_classes=["uncoupled-row"],
         sizing_mode="stretch_width",
     )
 
-    def show_uncoupled(*_):
-        if case.show_uncoupled and not uncoupled.objects:
+    @param.depends(state.case.param.show_uncoupled, watch=True)
+    def show_uncoupled(show=state.case.show_uncoupled):
+        if show and not uncoupled.objects:
             uncoupled.append(
                 card(
                     "Uncoupled subsystems: tire hub and chassis spindle-to-bushing",
-                    UncoupledView(case=case, x_range=freq),
+                    UncoupledView(store=results, x_range=freq),
                     420,
                 )
             )
 
-    case.param.watch(show_uncoupled, "show_uncoupled")
     show_uncoupled()
 
     upload = card(
@@ -97,28 +124,32 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
         pn.Row(
             card(
                 "Coupled response at the bushing (thesis eq. 4.1)",
-                MobilityView(case=case, x_range=freq),
+                MobilityView(store=results, x_range=freq),
                 500,
             ),
             card(
                 "Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
-                TruncationView(case=case, truncation=trunc, x_range=freq, n_range=modes),
+                TruncationView(store=results, x_range=freq, n_range=modes),
                 500,
             ),
         ),
         uncoupled,
         pn.Row(
-            card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", scatter, 500),
+            card(
+                "Noise scatter band (thesis 5.2, figs. 5.9-5.11)",
+                ScatterBandView(store=results, x_range=freq),
+                500,
+            ),
             card(
                 "Eigenfrequency versus number of modes (fig. 5.8)",
-                EigenView(case=case, n_range=modes),
+                EigenView(store=results, n_range=modes),
                 500,
             ),
         ),
         pn.Row(
             card(
                 "Suggested number of modes (thesis table 5.1)",
-                SuggestedModesView(case=case, truncation=trunc),
+                SuggestedModesView(store=results),
                 360,
             )
         ),
@@ -132,10 +163,12 @@ def create_app(state: DashboardState | None = None) -> pn.template.BootstrapTemp
         sidebar_width=340,
     )
     template.state = state  # for tests and benchmarks
-    if pn.state.curdoc is not None and pn.state.curdoc.session_context is not None:
-        pn.state.onload(scatter.start)
+    template.results = results
+    if served():
+        pn.state.onload(results.request_band)
+        pn.state.on_session_destroyed(lambda _ctx: results.close())
     else:
-        scatter.compute_now()
+        results.request_band(wait=True)
     return template
 
 

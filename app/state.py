@@ -30,6 +30,10 @@ __all__ = [
 NOISE_TARGETS = ("both", "tire", "vehicle")
 #: Retained-mode counts offered (thesis 5.1: 10 to 400 in steps of 10).
 MODE_COUNTS = tuple(range(10, 401, 10))
+#: Largest noise level in percent (fbs_core.scatter_band needs p < 1, two decimals here).
+MAX_NOISE_PCT = 99.99
+#: Largest seed offered (exact as a JavaScript number; fbs_core takes up to 2**64 - 1).
+MAX_SEED = 2**32 - 1
 #: What the truncation error map shows.
 MAP_MODES = ("selected DOF", "max over 6 DOFs")
 
@@ -75,10 +79,11 @@ class NoiseState(param.Parameterized):
 
     noise = param.Number(
         default=10.0,
-        bounds=(0.0, 100.0),
+        bounds=(0.0, MAX_NOISE_PCT),
         softbounds=(0.0, 10.0),
         step=0.1,
-        doc="Noise level p in percent: scaling factors uniform in [1-p, 1+p].",
+        doc="Noise level p in percent: scaling factors uniform in [1-p, 1+p] "
+        "(below 100 %: a factor must stay positive, as fbs_core.scatter_band requires).",
     )
     target = param.Selector(
         default="both", objects=list(NOISE_TARGETS), doc="Subsystem(s) that get noise."
@@ -92,7 +97,11 @@ class NoiseState(param.Parameterized):
         bounds=(1, 200_000),
         doc="Number of Monte-Carlo rounds R.",
     )
-    seed = param.Integer(default=0, bounds=(0, None), doc="Random seed of the study.")
+    seed = param.Integer(
+        default=0,
+        bounds=(0, MAX_SEED),
+        doc="Random seed of the study (up to 2**32 - 1: exact in a browser's numbers).",
+    )
     single_round = param.Integer(
         default=0,
         bounds=(0, 200_000 - 1),

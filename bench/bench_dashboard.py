@@ -12,6 +12,11 @@ document (the named ColumnDataSource of the view):
 Usage::
 
     .venv/bin/python bench/bench_dashboard.py [--rounds 10000] [--samples 20]
+    .venv/bin/python bench/bench_dashboard.py --tree /path/to/old/checkout --tree .
+
+With several ``--tree`` (source checkouts of the project), one server per tree runs at the
+same time and the samples alternate between them: a before/after comparison under the same
+machine load.
 """
 
 from __future__ import annotations
@@ -44,7 +49,7 @@ ARGS = [
 # until the named source's data differ (polled every 2 ms).
 JS_MEASURE = """
 async ([kind, cls, value, name, timeout]) => {
-  const models = () => [...Bokeh.documents[0]._all_models.values()];
+  const models = () => [...Bokeh.documents[0].all_models];
   const src = () => models().filter(m => m.name === name && m.type === 'ColumnDataSource')[0];
   const fp = () => { const d = src().data; let s = '';
     for (const [k, v] of Object.entries(d)) { const a = k === 'image' ? v[0] : v;
@@ -76,7 +81,7 @@ async ([kind, cls, value, name, timeout]) => {
 # A new seed; resolve with the milliseconds until the band's data change.
 JS_BAND = """
 async ([seed]) => {
-  const ms = [...Bokeh.documents[0]._all_models.values()];
+  const ms = [...Bokeh.documents[0].all_models];
   const w = ms.filter(m => m.css_classes && m.css_classes.includes('ctl-noise-seed')
                            && 'value' in m)[0];
   const src = ms.filter(m => m.name === 'scatter.minmax')[0];
@@ -89,7 +94,7 @@ async ([seed]) => {
 """
 
 JS_READY = """(name) => { if (!(window.Bokeh && Bokeh.documents.length)) return false;
-  const m = [...Bokeh.documents[0]._all_models.values()].filter(
+  const m = [...Bokeh.documents[0].all_models].filter(
       m => m.name === name && m.type === 'ColumnDataSource')[0];
   if (!m) return false; const k = Object.keys(m.data)[0];
   return k !== undefined && m.data[k].length > 0; }"""
@@ -101,7 +106,7 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def start_server(port: int, threads: int, warm: bool):
+def start_server(port: int, threads: int, warm: bool, tree: Path = ROOT):
     cmd = [
         sys.executable,
         "-m",
@@ -117,13 +122,16 @@ def start_server(port: int, threads: int, warm: bool):
     ]
     if warm:
         cmd.append("--warm")
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    if tree != ROOT:  # that tree's app and fbs_core before the installed ones
+        env["PYTHONPATH"] = os.pathsep.join([str(tree), env.get("PYTHONPATH", "")])
     proc = subprocess.Popen(
         cmd,
-        cwd=ROOT,
+        cwd=tree,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
-        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        env=env,
     )
     ready: queue.Queue = queue.Queue()
     proc.log = []  # the server's output, printed if the benchmark fails
@@ -150,7 +158,7 @@ def stats(ms: list[float]) -> str:
 def wait_band_idle(page, timeout=300_000):
     """Wait until no scatter band is being computed (its progress bar is hidden)."""
     page.wait_for_function(
-        "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
+        "() => [...Bokeh.documents[0].all_models].filter(m => m.css_classes && "
         "m.css_classes.includes('scatter-progress')).every(m => m.active === false)",
         timeout=timeout,
         polling=50,
@@ -163,7 +171,14 @@ def main():
     ap.add_argument("--samples", type=int, default=20)
     ap.add_argument("--threads", type=int, default=4)
     ap.add_argument("--no-warm", action="store_true")
+    ap.add_argument(
+        "--tree",
+        action="append",
+        type=Path,
+        help="a source checkout to serve (repeat to compare side by side); default this one",
+    )
     args = ap.parse_args()
+    trees = [t.resolve() for t in (args.tree or [ROOT])]
 
     launch = {"args": ARGS}
     if Path(CHROMIUM).exists():
@@ -171,36 +186,41 @@ def main():
     print(
         f"cores: {os.cpu_count()}, load average: {os.getloadavg()[0]:.1f}; "
         f"rounds R = {args.rounds:,}; --num-threads {args.threads}"
-        f"{'' if args.no_warm else ' --warm'}"
+        f"{'' if args.no_warm else ' --warm'}; trees: {', '.join(map(str, trees))}"
     )
     with sync_playwright() as p:
         browser = p.chromium.launch(**launch)
-        page = browser.new_page(viewport={"width": 1600, "height": 1200})
-        port = free_port()
-        t0 = time.perf_counter()
-        proc, ready = start_server(port, args.threads, not args.no_warm)
+        servers = []
         try:
-            t_ready = ready.get(timeout=600)
-            if t_ready is None:
-                raise RuntimeError("server did not start")
-            page.goto(f"http://127.0.0.1:{port}/main?rounds={args.rounds}")
-            page.wait_for_function(JS_READY, arg="mobility.truncated", timeout=300_000)
-            t_plot = time.perf_counter()
-            page.wait_for_function(JS_READY, arg="scatter.minmax", timeout=600_000)
-            t_band = time.perf_counter()
-            print(f"server start -> app running:          {t_ready - t0:6.1f} s")
-            print(
-                f"server start -> first rendered plot:  {t_plot - t0:6.1f} s "
-                f"(page request -> plot {t_plot - t_ready:.1f} s)"
-            )
-            print(f"server start -> scatter band shown:   {t_band - t0:6.1f} s")
-            wait_band_idle(page)
+            for tree in trees:
+                page = browser.new_page(viewport={"width": 1600, "height": 1200})
+                port = free_port()
+                t0 = time.perf_counter()
+                proc, ready = start_server(port, args.threads, not args.no_warm, tree)
+                servers.append((tree, page, proc, port, ready, t0))
+            for tree, page, _proc, port, ready, t0 in servers:
+                t_ready = ready.get(timeout=900)
+                if t_ready is None:
+                    raise RuntimeError(f"server of {tree} did not start")
+                page.goto(f"http://127.0.0.1:{port}/main?rounds={args.rounds}")
+                page.wait_for_function(JS_READY, arg="mobility.truncated", timeout=300_000)
+                t_plot = time.perf_counter()
+                page.wait_for_function(JS_READY, arg="scatter.minmax", timeout=600_000)
+                t_band = time.perf_counter()
+                print(f"[{tree.name}] server start -> app running:          {t_ready - t0:6.1f} s")
+                print(
+                    f"[{tree.name}] server start -> first rendered plot:  {t_plot - t0:6.1f} s "
+                    f"(page request -> plot {t_plot - t_ready:.1f} s)"
+                )
+                print(f"[{tree.name}] server start -> scatter band shown:   {t_band - t0:6.1f} s")
+                wait_band_idle(page)
 
             def measure(kind, cls, values, name):
-                out = []
-                for v in values:
-                    out.append(page.evaluate(JS_MEASURE, [kind, cls, v, name, 120_000]))
-                    wait_band_idle(page)  # the next sample starts from a settled page
+                out = {tree: [] for tree, *_ in servers}
+                for v in values:  # alternate: both trees see the same load
+                    for tree, page, *_ in servers:
+                        out[tree].append(page.evaluate(JS_MEASURE, [kind, cls, v, name, 120_000]))
+                        wait_band_idle(page)  # the next sample starts from a settled page
                 return out
 
             n = args.samples
@@ -223,28 +243,37 @@ def main():
                 ),
             }
             for k, v in res.items():
-                print(f"{k:36s} {stats(v)}")
+                for tree, ms in v.items():
+                    print(f"[{tree.name}] {k:36s} {stats(ms)}")
             # scatter band: a new seed forces a new band of R rounds; at the default
             # harmonic 1 (78 lines) and at harmonic 7 (633 lines, the largest)
             for h in (1, 7):
-                page.evaluate(
-                    JS_MEASURE, ["value", "ctl-case-harmonic", h, "mobility.truncated", 120_000]
-                )
-                band = []
+                band = {tree: [] for tree, *_ in servers}
+                for _, page, *_ in servers:
+                    page.evaluate(
+                        JS_MEASURE, ["value", "ctl-case-harmonic", h, "mobility.truncated", 120_000]
+                    )
                 for seed in range(100 * h + 1, 100 * h + 6):  # never computed before
-                    # the band of the previous change starts after a short debounce: let it
-                    # start and finish, so that its arrival is not taken for this one's
-                    page.wait_for_timeout(300)
-                    wait_band_idle(page)
-                    band.append(page.evaluate(JS_BAND, [seed]))
+                    for tree, page, *_ in servers:
+                        # the band of the previous change may start a little later: let it
+                        # start and finish, so that its arrival is not taken for this one's
+                        page.wait_for_timeout(300)
+                        wait_band_idle(page)
+                        band[tree].append(page.evaluate(JS_BAND, [seed]))
                 label = f"scatter band R={args.rounds:,}, harmonic {h}"
-                print(f"{label:36s} {stats(band)}")
+                for tree, ms in band.items():
+                    print(f"[{tree.name}] {label:36s} {stats(ms)}")
         except Exception:
-            print("server log (last lines):\n" + "".join(proc.log[-40:]), file=sys.stderr)
+            for tree, _, proc, *_ in servers:
+                print(
+                    f"[{tree}] server log (last lines):\n" + "".join(proc.log[-40:]),
+                    file=sys.stderr,
+                )
             raise
         finally:
-            proc.terminate()
-            proc.wait(timeout=20)
+            for _, _, proc, *_ in servers:
+                proc.terminate()
+                proc.wait(timeout=20)
             browser.close()
     print(f"load average at the end: {os.getloadavg()[0]:.1f}")
 

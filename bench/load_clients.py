@@ -232,6 +232,11 @@ class BokehSession:
         self._progress: list = []  # the progress bars of long computations (class name)
         self._n_models = 0
 
+    @property
+    def digest(self) -> str:
+        """Digest of the replica's plot data (:func:`column_digest`) after the last patch."""
+        return self._digest
+
     async def open(self, url: str, timeout_s: float) -> None:
         from bokeh.client.websocket import WebSocketClientConnectionWrapper
         from bokeh.document import Document

@@ -49,6 +49,9 @@ def test_every_control_of_the_issue_exists_with_its_range():
         (CaseState, "coupling", "4dof"),
         (NoiseState, "noise", -1.0),
         (NoiseState, "noise", 101.0),
+        (NoiseState, "noise", 100.0),  # fbs_core needs p < 1: a factor 1 - p of zero
+        (NoiseState, "seed", -1),
+        (NoiseState, "seed", 2**32),
         (NoiseState, "target", "road"),
         (NoiseState, "rounds", 0),
         (TruncationState, "threshold", 0.0),
@@ -57,6 +60,28 @@ def test_every_control_of_the_issue_exists_with_its_range():
 def test_out_of_range_values_are_rejected(obj, name, value):
     with pytest.raises(ValueError):
         setattr(obj(), name, value)
+
+
+def test_every_accepted_noise_level_and_seed_runs_in_the_library():
+    import fbs_core
+    from app.state import MAX_NOISE_PCT, MAX_SEED
+
+    n = NoiseState(noise=MAX_NOISE_PCT, seed=MAX_SEED)  # the largest values a user can set
+    band = fbs_core.scatter_band(1, noise=n.noise / 100, rounds=5, seed=n.seed)
+    assert band.rounds == 5 and np.all(band.upper >= band.lower)
+
+
+def test_one_bad_url_value_keeps_the_valid_ones():
+    from panel.io.location import Location
+
+    from app.main import sync_url
+
+    s = DashboardState()
+    # h=9 is out of range and comes first; the values after it must still apply
+    sync_url(s, Location(search="?h=9&N=150&dof=x&noise=100&seed=5&thr=12&map=nonsense"))
+    assert (s.case.harmonic, s.case.n_modes, s.case.dof) == (1, 150, "x")
+    assert (s.noise.noise, s.noise.seed) == (10.0, 5)
+    assert s.truncation.threshold == 12.0 and s.truncation.map_mode == "selected DOF"
 
 
 def test_single_round_stays_inside_the_batch():

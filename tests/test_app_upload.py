@@ -10,6 +10,7 @@ reference views.
 from __future__ import annotations
 
 import hashlib
+import html
 from pathlib import Path
 
 import numpy as np
@@ -197,8 +198,8 @@ def test_upload_view_shows_the_summary_or_the_error(doubled_mat):
     view.chassis_file.param.update(value=doubled_mat, filename="mine.mat")
     assert ds.error == "" and ds.models.chassis_name == "mine.mat"
     summary = view._summary()
-    assert summary.alert_type == "success" and "bushing:z" in summary.object
-    assert "uploaded chassis 'mine.mat'" in summary.object
+    assert "alert-success" in summary.object and "bushing:z" in summary.object
+    assert "uploaded chassis &#x27;mine.mat&#x27;" in summary.object
     assert not view._error().visible
     view.tire_file.param.update(value=b"no tire here", filename="t.mat")
     err = view._error()
@@ -208,7 +209,35 @@ def test_upload_view_shows_the_summary_or_the_error(doubled_mat):
     assert ds.models is REFERENCE and not view._error().visible
 
 
+def test_file_names_are_text_never_links_or_images(doubled_mat):
+    """A file name with Markdown or HTML in it is shown as text in the alerts: no live link,
+    no external image (the page renders what the pane's model holds)."""
+    ds = DataSource()
+    view = UploadView(data=ds)
+    view.__panel__().get_root()
+    evil = "[click](http://evil.example) ![x](http://evil.example/i.png) <img src=x>.mat"
+    view.tire_file.param.update(value=b"not a tire", filename=evil)
+    err = view._error()
+    shown = html.unescape(err.get_root().text)  # the HTML the browser renders
+    assert err.visible and "evil.example" in shown
+    assert "<a" not in shown and "<img" not in shown
+    view.spindle.value, view.bushing.value = "3", "8"
+    view.chassis_file.param.update(value=doubled_mat, filename=evil.replace(".mat", "2.mat"))
+    assert ds.error == ""
+    shown = html.unescape(view._summary().get_root().text)
+    assert "evil.example" in shown and "<a" not in shown and "<img" not in shown
+
+
 # -- the views on the session's models (app.compute keys its caches on them) -----------------
+def _results():
+    from app.state import DashboardState
+    from app.store import Results
+
+    state = DashboardState()
+    state.noise.rounds = 20
+    return Results(state)
+
+
 NAMES = [
     "mobility.reference",
     "mobility.truncated",
@@ -269,16 +298,13 @@ def test_the_page_runs_every_view_on_an_upload_of_this_session_only(doubled_mat)
 
 def test_views_on_the_unchanged_chassis_equal_the_reference(chassis_frf):
     from app import compute
-    from app.state import DashboardState
-    from app.views import MobilityView, UncoupledView
 
-    state = DashboardState()
-    state.case.param.update(harmonic=2, n_modes=60, dof="y")
-    mob, unc = MobilityView(case=state.case), UncoupledView(case=state.case)
-    ref, ref_u = mob.data(), unc.data()
+    res = _results()
+    res.state.case.param.update(harmonic=2, n_modes=60, dof="y", show_uncoupled=True)
+    ref, ref_u = res.response.columns, res.uncoupled.columns
     raw = save_frf(_renumber(chassis_frf, 1.0, "spindle", "bushing"), format="uff")
-    assert state.data.load_chassis(raw, "same.uff"), state.data.error
-    got, got_u = mob.data(), unc.data()
+    assert res.state.data.load_chassis(raw, "same.uff"), res.state.data.error
+    got, got_u = res.response.columns, res.uncoupled.columns
     for k in ("reference", "truncated"):
         np.testing.assert_allclose(got[k], ref[k], rtol=1e-5)  # UFF: single precision
     np.testing.assert_allclose(got_u["chassis"], ref_u["chassis"], rtol=1e-5)
@@ -288,14 +314,11 @@ def test_views_on_the_unchanged_chassis_equal_the_reference(chassis_frf):
 
 
 def test_doubled_chassis_shows_6_db_more_uncoupled_mobility(doubled_mat):
-    from app.state import DashboardState
-    from app.views import UncoupledView
-
-    state = DashboardState()
-    unc = UncoupledView(case=state.case)
-    ref = unc.data()
-    assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
-    got = unc.data()
+    res = _results()
+    res.state.case.show_uncoupled = True
+    ref = res.uncoupled.columns
+    assert res.state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    got = res.uncoupled.columns
     np.testing.assert_allclose(
         got["chassis_db"], ref["chassis_db"] + 20 * np.log10(2.0), rtol=0, atol=1e-9
     )
@@ -304,13 +327,12 @@ def test_doubled_chassis_shows_6_db_more_uncoupled_mobility(doubled_mat):
 
 def test_truncated_tire_upload_is_the_reference_with_fewer_modes(tmp_path):
     from app import compute
-    from app.state import DashboardState
-    from app.views import EigenView, MobilityView, TruncationView
 
-    state = DashboardState()
+    res = _results()
+    state = res.state
     state.case.param.update(harmonic=1, n_modes=100, dof="z")
     assert state.data.load_tire(_tire_bytes(tmp_path, _sub_tire(n_modes=200)), "t200.h5")
-    mob = MobilityView(case=state.case).data()
+    mob = res.response.columns
     ref100 = compute.mobility_data(1, 100, "z", "6dof")
     ref200 = compute.mobility_data(1, 200, "z", "6dof")
     # the first 100 modes are the reference's; "all modes" of this tire are its 200 (the
@@ -318,27 +340,25 @@ def test_truncated_tire_upload_is_the_reference_with_fewer_modes(tmp_path):
     # clusters of close modes whole, so a cut of the stored modes differs slightly)
     np.testing.assert_allclose(mob["truncated"], ref100["truncated"], rtol=1e-3)
     np.testing.assert_allclose(mob["reference"], ref200["truncated"], rtol=1e-3)
-    m = TruncationView(case=state.case, truncation=state.truncation).data()
+    m = res.error_map.draw["map"]
     assert m["n_modes"].tolist() == list(range(10, 200, 10))
-    e = EigenView(case=state.case).data()
+    e = res.eigen.draw["curves"]
     e_ref = compute.eigen_curves()
     k = e["n_modes"].size
     assert e["n_modes"][-1] == 200
     np.testing.assert_allclose(e["f_80"], e_ref["f_80"][:k], rtol=1e-12)
     state.case.n_modes = 300  # more than the tire has: all of its modes
-    mob = MobilityView(case=state.case).data()
+    mob = res.response.columns
     np.testing.assert_array_equal(mob["truncated"], mob["reference"])
 
 
 def test_zero_noise_band_on_an_upload_is_its_coupled_response(doubled_mat):
-    from app.state import DashboardState
-    from app.views import MobilityView, ScatterBandView
-
-    state = DashboardState()
-    state.noise.param.update(noise=0.0, rounds=20)
-    assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
-    b = ScatterBandView(case=state.case, noise=state.noise).data()
-    mob = MobilityView(case=state.case).data()
+    res = _results()
+    res.state.noise.param.update(noise=0.0, rounds=20)
+    assert res.state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
+    res.request_band(wait=True)
+    b = res.band_curves.draw["band"]
+    mob = res.response.columns
     np.testing.assert_allclose(b["reference"], mob["truncated"], rtol=1e-9)
     np.testing.assert_allclose(b["maximum"], np.abs(mob["truncated"]), rtol=1e-9)
 
@@ -355,20 +375,18 @@ def test_ill_conditioned_interface_is_refused(chassis_frf):
 
 
 def test_free_rolling_coupling_runs_on_an_upload(doubled_mat):
-    from app.state import DashboardState
-    from app.views import MobilityView, SuggestedModesView
-
-    state = DashboardState()
+    res = _results()
+    state = res.state
     assert state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
     state.case.param.update(coupling="5dof", harmonic=4, n_modes=80)
-    mob = MobilityView(case=state.case).data()
+    mob = res.response.columns
     br = fbs_core.bushing_response(
         4, n_modes=80, coupling="5dof", chassis=state.data.models.chassis
     )
     np.testing.assert_allclose(
         mob["truncated"], br.sel(outputs="bushing:z").data[:, 0, 0], rtol=1e-9
     )
-    tab = SuggestedModesView(case=state.case, truncation=state.truncation).table()
+    tab = res.suggested.draw["table"]
     assert list(tab["harmonic"]) == list(range(1, 8)) and np.all(tab["n_modes"] > 0)
 
 
@@ -378,8 +396,6 @@ def test_tire_from_matlab_in_the_documented_layout():
     from scipy.io import savemat
 
     from app import compute
-    from app.state import DashboardState
-    from app.views import MobilityView
 
     T = _sub_tire(n_modes=120)
     buf = io.BytesIO()
@@ -394,12 +410,13 @@ def test_tire_from_matlab_in_the_documented_layout():
             "participation": T.participation,
         },
     )
-    state = DashboardState()
+    res = _results()
+    state = res.state
     assert state.data.load_tire(buf.getvalue(), "supplier_tire.mat"), state.data.error
     assert "120 complex modes" in state.data.tire_summary
     assert "MATLAB" in state.data.tire_summary
     state.case.param.update(harmonic=5, n_modes=60)
-    mob = MobilityView(case=state.case).data()
+    mob = res.response.columns
     np.testing.assert_allclose(
         mob["truncated"], compute.mobility_data(5, 60, "z", "6dof")["truncated"], rtol=1e-9
     )

@@ -1,5 +1,12 @@
-"""Views without a browser: state -> computed data -> plot data (Bokeh models, rendered
-in-process), and which views each control touches."""
+"""Views without a browser: state -> published results -> plot data (Bokeh models, rendered
+in-process), which views each control touches, and what the CSV exports hold.
+
+Truth: ``fbs_core`` called directly (``bushing_response``, ``scatter_band``), closed forms
+(a band without noise is the reference; a stricter threshold never needs fewer modes), and
+the figures' own sources (an export must hold what is plotted).
+"""
+
+import threading
 
 import numpy as np
 import pytest
@@ -7,8 +14,10 @@ from bokeh.models import ColumnDataSource
 
 import fbs_core
 from app import compute
+from app.export import read_csv, to_csv
 from app.main import create_app
 from app.state import DashboardState
+from app.store import Results
 
 NAMES = [
     "mobility.reference",
@@ -53,6 +62,10 @@ def _same(a, b):
     )
 
 
+def _db(x):
+    return 20 * np.log10(np.abs(x))
+
+
 def test_plotted_mobility_is_the_core_prediction(page):
     state, _, root = page
     c = state.case
@@ -60,9 +73,9 @@ def test_plotted_mobility_is_the_core_prediction(page):
     br = fbs_core.bushing_response(c.harmonic, n_modes=c.n_modes, coupling=c.coupling)
     ref = fbs_core.bushing_response(c.harmonic, coupling=c.coupling)
     np.testing.assert_allclose(src["mobility.truncated"].data["freq"], br.freq)
-    want = 20 * np.log10(np.abs(br.sel(outputs=f"bushing:{c.dof}").data[:, 0, 0]))
+    want = _db(br.sel(outputs=f"bushing:{c.dof}").data[:, 0, 0])
     np.testing.assert_allclose(src["mobility.truncated"].data["level"], want, rtol=1e-9)
-    want = 20 * np.log10(np.abs(ref.sel(outputs=f"bushing:{c.dof}").data[:, 0, 0]))
+    want = _db(ref.sel(outputs=f"bushing:{c.dof}").data[:, 0, 0])
     np.testing.assert_allclose(src["mobility.reference"].data["level"], want, rtol=1e-9)
 
 
@@ -121,59 +134,70 @@ def test_threshold_caps_the_colour_scale(page):
     assert [m.high for m in mappers] == [12.0]
 
 
-def test_view_data_and_csv_columns_agree(page):
+def _csv(result, key="x"):
+    return read_csv(to_csv(result.columns, result.meta, key))
+
+
+def test_exports_hold_the_plotted_data_and_the_core_truth(page):
     state, app, root = page
-    from app.views import MobilityView, ScatterBandView, TruncationView
+    res, src, c = app.results, _sources(root), state.case
+    meta, cols = _csv(res.response)
+    np.testing.assert_array_equal(cols["truncated_dB"], src["mobility.truncated"].data["level"])
+    br = fbs_core.bushing_response(c.harmonic, n_modes=c.n_modes, coupling=c.coupling)
+    v = br.sel(outputs=f"bushing:{c.dof}").data[:, 0, 0]
+    np.testing.assert_allclose(cols["truncated_re"] + 1j * cols["truncated_im"], v, rtol=1e-9)
+    assert meta["harmonic"] == str(c.harmonic) and meta["response DOF"] == f"bushing:{c.dof}"
 
-    mob = MobilityView(case=state.case)
-    d = mob.data()
-    want = compute.mobility_data(
-        state.case.harmonic, state.case.n_modes, state.case.dof, state.case.coupling
+    meta, cols = _csv(res.error_map)
+    m = fbs_core.studies.truncation_map(c.harmonic, coupling=c.coupling)
+    err = m.dof_error(f"bushing:{c.dof}") if state.truncation.map_mode == "selected DOF" else None
+    if err is not None:
+        np.testing.assert_allclose(cols["error_pct"][: err.shape[1]], 100 * err[0], rtol=1e-9)
+
+    n = state.noise
+    meta, cols = _csv(res.band_curves)
+    band = fbs_core.scatter_band(
+        c.harmonic,
+        noise=n.noise / 100,
+        target=n.target,
+        rounds=n.rounds,
+        frequency_dependent=n.frequency_dependent,
+        seed=n.seed,
+        n_modes=c.n_modes,
+        coupling=c.coupling,
+        percentiles=compute.Q_LEVELS,
     )
-    np.testing.assert_array_equal(d["truncated_db"], want["truncated_db"])
-    cols = mob._csv_columns()
-    np.testing.assert_array_equal(cols["truncated_dB"], d["truncated_db"])
-    np.testing.assert_array_equal(cols["truncated"], d["truncated"])
-
-    tv = TruncationView(case=state.case, truncation=state.truncation)
-    m = tv.data()
-    assert m["error_pct"].shape == (m["n_modes"].size, m["centre_freq"].size)
-    long = tv._csv_columns()
-    np.testing.assert_array_equal(long["error_pct"], m["error_pct"].ravel())
-
-    sv = ScatterBandView(case=state.case, noise=state.noise)
-    b = sv.data()
-    assert np.all(b["minimum"] <= b["lower"] + 1e-12)
-    assert np.all(b["upper"] <= b["maximum"] + 1e-12)
-    r = sv.round_data()
-    band = compute.band(*sv.key())
-    np.testing.assert_array_equal(
-        r["round"],
-        band.round(state.noise.single_round)[:, band.dofs.index(f"bushing:{state.case.dof}")],
+    j = band.dofs.index(f"bushing:{c.dof}")
+    np.testing.assert_allclose(cols["maximum_dB"], _db(band.upper[:, j]), rtol=1e-12)
+    np.testing.assert_array_equal(cols["maximum_dB"], src["scatter.minmax"].data["upper"])
+    np.testing.assert_allclose(
+        cols[f"round_{n.single_round}_dB"], _db(band.round(n.single_round)[:, j]), rtol=1e-12
     )
+    assert np.all(cols["minimum_dB"] <= cols["pct_low_dB"] + 1e-9)
+    assert np.all(cols["pct_high_dB"] <= cols["maximum_dB"] + 1e-9)
+    assert meta["rounds"] == str(n.rounds) and meta["seed"] == str(n.seed)
 
 
 def test_zero_noise_band_collapses_on_the_reference():
     state = DashboardState()
     state.noise.param.update(noise=0.0, rounds=50)
-    from app.views import ScatterBandView
-
-    sv = ScatterBandView(case=state.case, noise=state.noise)
-    b = sv.data()
-    np.testing.assert_allclose(b["minimum"], np.abs(b["reference"]), rtol=1e-12)
-    np.testing.assert_allclose(b["maximum"], np.abs(b["reference"]), rtol=1e-12)
+    res = Results(state)
+    res.request_band(wait=True)
+    d = res.band_curves.draw["band"]
+    ref = fbs_core.bushing_response(1, n_modes=state.case.n_modes)
+    v = np.abs(ref.sel(outputs="bushing:z").data[:, 0, 0])
+    np.testing.assert_allclose(d["minimum"], v, rtol=1e-9)
+    np.testing.assert_allclose(d["maximum"], v, rtol=1e-9)
 
 
 def test_suggested_table_follows_threshold_and_map_mode():
-    state = DashboardState()
-    from app.views import SuggestedModesView
-
-    v = SuggestedModesView(case=state.case, truncation=state.truncation)
-    loose = v.table()["n_modes"]
-    state.truncation.threshold = 5.0
-    strict = v.table()["n_modes"]
+    res = Results(DashboardState())
+    loose = res.suggested.columns["n_modes"]
+    res.state.truncation.threshold = 5.0
+    strict = res.suggested.columns["n_modes"]
     assert np.all(strict >= loose)  # a stricter threshold never needs fewer modes
-    assert list(v.table()["harmonic"]) == list(range(1, 8))
+    assert list(res.suggested.columns["harmonic"]) == list(range(1, 8))
+    assert "5 %" in res.suggested.caption
 
 
 def test_frequency_and_mode_axes_are_linked(page):
@@ -187,48 +211,49 @@ def test_frequency_and_mode_axes_are_linked(page):
     assert figs["scatter.figure"].x_range is freq
     assert figs["truncation.figure"].x_range is freq
     assert figs["eigen.figure"].x_range is figs["truncation.figure"].y_range
-    f = compute.frequencies(state.case.harmonic)
+    f = fbs_core.harmonic(state.case.harmonic).frequencies()
     assert (freq.start, freq.end) == (f[0], f[-1])
     state.case.harmonic = 6
-    f = compute.frequencies(6)
+    f = fbs_core.harmonic(6).frequencies()
     assert (freq.start, freq.end) == (f[0], f[-1])
     assert (freq.reset_start, freq.reset_end) == (f[0], f[-1])
 
 
-def test_a_slow_update_of_an_older_state_never_lands_last():
+def test_an_older_state_computed_slowly_never_lands_last(monkeypatch):
     """Two control changes of one session handled by two worker threads: the thread that
-    read the older state finishes last. Its update must be dropped, so the plot shows the
-    latest state (the ticket is drawn before the state is read)."""
-    import threading
+    read the older state computes slowly. The published response must be the newest
+    state's (computed and published under the session's lock, the state read inside it)."""
+    res = Results(DashboardState())
+    res.state.noise.rounds = 20
+    slow_started, go_on = threading.Event(), threading.Event()
+    real = compute.mobility_data
 
-    from app.views.plots import Pusher
+    def mobility_data(harmonic, *args):
+        if harmonic == 3:
+            slow_started.set()
+            assert go_on.wait(30)
+        return real(harmonic, *args)
 
-    state, shown = {"harmonic": 3}, []
-    push = Pusher()
-    a_has_read, b_is_done = threading.Event(), threading.Event()
-
-    def make_a():  # reads harmonic 3, then computes slowly
-        h = state["harmonic"]
-        a_has_read.set()
-        assert b_is_done.wait(5)
-        return lambda: shown.append(h)
-
-    def make_b():  # the next change: harmonic 1, computed quickly
-        h = state["harmonic"]
-        return lambda: shown.append(h)
-
-    slow = threading.Thread(target=push, args=(make_a,))
-    slow.start()
-    assert a_has_read.wait(5)
-    state["harmonic"] = 1
-    push(make_b)
-    b_is_done.set()
-    slow.join(5)
-    assert shown == [1]
+    monkeypatch.setattr(compute, "mobility_data", mobility_data)
+    a = threading.Thread(target=setattr, args=(res.state.case, "harmonic", 3))
+    a.start()
+    assert slow_started.wait(30)
+    b = threading.Thread(target=setattr, args=(res.state.case, "harmonic", 1))
+    b.start()
+    go_on.set()
+    a.join(60)
+    b.join(60)
+    assert res.response.meta["harmonic"] == 1
+    want = fbs_core.bushing_response(1, n_modes=res.state.case.n_modes)
+    np.testing.assert_allclose(
+        res.response.columns["truncated"],
+        want.sel(outputs="bushing:z").data[:, 0, 0],
+        rtol=1e-9,
+    )
 
 
 def test_caption_text_is_escaped_html_with_bold_and_middots():
-    from app.views.common import inline_html
+    from app.views.live import inline_html
 
     # a DOF label from a user's file is text, never markup
     assert (
@@ -237,19 +262,14 @@ def test_caption_text_is_escaped_html_with_bold_and_middots():
     )
 
 
-def test_live_text_follows_its_parameters():
+def test_caption_follows_the_state(page):
     import html
 
-    import param
+    from app.views import MobilityView
 
-    from app.views.common import live_text
-
-    class P(param.Parameterized):
-        h = param.Integer(1)
-
-    p = P()
-    pane = live_text(lambda: f"**Harmonic {p.h}**", [(p, ["h"])])
-    model = pane.object
-    assert html.unescape(model.text) == "<p><b>Harmonic 1</b></p>"
-    p.h = 7  # no server: the update is applied at once
-    assert html.unescape(model.text) == "<p><b>Harmonic 7</b></p>"
+    state, app, _ = page
+    view = MobilityView(store=app.results)
+    view.__panel__()
+    state.case.n_modes = 70
+    text = html.unescape(view._caption.object)
+    assert f"<b>Harmonic {state.case.harmonic}</b>" in text and "N = 70" in text

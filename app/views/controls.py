@@ -6,18 +6,8 @@ import panel as pn
 import param
 from panel.viewable import Viewer
 
+from ..panel_private import respond_at_once
 from ..state import DashboardState
-
-#: Milliseconds Panel waits after a browser-side widget change before handling it (Panel's
-#: default, 50 ms, merges bursts of changes; the views here update in a few milliseconds
-#: and drop superseded updates, so the wait would only add to every control's latency).
-DEBOUNCE_MS = 5
-
-
-def _respond_at_once(widget: pn.widgets.Widget) -> None:
-    # composite widgets (DiscreteSlider, Editable*Slider) receive the change on a sub-widget
-    for w in widget.select(pn.widgets.Widget):
-        w._debounce = DEBOUNCE_MS
 
 
 class Controls(Viewer):
@@ -25,9 +15,13 @@ class Controls(Viewer):
 
     state = param.ClassSelector(class_=DashboardState)
 
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._widgets: dict[str, pn.widgets.Widget] | None = None
+
     def widgets(self) -> dict[str, pn.widgets.Widget]:
         """The widgets by ``"<group>.<parameter>"`` (built once, reused by the layout)."""
-        if getattr(self, "_widgets", None) is None:
+        if self._widgets is None:
             c, n, t = self.state.case, self.state.noise, self.state.truncation
             W = pn.widgets
             self._widgets = {
@@ -74,7 +68,7 @@ class Controls(Viewer):
             }
             for key, w in self._widgets.items():
                 w.css_classes = [*w.css_classes, "ctl-" + key.replace(".", "-")]
-                _respond_at_once(w)
+                respond_at_once(w)
         return self._widgets
 
     def __panel__(self):

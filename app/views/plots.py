@@ -2,26 +2,20 @@
 
 A view builds its figure(s) once; a control change only assigns new columns to the view's
 named :class:`~bokeh.models.ColumnDataSource` objects (and moves a span, a colour limit, a
-label). That is what makes the dashboard live: assigning the columns of six curves costs
-well under a millisecond on the server, where re-rendering the same layers through
-HoloViews' ``DynamicMap`` pipeline cost 35-200 ms each (``bench/bench_dashboard.py``
-measures the browser-side latency).
+label): far cheaper than re-rendering plot layers (``bench/bench_dashboard.py`` measures
+the browser-side latency).
 
 Every source carries a stable ``name`` (``"mobility.truncated"``, ``"scatter.minmax"`` ...):
 the browser tests and the benchmark find the plotted data by it.
 
-Model changes reach the browser through :func:`push`: directly when the session's document
-may be modified from the running code, else on the session's event loop (Panel runs widget
-callbacks on its thread pool with ``--num-threads``).
+When the figures are redrawn is the business of :class:`app.views.live.LiveView`.
 """
 
 from __future__ import annotations
 
-import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
-import panel as pn
 from bokeh.models import (
     ColorBar,
     ColumnDataSource,
@@ -44,8 +38,6 @@ __all__ = [
     "frequency_range",
     "modes_range",
     "new_figure",
-    "push",
-    "Pusher",
 ]
 
 TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
@@ -194,68 +186,3 @@ def add_span(
     )
     fig.add_layout(span)
     return span
-
-
-def push(update: Callable[[], None]) -> None:
-    """Apply Bokeh model changes now, or on the session's event loop when needed.
-
-    Compute before calling: ``update`` should only assign (it may run on the event loop,
-    where a slow callback would stall every session of the process).
-    """
-    doc = pn.state.curdoc
-    if doc is None or doc.session_context is None:
-        update()  # no server: tests, notebooks, exports
-    elif pn.state._unblocked(doc):
-        if _holds_document_lock(doc):
-            # a locked callback (a control change, a band result): Bokeh's own ordered
-            # path sends the patches once the callback returns
-            update()
-        else:
-            # on the session's thread but outside the lock (Panel runs some event
-            # coroutines unlocked): Panel's way of dispatching the events straight away
-            with pn.io.unlocked():
-                update()
-    else:
-        # another thread, or before the page has loaded: on the event loop, under the
-        # document lock
-        pn.state.execute(update, schedule=True)
-
-
-def _holds_document_lock(doc) -> bool:
-    """True inside a callback that holds the session's document lock (Bokeh keeps the
-    list of pending writes only then)."""
-    session = getattr(doc.session_context, "_session", None)
-    return session is not None and getattr(session, "_pending_writes", None) is not None
-
-
-class Pusher:
-    """Pushes the model updates of one view in order, dropping any a newer one overtook.
-
-    Control changes of one session may be handled by several worker threads at once. A
-    ticket is drawn *before* the view reads its state and computes the update, so the
-    update with the highest ticket is one computed from the latest state; an update whose
-    ticket is lower than one already applied is dropped (it may hold an older state, and a
-    slower thread could otherwise land it last). Each update must therefore set the view's
-    complete state (not a difference to the previous one).
-    """
-
-    def __init__(self):
-        self._lock = threading.Lock()
-        self._issued = 0
-        self._applied = 0
-
-    def __call__(self, make: Callable[[], Callable[[], None]]) -> None:
-        """Draw a ticket, then ``make()`` the update from the current state and push it."""
-        with self._lock:
-            self._issued += 1
-            seq = self._issued
-        update = make()
-
-        def latest():
-            with self._lock:
-                if seq <= self._applied:
-                    return
-                self._applied = seq
-            update()
-
-        push(latest)

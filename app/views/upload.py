@@ -8,6 +8,8 @@ file changes nothing; "Use reference data" goes back to the shipped models.
 
 from __future__ import annotations
 
+import html
+
 import panel as pn
 import param
 from panel.viewable import Viewer
@@ -21,6 +23,42 @@ HELP = (
     "number). Modal tire model: the project's .h5 format or MATLAB .mat. Uploads stay in "
     "this browser session."
 )
+
+
+#: Colours of the alert boxes (Bootstrap's): background, text, border.
+ALERT_STYLES = {
+    "success": ("#d1e7dd", "#0f5132", "#badbcc"),
+    "secondary": ("#e2e3e5", "#41464b", "#d3d6d8"),
+    "danger": ("#f8d7da", "#842029", "#f5c2c7"),
+}
+
+
+def _text(value: str) -> str:
+    """User text (file names, messages quoting them) as HTML text: never markup."""
+    return html.escape(str(value), quote=True)
+
+
+def _alert(body: str, kind: str, css: str, visible: bool = True) -> pn.pane.HTML:
+    """An alert box around ``body`` (HTML whose user text is escaped with :func:`_text`).
+
+    Not a Markdown pane: a file name like ``[x](http://...)`` or ``![](http://...)`` must
+    stay text, never a live link or an external image.
+    """
+    bg, fg, border = ALERT_STYLES[kind]
+    return pn.pane.HTML(
+        f'<div class="alert alert-{kind}" role="alert">{body}</div>',
+        styles={
+            "background": bg,
+            "color": fg,
+            "border": f"1px solid {border}",
+            "border-radius": "6px",
+            "padding": "2px 12px",
+        },
+        visible=visible,
+        margin=(4, 5),
+        css_classes=[css],
+        sizing_mode="stretch_width",
+    )
 
 
 class UploadView(Viewer):
@@ -93,31 +131,23 @@ class UploadView(Viewer):
     @param.depends("data.models", "data.tire_summary", "data.chassis_summary")
     def _summary(self):
         ds = self.data
-        parts = [f"**In use: {ds.describe()}**"]
+        parts = [f"<b>In use: {_text(ds.describe())}</b>"]
         for title, text in (("Chassis", ds.chassis_summary), ("Tire", ds.tire_summary)):
             if text and (
                 (title == "Chassis" and ds.models.chassis is not None)
                 or (title == "Tire" and ds.models.tire is not None)
             ):
-                parts.append(f"{title}:\n```\n{text}\n```")
+                parts.append(f"{title}:<pre>{_text(text)}</pre>")
         kind = "success" if not ds.models.is_reference else "secondary"
-        return pn.pane.Alert(
-            "\n\n".join(parts),
-            alert_type=kind,
-            margin=(4, 5),
-            css_classes=["upload-summary"],
-            sizing_mode="stretch_width",
-        )
+        return _alert("".join(parts), kind, "upload-summary")
 
     @param.depends("data.error")
     def _error(self):
-        return pn.pane.Alert(
-            f"**File refused, nothing changed.** {self.data.error}",
-            alert_type="danger",
+        return _alert(
+            f"<b>File refused, nothing changed.</b> {_text(self.data.error)}",
+            "danger",
+            "upload-error",
             visible=bool(self.data.error),
-            margin=(4, 5),
-            css_classes=["upload-error"],
-            sizing_mode="stretch_width",
         )
 
     def __panel__(self):

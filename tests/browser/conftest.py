@@ -138,7 +138,7 @@ def dashboard():
 JS_SOURCE = """
 (name) => {
   const doc = Bokeh.documents[0];
-  const ms = [...doc._all_models.values()].filter(
+  const ms = [...doc.all_models].filter(
       m => m.name === name && m.type === 'ColumnDataSource');
   if (ms.length !== 1) return null;
   const out = {};
@@ -153,7 +153,7 @@ JS_SOURCE = """
 JS_FINGERPRINT = """
 (name) => {
   const doc = Bokeh.documents[0];
-  const ms = [...doc._all_models.values()].filter(
+  const ms = [...doc.all_models].filter(
       m => m.name === name && m.type === 'ColumnDataSource');
   if (ms.length !== 1) return null;
   let s = '';
@@ -190,7 +190,7 @@ def wait_loaded(page, names=SOURCES, timeout=90_000):
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0", timeout=timeout)
     page.wait_for_function(
         """(names) => names.every(n => {
-             const ms = [...Bokeh.documents[0]._all_models.values()].filter(
+             const ms = [...Bokeh.documents[0].all_models].filter(
                  m => m.name === n && m.type === 'ColumnDataSource');
              if (ms.length !== 1) return false;
              const d = ms[0].data; const k = Object.keys(d)[0];
@@ -213,7 +213,7 @@ def wait_changed(page, name: str, before: str, timeout=30_000):
 def wait_band_idle(page, timeout=120_000):
     """Wait until no scatter band is being computed (its progress bar is hidden)."""
     page.wait_for_function(
-        "() => [...Bokeh.documents[0]._all_models.values()].filter(m => m.css_classes && "
+        "() => [...Bokeh.documents[0].all_models].filter(m => m.css_classes && "
         "m.css_classes.includes('scatter-progress')).every(m => m.active === false)",
         timeout=timeout,
         polling=50,
@@ -224,7 +224,7 @@ def set_model_value(page, css_class: str, value, model_type: str | None = None):
     """Set ``value`` of the widget model carrying ``css_class`` (as a user's drag would)."""
     page.evaluate(
         """([cls, value, type]) => {
-             const ms = [...Bokeh.documents[0]._all_models.values()].filter(
+             const ms = [...Bokeh.documents[0].all_models].filter(
                  m => m.css_classes && m.css_classes.includes(cls) && 'value' in m
                       && (type === null || m.type === type));
              if (ms.length !== 1) throw new Error(`${ms.length} widget models for ${cls}`);
@@ -236,7 +236,7 @@ def set_model_value(page, css_class: str, value, model_type: str | None = None):
 
 def model_value(page, css_class: str, model_type: str | None = None):
     return page.evaluate(
-        """([cls, type]) => [...Bokeh.documents[0]._all_models.values()].filter(
+        """([cls, type]) => [...Bokeh.documents[0].all_models].filter(
              m => m.css_classes && m.css_classes.includes(cls) && 'value' in m
                   && (type === null || m.type === type))[0].value""",
         [css_class, model_type],
@@ -245,7 +245,7 @@ def model_value(page, css_class: str, model_type: str | None = None):
 
 JS_TABLE = """
 (cls) => {
-  const ms = [...Bokeh.documents[0]._all_models.values()].filter(
+  const ms = [...Bokeh.documents[0].all_models].filter(
       m => m.css_classes && m.css_classes.includes(cls) && m.source);
   if (ms.length !== 1) return null;
   const out = {};
@@ -263,7 +263,7 @@ def table_json(page, css_class: str) -> str | None:
 def color_high(page) -> float:
     """Upper colour limit of the (only) colour mapper on the page: the error map's cap."""
     return page.evaluate(
-        """() => [...Bokeh.documents[0]._all_models.values()].filter(
+        """() => [...Bokeh.documents[0].all_models].filter(
              m => m.type === 'LinearColorMapper').map(m => m.high)[0]"""
     )
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import fbs_core
 from app import compute
 from app.export import read_csv
 
@@ -135,7 +136,7 @@ def test_threshold_caps_the_colour_and_f_max_changes_the_table(shared_page):
     before = {n: fingerprint(page, n) for n in SOURCES}
     _type(page, "ctl-truncation-threshold", 7)
     page.wait_for_function(
-        "() => [...Bokeh.documents[0]._all_models.values()].some("
+        "() => [...Bokeh.documents[0].all_models].some("
         "m => m.type === 'LinearColorMapper' && m.high === 7)"
     )
     assert color_high(page) == 7
@@ -182,17 +183,18 @@ def test_url_restores_the_state(browser, dashboard):
     assert model_value(page, "ctl-noise-single_round") == 7
     # the plotted data are those of the state in the URL
     mob = source(page, "mobility.truncated")
-    want = compute.mobility_data(3, 120, "rx", "5dof")
-    np.testing.assert_allclose(mob["freq"], want["freq"])
-    np.testing.assert_allclose(mob["level"], want["truncated_db"], rtol=1e-12)
+    want = fbs_core.bushing_response(3, n_modes=120, coupling="5dof")
+    np.testing.assert_allclose(mob["freq"], want.freq)
+    level = 20 * np.log10(np.abs(want.sel(outputs="bushing:rx").data[:, 0, 0]))
+    np.testing.assert_allclose(mob["level"], level, rtol=1e-9)
     err = compute.error_map_data(3, "5dof", None)["error_pct"]
     np.testing.assert_allclose(source(page, "truncation.map")["image"], err.ravel(), rtol=1e-12)
     band = compute.band(3, 120, "5dof", 5.5, "tire", True, 800, 3)
     d = compute.band_data(band, "rx", 50)
     pct = source(page, "scatter.percentile")
     np.testing.assert_allclose(pct["freq"], d["freq"])
-    np.testing.assert_allclose(pct["upper"], d["upper_db"], rtol=1e-12)
-    np.testing.assert_allclose(pct["lower"], d["lower_db"], rtol=1e-12)
+    np.testing.assert_allclose(pct["upper"], d["pct_high_db"], rtol=1e-12)
+    np.testing.assert_allclose(pct["lower"], d["pct_low_db"], rtol=1e-12)
     assert color_high(page) == 10
     # a control change goes back into the URL
     set_model_value(page, "ctl-case-n_modes", 12, "Slider")

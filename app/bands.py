@@ -1,0 +1,150 @@
+"""Scatter bands of all sessions: cancelled when superseded, computed in turns.
+
+A band is the one computation of the dashboard that takes seconds (up to minutes for
+200,000 rounds). Three rules keep one session from starving the others:
+
+- **one live band per session**: a new request of a session cancels its running band
+  (:class:`Job`); the kernel stops at its next chunk of lines
+  (``fbs_core.scatter_band(cancel=...)``), so a dragged slider leaves no queue behind;
+- **turns**: the kernel asks before every chunk of lines (a few hundred milliseconds of
+  work or less); all running bands queue for the next chunk in arrival order
+  (:class:`Turnstile`), so two sessions' bands advance chunk by chunk, alternately, and a
+  short band waits for at most one chunk of a long one per turn;
+- **no pool to fill**: each live band has its own thread (a session has at most one live
+  band, a cancelled one ends at its next turn), so no session can occupy the workers
+  others need.
+
+The numba kernels run one chunk at a time process-wide anyway (``fbs_core`` holds a lock
+around them), so the turns cost no parallelism.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+
+import panel as pn
+
+from fbs_core.errors import FBSError, StudyCancelled
+
+from . import compute
+
+__all__ = ["Job", "Turnstile", "TURNSTILE", "run", "served", "start"]
+
+
+def served() -> bool:
+    """True inside a served browser session (else: tests, notebooks, the warm-up)."""
+    doc = pn.state.curdoc
+    return doc is not None and doc.session_context is not None
+
+
+class Job:
+    """One requested band: its cache key, and a cancel flag the kernel checks."""
+
+    def __init__(self, key: tuple, owner=None) -> None:
+        self.key = key
+        self.owner = owner
+        self._cancelled = threading.Event()
+
+    def cancel(self) -> None:
+        self._cancelled.set()
+
+    @property
+    def cancelled(self) -> bool:
+        return self._cancelled.is_set()
+
+
+class Turnstile:
+    """First come, first served turns for the chunks of all running bands."""
+
+    def __init__(self) -> None:
+        self._cond = threading.Condition()
+        self._queue: deque[Job] = deque()
+        self._holder: Job | None = None
+
+    def next_turn(self, job: Job) -> bool:
+        """Give up ``job``'s turn, queue for the next one and wait for it.
+
+        Returns False (without a turn) when the job was cancelled meanwhile.
+        """
+        with self._cond:
+            if self._holder is job:
+                self._holder = None
+            self._queue.append(job)
+            self._cond.notify_all()
+            while not (self._holder is None and self._queue[0] is job):
+                if job.cancelled:
+                    self._queue.remove(job)
+                    self._cond.notify_all()
+                    return False
+                self._cond.wait(0.05)
+            self._queue.popleft()
+            self._holder = job
+            return not job.cancelled
+
+    def leave(self, job: Job) -> None:
+        """``job`` is done: free its turn and its place in the queue."""
+        with self._cond:
+            if self._holder is job:
+                self._holder = None
+            if job in self._queue:
+                self._queue.remove(job)
+            self._cond.notify_all()
+
+    @property
+    def waiting(self) -> int:
+        with self._cond:
+            return len(self._queue)
+
+
+#: The process-wide turns of the band kernels.
+TURNSTILE = Turnstile()
+
+Done = Callable[[Job, object, object, float, object], None]
+
+
+def run(job: Job, done: Done, context=None, turnstile: Turnstile | None = None) -> None:
+    """Compute ``job``'s band here and call ``done(job, context, band, seconds, error)``.
+
+    ``band`` is None when the job was cancelled (then ``done`` is not called) or failed
+    (``error`` holds the core's message).
+    """
+    t0 = time.perf_counter()
+    if job.cancelled:
+        return
+    turns = TURNSTILE if turnstile is None else turnstile
+    try:
+        res = compute.cached_band(job.key)
+        if res is None:
+            res = compute.band(*job.key, cancel=lambda: not turns.next_turn(job))
+    except StudyCancelled:
+        return
+    except Exception as exc:  # the page shows the message instead of a silent spinner
+        done(job, context, None, time.perf_counter() - t0, exc)
+        if not isinstance(exc, FBSError):
+            raise
+        return
+    finally:
+        turns.leave(job)
+    done(job, context, res, time.perf_counter() - t0, None)
+
+
+def start(
+    job: Job, done: Done, context=None, turnstile: Turnstile | None = None
+) -> threading.Thread:
+    """:func:`run` on a thread of its own (daemon: it never holds up a shutdown).
+
+    The thread works for the calling thread's session: Panel's current document is set in
+    it, so what ``done`` publishes is drawn through that session's event loop.
+    """
+    doc = pn.state.curdoc
+
+    def work():
+        pn.state.curdoc = doc
+        run(job, done, context, turnstile)
+
+    t = threading.Thread(target=work, name="scatter-band", daemon=True)
+    t.start()
+    return t

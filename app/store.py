@@ -1,0 +1,555 @@
+"""One session's results: computed from its state, published as parameters.
+
+:class:`Results` is the only place a session computes anything. It owns the session's
+:class:`~app.state.DashboardState` (the controls and the data source) and publishes one
+:class:`Result` per view as a parameter. Each result is declared once, next to the method
+that computes it, with the state parameters it depends on::
+
+    @param.depends("state.case.harmonic", "state.case.dof", watch=True, on_init=True)
+    def _response(self):
+        self._publish("response", lambda s: ...)
+
+so that adding a published result is a parameter and a method, and adding a view of it is a
+:class:`~app.views.live.LiveView` subclass that draws it.
+
+Ordering: every result is computed and published under the session's one lock, and it
+reads the state *inside* that lock. Control changes of one session arrive on several
+worker threads in any order; whichever thread publishes last read the state last, so the
+newest state always lands last (no tickets, no tokens).
+
+Consistency: a :class:`Result` carries its data *and* their description (the settings it was
+computed for, the CSV header, the file name, the caption) from one snapshot of the state,
+so a view or an export can never pair data with another state's description.
+
+The scatter band is the one long computation: it runs on its own thread
+(:mod:`app.bands`), one live band per session (a newer request cancels the older one
+between the kernel's chunks), and bands of all sessions take turns chunk by chunk.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import param
+
+from fbs_core.vocabulary import EIGEN_SPEEDS
+
+from . import bands, compute
+from .state import DashboardState
+
+__all__ = ["Result", "Results", "Snapshot"]
+
+
+@dataclass(frozen=True, eq=False)
+class Result:
+    """What one view shows: data and their description, from one state.
+
+    Attributes
+    ----------
+    columns : mapping of str to 1-D ndarray
+        The data as exported (CSV columns, equal length).
+    meta : mapping of str to object
+        The CSV header: the settings these data were computed for.
+    filename : str
+        The CSV file name.
+    caption : str
+        One line for the page (``**bold**`` and ``&middot;`` allowed; escaped as text).
+    draw : mapping
+        Anything else the view needs to draw these data (curves in dB, axis labels,
+        marker positions).
+    """
+
+    columns: Mapping[str, np.ndarray] = field(default_factory=dict)
+    meta: Mapping[str, Any] = field(default_factory=dict)
+    filename: str = "data.csv"
+    caption: str = ""
+    draw: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """The state of a session at one moment (plain values, read under the lock)."""
+
+    harmonic: int
+    n_modes: int
+    dof: str
+    coupling: str
+    show_uncoupled: bool
+    spindle_input: str
+    models: Any
+    noise: float
+    target: str
+    frequency_dependent: bool
+    rounds: int
+    seed: int
+    single_round: int
+    percentile: int
+    threshold: float
+    f_max: float
+    map_mode: str
+
+    @classmethod
+    def of(cls, state: DashboardState) -> Snapshot:
+        c, n, t = state.case, state.noise, state.truncation
+        return cls(
+            harmonic=int(c.harmonic),
+            n_modes=int(c.n_modes),
+            dof=c.dof,
+            coupling=c.coupling,
+            show_uncoupled=bool(c.show_uncoupled),
+            spindle_input=c.spindle_input,
+            models=c.models,
+            noise=float(n.noise),
+            target=n.target,
+            frequency_dependent=bool(n.frequency_dependent),
+            rounds=int(n.rounds),
+            seed=int(n.seed),
+            single_round=int(n.single_round),
+            percentile=int(n.percentile),
+            threshold=float(t.threshold),
+            f_max=float(t.f_max),
+            map_mode=t.map_mode,
+        )
+
+    @property
+    def map_dof(self) -> str | None:
+        """The DOF the error map and the suggestion judge (None: max over the 6 DOFs)."""
+        return self.dof if self.map_mode == "selected DOF" else None
+
+    def band_key(self) -> tuple:
+        return compute.band_key(
+            self.harmonic,
+            self.n_modes,
+            self.coupling,
+            self.noise,
+            self.target,
+            self.frequency_dependent,
+            self.rounds,
+            self.seed,
+            self.models,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Band:
+    """A finished scatter band and the settings it was computed for."""
+
+    result: Any  # fbs_core.ScatterBand
+    settings: Snapshot
+    seconds: float
+
+
+@dataclass(frozen=True)
+class BandStatus:
+    """Whether a band is being computed, and the line the page shows about it."""
+
+    busy: bool = False
+    text: str = ""
+
+
+class Results(param.Parameterized):
+    """The published results of one browser session (see the module docstring)."""
+
+    state = param.ClassSelector(class_=DashboardState, instantiate=False, constant=True)
+
+    response = param.ClassSelector(class_=Result, doc="Coupled response v_e* (eq. 4.1).")
+    error_map = param.ClassSelector(class_=Result, doc="Truncation error map (eq. 5.1).")
+    suggested = param.ClassSelector(class_=Result, doc="Suggested modes (table 5.1).")
+    eigen = param.ClassSelector(class_=Result, doc="Eigenfrequency vs N (fig. 5.8).")
+    uncoupled = param.ClassSelector(
+        class_=Result, allow_None=True, doc="Uncoupled tire and chassis (None until shown)."
+    )
+    band = param.ClassSelector(class_=Band, allow_None=True, doc="The latest scatter band.")
+    band_curves = param.ClassSelector(
+        class_=Result, allow_None=True, doc="The band's curves at the selected DOF."
+    )
+    band_status = param.ClassSelector(class_=BandStatus, doc="Band computation status.")
+    closed = param.Boolean(default=False, doc="The session has ended: nothing is drawn.")
+    background = param.Boolean(
+        default=None,
+        allow_None=True,
+        doc="Compute bands on a thread of their own (None: when the page is served).",
+    )
+
+    def __init__(self, state: DashboardState | None = None, **params):
+        self._lock = threading.RLock()
+        self._band_job: bands.Job | None = None
+        params["state"] = state if state is not None else DashboardState()
+        params.setdefault("band_status", BandStatus())
+        super().__init__(**params)
+
+    # -- publishing ------------------------------------------------------------------------
+    def _publish(self, name: str, make: Callable[[Snapshot], Any]) -> None:
+        """Compute ``make(snapshot)`` from the current state and publish it as ``name``,
+        all under the session's lock (the newest state lands last)."""
+        with self._lock:
+            if self.closed:
+                return
+            setattr(self, name, make(Snapshot.of(self.state)))
+
+    def snapshot(self) -> Snapshot:
+        """The current state as plain values."""
+        return Snapshot.of(self.state)
+
+    # -- the results, each next to what it depends on -----------------------------------------
+    @param.depends(
+        "state.case.harmonic",
+        "state.case.n_modes",
+        "state.case.dof",
+        "state.case.coupling",
+        "state.case.models",
+        watch=True,
+        on_init=True,
+    )
+    def _response(self):
+        self._publish("response", response_result)
+
+    @param.depends(
+        "state.case.harmonic",
+        "state.case.n_modes",
+        "state.case.dof",
+        "state.case.coupling",
+        "state.case.models",
+        "state.truncation.map_mode",
+        "state.truncation.threshold",
+        "state.truncation.f_max",
+        watch=True,
+        on_init=True,
+    )
+    def _error_map(self):
+        self._publish("error_map", error_map_result)
+
+    @param.depends(
+        "state.case.coupling",
+        "state.case.dof",
+        "state.case.models",
+        "state.truncation.map_mode",
+        "state.truncation.threshold",
+        "state.truncation.f_max",
+        watch=True,
+        on_init=True,
+    )
+    def _suggested(self):
+        self._publish("suggested", suggested_result)
+
+    @param.depends("state.case.models", "state.case.n_modes", watch=True, on_init=True)
+    def _eigen(self):
+        self._publish("eigen", eigen_result)
+
+    @param.depends(
+        "state.case.show_uncoupled",
+        "state.case.harmonic",
+        "state.case.n_modes",
+        "state.case.dof",
+        "state.case.spindle_input",
+        "state.case.models",
+        watch=True,
+        on_init=True,
+    )
+    def _uncoupled(self):
+        self._publish(
+            "uncoupled",
+            lambda s: uncoupled_result(s) if s.show_uncoupled or self.uncoupled else None,
+        )
+
+    @param.depends(
+        "band",
+        "state.case.dof",
+        "state.noise.percentile",
+        "state.noise.single_round",
+        watch=True,
+        on_init=True,
+    )
+    def _band_curves(self):
+        self._publish("band_curves", lambda s: band_result(self.band, s))
+
+    # -- the scatter band: long, off the session's threads --------------------------------
+    @param.depends(
+        "state.case.harmonic",
+        "state.case.n_modes",
+        "state.case.coupling",
+        "state.case.models",
+        "state.noise.noise",
+        "state.noise.target",
+        "state.noise.frequency_dependent",
+        "state.noise.rounds",
+        "state.noise.seed",
+        watch=True,
+    )
+    def request_band(self, *, wait: bool | None = None) -> None:
+        """Compute the band of the current settings (cancelling one still running).
+
+        ``wait=True`` computes it in the calling thread (no server: tests, exports, the
+        warm-up); by default it runs in the background when the page is served.
+        """
+        with self._lock:
+            if self.closed:
+                return
+            s = self.snapshot()
+            key = s.band_key()
+            running = self._band_job
+            if running is not None and running.key == key:
+                return  # already on its way
+            if running is not None:
+                running.cancel()
+                self._band_job = None
+            if self.band is not None and self.band.settings.band_key() == key:
+                self.band_status = _done_status(self.band)  # back to the shown band
+                return
+            job = self._band_job = bands.Job(key, owner=self)
+            self.band_status = BandStatus(True, f"Computing {s.rounds:,} rounds ...")
+        if wait is None:
+            wait = not (bands.served() if self.background is None else self.background)
+        if wait:
+            bands.run(job, self._band_done, s)
+        else:
+            bands.start(job, self._band_done, s)
+
+    def _band_done(self, job: bands.Job, settings: Snapshot, res, seconds: float, error) -> None:
+        with self._lock:
+            if job is not self._band_job or job.cancelled or self.closed:
+                return  # superseded: a newer job publishes
+            self._band_job = None
+            if error is not None:
+                self.band_status = BandStatus(False, f"Scatter band failed: {error}")
+                return
+            self.band = Band(res, settings, seconds)
+            self.band_status = _done_status(self.band)
+
+    def band_now(self) -> Band | None:
+        """The band of the current settings, computed here if needed (None if it failed)."""
+        self.request_band(wait=True)
+        return self.band
+
+    def pick_peak_round(self, freq: float) -> None:
+        """Show the round with the highest level at the line nearest ``freq`` (Hz)."""
+        band = self.band
+        if band is None:
+            return
+        self.state.noise.single_round = compute.peak_round(
+            band.result, float(freq), self.state.case.dof, "max"
+        )
+
+    def close(self) -> None:
+        """The session ended: cancel its band and publish nothing more."""
+        with self._lock:
+            self.closed = True
+            if self._band_job is not None:
+                self._band_job.cancel()
+                self._band_job = None
+
+
+def _done_status(band: Band) -> BandStatus:
+    conv = compute.convergence_db(band.result)
+    return BandStatus(
+        False,
+        f"{band.result.rounds:,} rounds in {band.seconds:.2f} s &middot; largest edge change "
+        f"in the last half of the rounds: {conv:.1f} dB",
+    )
+
+
+# -- what each result holds -----------------------------------------------------------------
+def response_result(s: Snapshot) -> Result:
+    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models)
+    return Result(
+        columns={
+            "freq_Hz": d["freq"],
+            "reference_dB": d["reference_db"],
+            "truncated_dB": d["truncated_db"],
+            "reference": d["reference"],
+            "truncated": d["truncated"],
+        },
+        meta={
+            "view": "coupled bushing response v_e* (thesis eq. 4.1)",
+            "harmonic": s.harmonic,
+            "N (retained tire modes)": s.n_modes,
+            "reference": "all tire modes",
+            "response DOF": f"bushing:{s.dof}",
+            "coupling": s.coupling,
+            "unit": compute.level_unit(s.dof),
+            "models": s.models.describe(),
+        },
+        filename=f"bushing_response_h{s.harmonic}_N{s.n_modes}_{s.dof}_{s.coupling}.csv",
+        caption=(
+            f"**Harmonic {s.harmonic}** &middot; bushing:{s.dof} &middot; N = {s.n_modes} "
+            f"&middot; {s.coupling} coupling"
+        ),
+        draw={"dof": s.dof},
+    )
+
+
+def _suggested_n(s: Snapshot) -> int:
+    tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models)
+    return int(tab["n_modes"][list(tab["harmonic"]).index(s.harmonic)])
+
+
+def error_map_result(s: Snapshot) -> Result:
+    d = compute.error_map_data(s.harmonic, s.coupling, s.map_dof, s.models)
+    what = f"bushing:{s.dof}" if s.map_dof else "max over 6 DOFs"
+    nn, ff = np.meshgrid(d["n_modes"], d["centre_freq"], indexing="ij")
+    return Result(
+        columns={
+            "n_modes": nn.ravel(),
+            "centre_freq_Hz": ff.ravel(),
+            "error_pct": d["error_pct"].ravel(),
+        },
+        meta={
+            "view": "truncation error map (thesis eq. 5.1, figs. 5.3/5.6/5.7)",
+            "harmonic": s.harmonic,
+            "coupling": s.coupling,
+            "response DOF": what,
+            "reference": "all tire modes",
+            "layout": "long: one row per (N, centre freq)",
+            "models": s.models.describe(),
+        },
+        filename=f"truncation_map_h{s.harmonic}_{s.map_dof or 'maxdof'}.csv",
+        draw={
+            "map": d,
+            "title": f"Harmonic {s.harmonic}, {what}",
+            "threshold": s.threshold,
+            "f_max": s.f_max,
+            "n_modes": s.n_modes,
+            "suggested_n": _suggested_n(s),
+            "freq": compute.frequencies(s.harmonic),
+        },
+    )
+
+
+def suggested_result(s: Snapshot) -> Result:
+    tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models)
+    where = f"bushing:{s.dof}" if s.map_dof else s.map_mode
+    return Result(
+        columns={
+            "harmonic": tab["harmonic"],
+            "f_low_Hz": tab["f_low"],
+            "f_high_Hz": tab["f_high"],
+            "n_modes": tab["n_modes"],
+            "eigenfrequency_Hz": tab["eigenfrequency"],
+        },
+        meta={
+            "view": "suggested number of modes (thesis table 5.1)",
+            "threshold_pct": s.threshold,
+            "f_max_Hz": s.f_max,
+            "coupling": s.coupling,
+            "response DOF": f"bushing:{s.dof}" if s.map_dof else "max over 6 DOFs",
+            "eigenfrequency": "highest retained eigenfrequency at 80 km/h",
+            "models": s.models.describe(),
+        },
+        filename=f"suggested_modes_thr{s.threshold:g}_fmax{s.f_max:g}.csv",
+        caption=(
+            f"Smallest N from which the error stays below **{s.threshold:g} %** up "
+            f"to **{s.f_max:g} Hz** ({where}), and the highest eigenfrequency among "
+            "those modes at 80 km/h."
+        ),
+        draw={"table": tab},
+    )
+
+
+def eigen_result(s: Snapshot) -> Result:
+    d = compute.eigen_curves(s.models)
+    return Result(
+        columns={
+            "n_modes": d["n_modes"],
+            **{f"f_{v:g}kmh_Hz": d[f"f_{int(v)}"] for v in EIGEN_SPEEDS},
+        },
+        meta={
+            "view": "highest retained eigenfrequency vs N (thesis fig. 5.8)",
+            "models": s.models.describe(),
+        },
+        filename="eigenfrequency_vs_modes.csv",
+        draw={"curves": d, "n_modes": s.n_modes},
+    )
+
+
+def chassis_label(dof: str, spindle_input: str) -> str:
+    """Axis label of the chassis mobility from a spindle input to a bushing DOF."""
+    unit = "dB re 1 (rad/s)/" if dof.startswith("r") else "dB re 1 (m/s)/"
+    unit += "(N m)" if spindle_input.startswith("r") else "N"
+    return f"Mobility ({unit})"
+
+
+def uncoupled_result(s: Snapshot) -> Result:
+    d = compute.uncoupled_data(s.harmonic, s.n_modes, s.dof, s.spindle_input, s.models)
+    keys = (
+        "freq",
+        "tire_reference_db",
+        "tire_truncated_db",
+        "chassis_db",
+        "tire_reference",
+        "tire_truncated",
+        "chassis",
+    )
+    return Result(
+        columns={k: d[k] for k in keys},
+        meta={
+            "view": "uncoupled subsystems",
+            "harmonic": s.harmonic,
+            "N (retained tire modes)": s.n_modes,
+            "tire output": f"hub:{s.dof}",
+            "chassis": f"spindle:{s.spindle_input} -> bushing:{s.dof}",
+            "models": s.models.describe(),
+        },
+        filename=f"uncoupled_h{s.harmonic}_N{s.n_modes}_{s.dof}_in{s.spindle_input}.csv",
+        draw={
+            "dof": s.dof,
+            "tire_title": f"Tire: free hub velocity hub:{s.dof} (figs. 4.6-4.7)",
+            "chassis_title": f"Chassis: spindle:{s.spindle_input} -> bushing:{s.dof} "
+            "(figs. 4.2-4.3)",
+            "chassis_label": chassis_label(s.dof, s.spindle_input),
+        },
+    )
+
+
+def band_result(band: Band | None, s: Snapshot) -> Result | None:
+    """The band's curves at the selected DOF, percentile band and round.
+
+    The header describes the band as it was computed (``band.settings``), whatever the
+    controls say now: a band still computing for new settings never relabels old data.
+    """
+    if band is None:
+        return None
+    b = band.settings
+    res = band.result
+    d = compute.band_data(res, s.dof, s.percentile)
+    k = min(s.single_round, res.rounds - 1)  # the round must exist in this band
+    r = compute.single_round_data(res, k, s.dof)
+    lo = (100 - s.percentile) / 2
+    fd = "fdep" if b.frequency_dependent else "findep"
+    return Result(
+        columns={
+            "freq_Hz": d["freq"],
+            "reference_dB": d["reference_db"],
+            "minimum_dB": d["minimum_db"],
+            "maximum_dB": d["maximum_db"],
+            "pct_low_dB": d["pct_low_db"],
+            "pct_high_dB": d["pct_high_db"],
+            f"round_{k}_dB": r["round_db"],
+        },
+        meta={
+            "view": "Monte-Carlo scatter band (thesis 5.2)",
+            "harmonic": b.harmonic,
+            "N (retained tire modes)": b.n_modes,
+            "response DOF": f"bushing:{s.dof}",
+            "coupling": b.coupling,
+            "noise_pct": b.noise,
+            "noise target": b.target,
+            "frequency dependent": b.frequency_dependent,
+            "rounds": b.rounds,
+            "seed": b.seed,
+            "single round": k,
+            "percentiles": f"{lo:g}-{100 - lo:g}",
+            "unit": compute.level_unit(s.dof),
+            "minimum/maximum": "min/max of |v_e| over the rounds",
+            "pct_low/pct_high": "percentiles of |v_e| over the rounds (numpy 'linear')",
+            "models": b.models.describe(),
+        },
+        filename=(
+            f"scatter_band_h{b.harmonic}_{s.dof}_p{b.noise:g}_{b.target}_{fd}"
+            f"_R{b.rounds}_seed{b.seed}.csv"
+        ),
+        draw={"band": d, "round": r, "dof": s.dof, "seconds": band.seconds},
+    )

@@ -1,0 +1,184 @@
+"""The skeleton every view shares: a figure built once, redrawn from a published result.
+
+A view is a :class:`LiveView` subclass that says which result of the session's
+:class:`~app.store.Results` it shows and how to draw it::
+
+    class EigenView(LiveView):
+        key = "eigen"                                   # CSV name, css class
+
+        def result(self):
+            return self.store.eigen
+
+        @param.depends("store.eigen", watch=True)
+        def _changed(self):
+            self.redraw()
+
+        def _build(self):                              # Bokeh figures, once per session
+            ...
+
+        def _draw(self, r):                            # assign sources from ``r``
+            ...
+
+Drawing goes through Panel's documented way of changing Bokeh models from any thread:
+:func:`panel.state.execute` with ``schedule=True`` (on the session's event loop, under its
+document lock), or Bokeh's own ``Document.add_next_tick_callback`` from a thread that is
+not Panel's. A redraw draws the result published *when it runs*, so redraws may come from
+any thread in any order: the last one shows the newest result. Redraws already waiting are
+not queued twice.
+"""
+
+from __future__ import annotations
+
+import html
+import io
+import re
+import threading
+
+import panel as pn
+import param
+from panel.viewable import Viewer
+
+from .. import compute
+from ..export import to_csv
+from ..store import Result, Results
+
+__all__ = ["LiveView", "download_button", "inline_html", "served_document"]
+
+
+def served_document():
+    """The Bokeh document of the current served session (None: no server)."""
+    doc = pn.state.curdoc
+    return doc if doc is not None and doc.session_context is not None else None
+
+
+def inline_html(text: str) -> str:
+    """A caption's text as HTML: escaped, then ``**bold**`` and ``&middot;`` restored.
+
+    Values in captions may come from users' files (DOF labels), hence the escaping.
+    """
+    out = html.escape(text, quote=False).replace("&amp;middot;", "&middot;")
+    return re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", out)
+
+
+def download_button(key: str, result) -> pn.widgets.FileDownload:
+    """A CSV download of ``result()``: its columns under its own header and file name."""
+
+    def callback():
+        r = result()
+        if r is None:
+            return io.StringIO("")
+        btn.filename = r.filename
+        return io.StringIO(
+            to_csv(r.columns, {**r.meta, "fbs_core version": compute.version()}, key)
+        )
+
+    first = result()
+    btn = pn.widgets.FileDownload(
+        callback=callback,
+        filename=first.filename if first is not None else f"{key}.csv",
+        label="CSV",
+        button_type="light",
+        width=90,
+        embed=False,
+        css_classes=[f"download-{key}"],
+    )
+    return btn
+
+
+class LiveView(Viewer):
+    """Base of the plot views: build once, redraw the published result in place."""
+
+    store = param.ClassSelector(class_=Results, doc="The session's results.")
+
+    #: Short name: CSV view key and download css class.
+    key = "view"
+    #: Text beside the download button when the view has no caption of its own.
+    note = ""
+    #: Smallest height of the plot row (px).
+    min_height = 340
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._layout = None
+        self._doc = None
+        self._caption: pn.pane.HTML | None = None
+        self._pending = False
+        self._guard = threading.Lock()
+
+    # -- what a subclass provides ----------------------------------------------------------
+    def result(self) -> Result | None:
+        """The published result this view shows."""
+        raise NotImplementedError
+
+    def _build(self) -> list:
+        """The view's Bokeh figures (called once)."""
+        raise NotImplementedError
+
+    def _draw(self, r: Result) -> None:
+        """Assign the figures' sources and properties from ``r`` (only assignments)."""
+        raise NotImplementedError
+
+    def _controls(self) -> list:
+        """Widgets shown in the view's header row."""
+        return []
+
+    # -- machinery ---------------------------------------------------------------------------
+    def redraw(self) -> None:
+        """Draw the newest published result, on the session's event loop when served."""
+        if self._layout is None:
+            return
+        with self._guard:
+            if self._pending:
+                return
+            self._pending = True
+        doc = self._doc
+        if doc is None:
+            self._apply()  # no server: tests, notebooks, exports
+        elif served_document() is doc:
+            pn.state.execute(self._apply, schedule=True)
+        else:  # a thread outside Panel's: Bokeh's thread-safe scheduling
+            doc.add_next_tick_callback(self._apply)
+
+    def _apply(self) -> None:
+        with self._guard:
+            self._pending = False
+        if self.store.closed:
+            return
+        r = self.result()
+        if r is None:
+            return
+        if self._caption is not None and r.caption:
+            text = f"<p>{inline_html(r.caption)}</p>"
+            if self._caption.object != text:
+                self._caption.object = text
+        self._draw(r)
+
+    def _header(self) -> pn.Row:
+        if self.note:
+            first = pn.pane.HTML(
+                f"<p>{inline_html(self.note)}</p>",
+                margin=(0, 10),
+                styles={"color": "#495057", "font-size": "0.9em"},
+                sizing_mode="stretch_width",
+            )
+        else:
+            first = self._caption = pn.pane.HTML("", margin=(0, 10), sizing_mode="stretch_width")
+        return pn.Row(*self._controls(), first, download_button(self.key, self.result))
+
+    def __panel__(self):
+        if self._layout is None:
+            self._doc = served_document()
+            figures = self._build()
+            header = self._header()
+            plots = [
+                pn.pane.Bokeh(f, sizing_mode="stretch_both", min_height=self.min_height)
+                for f in figures
+            ]
+            body = plots[0] if len(plots) == 1 else pn.Row(*plots, sizing_mode="stretch_both")
+            self._layout = pn.Column(header, *self._extra(), body, sizing_mode="stretch_both")
+            self._apply()
+        return self._layout
+
+    def _extra(self) -> list:
+        """Rows between the header and the plot (e.g. a status line)."""
+        return []

@@ -1,0 +1,172 @@
+"""A session's results store and its scatter bands: an export always describes its own
+data, a superseded band is cancelled, bands of several sessions take turns, a closed page
+computes and draws nothing more.
+
+Truth: ``fbs_core.scatter_band`` called directly, the grids of the harmonics, and the order
+in which the kernel's chunks actually ran (recorded by the turnstile).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import fbs_core
+from app import bands, compute
+from app.export import read_csv, to_csv
+from app.state import DashboardState
+from app.store import Results
+
+WAIT_S = 300.0
+
+
+def _wait(cond, what: str, timeout: float = WAIT_S) -> None:
+    t0 = time.monotonic()
+    while not cond():
+        if time.monotonic() - t0 > timeout:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.01)
+
+
+def _results(**noise) -> Results:
+    state = DashboardState()
+    state.noise.param.update(**{"rounds": 200, **noise})
+    return Results(state, background=True)
+
+
+def test_an_export_during_a_band_describes_the_band_it_holds(monkeypatch):
+    """Click CSV while a band for new settings computes: the file holds the previous band
+    under the previous band's settings, never old data under the new settings."""
+    res = _results()
+    res.request_band()
+    _wait(lambda: res.band is not None and not res.band_status.busy, "the first band")
+    assert res.band_curves.meta["harmonic"] == 1
+    gate = threading.Event()
+    real = compute.band
+
+    def slow_band(*args, **kw):
+        if args[0] == 7:
+            assert gate.wait(WAIT_S)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(compute, "band", slow_band)
+    res.state.case.harmonic = 7  # a band for harmonic 7 starts and waits
+    assert res.band_status.busy
+    meta, cols = read_csv(to_csv(res.band_curves.columns, res.band_curves.meta, "scatter"))
+    assert meta["harmonic"] == "1" and meta["rounds"] == "200"
+    np.testing.assert_allclose(cols["freq_Hz"], fbs_core.harmonic(1).frequencies())
+    gate.set()
+    _wait(lambda: not res.band_status.busy, "the harmonic-7 band")
+    meta, cols = read_csv(to_csv(res.band_curves.columns, res.band_curves.meta, "scatter"))
+    assert meta["harmonic"] == "7"
+    np.testing.assert_allclose(cols["freq_Hz"], fbs_core.harmonic(7).frequencies())
+    want = fbs_core.scatter_band(
+        7, noise=0.1, rounds=200, n_modes=50, percentiles=compute.Q_LEVELS, seed=0
+    )
+    j = want.dofs.index("bushing:z")
+    np.testing.assert_allclose(cols["maximum_dB"], 20 * np.log10(want.upper[:, j]), rtol=1e-12)
+
+
+class Recorder(bands.Turnstile):
+    """The process' turnstile, recording whose chunk ran when."""
+
+    def __init__(self):
+        super().__init__()
+        self.turns: list[tuple] = []
+
+    def next_turn(self, job):
+        ok = super().next_turn(job)
+        if ok:
+            self.turns.append(job.key)
+        return ok
+
+
+@pytest.fixture
+def turns(monkeypatch):
+    rec = Recorder()
+    monkeypatch.setattr(bands, "TURNSTILE", rec)
+    return rec
+
+
+def _live_band_threads() -> int:
+    return sum(t.name == "scatter-band" and t.is_alive() for t in threading.enumerate())
+
+
+def test_a_newer_request_cancels_the_running_band_and_nothing_queues(turns):
+    res = _results(rounds=150_000, seed=11)
+    res.state.case.harmonic = 7
+    res.request_band()
+    _wait(lambda: len(turns.turns) >= 2, "the long band to run")
+    # six more requests in a row, as a dragged slider or an impatient user sends them
+    for seed in range(12, 18):
+        res.state.noise.seed = seed
+    res.state.noise.rounds = 300
+    _wait(lambda: res.band is not None and not res.band_status.busy, "the last band")
+    assert res.band.settings.seed == 17 and res.band.result.rounds == 300
+    _wait(lambda: _live_band_threads() == 0, "every band thread to end")
+    long_key = (7, 50, "6dof", 10.0, "both", False, 150_000, 11, None)
+    # the long band stopped after a few chunks instead of running its ~100
+    assert 2 <= turns.turns.count(long_key) < 20
+    ran = {k[7] for k in turns.turns}
+    assert ran <= {11, 12, 13, 14, 15, 16, 17}
+
+
+def test_bands_of_two_sessions_take_turns_chunk_by_chunk(turns):
+    hog = _results(rounds=150_000, seed=21)
+    hog.state.case.harmonic = 7
+    hog.request_band()
+    _wait(lambda: len(turns.turns) >= 2, "the long band to run")
+    small = _results(rounds=2_000, seed=22)
+    done_at = []  # how many chunks had started when the small band was published
+    small.param.watch(lambda e: done_at.append(len(turns.turns)), "band")
+    small.request_band()
+    _wait(lambda: small.band is not None and not small.band_status.busy, "the small band")
+    # the small band finished while the long one still runs: it waited for at most one
+    # chunk of the long band per chunk of its own
+    assert hog.band_status.busy and hog.band is None
+    order = [k[7] for k in turns.turns[: done_at[0]]]
+    first_small = order.index(22)
+    assert order[first_small + 1 :].count(21) <= order.count(22)
+    hog.close()
+    _wait(lambda: _live_band_threads() == 0, "the long band to stop")
+    assert hog.band is None  # a closed session publishes nothing
+
+
+def test_turns_alternate_between_waiting_bands():
+    t = bands.Turnstile()
+    a, b = bands.Job("a"), bands.Job("b")
+    order = []
+
+    def work(job, n):
+        for _ in range(n):
+            assert t.next_turn(job)
+            order.append(job.key)
+            time.sleep(0.002)  # a chunk of work
+        t.leave(job)
+
+    assert t.next_turn(a)  # a holds the turn; b arrives and queues
+    tb = threading.Thread(target=work, args=(b, 3))
+    tb.start()
+    _wait(lambda: t.waiting == 1, "b to queue")
+    work(a, 3)
+    tb.join(WAIT_S)
+    assert order == ["b", "a", "b", "a", "b", "a"] or order == ["a", "b", "a", "b", "a", "b"]
+
+
+def test_a_page_closed_during_a_band_draws_nothing_more(turns):
+    from app.main import create_app
+
+    res = _results(rounds=100_000, seed=31)
+    app = create_app(results=res)  # no server: the first band computed in place
+    res.state.case.harmonic = 6  # with background=True this one runs on its thread
+    _wait(lambda: len(turns.turns) >= 1, "the band to start")
+    before = res.band_curves
+    res.close()  # the session ends
+    _wait(lambda: _live_band_threads() == 0, "the band to stop")
+    assert res.band_curves is before
+    res.state.case.harmonic = 2  # a late event of the closed page
+    assert res.band_curves is before and res.response.meta["harmonic"] == 6
+    assert app is not None
