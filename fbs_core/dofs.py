@@ -79,7 +79,11 @@ def validate_labels(labels: Iterable[str], what: str = "DOF") -> tuple[str, ...]
     for lab in out:
         parse_label(lab)
     seen: set[str] = set()
-    dups = [lab for lab in out if lab in seen or seen.add(lab)]
+    dups = []
+    for lab in out:
+        if lab in seen:
+            dups.append(lab)
+        seen.add(lab)
     if dups:
         raise DOFError(f"duplicate {what} labels: {', '.join(sorted(set(dups)))}")
     return out

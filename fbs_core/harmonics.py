@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import FrequencyGridError, HarmonicError
 
@@ -72,7 +73,7 @@ class Harmonic:
         lo, hi = self.speed_range
         return (lo / 3.6 / self.wavelength, hi / 3.6 / self.wavelength)
 
-    def _check(self, freq) -> np.ndarray:
+    def _check(self, freq: ArrayLike) -> np.ndarray:
         f = np.asarray(freq, dtype=float)
         lo, hi = self.freq_range
         bad = (f < lo * (1 - _REL_TOL)) | (f > hi * (1 + _REL_TOL)) | ~np.isfinite(f)
@@ -85,7 +86,7 @@ class Harmonic:
             )
         return f
 
-    def speed_at(self, freq):
+    def speed_at(self, freq: ArrayLike) -> np.ndarray | float:
         """Vehicle speed in km/h at which the road wave excites ``freq`` Hz: ``3.6 f lambda``.
 
         Parameters
@@ -135,7 +136,7 @@ class Harmonic:
 HARMONICS: tuple[Harmonic, ...] = tuple(Harmonic(k + 1, lam) for k, lam in enumerate(WAVELENGTHS))
 
 
-def harmonic(k) -> Harmonic:
+def harmonic(k: int | Harmonic) -> Harmonic:
     """The harmonic excitation case number ``k`` (1..7, thesis table 5.1).
 
     Parameters

@@ -35,7 +35,7 @@ HARMONIC_CASES: tuple[int, ...] = tuple(range(1, 8))
 DB_FLOOR = 1e-30
 
 
-def readonly(a: ArrayLike, dtype: DTypeLike = None) -> np.ndarray:
+def readonly(a: ArrayLike, dtype: DTypeLike | None = None) -> np.ndarray:
     """A read-only copy of ``a`` (results are immutable: nobody can change them in place).
 
     Parameters
@@ -80,4 +80,5 @@ def magnitude_db(x: ArrayLike, ref: float = 1.0, floor: float | None = DB_FLOOR)
     if floor is not None:
         mag = np.maximum(mag, floor)
     with np.errstate(divide="ignore"):
-        return 20.0 * np.log10(mag)
+        out: np.ndarray = 20.0 * np.log10(mag)
+    return out

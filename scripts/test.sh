@@ -33,5 +33,7 @@ export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}" OMP_NUM_THREADS="${OMP_
 echo "== ruff"
 .venv/bin/ruff check .
 .venv/bin/ruff format --check .
+echo "== mypy (strict on fbs_core, lighter on app; see [tool.mypy] in pyproject.toml)"
+.venv/bin/python -m mypy
 echo "== pytest"
 exec .venv/bin/python -m pytest "$@"
