@@ -26,6 +26,7 @@ import numpy as np
 
 import fbs_core
 from fbs_core import studies
+from fbs_core.units import frf_unit, output_kind
 from fbs_core.vocabulary import DB_FLOOR, DIRECTIONS, EIGEN_SPEEDS, magnitude_db, readonly
 
 __all__ = [
@@ -107,7 +108,8 @@ def level_unit(dof: str) -> str:
     The ``patch`` input of the reference tire is a unit road wave (1 m amplitude), so
     responses are m/s (rad/s) per metre of road amplitude (``fbs_core.bushing_response``).
     """
-    return "dB re 1 (rad/s)/m" if dof.startswith("r") else "dB re 1 (m/s)/m"
+    d = dof.split(":")[-1]
+    return f"dB re 1 {frf_unit(output_kind(f'bushing:{d}'), 'road', 'mobility')}"
 
 
 @shared_cache(maxsize=8)

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 import param
 
+from fbs_core.units import frf_unit, input_kind, output_kind
 from fbs_core.vocabulary import EIGEN_SPEEDS
 
 from . import bands, compute
@@ -467,9 +468,8 @@ def eigen_result(s: Snapshot) -> Result:
 
 def chassis_label(dof: str, spindle_input: str) -> str:
     """Axis label of the chassis mobility from a spindle input to a bushing DOF."""
-    unit = "dB re 1 (rad/s)/" if dof.startswith("r") else "dB re 1 (m/s)/"
-    unit += "(N m)" if spindle_input.startswith("r") else "N"
-    return f"Mobility ({unit})"
+    out, inp = output_kind(f"bushing:{dof}"), input_kind(f"spindle:{spindle_input}")
+    return f"Mobility (dB re 1 {frf_unit(out, inp, 'mobility')})"
 
 
 def uncoupled_result(s: Snapshot) -> Result:

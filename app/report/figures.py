@@ -22,6 +22,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from fbs_core.units import frf_unit, output_kind
+
 from .colormap import LINE_STYLES, ErrorColorScale, threshold_contour
 from .snapshot import Snapshot
 from .titles import TitleBlock
@@ -55,7 +57,7 @@ _DASH = {"solid": "-", "dashed": (0, (6, 3)), "dotted": (0, (1.5, 2.5))}
 def level_unit(dof: str) -> str:
     """Unit of a bushing velocity level per road amplitude (``bushing:rz`` -> rad/s)."""
     d = dof.split(":")[-1]
-    return "dB re 1 (rad/s)/m" if d.startswith("r") else "dB re 1 (m/s)/m"
+    return f"dB re 1 {frf_unit(output_kind(f'bushing:{d}'), 'road', 'mobility')}"
 
 
 def _db(x) -> np.ndarray:
