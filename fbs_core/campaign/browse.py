@@ -11,18 +11,25 @@ responses were stored) or as the error map alone.
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._typing import AnyArray, FloatArray, IntArray
 from .spec import CampaignError
 from .store import CampaignStore
+
+if TYPE_CHECKING:
+    from ..studies.scatter import ScatterBand
+    from ..studies.truncation import TruncationMap
 
 __all__ = ["open_campaign", "CampaignResult", "CaseEntry", "TruncationEntry"]
 
 
-def _attr(v):
+def _attr(v: Any) -> Any:
     if isinstance(v, bytes):
         v = v.decode()
     if isinstance(v, np.generic):
@@ -30,7 +37,7 @@ def _attr(v):
     return v
 
 
-def _json(v):
+def _json(v: Any) -> Any:
     v = _attr(v)
     if isinstance(v, str) and v[:1] in "[{":
         return json.loads(v)
@@ -54,7 +61,7 @@ class CaseEntry:
 
     name: str
     kind: str
-    settings: dict
+    settings: dict[str, Any]
     lines_done: int
     n_lines: int
 
@@ -94,20 +101,20 @@ class TruncationEntry:
         The full map when the responses were stored.
     """
 
-    n_modes: np.ndarray
-    centres: np.ndarray
-    dofs: tuple
-    error: np.ndarray | None
-    suggested: np.ndarray | None
-    thresholds: tuple
-    f_max: tuple
-    map: object
+    n_modes: IntArray
+    centres: FloatArray
+    dofs: tuple[str, ...]
+    error: FloatArray | None
+    suggested: IntArray | None
+    thresholds: tuple[float, ...]
+    f_max: tuple[float, ...]
+    map: TruncationMap | None
 
 
 class CampaignResult:
     """A campaign result file opened for reading (see :func:`open_campaign`)."""
 
-    def __init__(self, path) -> None:
+    def __init__(self, path: str | os.PathLike[str]) -> None:
         import h5py
 
         self.path = Path(path)
@@ -115,9 +122,9 @@ class CampaignResult:
         files = self._store.files()
         if not files:
             raise CampaignError(f"{self.path}: no campaign result file (nor parts of a run)")
-        self.attrs: dict = {}
-        self.runs: list[dict] = []
-        cases: dict[str, dict] = {}
+        self.attrs: dict[str, Any] = {}
+        self.runs: list[dict[str, Any]] = []
+        cases: dict[str, dict[str, Any]] = {}
         self._where: dict[str, Path] = {}  # unit path -> file
         for p in files:
             try:
@@ -172,13 +179,13 @@ class CampaignResult:
             f"no case {name!r} in {self.path}; cases: {', '.join(c.name for c in self.cases)}"
         )
 
-    def find(self, **settings) -> tuple[CaseEntry, ...]:
+    def find(self, **settings: Any) -> tuple[CaseEntry, ...]:
         """The cases whose settings match all given values (e.g. ``harmonic=4, noise=0.1``)."""
         return tuple(
             c for c in self.cases if all(c.settings.get(k) == v for k, v in settings.items())
         )
 
-    def _inputs(self, name: str):
+    def _inputs(self, name: str) -> tuple[dict[str, AnyArray], tuple[str, ...]]:
         import h5py
 
         p = self._where.get(f"inputs/{name}")
@@ -190,7 +197,7 @@ class CampaignResult:
             dofs = tuple(_json(g.attrs["dofs"]))
         return arr, dofs
 
-    def band(self, name: str):
+    def band(self, name: str) -> ScatterBand:
         """The :class:`~fbs_core.ScatterBand` of a complete scatter case.
 
         Raises
@@ -215,8 +222,8 @@ class CampaignResult:
         d = self._cases[name]
         st = c.settings
         arr, dofs = self._inputs(d["attrs"]["inputs"])
-        parts: dict[str, list] = {}
-        keys = ("lower", "upper", "argmin_round", "argmax_round", "percentiles")
+        parts: dict[str, list[AnyArray | None]] = {}
+        keys: tuple[str, ...] = ("lower", "upper", "argmin_round", "argmax_round", "percentiles")
         keys += ("conv_lower", "conv_upper")
         ck = None
         for (a, z), p in sorted(d["blocks"].items()):
@@ -229,9 +236,14 @@ class CampaignResult:
         if any(v is None for v in parts["lower"]):
             raise CampaignError(f"case {name} was stored without its band ([outputs] scatter)")
 
-        def cat(k, axis):
-            v = parts[k]
-            return None if any(x is None for x in v) else np.concatenate(v, axis=axis)
+        def cat(k: str, axis: int) -> AnyArray | None:
+            v = [x for x in parts[k] if x is not None]
+            return None if len(v) < len(parts[k]) else np.concatenate(v, axis=axis)
+
+        def edge(k: str) -> AnyArray:
+            v = cat(k, 0)
+            assert v is not None  # stored together with "lower" (checked above)
+            return v
 
         nq = len(st["percentiles"])
         ne = len(dofs)
@@ -240,20 +252,20 @@ class CampaignResult:
         nf = arr["freq"].size
         if pct is None:
             pct = np.full((nq, nf, ne), np.nan)
-        if clo is None or ck is None:
+        if clo is None or chi is None or ck is None:
             ck = np.array([st["rounds"]], np.int64)
-            clo = cat("lower", 0)[None]
-            chi = cat("upper", 0)[None]
+            clo = edge("lower")[None]
+            chi = edge("upper")[None]
         seed = int(st["seed"])
         arrays = _sc._check_inputs(arr["YjjA"], arr["vj"], arr["YjjE"], arr["YejE"])
         return _sc.ScatterBand(
             freq=_sc._ro(arr["freq"]),
             dofs=dofs,
             reference=_sc._ro(arr["reference"]),
-            lower=_sc._ro(cat("lower", 0)),
-            upper=_sc._ro(cat("upper", 0)),
-            argmin_round=_sc._ro(cat("argmin_round", 0)),
-            argmax_round=_sc._ro(cat("argmax_round", 0)),
+            lower=_sc._ro(edge("lower")),
+            upper=_sc._ro(edge("upper")),
+            argmin_round=_sc._ro(edge("argmin_round")),
+            argmax_round=_sc._ro(edge("argmax_round")),
             q=_sc._ro(np.asarray(st["percentiles"], float)),
             percentiles=_sc._ro(pct),
             convergence=_sc.Convergence(_sc._ro(ck), _sc._ro(clo), _sc._ro(chi)),
@@ -355,7 +367,7 @@ class CampaignResult:
         return "\n".join(out)
 
 
-def open_campaign(path) -> CampaignResult:
+def open_campaign(path: str | os.PathLike[str]) -> CampaignResult:
     """Open a campaign result file (and the parts of an unfinished run) for browsing.
 
     Raises

@@ -38,10 +38,18 @@ from __future__ import annotations
 import os
 import socket
 import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
+from .._typing import ComplexArray, FloatArray
 from ..errors import FBSError
+
+if TYPE_CHECKING:
+    from ..frf import FRF
+    from .spec import TruncationCase
 
 __all__ = ["BandInputs", "resolve_model", "prepare_inputs", "band_block", "truncation_case"]
 
@@ -60,7 +68,16 @@ class BandInputs:
     n_modes_total : int
     """
 
-    def __init__(self, freq, dofs, YjjA, vj, YjjE, YejE, n_modes_total):
+    def __init__(
+        self,
+        freq: ArrayLike,
+        dofs: Sequence[str],
+        YjjA: ArrayLike,
+        vj: ArrayLike,
+        YjjE: ArrayLike,
+        YejE: ArrayLike,
+        n_modes_total: int,
+    ) -> None:
         from ..studies import scatter as _sc
 
         self.freq = _sc._ro(freq)
@@ -73,7 +90,7 @@ class BandInputs:
         )
         self.reference = _sc._ro(ref[0])
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: dict[str, Any]) -> None:
         # arrays arrive writeable from pickling: read-only again, so that the compiled
         # kernels see the one signature they were compiled (and cached) for
         for v in state.values():
@@ -88,7 +105,7 @@ class BandInputs:
         return int(self.freq.size)
 
 
-def resolve_model(kind: str, spec):
+def resolve_model(kind: str, spec: Any) -> Any:
     """A model from its campaign spec: ``"reference"`` or an already loaded object."""
     if isinstance(spec, str):
         if spec != "reference":
@@ -99,7 +116,7 @@ def resolve_model(kind: str, spec):
     return spec
 
 
-def load_model(kind: str, source: str):
+def load_model(kind: str, source: str) -> Any:
     """Load a model variant from a file (on the client; the object is then scattered).
 
     Tire: a modal tire model (:func:`fbs_core.io.load_tire_model`). Chassis: an FRF file
@@ -115,7 +132,7 @@ def load_model(kind: str, source: str):
     return io.load_frf(source).frf
 
 
-def chassis_on(chassis, f):
+def chassis_on(chassis: Any, f: FloatArray) -> FRF:
     """The chassis FRF on the grid ``f``: a model's exact synthesis, or an FRF (from a file)
     interpolated onto ``f`` (never extrapolated; an FRF already on ``f`` as it is)."""
     from ..frf import FRF
@@ -125,15 +142,18 @@ def chassis_on(chassis, f):
         if chassis.freq.shape == f.shape and np.array_equal(chassis.freq, f):
             return chassis
         return chassis.interpolate(f)
-    return chassis.mobility(f)
+    Y: FRF = chassis.mobility(f)
+    return Y
 
 
-def frf_payload(frf) -> tuple:
+def frf_payload(
+    frf: FRF,
+) -> tuple[FloatArray, ComplexArray, tuple[str, ...], tuple[str, ...], str]:
     """An FRF as plain arrays and labels, to send to a worker (FRF objects do not pickle)."""
     return (np.asarray(frf.freq), np.asarray(frf.data), frf.outputs, frf.inputs, frf.quantity)
 
 
-def frf_from(payload):
+def frf_from(payload: Any) -> Any:
     """The FRF of :func:`frf_payload` (or the object itself when it is not a payload)."""
     from ..frf import FRF
 
@@ -142,7 +162,9 @@ def frf_from(payload):
     return payload
 
 
-def prepare_inputs(tire, chassis, harmonic: int, n_modes, coupling: str, df: float) -> BandInputs:
+def prepare_inputs(
+    tire: Any, chassis: Any, harmonic: int, n_modes: int | None, coupling: str, df: float
+) -> BandInputs:
     """The arrays of :func:`fbs_core.scatter_band` for one harmonic, model pair and coupling."""
     from ..studies import _models
 
@@ -159,7 +181,7 @@ def prepare_inputs(tire, chassis, harmonic: int, n_modes, coupling: str, df: flo
     return BandInputs(f, resp, YjjA[0], vj[0], YjjE, YejE, n_total)
 
 
-def _where() -> dict:
+def _where() -> dict[str, Any]:
     try:
         from distributed import get_worker
 
@@ -176,12 +198,12 @@ def band_block(
     rounds: int,
     frequency_dependent: bool,
     seed: int,
-    percentiles,
+    percentiles: ArrayLike,
     l0: int,
     l1: int,
     max_chunk_bytes: float = 64e6,
     numba_threads: int | None = None,
-) -> dict:
+) -> dict[str, Any]:
     """Band statistics of lines ``l0 .. l1 - 1`` over all ``rounds`` (exactly the numbers of
     :func:`fbs_core.studies.scatter_band_arrays` for those lines).
 
@@ -201,7 +223,8 @@ def band_block(
     if numba_threads:
         import numba
 
-        numba.set_num_threads(max(1, min(int(numba_threads), numba.config.NUMBA_NUM_THREADS)))
+        n_max = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # not in numba's stubs
+        numba.set_num_threads(max(1, min(int(numba_threads), n_max)))
     nf, ne = inputs.n_lines, len(inputs.dofs)
     if not 0 <= l0 < l1 <= nf:
         raise FBSError(f"line block {l0}..{l1} outside 0..{nf}")
@@ -257,7 +280,7 @@ def band_block(
     }
 
 
-def truncation_case(tire, chassis, case) -> dict:
+def truncation_case(tire: Any, chassis: Any, case: TruncationCase) -> dict[str, Any]:
     """Error map (eq. 5.1) and suggested mode counts (table 5.1) of a
     :class:`~fbs_core.campaign.spec.TruncationCase`.
 
@@ -285,6 +308,7 @@ def truncation_case(tire, chassis, case) -> dict:
         coupling=case.coupling,
     )
     sugg = np.array([[m.suggest(t, fm) for fm in case.f_max] for t in case.thresholds], np.int64)
+    assert m.n_modes_total is not None  # truncation_map always sets it
     return {
         "n_modes": np.asarray(m.n_modes),
         "n_modes_total": int(m.n_modes_total),
