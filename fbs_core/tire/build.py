@@ -9,6 +9,8 @@ of every harmonic case.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ..harmonics import WAVELENGTHS
@@ -27,7 +29,9 @@ OPERATING_POINTS: tuple[float, ...] = tuple(20.0 + 2.5 * i for i in range(41))
 
 
 def build_modal_model(
-    params: TireParameters = DEFAULT_PARAMETERS, speeds=OPERATING_POINTS, wavelengths=WAVELENGTHS
+    params: TireParameters = DEFAULT_PARAMETERS,
+    speeds: Sequence[float] | np.ndarray = OPERATING_POINTS,
+    wavelengths: Sequence[float] | np.ndarray = WAVELENGTHS,
 ) -> TireModel:
     """Complex-mode model of the physical tire at the given operating points.
 
