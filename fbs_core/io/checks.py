@@ -66,6 +66,14 @@ __all__ = [
     "interface_check",
     "prepare_chassis",
     "describe",
+    # re-exported from .units for the importers
+    "check_quantity_arg",
+    "frequency_from_units",
+    "kinds_text",
+    "parse_kinds",
+    "reconcile_quantity",
+    "units_line",
+    "units_note",
 ]
 
 #: Default upper limit of a file's size in bytes (100 MiB).
