@@ -314,7 +314,7 @@ def rename_node(label: str, nodes: Mapping[Any, Any] | None) -> str:
 
 
 def missing_pairs(
-    outputs: Sequence[str], inputs: Sequence[str], present: Collection[tuple[str, str]]
+    outputs: Collection[str], inputs: Collection[str], present: Collection[tuple[str, str]]
 ) -> tuple[int, list[tuple[str, str]]]:
     """How many output/input pairs of the full matrix are not in ``present`` (a set or
     dict of pairs), and the first eight of them.
