@@ -7,8 +7,11 @@ the plot picks the round with the highest level at that frequency.
 
 from __future__ import annotations
 
+import dataclasses
+
 import panel as pn
 import param
+from bokeh.core.properties import value
 from bokeh.events import Tap
 
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
@@ -68,7 +71,6 @@ class ScatterBandView(LiveView):
             y_label=level_label("z", "Band level"),
             x_range=self.x_range,
             name="scatter.figure",
-            title="Click a frequency: the round with the highest level there",
         )
         self._minmax = add_band(
             fig, "scatter.minmax", color=COLORS["band"], alpha=0.35, legend="min-max corridor"
@@ -98,6 +100,31 @@ class ScatterBandView(LiveView):
         fig.on_event(Tap, self._tapped)
         return [fig]
 
+    def _title_state(self):
+        """The band's own settings (it may be older than the controls), the shown DOF,
+        percentile band and round."""
+        s = self.store.snapshot()
+        band = self.store.band
+        if band is None:
+            return s
+        k = min(s.single_round, band.result.rounds - 1)
+        return dataclasses.replace(
+            band.settings, dof=s.dof, percentile=s.percentile, single_round=k
+        )
+
+    def _draw_title(self):
+        super()._draw_title()
+        st, band = self.store.band_status, self.store.band
+        stale = band is not None and band.settings.band_key() != self.store.snapshot().band_key()
+        for t in self._titles:
+            what = t.heading.text.split(" [")[0]
+            if stale:
+                what += " [shown: the previous settings' band" + (
+                    ", the new one is computing]" if st.busy else "]"
+                )
+            if t.heading.text != what:
+                t.heading.text = what
+
     def _tapped(self, event):
         if event.x is not None:
             self.store.pick_peak_round(event.x)
@@ -122,3 +149,13 @@ class ScatterBandView(LiveView):
         self._ref.data = {"freq": f, "level": d["reference_db"]}
         self._round.data = {"freq": f, "level": single["round_db"]}
         self._fig.yaxis.axis_label = level_label(r.draw["dof"], "Band level")
+        labels = [
+            f"min-max over {r.meta['rounds']:,} rounds",
+            f"central band, percentiles {r.meta['percentiles']} %",
+            "unpolluted",
+            f"round #{r.meta['single round']} (click: highest round there)",
+        ]
+        for leg in self._fig.legend:
+            for item, text in zip(leg.items, labels, strict=False):
+                if getattr(item.label, "value", None) != text:
+                    item.label = value(text)
