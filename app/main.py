@@ -26,7 +26,7 @@ from app.bands import served
 from app.report.live import page_url
 from app.report.page import CARD_CSS, PAGE_CSS, PAGE_URL_KEYS, PRESENT_CSS, PageState
 from app.report.panel import data_key, help_page, link_notice, report_buttons
-from app.report.session import provenance_of, session_snapshot
+from app.report.session import provenance_of, session_snapshot, store_sections
 from app.state import URL_KEYS, DashboardState
 from app.store import Results
 from app.views import (
@@ -309,6 +309,7 @@ def create_app(
             band=band.result if band is not None else None,
             band_n_modes=band.settings.n_modes if band is not None else None,
             n_axis=page.n_axis,
+            extra=store_sections(results),  # what other views publish in the store
         )
 
     template = pn.template.BootstrapTemplate(

@@ -15,7 +15,7 @@ from .session import provenance_of
 from .snapshot import SETTING_KEYS, Snapshot
 from .titles import TitleBlock, compact_title, file_stem
 
-__all__ = ["VIEW_OF_KEY", "title_snapshot", "view_title", "page_url"]
+__all__ = ["VIEW_OF_KEY", "title_snapshot", "view_title", "page_url", "short_query"]
 
 #: LiveView key -> title-block view.
 VIEW_OF_KEY = {
@@ -57,12 +57,49 @@ def view_title(key: str, s, url: str = "", n_axis: str = "linear") -> tuple[Titl
     return compact_title(snap, view), file_stem(snap, view)
 
 
+def _url_defaults() -> dict[str, object]:
+    """Default value of every URL query key of the page (state and layout)."""
+    from ..state import URL_KEYS, DashboardState
+    from .page import PAGE_URL_KEYS, PageState
+
+    out: dict[str, object] = {}
+    for group, keys in URL_KEYS.items():
+        cls = DashboardState.param[group].class_
+        for name, key in keys.items():
+            out[key] = cls.param[name].default
+    for name, key in PAGE_URL_KEYS.items():
+        out[key] = PageState.param[name].default
+    return out
+
+
+def _is_default(value, default) -> bool:
+    if isinstance(default, bool) or isinstance(value, bool):
+        return str(value).lower() == str(default).lower()
+    if isinstance(default, (int, float)):
+        try:
+            return float(value) == float(default)
+        except (TypeError, ValueError):
+            return False
+    return str(value) == str(default)
+
+
+def short_query(query: dict) -> dict:
+    """``query`` without the pairs that hold the default value (the page applies those
+    anyway): a link that reproduces the same state, short enough for a title block."""
+    defaults = _url_defaults()
+    return {k: v for k, v in query.items() if not (k in defaults and _is_default(v, defaults[k]))}
+
+
 def page_url() -> str:
-    """The served page's URL with its query (``""`` when not served)."""
+    """The served page's URL that reproduces its state: the address and the query values
+    that differ from the defaults (``""`` when not served)."""
+    import urllib.parse
+
     import panel as pn
 
     loc = pn.state.location
     if loc is None or not loc.href:
         return ""
     href = loc.href.split("?")[0]
-    return href + (loc.search or "")
+    query = short_query(loc.query_params)
+    return href + ("?" + urllib.parse.urlencode(query) if query else "")

@@ -29,6 +29,7 @@ not queued twice.
 
 from __future__ import annotations
 
+import datetime as dt
 import html
 import io
 import re
@@ -44,7 +45,7 @@ from ..report.bokeh import TitleBlockModels, style_figure
 from ..report.live import page_url, view_title
 from ..store import Result, Results
 
-__all__ = ["LiveView", "download_button", "inline_html", "served_document"]
+__all__ = ["LiveView", "download_button", "export_meta", "inline_html", "served_document"]
 
 
 def served_document():
@@ -62,6 +63,19 @@ def inline_html(text: str) -> str:
     return re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", out)
 
 
+def export_meta(meta, url: str | None = None, now: dt.datetime | None = None) -> dict:
+    """A result's CSV header with the provenance every export carries: the core's version,
+    the date of the export and the page URL that reproduces it."""
+    now = now or dt.datetime.now(dt.UTC)
+    url = page_url() if url is None else url
+    return {
+        **meta,
+        "fbs_core version": compute.version(),
+        "exported": now.strftime("%Y-%m-%d %H:%M UTC"),
+        "page URL": url or "(not served: no page URL)",
+    }
+
+
 def download_button(key: str, result) -> pn.widgets.FileDownload:
     """A CSV download of ``result()``: its columns under its own header and file name."""
 
@@ -70,9 +84,7 @@ def download_button(key: str, result) -> pn.widgets.FileDownload:
         if r is None:
             return io.StringIO("")
         btn.filename = r.filename
-        return io.StringIO(
-            to_csv(r.columns, {**r.meta, "fbs_core version": compute.version()}, key)
-        )
+        return io.StringIO(to_csv(r.columns, export_meta(r.meta), key))
 
     first = result()
     btn = pn.widgets.FileDownload(

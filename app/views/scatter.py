@@ -18,6 +18,10 @@ from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
 from .live import LiveView, download_button, inline_html
 from .plots import add_band, add_line, fit_range, frequency_range, new_figure
 
+#: Styles of the progress bar: hidden when idle (its box kept: no new layout of the page).
+IDLE = {"visibility": "hidden"}
+BUSY = {"visibility": "visible"}
+
 
 class ScatterBandView(LiveView):
     """Min/max corridor, percentile band, unpolluted reference and one single round."""
@@ -39,17 +43,33 @@ class ScatterBandView(LiveView):
         # The indicator and the status line keep their place and size: changing their
         # content does not make the browser lay out the page again (toggling visibility
         # did, and delayed every plot update sent with it).
+        # Idle, the bar is hidden (an empty bar looked like a text field) but keeps its box.
         self._progress = pn.indicators.Progress(
             active=False,
             value=0,
             max=100,
             bar_color="primary",
             width=160,
-            height=12,
+            height=14,
             css_classes=["scatter-progress"],
             margin=(12, 10),
+            styles=IDLE,
         )
-        return pn.Row(self._progress, pn.layout.HSpacer(), download_button(self.key, self.result))
+        self._cancel = pn.widgets.Button(
+            label="Cancel band",
+            button_type="danger",
+            button_style="outline",
+            disabled=True,
+            width=110,
+            css_classes=["scatter-cancel"],
+        )
+        self._cancel.on_click(lambda _e: self.store.cancel_band())
+        return pn.Row(
+            self._progress,
+            self._cancel,
+            pn.layout.HSpacer(),
+            download_button(self.key, self.result),
+        )
 
     def _extra(self):
         # its own line, two lines high: the text's length changes, its box does not
@@ -137,8 +157,13 @@ class ScatterBandView(LiveView):
         text = f"<p>{inline_html(st.text)}</p>" if st.text else ""
         if self._status.object != text:
             self._status.object = text
-        if self._progress.active != st.busy:
-            self._progress.param.update(active=st.busy, value=-1 if st.busy else 0)
+        value = (st.percent if st.total else -1) if st.busy else 0
+        if self._progress.active != st.busy or self._progress.value != value:
+            self._progress.param.update(
+                active=st.busy, value=value, styles=BUSY if st.busy else IDLE
+            )
+        if self._cancel.disabled == st.busy:
+            self._cancel.disabled = not st.busy
 
     def _draw(self, r):
         d, single = r.draw["band"], r.draw["round"]

@@ -286,6 +286,7 @@ def scatter_band_arrays(
     checkpoints=None,
     max_chunk_bytes: float = 64e6,
     cancel=None,
+    progress=None,
 ) -> ScatterBand:
     """The scatter band from arrays (the kernel behind :func:`scatter_band`).
 
@@ -321,6 +322,9 @@ def scatter_band_arrays(
         Called without arguments before each chunk of lines; when it returns True the
         study stops with :class:`~fbs_core.errors.StudyCancelled` (a dashboard whose
         settings changed). It may also wait (e.g. to take turns with other studies).
+    progress : callable, optional
+        Called as ``progress(lines_done, lines_total)`` before the first chunk of lines and
+        after each one (a progress indicator: done/total and the time left).
 
     Returns
     -------
@@ -385,6 +389,8 @@ def scatter_band_arrays(
     chunk = int(max(1, min(nf, max_chunk_bytes // per_line)))
     mag = np.empty((chunk, ne, rounds))
     rids = np.arange(rounds, dtype=np.int64)
+    if progress is not None:
+        progress(0, nf)
     for l0 in range(0, nf, chunk):
         if cancel is not None and cancel():
             raise StudyCancelled(f"scatter band cancelled after {l0} of {nf} lines")
@@ -405,6 +411,8 @@ def scatter_band_arrays(
                 _EMPTY_CPLX,
             )
             _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
+        if progress is not None:
+            progress(l1, nf)
     del mag
     for name, x in (("reference", np.abs(ref)), ("upper edge", hi), ("lower edge", lo)):
         if not np.all(np.isfinite(x)):
@@ -452,6 +460,7 @@ def scatter_band(
     checkpoints=None,
     max_chunk_bytes: float = 64e6,
     cancel=None,
+    progress=None,
 ) -> ScatterBand:
     """Noise scatter band of the bushing response for one harmonic (thesis 5.2, eqs. 5.2-5.4).
 
@@ -468,7 +477,7 @@ def scatter_band(
     tire, chassis : optional
         Models (default the reference ones); ``chassis`` may be an FRF on ``freq``.
     coupling : {"6dof", "5dof"} or sequence of directions
-    percentiles, checkpoints, max_chunk_bytes, cancel
+    percentiles, checkpoints, max_chunk_bytes, cancel, progress
         See :func:`scatter_band_arrays`.
 
     Returns
@@ -509,4 +518,5 @@ def scatter_band(
         checkpoints=checkpoints,
         max_chunk_bytes=max_chunk_bytes,
         cancel=cancel,
+        progress=progress,
     )
