@@ -210,7 +210,7 @@ class DataSource(param.Parameterized):
         super().__init__(**params)
         self._tire_key = self._chassis_key = ""
         self._last_chassis: tuple[bytes, str] | None = None
-        self._last_settings: tuple[str, str, bool] | None = None
+        self._last_settings: tuple[str, str, bool, str] | None = None
         # uploads of one session are read one at a time (a click and a settings change
         # arrive on different worker threads: the last read must see the last settings)
         self._lock = threading.RLock()

@@ -106,7 +106,9 @@ class PageParts:
 
     @property
     def state(self) -> DashboardState:
-        return self.results.state
+        state = self.results.state
+        assert state is not None  # a Results always owns a state
+        return state
 
     def card(self, title: str, view, height: int | None = PLOT_HEIGHT, **kw) -> pn.Card:
         """A collapsible card of the page's style; plot cards grow in the presentation view

@@ -52,6 +52,10 @@ def out_of_bounds(obj: param.Parameterized, name: str, value, label: str = "") -
     return ""
 
 
+def _harmonic_html(k: int) -> str:
+    return html.escape(harmonic_text(k))
+
+
 def harmonic_text(k: int) -> str:
     """Wavelength, speed range and frequency band of harmonic case ``k``."""
     h = fbs_core.harmonic(int(k))
@@ -78,6 +82,7 @@ class Controls(Viewer):
         obj = getattr(self.state, group)
         kind, label, kw = _TYPED[key]
         p = obj.param[name]
+        w: pn.widgets.Widget
         if kind == "slider":
             lo, hi = p.softbounds or p.bounds
             w = pn.widgets.EditableFloatSlider(
@@ -173,7 +178,7 @@ class Controls(Viewer):
         label = pn.pane.Markdown
         case = self.state.case
         info = pn.pane.HTML(
-            pn.bind(lambda k: html.escape(harmonic_text(k)), case.param.harmonic),
+            pn.bind(_harmonic_html, case.param.harmonic),
             css_classes=["ctl-harmonic-info"],
             styles={"font-size": "0.9em", "color": "#343a40"},
             margin=(0, 12),
