@@ -15,6 +15,7 @@ from panel.viewable import Viewer
 
 import fbs_core
 
+from ..bands import served
 from ..panel_private import respond_at_once
 from ..state import DashboardState
 
@@ -50,6 +51,10 @@ def out_of_bounds(obj: param.Parameterized, name: str, value, label: str = "") -
             f"still {_fmt(getattr(obj, name))} in use."
         )
     return ""
+
+
+def _put_back(w: pn.widgets.Widget, obj: param.Parameterized, name: str) -> None:
+    w.value = getattr(obj, name)
 
 
 def _harmonic_html(k: int) -> str:
@@ -112,7 +117,13 @@ class Controls(Viewer):
             text = out_of_bounds(obj, name, event.new, label)
             if text:
                 msg.param.update(object=html.escape(text), visible=True)
-                w.value = getattr(obj, name)  # the field shows the value in force
+                # the field shows the value in force again; when served, after Panel has
+                # handled the browser's change (a change of the same property while it is
+                # handled is not sent back)
+                if served():
+                    pn.state.execute(lambda: _put_back(w, obj, name), schedule=True)
+                else:
+                    _put_back(w, obj, name)
                 if pn.state.notifications is not None:
                     pn.state.notifications.error(text, duration=8000)
                 return

@@ -1,6 +1,9 @@
-"""Review meetings in chromium at projector and desktop sizes: the presentation view, title
-blocks on every plot and saved image, the readable error map, the report downloads and a
-shared link that needs uploaded data. Screenshots go to tests/browser/artifacts/."""
+"""Review meetings in chromium at projector and desktop sizes (issue 17): the presentation
+view and the first screen, title blocks with the data in use on every plot and saved image,
+the readable error map, validation messages, the band's progress and cancel, the report
+downloads, help, exports with date and link, a shared link that needs uploaded data, and a
+page closed during a band. Screenshots go to tests/browser/artifacts/ (git-ignored; the
+path is printed)."""
 
 from __future__ import annotations
 
@@ -9,15 +12,44 @@ import re
 from html.parser import HTMLParser
 from pathlib import Path
 
+import numpy as np
 import pytest
+from playwright.sync_api import expect
 from pypdf import PdfReader
 
-from .conftest import open_dashboard, table_json
+from app.export import read_csv
+
+from .conftest import model_value, open_dashboard, set_model_value, table_json, wait_band_idle
 
 pytestmark = pytest.mark.browser
 
 ARTIFACTS = Path(__file__).parent / "artifacts"
 SIZES = [(1280, 720), (1920, 1080)]
+#: Where layout matters: the projector sizes too.
+LAYOUT_SIZES = [(1280, 720), (1366, 768), (1920, 1080)]
+
+
+def _shot(page, name: str) -> None:
+    ARTIFACTS.mkdir(exist_ok=True)
+    path = ARTIFACTS / name
+    page.screenshot(path=str(path))
+    print(f"screenshot: {path}")
+
+
+def _first_screen(page, size, title: str) -> None:
+    """The card ``title``'s plot starts on the first screen with room for a plot."""
+    box = page.get_by_text(title).first.bounding_box()
+    assert box is not None and box["y"] + 250 < size[1], (title, box)
+
+
+def _collapse_control_visible(page) -> None:
+    """The data card's collapse control is drawn (a framed button of at least 20 px)."""
+    btn = page.locator(".upload-card .card-button").first
+    btn.wait_for(state="visible")
+    box = btn.bounding_box()
+    assert box is not None and box["width"] >= 20 and box["height"] >= 20, box
+    assert btn.evaluate("b => getComputedStyle(b).borderTopStyle") == "solid"
+
 
 JS_FIGURES = """
 () => {
@@ -50,7 +82,7 @@ def _context(browser, size):
     )
 
 
-@pytest.mark.parametrize("size", SIZES)
+@pytest.mark.parametrize("size", LAYOUT_SIZES)
 def test_presentation_view(browser, dashboard, size):
     ctx = _context(browser, size)
     page = ctx.new_page()
@@ -67,8 +99,8 @@ def test_presentation_view(browser, dashboard, size):
         "m.css_classes.includes('upload-card')).map(m => m.collapsed)"
     )
     assert collapsed == [True]
-    box = page.get_by_text("Coupled response at the bushing").first.bounding_box()
-    assert box is not None and box["y"] + 250 < size[1]
+    _first_screen(page, size, "Coupled response at the bushing")
+    _collapse_control_visible(page)
     figs = _figures(page)
     assert {"truncation.figure", "scatter.figure", "eigen.figure"} <= set(figs)
     for name, f in figs.items():
@@ -81,8 +113,7 @@ def test_presentation_view(browser, dashboard, size):
         "tire-fbs_scatter-band_h1_bushing-z_N50_6dof_p10-both_R1000_"
     )
     assert "view=present" in page.url
-    ARTIFACTS.mkdir(exist_ok=True)
-    page.screenshot(path=str(ARTIFACTS / f"present_{size[0]}x{size[1]}.png"))
+    _shot(page, f"present_{size[0]}x{size[1]}.png")
     assert not errors, errors
     ctx.close()
 
@@ -115,7 +146,7 @@ def test_readable_error_map_and_layout_in_link(browser, dashboard, size):
         "m.css_classes.includes('upload-card')).map(m => m.collapsed)"
     )
     assert collapsed == [True]
-    page.screenshot(path=str(ARTIFACTS / f"errormap_log_{size[0]}x{size[1]}.png"))
+    _shot(page, f"errormap_log_{size[0]}x{size[1]}.png")
     ctx.close()
 
 
@@ -133,8 +164,9 @@ class _Tables(HTMLParser):
             self.cells.append(data.strip())
 
 
-def test_report_downloads_hold_what_the_page_shows(browser, dashboard, tmp_path):
-    ctx = _context(browser, (1920, 1080))
+@pytest.mark.parametrize("size", SIZES)
+def test_report_downloads_hold_what_the_page_shows(browser, dashboard, tmp_path, size):
+    ctx = _context(browser, size)
     page = ctx.new_page()
     open_dashboard(page, dashboard.url + "?h=3&N=60&rounds=1000")
     table = table_json(page, "suggested-table")
@@ -159,16 +191,153 @@ def test_report_downloads_hold_what_the_page_shows(browser, dashboard, tmp_path)
     pdf = dl.value.path().read_bytes()
     text = "".join(p.extract_text() for p in PdfReader(io.BytesIO(pdf)).pages)
     assert "Harmonic 3: road wavelength 0.339 m, 30-120 km/h" in text
-    ARTIFACTS.mkdir(exist_ok=True)
+    # the report opened in the browser shows the page's numbers
+    view = ctx.new_page()
+    view.goto(path.as_uri())
+    view.locator("h1", has_text="Harmonic 3, bushing:z, N = 60").wait_for()
+    _shot(view, f"report_from_page_{size[0]}x{size[1]}.png")
     ctx.close()
 
 
-def test_shared_link_that_needs_uploads_says_so(browser, dashboard):
-    ctx = _context(browser, (1280, 720))
+@pytest.mark.parametrize("size", SIZES)
+def test_shared_link_that_needs_uploads_says_so(browser, dashboard, size):
+    ctx = _context(browser, size)
     page = ctx.new_page()
     open_dashboard(page, dashboard.url + "?data=chassis:0123456789ab&rounds=1000")
     # the alert's text is inside the pane's shadow root: match it there
     page.locator(".link-notice", has_text="made with uploaded data").wait_for(state="visible")
     page.locator(".link-notice", has_text="chassis: chassis:0123456789ab").wait_for()
-    page.screenshot(path=str(ARTIFACTS / "link_notice_1280x720.png"))
+    _shot(page, f"link_notice_{size[0]}x{size[1]}.png")
+    ctx.close()
+
+
+@pytest.mark.parametrize("size", LAYOUT_SIZES[:2])
+def test_normal_view_first_screen_shows_a_plot(browser, dashboard, size):
+    ctx = _context(browser, size)
+    page = ctx.new_page()
+    open_dashboard(page, dashboard.url + "?h=5&rounds=1000")
+    _first_screen(page, size, "Coupled response at the bushing")
+    _collapse_control_visible(page)
+    # the harmonic's wavelength, speed range and band beside its control
+    page.locator(
+        ".ctl-harmonic-info", has_text="Harmonic 5: road wavelength 0.166 m, 30-120 km/h, band"
+    ).wait_for()
+    # the quantity is chosen in the data card (files that do not say it)
+    page.locator(".upload-quantity select").wait_for(state="visible")
+    _shot(page, f"normal_{size[0]}x{size[1]}.png")
+    ctx.close()
+
+
+def _status(page, words: str, timeout=120_000):
+    page.locator(".scatter-status", has_text=words).first.wait_for(timeout=timeout)
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_out_of_range_input_gets_a_message(browser, dashboard, size):
+    ctx = _context(browser, size)
+    page = ctx.new_page()
+    open_dashboard(page, dashboard.url + "?rounds=1000")
+    for cls, typed, words in (
+        ("ctl-noise-rounds", "300000", "Rounds R: 300,000 is outside the allowed range"),
+        ("ctl-noise-rounds", "0", "Rounds R: 0 is outside the allowed range"),
+        ("ctl-noise-noise", "150", "Noise level p (%): 150 is outside the allowed range"),
+    ):
+        box = page.locator(f".{cls} input").first
+        box.fill(typed)
+        box.press("Enter")
+        msg = page.locator(f".ctl-message-{cls[4:]}", has_text=words)
+        msg.wait_for(state="visible")
+        # the field shows the value in force again
+        expect(box).not_to_have_value(typed)
+    assert model_value(page, "ctl-noise-rounds") == 1000
+    _shot(page, f"validation_{size[0]}x{size[1]}.png")
+    ctx.close()
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_long_band_shows_progress_time_left_and_cancels(browser, dashboard, size):
+    ctx = _context(browser, size)
+    page = ctx.new_page()
+    open_dashboard(page, dashboard.url + "?rounds=1000")
+    wait_band_idle(page)
+    # idle: no progress bar drawn (an empty bar looked like a text field), cancel disabled
+    assert (
+        page.locator(".scatter-progress").first.evaluate("e => getComputedStyle(e).visibility")
+        == "hidden"
+    )
+    box = page.locator(".ctl-noise-rounds input").first
+    box.fill("150000")
+    box.press("Enter")
+    set_model_value(page, "ctl-case-harmonic", 7)
+    _status(page, "frequency lines")
+    page.locator(".scatter-status", has_text=" left").first.wait_for(timeout=120_000)
+    text = page.locator(".scatter-status").first.inner_text()
+    assert re.search(r"Computing 150,000 rounds: \d+ % \(\d+ of 633 frequency lines\)", text)
+    assert (
+        page.locator(".scatter-progress").first.evaluate("e => getComputedStyle(e).visibility")
+        == "visible"
+    )
+    # the band on screen is marked as not of the current settings
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0].all_models].some(m => m.type === 'Title' && "
+        'm.text.includes("[shown: the previous settings\' band, the new one is computing]"))'
+    )
+    _shot(page, f"band_progress_{size[0]}x{size[1]}.png")
+    page.locator(".scatter-cancel button").click()
+    _status(page, "Cancelled after")
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0].all_models].some(m => m.type === 'Title' && "
+        'm.text.includes("[shown: the previous settings\' band]"))'
+    )
+    assert page.locator(".scatter-cancel button").is_disabled()
+    _shot(page, f"band_cancelled_{size[0]}x{size[1]}.png")
+    ctx.close()
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_help_page_and_exports_with_date_and_link(browser, dashboard, size, tmp_path):
+    ctx = _context(browser, size)
+    page = ctx.new_page()
+    open_dashboard(page, dashboard.url + "?h=2&N=80&rounds=1000")
+    page.locator(".help-button button").click()
+    help_ = page.locator(".help-page")
+    help_.get_by_text("Assembly of a tire and a vehicle model").first.wait_for(state="visible")
+    for words in ("Chalmers University of Technology", "How to read each view", "eq. 4.1"):
+        help_.get_by_text(words).first.wait_for(state="attached")
+    _shot(page, f"help_{size[0]}x{size[1]}.png")
+    page.keyboard.press("Escape")
+    with page.expect_download() as dl:
+        page.locator(".download-mobility").first.click()
+    meta, cols = read_csv(dl.value.path().read_text())
+    assert re.fullmatch(r"\d{4}-\d\d-\d\d \d\d:\d\d UTC", meta["exported"])
+    url = meta["page URL"]
+    assert url.startswith(dashboard.url) and "h=2" in url and "N=80" in url
+    # the export's link reproduces what it holds
+    other = ctx.new_page()
+    open_dashboard(other, url)
+    shown = other.evaluate(
+        "() => Array.from([...Bokeh.documents[0].all_models].filter(m => "
+        "m.name === 'mobility.truncated')[0].data.level)"
+    )
+    np.testing.assert_allclose(shown, cols["truncated_dB"], rtol=1e-12, atol=1e-9)
+    ctx.close()
+
+
+def test_a_page_closed_during_a_band_logs_no_error(browser, dashboard):
+    ctx = _context(browser, (1280, 720))
+    page = ctx.new_page()
+    open_dashboard(page, dashboard.url + "?rounds=1000")
+    start = len(dashboard.log)
+    box = page.locator(".ctl-noise-rounds input").first
+    box.fill("120000")
+    box.press("Enter")
+    _status(page, "Computing 120,000 rounds")
+    page.close()  # the session ends while its band computes
+    # a new page loads and gets its band: the closed page's band has stopped or finished
+    other = ctx.new_page()
+    open_dashboard(other, dashboard.url + "?rounds=1000&seed=5")
+    wait_band_idle(other)
+    log = "".join(dashboard.log[start:])
+    assert "IndexError" not in log, log
+    assert "/app/" not in log, log  # no traceback through the app's code
     ctx.close()
