@@ -41,12 +41,35 @@ def served() -> bool:
 
 
 class Job:
-    """One requested band: its cache key, and a cancel flag the kernel checks."""
+    """One requested band: its cache key, a cancel flag the kernel checks, and its progress
+    (lines done of the total, reported by the kernel after each chunk)."""
 
-    def __init__(self, key: tuple, owner=None) -> None:
+    def __init__(self, key: tuple, owner=None, on_progress=None) -> None:
         self.key = key
         self.owner = owner
         self._cancelled = threading.Event()
+        self.started = time.perf_counter()
+        self.done = 0
+        self.total = 0
+        #: ``on_progress(job)`` after each chunk (from the band's thread)
+        self.on_progress = on_progress
+
+    def report(self, done: int, total: int) -> None:
+        """The kernel's progress callback: ``done`` of ``total`` lines."""
+        self.done, self.total = int(done), int(total)
+        if self.on_progress is not None and not self.cancelled:
+            self.on_progress(self)
+
+    @property
+    def fraction(self) -> float:
+        return self.done / self.total if self.total else 0.0
+
+    def seconds_left(self) -> float | None:
+        """Time left at the rate so far (None before the first chunk is done)."""
+        if not self.done or not self.total:
+            return None
+        spent = time.perf_counter() - self.started
+        return spent * (self.total - self.done) / self.done
 
     def cancel(self) -> None:
         self._cancelled.set()
@@ -118,7 +141,9 @@ def run(job: Job, done: Done, context=None, turnstile: Turnstile | None = None) 
     try:
         res = compute.cached_band(job.key)
         if res is None:
-            res = compute.band(*job.key, cancel=lambda: not turns.next_turn(job))
+            res = compute.band(
+                *job.key, cancel=lambda: not turns.next_turn(job), progress=job.report
+            )
     except StudyCancelled:
         return
     except Exception as exc:  # the page shows the message instead of a silent spinner

@@ -367,11 +367,12 @@ def cached_band(key: tuple):
         return res
 
 
-def band(*args, cancel=None, **kwargs):
+def band(*args, cancel=None, progress=None, **kwargs):
     """The Monte-Carlo scatter band (thesis 5.2) of :func:`band_key`'s settings, cached.
 
     ``cancel`` is handed to :func:`fbs_core.scatter_band` (asked between chunks of lines;
-    :class:`fbs_core.StudyCancelled` when it returns True). Two sessions that ask for the
+    :class:`fbs_core.StudyCancelled` when it returns True), and ``progress`` (called with
+    the lines done and the total after each chunk). Two sessions that ask for the
     same missing band at once each compute it (a cancel of one never fails the other).
     """
     key = band_key(*args, **kwargs)
@@ -390,6 +391,7 @@ def band(*args, cancel=None, **kwargs):
         coupling=coupling,
         percentiles=Q_LEVELS,
         cancel=cancel,
+        progress=progress,
         **_models_kw(models),
     )
     with _bands_lock:

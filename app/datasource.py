@@ -159,6 +159,19 @@ def parse_node(text: str, role: str) -> tuple[str, int | None]:
     return t, None
 
 
+#: The quantity choice "as the file says".
+FROM_FILE = "as the file says"
+QUANTITIES = ("receptance", "mobility", "accelerance")
+
+
+def quantity_hint(message: str) -> str:
+    """The core's "pass quantity=..." (a Python hint) as what to do on the page."""
+    return message.replace(
+        "pass quantity=...",
+        "choose what it holds under 'Quantity' (receptance, mobility or accelerance)",
+    )
+
+
 class DataSource(param.Parameterized):
     """The models of one session: the shipped reference or the session's uploads.
 
@@ -186,12 +199,18 @@ class DataSource(param.Parameterized):
         doc="Interpolate the chassis FRF onto the "
         "analysis grids when the file lacks their lines (explicit).",
     )
+    quantity = param.Selector(
+        default=FROM_FILE,
+        objects=[FROM_FILE, *QUANTITIES],
+        doc="What the chassis FRF holds when its file does not say (receptance, mobility or "
+        "accelerance); checked against the file when it does.",
+    )
 
     def __init__(self, **params):
         super().__init__(**params)
         self._tire_key = self._chassis_key = ""
         self._last_chassis: tuple[bytes, str] | None = None
-        self._last_settings: tuple[str, str, bool] | None = None
+        self._last_settings: tuple[str, str, bool, str] | None = None
         # uploads of one session are read one at a time (a click and a settings change
         # arrive on different worker threads: the last read must see the last settings)
         self._lock = threading.RLock()
@@ -222,8 +241,8 @@ class DataSource(param.Parameterized):
                 return None
             return self._load_chassis(None, None, None, None, None)
 
-    def _settings(self) -> tuple[str, str, bool]:
-        return (self.spindle, self.bushing, bool(self.interpolate))
+    def _settings(self) -> tuple[str, str, bool, str]:
+        return (self.spindle, self.bushing, bool(self.interpolate), self.quantity)
 
     def _load_chassis(self, data, filename, spindle, bushing, interpolate) -> bool:
         if data is None:
@@ -236,12 +255,13 @@ class DataSource(param.Parameterized):
         interp = self.interpolate if interpolate is None else bool(interpolate)
         name = filename or "upload"
         self._last_chassis = (bytes(data), name)  # settings can be changed and re-read
-        self._last_settings = (sp, bu, interp)
+        self._last_settings = (sp, bu, interp, self.quantity)
+        q = None if self.quantity == FROM_FILE else self.quantity
         try:
-            chassis, summary, key = self._read_chassis(bytes(data), name, sp, bu, interp)
+            chassis, summary, key = self._read_chassis(bytes(data), name, sp, bu, interp, q)
             check_pair(self.models.tire, chassis)
         except FBSError as e:
-            self.error = f"{name}: {e}"
+            self.error = quantity_hint(f"{name}: {e}")
             return False
         self._chassis_key = key
         m = self.models
@@ -252,7 +272,7 @@ class DataSource(param.Parameterized):
             self.models = _models(m.tire, self._tire_key, m.tire_name, chassis, key, name)
         return True
 
-    def _read_chassis(self, data, name, spindle, bushing, interpolate):
+    def _read_chassis(self, data, name, spindle, bushing, interpolate, quantity=None):
         from fbs_core.io import load_frf, prepare_chassis, require_dofs
 
         sp_name, sp_num = parse_node(spindle, "spindle")
@@ -264,7 +284,7 @@ class DataSource(param.Parameterized):
             nodes[bu_num] = bu_name = "bushing"
         if sp_num is not None and sp_num == bu_num:
             raise FBSError(f"the spindle and the bushing must be different nodes, got {sp_num}")
-        res = load_frf(data, filename=name, nodes=nodes or None)
+        res = load_frf(data, filename=name, nodes=nodes or None, quantity=quantity)
         present = sorted({parse_label(x)[0] for x in res.frf.outputs + res.frf.inputs})
         for role, node, given in (("spindle", sp_name, spindle), ("bushing", bu_name, bushing)):
             if node not in present:
@@ -289,7 +309,8 @@ class DataSource(param.Parameterized):
                 + " (linear in real and imaginary part)"
             )
         summary = res.summary + ("\nchassis: " + "; ".join(notes) if notes else "")
-        key = _digest(data, spindle=spindle, bushing=bushing, interpolate=interpolate)
+        chosen = {"quantity": quantity} if quantity else {}  # digests of files that say it
+        key = _digest(data, spindle=spindle, bushing=bushing, interpolate=interpolate, **chosen)
         return chassis, summary, key
 
     def load_tire(self, data: bytes, filename: str | None = None) -> bool:

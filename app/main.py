@@ -1,17 +1,32 @@
 """The servable page: ``panel serve app/main.py``.
 
 Every browser session gets its own :class:`~app.state.DashboardState`, synchronised with the
-URL query (``?h=5&N=150&dof=z...``), so that a link reproduces the view.
+URL query (``?h=5&N=150&dof=z...``), so that a link reproduces the view; the page layout
+(presentation view, data card, N-axis scale, the uploads a link needs) is in the link too
+(:class:`~app.report.page.PageState`).
+
+Layout, top to bottom: the page bar (report, help, layout switches), the notice of a link
+that needs uploads, the first plot row (coupled response, error map: on the first screen
+at 1280x720), the "Your data" card, the other built-in plot rows (:func:`plot_rows`), then
+one card per entry of :data:`EXTRA_CARDS`, the place where further views (in their own
+modules under ``app/views/``) add themselves with one line.
 """
 
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import panel as pn
 import param
 
 from app.bands import served
+from app.report.live import page_url
+from app.report.page import CARD_CSS, PAGE_CSS, PAGE_URL_KEYS, PRESENT_CSS, PageState
+from app.report.panel import data_key, help_page, link_notice, report_buttons
+from app.report.session import provenance_of, session_snapshot, store_sections
 from app.state import URL_KEYS, DashboardState
 from app.store import Results
 from app.views import (
@@ -35,8 +50,13 @@ Prediction of the vibration at a rear-chassis bushing from a rolling-tire modal 
 coupled to a chassis FRF model at the hub (receptance coupling, thesis eq. 4.1), with the
 two sensitivity studies of the thesis: **modal truncation** of the tire (5.1) and **random
 noise** in the subsystem FRFs (5.2). Zoom and pan are linked across the frequency axes;
-every view downloads its data as CSV; the URL holds the page state.
+every view downloads its data as CSV; the URL holds the page state. **Help** explains the
+method and how to read each view.
 """
+
+#: Plot card heights (px) in the normal view; the presentation view adds PRESENT_EXTRA.
+PLOT_HEIGHT = 580
+PRESENT_EXTRA = 140
 
 
 def apply_valid(obj: param.Parameterized, values: dict) -> list[str]:
@@ -65,6 +85,205 @@ def sync_url(state: DashboardState, location=None) -> None:
         loc.sync(obj, keys, on_error=functools.partial(apply_valid, obj))
 
 
+@dataclass
+class PageParts:
+    """What a card of the page is built from: one session's store, state and layout.
+
+    Attributes
+    ----------
+    results : Results
+        The session's results store (``results.state`` is its ``DashboardState``).
+    page : PageState
+        The layout state (``page.view`` is ``"normal"`` or ``"present"``).
+    freq, modes : bokeh Range1d
+        The shared frequency axis and N axis (zoom and pan linked across views).
+    """
+
+    results: Results
+    page: PageState
+    freq: Any
+    modes: Any
+
+    @property
+    def state(self) -> DashboardState:
+        state = self.results.state
+        assert state is not None  # a Results always owns a state
+        return state
+
+    def card(self, title: str, view, height: int | None = PLOT_HEIGHT, **kw) -> pn.Card:
+        """A collapsible card of the page's style; plot cards grow in the presentation view
+        (larger type, the same plot area)."""
+        if height is not None and self.page.view == "present":
+            height += PRESENT_EXTRA
+        kw.setdefault("css_classes", [])
+        kw["css_classes"] = [*kw["css_classes"], "fbs-card"]
+        return pn.Card(
+            view,
+            title=title,
+            collapsible=True,
+            height=height,
+            sizing_mode="stretch_width",
+            header_background="#dee2e6",
+            margin=(4, 4),
+            stylesheets=[CARD_CSS],
+            **kw,
+        )
+
+
+#: Further cards, below the built-in plots, in this order: ``builder(parts) -> panel object``
+#: (None: nothing). A view in its own module under ``app/views/`` adds its builder here.
+EXTRA_CARDS: list[Callable[[PageParts], Any]] = []
+
+
+def extra_cards(parts: PageParts) -> list:
+    """The cards of :data:`EXTRA_CARDS` for this session."""
+    return [c for c in (build(parts) for build in EXTRA_CARDS) if c is not None]
+
+
+class PlotViews:
+    """The built-in plot views of one page, and the page-layout switches they follow."""
+
+    def __init__(self, parts: PageParts):
+        r, p, mode = parts.results, parts.page, parts.page.view
+        self.parts = parts
+        self.mobility = MobilityView(store=r, x_range=parts.freq, mode=mode)
+        self.scatter = ScatterBandView(store=r, x_range=parts.freq, mode=mode)
+        self.eigen = EigenView(store=r, n_range=parts.modes, mode=mode)
+        self.truncation = pn.Column(self._map(p.n_axis), sizing_mode="stretch_both")
+        self.suggested = SuggestedModesView(store=r)
+        # the uncoupled subsystems are built on first request (two plots less per page load)
+        self.uncoupled = pn.Row(
+            visible=r.state.case.param.show_uncoupled,
+            css_classes=["uncoupled-row"],
+            sizing_mode="stretch_width",
+        )
+        r.state.case.param.watch(lambda e: self._show_uncoupled(e.new), "show_uncoupled")
+        self._show_uncoupled(r.state.case.show_uncoupled)
+        p.param.watch(lambda e: self._rebuild_map(e.new), "n_axis")
+        p.param.watch(lambda e: self._restyle(e.new), "view")
+
+    def _map(self, n_axis: str) -> TruncationView:
+        pa = self.parts
+        return TruncationView(
+            store=pa.results,
+            x_range=pa.freq,
+            n_range=pa.modes,
+            mode=pa.page.view,
+            n_axis=n_axis,
+        )
+
+    def _rebuild_map(self, n_axis: str) -> None:  # the axis scale is fixed at build
+        self.truncation.objects = [self._map(n_axis)]
+
+    def _show_uncoupled(self, show: bool) -> None:
+        if show and not self.uncoupled.objects:
+            pa = self.parts
+            view = UncoupledView(store=pa.results, x_range=pa.freq, mode=pa.page.view)
+            self.uncoupled.append(
+                pa.card("Uncoupled subsystems: tire hub and chassis spindle-to-bushing", view, 420)
+            )
+
+    def live(self) -> list:
+        """The plot views now on the page."""
+        unc = [c.objects[0] for c in self.uncoupled.objects]
+        return [self.mobility, self.scatter, self.eigen, *self.truncation.objects, *unc]
+
+    def _restyle(self, view: str) -> None:
+        for v in self.live():
+            v.mode = view
+
+
+def plot_rows(parts: PageParts, views: PlotViews) -> list:
+    """The built-in plots: coupled response and error map first (on the first screen)."""
+    card = parts.card
+    return [
+        pn.Row(
+            card("Coupled response at the bushing (thesis eq. 4.1)", views.mobility),
+            card("Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)", views.truncation),
+        ),
+        views.uncoupled,
+        pn.Row(
+            card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", views.scatter),
+            card("Eigenfrequency versus number of modes (fig. 5.8)", views.eigen),
+        ),
+        pn.Row(card("Suggested number of modes (thesis table 5.1)", views.suggested, 360)),
+    ]
+
+
+def data_card(parts: PageParts) -> pn.Card:
+    """The "Your data" card; collapsed in the presentation view or with ``card=closed``, and
+    its state kept in the link."""
+    page = parts.page
+    upload = parts.card(
+        "Your data: chassis FRF and tire model for this session",
+        UploadView(data=parts.state.data),
+        None,
+        collapsed=page.view == "present" or page.data_card == "closed",
+        css_classes=["upload-card"],
+    )
+    upload.param.watch(
+        lambda e: setattr(page, "data_card", "closed" if e.new else "open"), "collapsed"
+    )
+
+    def follow_view(e):
+        if e.new == "present":
+            upload.collapsed = True
+
+    page.param.watch(follow_view, "view")
+    return upload
+
+
+def link_notice_pane(parts: PageParts) -> pn.pane.Alert:
+    """The notice of a link made with uploads this session lacks; the link names the
+    uploads in use."""
+    state, page = parts.state, parts.page
+    notice = pn.pane.Alert(
+        "", alert_type="warning", visible=False, css_classes=["link-notice"], margin=(4, 8)
+    )
+
+    def check(*_):  # the link's uploads (from the URL) vs the session's
+        text = link_notice(page.data, provenance_of(state.data.models))
+        notice.param.update(object=text, visible=bool(text))
+
+    def data_in_use(*_):  # the link names the uploads now in use
+        page.data = data_key(provenance_of(state.data.models))
+
+    page.param.watch(check, "data")
+    state.data.param.watch(data_in_use, "models")
+    check()
+    return notice
+
+
+def page_bar(parts: PageParts, snapshot: Callable, open_help: Callable) -> pn.Row:
+    """Report downloads, help and the layout switches (presentation view, N axis)."""
+    page = parts.page
+    help_button = pn.widgets.Button(
+        label="Help", button_type="light", css_classes=["help-button"], width=70
+    )
+    help_button.on_click(lambda _e: open_help())
+    return pn.Row(
+        report_buttons(snapshot),
+        help_button,
+        pn.widgets.RadioButtonGroup.from_param(
+            page.param.view,
+            name="Page",
+            options={"Normal view": "normal", "Presentation": "present"},
+            css_classes=["ctl-page-view"],
+            width=220,
+        ),
+        pn.widgets.RadioButtonGroup.from_param(
+            page.param.n_axis,
+            name="N axis",
+            options={"N linear": "linear", "N log": "log"},
+            css_classes=["ctl-page-naxis"],
+            width=150,
+        ),
+        css_classes=["page-bar"],
+        sizing_mode="stretch_width",
+        margin=(2, 4),
+    )
+
+
 def create_app(
     state: DashboardState | None = None, results: Results | None = None
 ) -> pn.template.BootstrapTemplate:
@@ -76,94 +295,50 @@ def create_app(
     results = results if results is not None else Results(state)
     state = results.state
     sync_url(state)
-    # one frequency axis range for all spectra of the session: zoom and pan are linked
-    freq = frequency_range()
-    modes = modes_range()  # the error map's N axis and the eigenfrequency plot's
+    page = PageState()
+    if pn.state.location is not None:  # the layout is kept in the link too
+        pn.state.location.sync(page, PAGE_URL_KEYS, on_error=functools.partial(apply_valid, page))
+    # one frequency axis range for all spectra of the session: zoom and pan are linked;
+    # one N range for the error map and the eigenfrequency plot
+    parts = PageParts(results=results, page=page, freq=frequency_range(), modes=modes_range())
+    views = PlotViews(parts)
 
-    def card(title, view, height, **kw):
-        return pn.Card(
-            view,
-            title=title,
-            collapsible=True,
-            height=height,
-            sizing_mode="stretch_width",
-            header_background="#e9ecef",
-            margin=(4, 4),
-            **kw,
+    def snapshot():
+        band = results.band
+        return session_snapshot(
+            state,
+            url=page_url(),
+            band=band.result if band is not None else None,
+            band_n_modes=band.settings.n_modes if band is not None else None,
+            n_axis=page.n_axis,
+            extra=store_sections(results),  # what other views publish in the store
         )
 
-    # the uncoupled subsystems are built on first request (two plots less per page load)
-    uncoupled = pn.Row(
-        visible=state.case.param.show_uncoupled,
-        css_classes=["uncoupled-row"],
-        sizing_mode="stretch_width",
-    )
-
-    @param.depends(state.case.param.show_uncoupled, watch=True)
-    def show_uncoupled(show=state.case.show_uncoupled):
-        if show and not uncoupled.objects:
-            uncoupled.append(
-                card(
-                    "Uncoupled subsystems: tire hub and chassis spindle-to-bushing",
-                    UncoupledView(store=results, x_range=freq),
-                    420,
-                )
-            )
-
-    show_uncoupled()
-
-    upload = card(
-        "Your data: chassis FRF and tire model for this session",
-        UploadView(data=state.data),
-        None,
-        collapsed=False,
-        css_classes=["upload-card"],
-    )
-    main = pn.Column(
-        pn.Row(upload),
-        pn.Row(
-            card(
-                "Coupled response at the bushing (thesis eq. 4.1)",
-                MobilityView(store=results, x_range=freq),
-                500,
-            ),
-            card(
-                "Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)",
-                TruncationView(store=results, x_range=freq, n_range=modes),
-                500,
-            ),
-        ),
-        uncoupled,
-        pn.Row(
-            card(
-                "Noise scatter band (thesis 5.2, figs. 5.9-5.11)",
-                ScatterBandView(store=results, x_range=freq),
-                500,
-            ),
-            card(
-                "Eigenfrequency versus number of modes (fig. 5.8)",
-                EigenView(store=results, n_range=modes),
-                500,
-            ),
-        ),
-        pn.Row(
-            card(
-                "Suggested number of modes (thesis table 5.1)",
-                SuggestedModesView(store=results),
-                360,
-            )
-        ),
-        sizing_mode="stretch_width",
-    )
     template = pn.template.BootstrapTemplate(
         title="Tire-chassis FBS: bushing vibration dashboard",
         sidebar=[pn.pane.Markdown(INTRO, styles={"font-size": "0.85em"}), Controls(state=state)],
-        main=[main],
+        modal=[help_page()],
         header_background=ACCENT,
         sidebar_width=340,
     )
+    first, *rest = plot_rows(parts, views)
+    main = pn.Column(
+        page_bar(parts, snapshot, template.open_modal),
+        link_notice_pane(parts),
+        first,  # a plot on the first screen, also at 1280x720
+        data_card(parts),
+        *rest,
+        *extra_cards(parts),
+        sizing_mode="stretch_width",
+    )
+    template.main.append(main)
+    template.config.raw_css.append(PAGE_CSS)
+    if page.view == "present":
+        template.config.raw_css.append(PRESENT_CSS)
+    template.page = page
     template.state = state  # for tests and benchmarks
     template.results = results
+    template.views = views
     if served():
         pn.state.onload(results.request_band)
         pn.state.on_session_destroyed(lambda _ctx: results.close())

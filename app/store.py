@@ -29,6 +29,7 @@ between the kernel's chunks), and bands of all sessions take turns chunk by chun
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -42,7 +43,7 @@ from fbs_core.vocabulary import EIGEN_SPEEDS
 from . import bands, compute
 from .state import DashboardState
 
-__all__ = ["Result", "Results", "Snapshot"]
+__all__ = ["Result", "Results", "Snapshot", "BandStatus", "progress_status"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,10 +147,42 @@ class Band:
 
 @dataclass(frozen=True)
 class BandStatus:
-    """Whether a band is being computed, and the line the page shows about it."""
+    """Whether a band is being computed, and the line the page shows about it.
+
+    During a computation ``done`` of ``total`` frequency lines are done (0 of 0 before the
+    kernel's first report) and ``seconds_left`` estimates the rest (None: not yet known).
+    """
 
     busy: bool = False
     text: str = ""
+    done: int = 0
+    total: int = 0
+    seconds_left: float | None = None
+
+    @property
+    def percent(self) -> int:
+        return int(100 * self.done / self.total) if self.total else 0
+
+
+def duration_text(seconds: float) -> str:
+    """``"about 1 min 10 s"``, ``"about 8 s"``, ``"under a second"``."""
+    if seconds < 1:
+        return "under a second"
+    s = int(round(seconds))
+    return f"about {s // 60} min {s % 60} s" if s >= 60 else f"about {s} s"
+
+
+def progress_status(rounds: int, done: int, total: int, seconds_left) -> BandStatus:
+    """The status of a running band: done/total lines and the time left."""
+    text = f"Computing {rounds:,} rounds ..."
+    if total:
+        text = (
+            f"Computing {rounds:,} rounds: {int(100 * done / total)} % "
+            f"({done} of {total} frequency lines)"
+        )
+        if seconds_left is not None:
+            text += f", {duration_text(seconds_left)} left"
+    return BandStatus(True, text, done, total, seconds_left)
 
 
 class Results(param.Parameterized):
@@ -301,14 +334,47 @@ class Results(param.Parameterized):
             if self.band is not None and self.band.settings.band_key() == key:
                 self.band_status = _done_status(self.band)  # back to the shown band
                 return
-            job = self._band_job = bands.Job(key, owner=self)
-            self.band_status = BandStatus(True, f"Computing {s.rounds:,} rounds ...")
+            job = self._band_job = bands.Job(key, owner=self, on_progress=self._band_progress)
+            self.band_status = progress_status(s.rounds, 0, 0, None)
         if wait is None:
             wait = not (bands.served() if self.background is None else self.background)
         if wait:
             bands.run(job, self._band_done, s)
         else:
             bands.start(job, self._band_done, s)
+
+    #: Shortest interval between two progress updates of the page (s).
+    PROGRESS_INTERVAL = 0.4
+
+    def _band_progress(self, job: bands.Job) -> None:
+        """The kernel finished a chunk of ``job``: publish done/total and the time left
+        (at most every PROGRESS_INTERVAL seconds; short bands finish before the first)."""
+        now = time.perf_counter()
+        last = getattr(job, "published", job.started)
+        if job.done < job.total and now - last < self.PROGRESS_INTERVAL:
+            return
+        job.published = now
+        with self._lock:
+            if job is not self._band_job or job.cancelled or self.closed:
+                return
+            rounds = job.key[6]
+            self.band_status = progress_status(rounds, job.done, job.total, job.seconds_left())
+
+    def cancel_band(self) -> None:
+        """Stop the running band (the cancel button); the band on the page stays, marked as
+        not of the current settings."""
+        with self._lock:
+            job = self._band_job
+            if job is None:
+                return
+            job.cancel()
+            self._band_job = None
+            shown = "" if self.band is None else " The plot shows the band of earlier settings."
+            self.band_status = BandStatus(
+                False,
+                f"Cancelled after {job.done} of {job.total} frequency lines.{shown} "
+                "Change a noise setting to compute again.",
+            )
 
     def _band_done(self, job: bands.Job, settings: Snapshot, res, seconds: float, error) -> None:
         with self._lock:
@@ -474,23 +540,33 @@ def chassis_label(dof: str, spindle_input: str) -> str:
 
 def uncoupled_result(s: Snapshot) -> Result:
     d = compute.uncoupled_data(s.harmonic, s.n_modes, s.dof, s.spindle_input, s.models)
-    keys = (
-        "freq",
-        "tire_reference_db",
-        "tire_truncated_db",
-        "chassis_db",
-        "tire_reference",
-        "tire_truncated",
-        "chassis",
+    # column name -> key of the computed data (units in the names, as every export)
+    keys = {
+        "freq_Hz": "freq",
+        "tire_reference_dB": "tire_reference_db",
+        "tire_truncated_dB": "tire_truncated_db",
+        "chassis_dB": "chassis_db",
+        "tire_reference": "tire_reference",
+        "tire_truncated": "tire_truncated",
+        "chassis": "chassis",
+    }
+    chassis_unit = frf_unit(
+        output_kind(f"bushing:{s.dof}"), input_kind(f"spindle:{s.spindle_input}"), "mobility"
     )
+    tire_unit = frf_unit(output_kind(f"hub:{s.dof}"), "road", "mobility")
     return Result(
-        columns={k: d[k] for k in keys},
+        columns={name: d[k] for name, k in keys.items()},
         meta={
             "view": "uncoupled subsystems",
             "harmonic": s.harmonic,
             "N (retained tire modes)": s.n_modes,
             "tire output": f"hub:{s.dof}",
             "chassis": f"spindle:{s.spindle_input} -> bushing:{s.dof}",
+            "unit": (
+                f"tire_*: {tire_unit} (free hub velocity per metre of road amplitude), "
+                f"tire_*_dB: dB re 1 {tire_unit}; chassis: {chassis_unit}, chassis_dB: "
+                f"dB re 1 {chassis_unit}"
+            ),
             "models": s.models.describe(),
         },
         filename=f"uncoupled_h{s.harmonic}_N{s.n_modes}_{s.dof}_in{s.spindle_input}.csv",

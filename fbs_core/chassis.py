@@ -28,16 +28,11 @@ once by complex modes and every FRF is an exact modal sum (no truncation).
 from __future__ import annotations
 
 import functools
-import os
-from collections.abc import Iterable
 from dataclasses import asdict, dataclass
-from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
-from numpy.typing import ArrayLike
 
-from ._typing import ComplexArray, FloatArray, IntArray
 from .direct import SecondOrderSystem
 from .dofs import DIRECTIONS, index_of, node_labels
 from .errors import DataFormatError, FrequencyGridError, QuantityError
@@ -100,7 +95,7 @@ class ChassisParameters:
 STEEL_E, STEEL_NU, STEEL_RHO = 210e9, 0.3, 7850.0
 
 
-def _n_el(p: ArrayLike, q: ArrayLike, h: float) -> int:
+def _n_el(p, q, h) -> int:
     return max(1, round(float(np.linalg.norm(np.subtract(q, p))) / h))
 
 
@@ -168,9 +163,7 @@ def build_chassis(p: ChassisParameters) -> FEModel:
 
 
 @functools.lru_cache(maxsize=8)
-def _modal(
-    p: ChassisParameters,
-) -> tuple[SecondOrderSystem, ComplexArray, ComplexArray, ComplexArray]:
+def _modal(p: ChassisParameters):
     """Complex modes of ``M^-1 K`` (hysteretic K): ``K V = M V diag(lam)``."""
     s = build_chassis(p).system()
     K, M = s.K.toarray(), s.M.toarray()
@@ -225,26 +218,20 @@ class ChassisModel:
         ``spindle:*`` and ``bushing:*``; no viscous damping)."""
         return _modal(self._p)[0]
 
-    def eigenvalues(self) -> ComplexArray:
+    def eigenvalues(self) -> np.ndarray:
         """Complex eigenvalues ``lam_r = omega_r^2 (1 + j eta_r)``, sorted by real part."""
         return _modal(self._p)[1]
 
-    def eigenfrequencies(self) -> FloatArray:
+    def eigenfrequencies(self) -> np.ndarray:
         """Natural frequencies ``sqrt(Re lam_r) / 2 pi`` in Hz, ascending."""
         return np.sqrt(self.eigenvalues().real) / (2 * np.pi)
 
-    def loss_factors(self) -> FloatArray:
+    def loss_factors(self) -> np.ndarray:
         """Modal loss factors ``Im lam_r / Re lam_r``."""
         lam = self.eigenvalues()
         return lam.imag / lam.real
 
-    def mobility(
-        self,
-        freq: ArrayLike,
-        outputs: Iterable[str] | None = None,
-        inputs: Iterable[str] | None = None,
-        quantity: str = "mobility",
-    ) -> FRF:
+    def mobility(self, freq, outputs=None, inputs=None, quantity: str = "mobility") -> FRF:
         """FRFs by exact complex-mode synthesis on any grid.
 
         ``H(omega) = V_o diag(1 / (lam_r - omega^2)) (V^-1 M^-1)_i`` is the
@@ -273,7 +260,7 @@ class ChassisModel:
         jw = 1j * 2 * np.pi * f
         return FRF(f, data * (jw ** QUANTITIES[quantity])[:, None, None], outputs, inputs, quantity)
 
-    def driving_point(self, freq: ArrayLike) -> FRF:
+    def driving_point(self, freq) -> FRF:
         """``Y_jj^E``: spindle mobility, 6 x 6 (``spindle:*`` to ``spindle:*``).
 
         Parameters
@@ -283,7 +270,7 @@ class ChassisModel:
         """
         return self.mobility(freq, outputs=SPINDLE, inputs=SPINDLE)
 
-    def transfer(self, freq: ArrayLike) -> FRF:
+    def transfer(self, freq) -> FRF:
         """``Y_ej^E``: spindle-to-bushing mobility, 6 x 6 (``spindle:*`` to ``bushing:*``).
 
         Parameters
@@ -293,15 +280,13 @@ class ChassisModel:
         """
         return self.mobility(freq, outputs=BUSHING, inputs=SPINDLE)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict:
         """The parameters as a plain dict (for storage)."""
         return asdict(self._p)
 
 
 @functools.lru_cache(maxsize=32)
-def _synth(
-    p: ChassisParameters, fbytes: bytes, outputs: tuple[str, ...], inputs: tuple[str, ...]
-) -> ComplexArray:
+def _synth(p: ChassisParameters, fbytes: bytes, outputs: tuple, inputs: tuple) -> np.ndarray:
     s, lam, V, W = _modal(p)
     oi = index_of(s.dofs, outputs, "chassis output DOF")
     ii = index_of(s.dofs, inputs, "chassis input DOF")
@@ -313,7 +298,7 @@ def _synth(
     return H
 
 
-def read_chassis_frf(path: str | os.PathLike[str]) -> FRF:
+def read_chassis_frf(path) -> FRF:
     """Read the FRF stored by ``scripts/build_reference_chassis.py`` (HDF5, no pickle).
 
     The file follows the project's HDF5 layout (``fbs_core.io.hdf5``), so
@@ -339,7 +324,7 @@ def read_chassis_frf(path: str | os.PathLike[str]) -> FRF:
             )
         g = h["frf"]
 
-        def labels(key: str) -> list[str]:
+        def labels(key):
             return [v.decode() if isinstance(v, bytes) else str(v) for v in g.attrs[key]]
 
         return FRF(
@@ -362,7 +347,7 @@ def reference_chassis() -> ChassisModel:
     return ChassisModel()
 
 
-def modal_energy(chassis: ChassisModel, node: str = "spindle") -> FloatArray:
+def modal_energy(chassis: ChassisModel, node: str = "spindle") -> np.ndarray:
     """Share of each mode's kinetic energy in the six DOFs of ``node``.
 
     Returns
@@ -371,11 +356,10 @@ def modal_energy(chassis: ChassisModel, node: str = "spindle") -> FloatArray:
         ``Re(conj(v_d) (M v)_d) / Re(v^H M v)`` for d = x .. rz.
     """
     s, lam, V, _ = _modal(chassis.params)
-    MV: ComplexArray = s.M @ V  # s.M is scipy.sparse (untyped)
+    MV = s.M @ V
     e = np.real(np.conj(V) * MV)
     idx = index_of(s.dofs, node_labels(node), "chassis DOF")
-    share: FloatArray = (e[idx] / e.sum(axis=0)).T
-    return share
+    return (e[idx] / e.sum(axis=0)).T
 
 
 def carrier_mode_table(chassis: ChassisModel, fmax: float = 100.0) -> dict[str, float]:
@@ -390,7 +374,7 @@ def carrier_mode_table(chassis: ChassisModel, fmax: float = 100.0) -> dict[str, 
     return {d: float(f[keep][np.argmax(e[keep, k])]) for k, d in enumerate(DIRECTIONS)}
 
 
-def match_grid(available: ArrayLike, wanted: ArrayLike, rtol: float = 1e-9) -> IntArray | None:
+def match_grid(available, wanted, rtol: float = 1e-9) -> np.ndarray | None:
     """Positions of the ``wanted`` frequencies in the sorted grid ``available``.
 
     A line matches when it lies within ``rtol * max(1, |f|)`` Hz of a wanted frequency
@@ -455,11 +439,11 @@ class FRFChassis:
     def __repr__(self) -> str:
         return f"FRFChassis({self.frf!r}, interpolate={self.interpolate})"
 
-    def needs_interpolation(self, freq: ArrayLike) -> bool:
+    def needs_interpolation(self, freq) -> bool:
         """True when some of ``freq`` (Hz) is not a line of the FRF."""
         return match_grid(self.frf.freq, freq) is None
 
-    def on_grid(self, freq: ArrayLike) -> FRF:
+    def on_grid(self, freq) -> FRF:
         """The whole FRF on ``freq`` (Hz): its own lines, else interpolated if allowed.
 
         Raises
@@ -485,13 +469,7 @@ class FRFChassis:
             "interpolate it explicitly (linear in real and imaginary part)"
         )
 
-    def mobility(
-        self,
-        freq: ArrayLike,
-        outputs: Iterable[str] | None = None,
-        inputs: Iterable[str] | None = None,
-        quantity: str = "mobility",
-    ) -> FRF:
+    def mobility(self, freq, outputs=None, inputs=None, quantity: str = "mobility") -> FRF:
         """The FRF on ``freq`` (Hz), same signature as :meth:`ChassisModel.mobility`."""
         Y = self.on_grid(freq)
         Y = Y.sel(

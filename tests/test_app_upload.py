@@ -320,7 +320,7 @@ def test_doubled_chassis_shows_6_db_more_uncoupled_mobility(doubled_mat):
     assert res.state.data.load_chassis(doubled_mat, "c.mat", spindle="3", bushing="8")
     got = res.uncoupled.columns
     np.testing.assert_allclose(
-        got["chassis_db"], ref["chassis_db"] + 20 * np.log10(2.0), rtol=0, atol=1e-9
+        got["chassis_dB"], ref["chassis_dB"] + 20 * np.log10(2.0), rtol=0, atol=1e-9
     )
     np.testing.assert_array_equal(got["tire_truncated"], ref["tire_truncated"])
 

@@ -130,8 +130,12 @@ def test_threshold_caps_the_colour_scale(page):
     state.truncation.threshold = 12.0
     from bokeh.models import LinearColorMapper
 
+    from app.report import ErrorColorScale
+
     mappers = list(root.select({"type": LinearColorMapper}))
-    assert [m.high for m in mappers] == [12.0]
+    # the largest value below the threshold: 12 % itself is "at or above" (red)
+    assert [m.high for m in mappers] == [np.nextafter(12.0, 0.0)]
+    assert mappers[0].high_color == ErrorColorScale(12.0).above
 
 
 def _csv(result, key="x"):

@@ -18,9 +18,9 @@ def _px(size: str) -> float:
 
 def test_title_block_models_show_the_block_and_name_the_saved_file():
     fig = figure(tools="pan,save")
-    tbm = TitleBlockModels(fig)
     s = snap(url="http://localhost:5006/main?h=4")
     tb = title_block(s, "scatter-band")
+    tbm = TitleBlockModels(fig, lines=1 + len(tb.lines))  # room for every line
     tbm.update(tb, file_stem(s, "scatter-band"))
     assert tbm.heading.text == tb.what
     shown = [t.text for t in tbm.titles if t.visible]
@@ -32,6 +32,13 @@ def test_title_block_models_show_the_block_and_name_the_saved_file():
     short = title_block(s, "eigenfrequency")
     tbm.update(short)
     assert [t.text for t in tbm.titles if t.visible] == list(short.lines)
+    # fewer models than lines (a live plot's compact block): nothing is lost, the lines
+    # beyond the count are joined into the last one
+    small = TitleBlockModels(figure(tools="save"), lines=len(tb.lines))
+    small.update(tb)
+    shown = [t.text for t in small.titles if t.visible]
+    assert shown[:-1] == list(tb.lines[:-2])
+    assert shown[-1] == " | ".join(tb.lines[-2:])
 
 
 @pytest.mark.parametrize("mode", ["normal", "present"])

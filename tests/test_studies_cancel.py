@@ -32,3 +32,18 @@ def test_cancel_is_asked_before_every_chunk_and_stops_the_study():
         fbs_core.scatter_band(1, cancel=stop_at_third, **kw)
     assert len(calls) == 3  # nothing ran after the cancel
     assert not issubclass(StudyCancelled, fbs_core.FBSError)  # not an input error
+
+
+def test_progress_reports_lines_done_of_the_total_after_every_chunk():
+    f = fbs_core.harmonic(2).frequencies()
+    rounds = 300
+    chunk = 7
+    kw = dict(rounds=rounds, seed=1, max_chunk_bytes=8 * 6 * rounds * chunk)
+    seen = []
+    band = fbs_core.scatter_band(2, progress=lambda done, total: seen.append((done, total)), **kw)
+    n = f.size
+    # before the first chunk, then after each chunk of `chunk` lines (the last one shorter)
+    expected = [(0, n)] + [(min(n, k), n) for k in range(chunk, n + chunk, chunk)]
+    assert seen == expected
+    plain = fbs_core.scatter_band(2, **kw)
+    np.testing.assert_array_equal(band.upper, plain.upper)  # reporting changes nothing

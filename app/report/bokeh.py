@@ -27,19 +27,19 @@ STYLES: dict[str, dict[str, str]] = {
         "tick": "12px",
         "axis": "13px",
         "title": "13px",
-        "detail": "11px",
+        "detail": "10px",
         "legend": "10pt",
     },
     "present": {
         "tick": "16px",
         "axis": "17px",
         "title": "18px",
-        "detail": "14px",
+        "detail": "13px",
         "legend": "13pt",
     },
 }
-#: Lines of a title block (heading + harmonic, case, noise, data, date, link).
-TITLE_LINES = 7
+#: Lines of a live plot's title block (heading + case, noise, data and date, link).
+TITLE_LINES = 6
 
 
 class TitleBlockModels:
@@ -52,10 +52,19 @@ class TitleBlockModels:
     def __init__(self, fig, lines: int = TITLE_LINES):
         self.fig = fig
         # Bokeh stacks the "above" panels from the plot outwards: add the last line first
-        self.titles = [Title(text="", text_font_size="11px") for _ in range(lines - 1)]
+        self.titles = [
+            Title(
+                text="",
+                text_font_size="11px",
+                text_font_style="normal",
+                text_color="#343a40",
+                standoff=0,  # tight lines: the plot keeps its height
+            )
+            for _ in range(lines - 1)
+        ]
         for t in reversed(self.titles):
             fig.add_layout(t, "above")
-        self.heading = Title(text="", text_font_size="13px", text_font_style="bold")
+        self.heading = Title(text="", text_font_size="13px", text_font_style="bold", standoff=2)
         fig.add_layout(self.heading, "above")
 
     def update(self, tb: TitleBlock, stem: str | None = None) -> None:
@@ -109,6 +118,7 @@ def style_figure(fig, mode: str = "normal", legend_side: str = "right") -> None:
             leg.location = "top_left" if legend_side in ("right", "left") else "center"
             if legend_side in ("below", "above"):
                 leg.orientation = "horizontal"
+                leg.nrows = 2 if len(leg.items) > 2 else 1
             fig.add_layout(leg, legend_side)
 
 
@@ -151,6 +161,7 @@ class ErrorMapLayers:
         leg = Legend(
             items=[LegendItem(label=lab, renderers=[r]) for lab, r in items],
             orientation="horizontal",
+            nrows=2,
             location="center",
             name="truncation.legend",
         )

@@ -53,7 +53,7 @@ CONTOUR_COLOR = "#000000"
 #: blue, dark blue and red alike.
 LINE_STYLES: dict[str, tuple[str, str, float, str]] = {
     "threshold contour": (CONTOUR_COLOR, "solid", 1.5, "#ffffff"),
-    "chosen N": ("#ffd43b", "solid", 3.0, "#000000"),
+    "chosen N": ("#f59f00", "solid", 3.0, "#000000"),
     "suggested N": ("#000000", "dashed", 2.0, "#ffffff"),
     "f_max": ("#000000", "dotted", 2.0, "#ffffff"),
 }

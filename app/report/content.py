@@ -7,6 +7,7 @@ the PDF hold the same text.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -344,6 +345,22 @@ def _eigen_section(snap: Snapshot) -> Section:
     return Section("eigenfrequency", "Eigenfrequency vs number of modes", para, fig, (table,))
 
 
+def _extra_section(snap: Snapshot, ex) -> Section:
+    """A section contributed by another view (:class:`~app.report.snapshot.ExtraSection`)."""
+    table = Table(f"{ex.heading}: settings and description", ("item", "value"), ex.rows)
+    fig = None
+    if ex.curves:
+        base = title_block(snap, "report")
+        tb = TitleBlock(ex.heading, base.lines)
+        fig = FigureBlock(
+            ex.key,
+            tb,
+            figures.draw_curves(ex.freq, ex.curves, ex.y_label),
+            stem=f"{file_stem(snap, 'report')}_{re.sub(r'[^A-Za-z0-9._-]', '-', ex.key)}",
+        )
+    return Section(ex.key, ex.heading, ex.paragraphs, fig, (table,) if ex.rows else ())
+
+
 def report_content(snap: Snapshot) -> Report:
     """The formatted content of the report of a snapshot (all results it holds)."""
     sections = []
@@ -357,6 +374,7 @@ def report_content(snap: Snapshot) -> Report:
         sections.append(_band_section(snap))
     if snap.eigen is not None:
         sections.append(_eigen_section(snap))
+    sections.extend(_extra_section(snap, ex) for ex in snap.extra)
     s = snap.settings
     if snap.provenance.is_reference:
         note = "The link reproduces this page with the shipped reference models."

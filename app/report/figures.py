@@ -35,6 +35,7 @@ __all__ = [
     "draw_truncation",
     "draw_band",
     "draw_eigen",
+    "draw_curves",
     "draw_title_block",
     "standalone",
     "render",
@@ -247,6 +248,27 @@ def draw_eigen(snap: Snapshot):
         handles.append(ax.axvline(n, color=COLORS["round"], lw=1.5, label=f"chosen N = {n}"))
         _labels(ax, "Retained modes N", "Highest retained eigenfrequency (Hz)")
         _legend_below(ax, handles, rect, ncol=4)
+
+    return draw
+
+
+_CURVE_COLORS = ("#1f2937", "#d9480f", "#1c7ed6", "#2f9e44", "#ae3ec9", "#f59f00")
+
+
+def draw_curves(freq, curves, y_label: str):
+    """Curves in dB versus frequency (a section contributed by another view)."""
+
+    def draw(fig, rect):
+        ax = _axes(fig, rect, legend_rows=1 + (len(curves) - 1) // 3)
+        handles = []
+        for i, (label, y) in enumerate(curves.items()):
+            style = "-" if i < len(_CURVE_COLORS) else "--"
+            (ln,) = ax.plot(
+                freq, y, style, color=_CURVE_COLORS[i % len(_CURVE_COLORS)], lw=1.5, label=label
+            )
+            handles.append(ln)
+        _labels(ax, "Frequency (Hz)", y_label)
+        _legend_below(ax, handles, rect, ncol=min(3, max(1, len(handles))))
 
     return draw
 

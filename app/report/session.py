@@ -16,9 +16,16 @@ import fbs_core
 from fbs_core import studies
 
 from .. import compute
-from .snapshot import DataFile, Provenance, Snapshot
+from .snapshot import DataFile, ExtraSection, Provenance, Snapshot
 
-__all__ = ["settings_of", "provenance_of", "session_snapshot", "band_matches"]
+__all__ = [
+    "settings_of",
+    "provenance_of",
+    "session_snapshot",
+    "band_matches",
+    "store_sections",
+    "BUILTIN_RESULTS",
+]
 
 _DIRS = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -87,6 +94,37 @@ def band_matches(band, settings: dict, models=None) -> bool:
     )
 
 
+#: Results of the store that the report's own sections show; every other published
+#: ``Result`` (or tuple of them) of the store becomes a section of its own.
+BUILTIN_RESULTS = ("response", "error_map", "suggested", "eigen", "band_curves")
+
+
+def store_sections(store) -> tuple[ExtraSection, ...]:
+    """The sections other views contribute: each published :class:`app.store.Result`
+    parameter of ``store`` beyond :data:`BUILTIN_RESULTS` (and the uncoupled subsystems only
+    while the page shows them), in the store's parameter order.
+
+    A view that wants its result in the report publishes it as a parameter of the store
+    (``param.ClassSelector(class_=Result)``, or a tuple of results, e.g. pinned curves);
+    nothing in :mod:`app.report` needs to change.
+    """
+    from ..store import Result
+
+    out = []
+    for name in store.param:
+        if name in BUILTIN_RESULTS:
+            continue
+        if name == "uncoupled" and not store.state.case.show_uncoupled:
+            continue
+        value = getattr(store, name, None)
+        if isinstance(value, Result):
+            out.append(ExtraSection.of_result(name, value))
+        elif isinstance(value, (tuple, list)) and value:
+            if all(isinstance(v, Result) for v in value):
+                out += [ExtraSection.of_result(f"{name}-{i + 1}", v) for i, v in enumerate(value)]
+    return tuple(out)
+
+
 def _frf(freq, data) -> fbs_core.FRF:
     return fbs_core.FRF(
         np.asarray(freq, float),
@@ -105,6 +143,7 @@ def session_snapshot(
     n_axis: str = "linear",
     notes=(),
     created: dt.datetime | None = None,
+    extra=(),
 ) -> Snapshot:
     """The report snapshot of a session's current state.
 
@@ -120,6 +159,8 @@ def session_snapshot(
         Scale of the error map's N axis on the page.
     notes : sequence of str
         Import notes of the uploads.
+    extra : sequence of ExtraSection
+        Sections of other views (:func:`store_sections` of the page's store).
     """
     s = settings_of(state, n_axis)
     models = state.case.models
@@ -151,4 +192,5 @@ def session_snapshot(
         band=band if keep else None,
         eigen=eigen,
         n_modes_total=m.n_modes_total,
+        extra=tuple(extra),
     )

@@ -20,6 +20,7 @@ import fbs_core
 from fbs_core.errors import FBSError
 
 __all__ = [
+    "ExtraSection",
     "ReportError",
     "DataFile",
     "Provenance",
@@ -215,6 +216,85 @@ def normalise_settings(settings: Mapping) -> Mapping:
 
 
 @dataclass(frozen=True, eq=False)
+class ExtraSection:
+    """A section another view contributes to the report (an analysis, a pinned curve).
+
+    Built from a published ``app.store.Result`` with :meth:`of_result` (its description,
+    its CSV header as a table and, when it has a ``freq_Hz`` column, its ``*_dB`` columns
+    as curves), so a new view appears in the report without code in :mod:`app.report`.
+
+    Attributes
+    ----------
+    key : str
+        Short name (anchor and file name).
+    heading : str
+    paragraphs : tuple of str
+    rows : tuple of (str, str)
+        Described values (the CSV header of the result).
+    freq : ndarray or None
+        Frequencies (Hz) of the curves.
+    curves : mapping of str to ndarray
+        Levels in dB on ``freq``, by label.
+    y_label : str
+    """
+
+    key: str
+    heading: str
+    paragraphs: tuple[str, ...] = ()
+    rows: tuple[tuple[str, str], ...] = ()
+    freq: object = None
+    curves: Mapping = field(default_factory=dict)
+    y_label: str = "Level (dB)"
+
+    def __post_init__(self):
+        import numpy as np
+
+        if not str(self.key).strip() or not str(self.heading).strip():
+            raise ReportError("an extra report section needs a key and a heading")
+        if self.curves:
+            if self.freq is None:
+                raise ReportError(f"section {self.key!r}: curves need their frequencies")
+            f = np.asarray(self.freq, float)
+            for label, c in self.curves.items():
+                if np.shape(c) != f.shape:
+                    raise ReportError(
+                        f"section {self.key!r}: curve {label!r} has shape {np.shape(c)}, "
+                        f"the frequencies {f.shape}"
+                    )
+
+    @classmethod
+    def of_result(cls, key: str, result) -> ExtraSection:
+        """The section of a published result (``columns``, ``meta``, ``caption``)."""
+        import re
+
+        import numpy as np
+
+        meta = dict(result.meta)
+        heading = str(meta.pop("view", key))
+        caption = re.sub(r"\*\*(.+?)\*\*", r"\1", str(result.caption or ""))
+        caption = caption.replace("&middot;", "-")
+        cols = result.columns
+        freq = cols.get("freq_Hz")
+        curves = {}
+        if freq is not None:
+            curves = {
+                k[: -len("_dB")].replace("_", " "): np.asarray(v, float)
+                for k, v in cols.items()
+                if k.endswith("_dB") and np.shape(v) == np.shape(freq)
+            }
+        unit = meta.get("unit")
+        return cls(
+            key=key,
+            heading=heading[:1].upper() + heading[1:],
+            paragraphs=(caption,) if caption else (),
+            rows=tuple((str(k), str(v)) for k, v in meta.items()),
+            freq=None if not curves else np.asarray(freq, float),
+            curves=curves,
+            y_label=f"Level ({unit})" if unit else "Level (dB)",
+        )
+
+
+@dataclass(frozen=True, eq=False)
 class Snapshot:
     """Everything one report shows, as plain data.
 
@@ -242,6 +322,8 @@ class Snapshot:
         Highest retained eigenfrequency versus N (thesis fig. 5.8).
     n_modes_total : int, optional
         Modes of the tire (default from the truncation map).
+    extra : tuple of ExtraSection
+        Sections contributed by other views (after the built-in ones).
     """
 
     settings: Mapping
@@ -255,6 +337,7 @@ class Snapshot:
     band: fbs_core.ScatterBand | None = None
     eigen: fbs_core.ModeFrequencies | None = None
     n_modes_total: int | None = None
+    extra: tuple = ()
 
     def __post_init__(self):
         s = normalise_settings(self.settings)
@@ -289,6 +372,10 @@ class Snapshot:
                     raise ReportError(
                         f"the {name} result needs the setting(s) {', '.join(missing)}"
                     )
+        object.__setattr__(self, "extra", tuple(self.extra))
+        for ex in self.extra:
+            if not isinstance(ex, ExtraSection):
+                raise ReportError(f"extra sections must be ExtraSection, got {type(ex).__name__}")
         self._check_results(s)
         if self.n_modes_total is None and self.truncation is not None:
             object.__setattr__(self, "n_modes_total", self.truncation.n_modes_total)

@@ -24,6 +24,7 @@ __all__ = [
     "modes_description",
     "noise_description",
     "title_block",
+    "compact_title",
     "file_stem",
 ]
 
@@ -193,6 +194,68 @@ def title_block(snap: Snapshot, view: str) -> TitleBlock:
     if view == "truncation-map" and snap.map_dof is None:
         what = "Truncation error (eq. 5.1), maximum over the 6 bushing DOFs (thesis fig. 5.6)"
     return TitleBlock(what, tuple(lines))
+
+
+_SHORT_WHAT = {
+    "coupled-response": "Coupled bushing response v_e* (eq. 4.1)",
+    "truncation-map": "Truncation error, eq. 5.1",
+    "scatter-band": "Noise scatter band of v_e* (eqs. 5.2-5.4)",
+    "eigenfrequency": "Highest retained eigenfrequency (fig. 5.8)",
+    "uncoupled": "Uncoupled subsystems",
+    "suggested-modes": "Suggested number of modes (table 5.1)",
+    "report": "tire-fbs",
+}
+_SHORT_COUPLING = {"6dof": "6-DOF hub (braked)", "5dof": "5-DOF hub (spin free)"}
+
+
+def compact_title(snap: Snapshot, view: str) -> TitleBlock:
+    """The title block of a live plot in short lines (a plot's title does not wrap).
+
+    The harmonic (wavelength, speeds, band); DOF, N, threshold, coupling; the noise
+    (scatter band); the data in use with the date; the link.
+    """
+    if view not in VIEWS:
+        raise ReportError(f"unknown view {view!r}; allowed: {', '.join(VIEWS)}")
+    s = snap.settings
+    lines = []
+    if view not in ("eigenfrequency", "suggested-modes"):
+        h = snap.harmonic
+        lo, hi = h.freq_range
+        lines.append(
+            f"Harmonic {h.k}: wavelength {h.wavelength:g} m, {h.speed_range[0]:g}-"
+            f"{h.speed_range[1]:g} km/h, {lo:.1f}-{hi:.1f} Hz"
+        )
+    case = []
+    if view != "eigenfrequency":
+        d = snap.map_dof if view in ("truncation-map", "suggested-modes") else snap.response_dof
+        case.append(d or "max over 6 DOFs")
+    total = snap.n_modes_total
+    n = f"N = {s['n_modes']}" + (f" of {total}" if total else "")
+    if view in ("truncation-map", "eigenfrequency"):
+        n = "chosen " + n
+    if view != "suggested-modes":
+        case.append(n)
+    if view in ("truncation-map", "suggested-modes") and "threshold" in s:
+        case.append(f"threshold {s['threshold']:g} % to {s['f_max']:g} Hz")
+    if view not in ("eigenfrequency", "uncoupled"):
+        case.append(_SHORT_COUPLING[s["coupling"]])
+    lines.append(" | ".join(case))
+    if view == "scatter-band" and "noise" in s:
+        how = "every line" if s["frequency_dependent"] else "per round"
+        lines.append(
+            f"Noise p = {s['noise']:g} % in {_NOISE_WHERE[s['target']]} (eq. "
+            f"{_NOISE_EQ[s['target']]}), {how}, R = {s['rounds']:,}, seed {s['seed']}"
+        )
+    p = snap.provenance
+    data = (
+        "reference models"
+        if p.is_reference
+        else ", ".join(f"uploaded {d.role} '{d.name}'" for d in p.uploads)
+    )
+    lines.append(f"Data: {data} | {_date_text(snap)}")
+    if snap.url:
+        lines.append(snap.url)
+    return TitleBlock(_SHORT_WHAT[view], tuple(lines))
 
 
 def _num(x: float) -> str:

@@ -29,6 +29,7 @@ not queued twice.
 
 from __future__ import annotations
 
+import datetime as dt
 import html
 import io
 import re
@@ -40,9 +41,11 @@ from panel.viewable import Viewer
 
 from .. import compute
 from ..export import to_csv
+from ..report.bokeh import TitleBlockModels, style_figure
+from ..report.live import page_url, view_title
 from ..store import Result, Results
 
-__all__ = ["LiveView", "download_button", "inline_html", "served_document"]
+__all__ = ["LiveView", "download_button", "export_meta", "inline_html", "served_document"]
 
 
 def served_document():
@@ -60,6 +63,19 @@ def inline_html(text: str) -> str:
     return re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", out)
 
 
+def export_meta(meta, url: str | None = None, now: dt.datetime | None = None) -> dict:
+    """A result's CSV header with the provenance every export carries: the core's version,
+    the date of the export and the page URL that reproduces it."""
+    now = now or dt.datetime.now(dt.UTC)
+    url = page_url() if url is None else url
+    return {
+        **meta,
+        "fbs_core version": compute.version(),
+        "exported": now.strftime("%Y-%m-%d %H:%M UTC"),
+        "page URL": url or "(not served: no page URL)",
+    }
+
+
 def download_button(key: str, result) -> pn.widgets.FileDownload:
     """A CSV download of ``result()``: its columns under its own header and file name."""
 
@@ -68,9 +84,7 @@ def download_button(key: str, result) -> pn.widgets.FileDownload:
         if r is None:
             return io.StringIO("")
         btn.filename = r.filename
-        return io.StringIO(
-            to_csv(r.columns, {**r.meta, "fbs_core version": compute.version()}, key)
-        )
+        return io.StringIO(to_csv(r.columns, export_meta(r.meta), key))
 
     first = result()
     btn = pn.widgets.FileDownload(
@@ -89,6 +103,11 @@ class LiveView(Viewer):
     """Base of the plot views: build once, redraw the published result in place."""
 
     store = param.ClassSelector(class_=Results, doc="The session's results.")
+    mode = param.Selector(
+        default="normal",
+        objects=["normal", "present"],
+        doc="Type sizes: normal or presentation view (projector).",
+    )
 
     #: Short name: CSV view key and download css class.
     key = "view"
@@ -104,6 +123,8 @@ class LiveView(Viewer):
         self._caption: pn.pane.HTML | None = None
         self._pending = False
         self._guard = threading.Lock()
+        self._figures: list = []
+        self._titles: list[TitleBlockModels] = []
 
     # -- what a subclass provides ----------------------------------------------------------
     def result(self) -> Result | None:
@@ -152,6 +173,26 @@ class LiveView(Viewer):
             if self._caption.object != text:
                 self._caption.object = text
         self._draw(r)
+        self._draw_title()
+
+    # -- title block: what the plot shows, on the plot and in its saved PNG -----------------
+    def _title_state(self):
+        """The state snapshot the title describes (the band view: the band's own)."""
+        return self.store.snapshot()
+
+    def _draw_title(self) -> None:
+        if not self._titles:
+            return
+        tb, stem = view_title(self.key, self._title_state(), page_url())
+        for t in self._titles:
+            t.update(tb, stem)
+
+    @param.depends("mode", watch=True)
+    def _restyle(self) -> None:
+        for fig in self._figures:
+            style_figure(fig, self.mode, legend_side="below")
+        for t in self._titles:
+            t.style(self.mode)
 
     def _header(self) -> pn.Row:
         if self.note:
@@ -168,7 +209,9 @@ class LiveView(Viewer):
     def __panel__(self):
         if self._layout is None:
             self._doc = served_document()
-            figures = self._build()
+            figures = self._figures = self._build()
+            self._titles = [TitleBlockModels(f) for f in figures]
+            self._restyle()
             header = self._header()
             plots = [
                 pn.pane.Bokeh(f, sizing_mode="stretch_both", min_height=self.min_height)

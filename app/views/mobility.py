@@ -120,10 +120,11 @@ class UncoupledView(LiveView):
 
     def _draw(self, r):
         c, d = r.columns, r.draw
-        fit_range(self.x_range, c["freq"])
-        self._tire_ref.data = {"freq": c["freq"], "level": c["tire_reference_db"]}
-        self._tire_tr.data = {"freq": c["freq"], "level": c["tire_truncated_db"]}
-        self._chassis.data = {"freq": c["freq"], "level": c["chassis_db"]}
+        f = c["freq_Hz"]
+        fit_range(self.x_range, f)
+        self._tire_ref.data = {"freq": f, "level": c["tire_reference_dB"]}
+        self._tire_tr.data = {"freq": f, "level": c["tire_truncated_dB"]}
+        self._chassis.data = {"freq": f, "level": c["chassis_dB"]}
         self._tire_fig.title.text = d["tire_title"]
         self._tire_fig.yaxis.axis_label = level_label(d["dof"])
         self._chassis_fig.title.text = d["chassis_title"]

@@ -78,9 +78,11 @@ def new_figure(
     title: str | None = None,
     min_height: int = 320,
     name: str | None = None,
+    y_axis_type: str = "linear",
 ):
     """A responsive figure with pan/zoom/box-zoom/reset/save, wheel zoom active."""
     fig = figure(
+        y_axis_type=y_axis_type,
         x_range=x_range if x_range is not None else DataRange1d(range_padding=0.0),
         y_range=y_range
         if y_range is not None

@@ -7,13 +7,20 @@ the plot picks the round with the highest level at that frequency.
 
 from __future__ import annotations
 
+import dataclasses
+
 import panel as pn
 import param
+from bokeh.core.properties import value
 from bokeh.events import Tap
 
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
 from .live import LiveView, download_button, inline_html
 from .plots import add_band, add_line, fit_range, frequency_range, new_figure
+
+#: Styles of the progress bar: hidden when idle (its box kept: no new layout of the page).
+IDLE = {"visibility": "hidden"}
+BUSY = {"visibility": "visible"}
 
 
 class ScatterBandView(LiveView):
@@ -36,17 +43,33 @@ class ScatterBandView(LiveView):
         # The indicator and the status line keep their place and size: changing their
         # content does not make the browser lay out the page again (toggling visibility
         # did, and delayed every plot update sent with it).
+        # Idle, the bar is hidden (an empty bar looked like a text field) but keeps its box.
         self._progress = pn.indicators.Progress(
             active=False,
             value=0,
             max=100,
             bar_color="primary",
             width=160,
-            height=12,
+            height=14,
             css_classes=["scatter-progress"],
             margin=(12, 10),
+            styles=IDLE,
         )
-        return pn.Row(self._progress, pn.layout.HSpacer(), download_button(self.key, self.result))
+        self._cancel = pn.widgets.Button(
+            label="Cancel band",
+            button_type="danger",
+            button_style="outline",
+            disabled=True,
+            width=110,
+            css_classes=["scatter-cancel"],
+        )
+        self._cancel.on_click(lambda _e: self.store.cancel_band())
+        return pn.Row(
+            self._progress,
+            self._cancel,
+            pn.layout.HSpacer(),
+            download_button(self.key, self.result),
+        )
 
     def _extra(self):
         # its own line, two lines high: the text's length changes, its box does not
@@ -68,7 +91,6 @@ class ScatterBandView(LiveView):
             y_label=level_label("z", "Band level"),
             x_range=self.x_range,
             name="scatter.figure",
-            title="Click a frequency: the round with the highest level there",
         )
         self._minmax = add_band(
             fig, "scatter.minmax", color=COLORS["band"], alpha=0.35, legend="min-max corridor"
@@ -98,6 +120,31 @@ class ScatterBandView(LiveView):
         fig.on_event(Tap, self._tapped)
         return [fig]
 
+    def _title_state(self):
+        """The band's own settings (it may be older than the controls), the shown DOF,
+        percentile band and round."""
+        s = self.store.snapshot()
+        band = self.store.band
+        if band is None:
+            return s
+        k = min(s.single_round, band.result.rounds - 1)
+        return dataclasses.replace(
+            band.settings, dof=s.dof, percentile=s.percentile, single_round=k
+        )
+
+    def _draw_title(self):
+        super()._draw_title()
+        st, band = self.store.band_status, self.store.band
+        stale = band is not None and band.settings.band_key() != self.store.snapshot().band_key()
+        for t in self._titles:
+            what = t.heading.text.split(" [")[0]
+            if stale:
+                what += " [shown: the previous settings' band" + (
+                    ", the new one is computing]" if st.busy else "]"
+                )
+            if t.heading.text != what:
+                t.heading.text = what
+
     def _tapped(self, event):
         if event.x is not None:
             self.store.pick_peak_round(event.x)
@@ -110,8 +157,13 @@ class ScatterBandView(LiveView):
         text = f"<p>{inline_html(st.text)}</p>" if st.text else ""
         if self._status.object != text:
             self._status.object = text
-        if self._progress.active != st.busy:
-            self._progress.param.update(active=st.busy, value=-1 if st.busy else 0)
+        value = (st.percent if st.total else -1) if st.busy else 0
+        if self._progress.active != st.busy or self._progress.value != value:
+            self._progress.param.update(
+                active=st.busy, value=value, styles=BUSY if st.busy else IDLE
+            )
+        if self._cancel.disabled == st.busy:
+            self._cancel.disabled = not st.busy
 
     def _draw(self, r):
         d, single = r.draw["band"], r.draw["round"]
@@ -122,3 +174,13 @@ class ScatterBandView(LiveView):
         self._ref.data = {"freq": f, "level": d["reference_db"]}
         self._round.data = {"freq": f, "level": single["round_db"]}
         self._fig.yaxis.axis_label = level_label(r.draw["dof"], "Band level")
+        labels = [
+            f"min-max over {r.meta['rounds']:,} rounds",
+            f"central band, percentiles {r.meta['percentiles']} %",
+            "unpolluted",
+            f"round #{r.meta['single round']} (click: highest round there)",
+        ]
+        for leg in self._fig.legend:
+            for item, text in zip(leg.items, labels, strict=False):
+                if getattr(item.label, "value", None) != text:
+                    item.label = value(text)

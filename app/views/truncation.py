@@ -6,8 +6,11 @@ from __future__ import annotations
 import numpy as np
 import panel as pn
 import param
+from bokeh.core.properties import value
 from panel.viewable import Viewer
 
+from ..report.bokeh import ErrorMapLayers
+from ..report.colormap import LINE_STYLES, log_rows
 from ..store import Results
 from .common import COLORS, MODES_LABEL
 from .live import LiveView, download_button, inline_html
@@ -61,8 +64,8 @@ class TruncationView(LiveView):
 
     key = "truncation"
     note = (
-        "Error vs all modes, 12 Hz floating band; black: at or above the threshold. "
-        "Solid: chosen N; dashed: suggested N up to the dotted frequency."
+        "Error vs all modes, 12 Hz floating band; blue below the threshold (darker: larger), "
+        "red at or above it, black line: the threshold contour."
     )
     x_range = param.Parameter(
         default=None,
@@ -71,6 +74,11 @@ class TruncationView(LiveView):
     n_range = param.Parameter(
         default=None,
         doc="Retained-modes range shared with the eigenfrequency plot; a new one if None.",
+    )
+    n_axis = param.Selector(
+        default="linear",
+        objects=["linear", "log"],
+        doc="Scale of the N axis (log: the detail below N = 100 spreads out); set at build.",
     )
 
     def result(self):
@@ -91,8 +99,10 @@ class TruncationView(LiveView):
             x_range=self.x_range,
             y_range=self.n_range,
             name="truncation.figure",
+            y_axis_type=self.n_axis,
         )
         fig.grid.visible = False
+        fig.title.visible = False  # the title block above says what the map shows
         self._src, self._mapper, self._bar = add_image(
             fig,
             "truncation.map",
@@ -103,23 +113,53 @@ class TruncationView(LiveView):
                 ("Error", "@image{0.0} %"),
             ],
         )
-        self._suggested = add_span(
-            fig,
-            dimension="width",
-            color=COLORS["suggested"],
-            dash="dashed",
-            name="truncation.suggested_n",
+        # colours split at the threshold, the threshold contour, lines with a halo
+        self._layers = ErrorMapLayers(fig, 20.0)
+        for rend in fig.renderers:
+            for g in (rend.glyph, rend.nonselection_glyph, rend.selection_glyph, rend.hover_glyph,
+                      rend.muted_glyph):  # fmt: skip
+                if getattr(g, "color_mapper", None) is self._mapper:
+                    g.color_mapper = self._layers.mapper
+        self._bar.color_mapper = self._mapper = self._layers.mapper
+        self._bar.title = "Error (%)"
+        spans = {}
+        for key, name, dim in (
+            ("suggested N", "truncation.suggested_n", "width"),
+            ("f_max", "truncation.f_max", "height"),
+            ("chosen N", "truncation.chosen_n", "width"),
+        ):
+            color, dash, width, halo = LINE_STYLES[key]
+            under = add_span(fig, dimension=dim, color=halo, width=width + 2.5)
+            spans[key] = (
+                add_span(fig, dimension=dim, color=color, dash=dash, width=width, name=name),
+                under,
+            )
+        self._suggested, self._f_max, self._chosen = (
+            spans["suggested N"],
+            spans["f_max"],
+            spans["chosen N"],
         )
-        self._f_max = add_span(
-            fig,
-            dimension="height",
-            color=COLORS["suggested"],
-            dash="dotted",
-            name="truncation.f_max",
+        # legend entries (spans cannot be legend items): empty lines styled like them
+        items = [("threshold contour", self._layers.contour_line)]
+        for key, label in (
+            ("chosen N", "chosen N"),
+            ("suggested N", "suggested N"),
+            ("f_max", "f_max of the suggestion"),
+        ):
+            color, dash, width, _ = LINE_STYLES[key]
+            items.append(  # one NaN point: a legend draws no sample for an empty source
+                (
+                    label,
+                    fig.line(
+                        [np.nan], [np.nan], line_color=color, line_dash=dash, line_width=width
+                    ),
+                )
+            )
+        above = fig.scatter(
+            [np.nan], [np.nan], marker="square", size=12, color=self._layers.scale.above
         )
-        self._chosen = add_span(
-            fig, dimension="width", color=COLORS["round"], name="truncation.chosen_n"
-        )
+        items.insert(0, ("at or above the threshold", above))
+        self._legend = self._layers.legend(items, side="below")
         return [fig]
 
     def _draw(self, r):
@@ -128,16 +168,29 @@ class TruncationView(LiveView):
         nm = d["map"]["n_modes"]
         dn = float(nm[1] - nm[0]) if nm.size > 1 else 10.0
         fit_range(self.x_range, d["freq"])
-        # up to the all-modes count too (the reference: no error, not in the map)
-        fit_range(self.n_range, [cols["y"][0], cols["y"][0] + cols["dh"][0] + dn])
+        top = cols["y"][0] + cols["dh"][0] + dn  # up to the all-modes count (no error)
+        if self.n_axis == "log":  # rows uniform in log N: the image stretches linearly
+            low, high, img = log_rows(nm, d["map"]["error_pct"], 512)
+            cols = {**cols, "image": [img], "y": [low], "dh": [high - low]}
+            fit_range(self.n_range, [low, top])
+        else:
+            fit_range(self.n_range, [cols["y"][0], top])
         if not _same_columns(self._src.data, cols):
             self._src.data = cols
-        self._mapper.high = d["threshold"]
-        self._bar.title = f"Error (%), capped at {d['threshold']:g} %"
+        thr = float(d["threshold"])
+        m = d["map"]
+        self._layers.update(m["centre_freq"], m["n_modes"], m["error_pct"], thr)
+        self._bar.title = f"Error (%), red: >= {thr:g} %"
+        label = f"error >= {thr:g} %"
+        if getattr(self._legend.items[0].label, "value", None) != label:
+            self._legend.items[0].label = value(label)
         self._fig.title.text = d["title"]
-        self._suggested.location = float(d["suggested_n"])
-        self._f_max.location = d["f_max"]
-        self._chosen.location = float(d["n_modes"])
+        for (line, halo), loc in (
+            (self._suggested, float(d["suggested_n"])),
+            (self._f_max, float(d["f_max"])),
+            (self._chosen, float(d["n_modes"])),
+        ):
+            line.location = halo.location = loc
 
 
 class SuggestedModesView(Viewer):

@@ -82,6 +82,12 @@ class UploadView(Viewer):
         self.bushing = W.TextInput.from_param(
             ds.param.bushing, name="Bushing node", width=120, css_classes=["upload-bushing"]
         )
+        self.quantity = W.Select.from_param(
+            ds.param.quantity,
+            name="Quantity (if the file does not say)",
+            width=250,
+            css_classes=["upload-quantity"],
+        )
         self.interpolate = W.Checkbox.from_param(
             ds.param.interpolate,
             name="Interpolate onto the analysis grid (linear Re/Im)",
@@ -103,7 +109,8 @@ class UploadView(Viewer):
         # this also settles a click on "Read chassis again" that overtook the change
         # (Panel hands both to its worker threads, in either order)
         ds.param.watch(
-            lambda *_: self._run(ds.reread_if_changed), ["spindle", "bushing", "interpolate"]
+            lambda *_: self._run(ds.reread_if_changed),
+            ["spindle", "bushing", "interpolate", "quantity"],
         )
         self.reset.on_click(lambda _: ds.reset())
 
@@ -159,6 +166,7 @@ class UploadView(Viewer):
                     label("**Chassis FRF**", margin=(0, 5)),
                     self.chassis_file,
                     pn.Row(self.spindle, self.bushing),
+                    self.quantity,
                     self.interpolate,
                     self.reread,
                 ),

@@ -1,0 +1,105 @@
+"""Title blocks of the live views, from the store's plain state snapshot.
+
+The views draw their title block (:class:`app.report.bokeh.TitleBlockModels`) from the
+settings a result was computed for: :func:`view_title` takes the store's snapshot (any
+object with the state's attribute names), the page URL and the N-axis scale.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import fbs_core
+
+from .session import provenance_of
+from .snapshot import SETTING_KEYS, Snapshot
+from .titles import TitleBlock, compact_title, file_stem
+
+__all__ = ["VIEW_OF_KEY", "title_snapshot", "view_title", "page_url", "short_query"]
+
+#: LiveView key -> title-block view.
+VIEW_OF_KEY = {
+    "mobility": "coupled-response",
+    "truncation": "truncation-map",
+    "scatter": "scatter-band",
+    "eigen": "eigenfrequency",
+    "uncoupled": "uncoupled",
+    "suggested": "suggested-modes",
+}
+
+
+def _n_total(models) -> int | None:
+    tire = None if models is None else getattr(models, "tire", None)
+    try:
+        return int((tire or fbs_core.reference_tire()).n_modes)
+    except Exception:  # a tire without a count: the title omits "of N"
+        return None
+
+
+def title_snapshot(s, url: str = "", n_axis: str = "linear", created=None) -> Snapshot:
+    """A results-free report snapshot of a state snapshot ``s`` (for titles and names)."""
+    settings = {k: getattr(s, k) for k in SETTING_KEYS if hasattr(s, k)}
+    settings["n_axis"] = n_axis
+    models = getattr(s, "models", None)
+    return Snapshot(
+        settings=settings,
+        provenance=provenance_of(models),
+        url=url if url.startswith(("http://", "https://")) else "",
+        created=created or dt.datetime.now(dt.UTC),
+        n_modes_total=_n_total(models),
+    )
+
+
+def view_title(key: str, s, url: str = "", n_axis: str = "linear") -> tuple[TitleBlock, str]:
+    """``(title block, file stem)`` of the live view ``key`` for the state snapshot ``s``."""
+    snap = title_snapshot(s, url, n_axis)
+    view = VIEW_OF_KEY[key]
+    return compact_title(snap, view), file_stem(snap, view)
+
+
+def _url_defaults() -> dict[str, object]:
+    """Default value of every URL query key of the page (state and layout)."""
+    from ..state import URL_KEYS, DashboardState
+    from .page import PAGE_URL_KEYS, PageState
+
+    out: dict[str, object] = {}
+    for group, keys in URL_KEYS.items():
+        cls = DashboardState.param[group].class_
+        for name, key in keys.items():
+            out[key] = cls.param[name].default
+    for name, key in PAGE_URL_KEYS.items():
+        out[key] = PageState.param[name].default
+    return out
+
+
+def _is_default(value, default) -> bool:
+    if isinstance(default, bool) or isinstance(value, bool):
+        return str(value).lower() == str(default).lower()
+    if isinstance(default, (int, float)):
+        try:
+            return float(value) == float(default)
+        except (TypeError, ValueError):
+            return False
+    return str(value) == str(default)
+
+
+def short_query(query: dict) -> dict:
+    """``query`` without the pairs that hold the default value (the page applies those
+    anyway): a link that reproduces the same state, short enough for a title block."""
+    defaults = _url_defaults()
+    return {k: v for k, v in query.items() if not (k in defaults and _is_default(v, defaults[k]))}
+
+
+def page_url() -> str:
+    """The served page's URL that reproduces its state: the address and the query values
+    that differ from the defaults (``""`` when not served)."""
+    import urllib.parse
+
+    import panel as pn
+
+    loc = pn.state.location
+    if loc is None or not loc.href:
+        return ""
+    href = loc.href.split("?")[0]
+    query = short_query(loc.query_params)
+    return href + ("?" + urllib.parse.urlencode(query) if query else "")

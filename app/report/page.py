@@ -1,0 +1,59 @@
+"""Page layout state kept in the link: presentation view, data card, N-axis scale, uploads.
+
+``?view=present`` is the presentation view for a projector (data card collapsed, larger type,
+legends outside the plots); ``card=closed`` keeps the data card collapsed; ``naxis=log`` draws
+the error map's N axis logarithmically; ``data=chassis:<digest>`` names the uploads a link
+needs (the page says so when the session lacks them).
+"""
+
+from __future__ import annotations
+
+import param
+
+__all__ = ["PageState", "PAGE_URL_KEYS", "PAGE_CSS", "PRESENT_CSS", "CARD_CSS"]
+
+
+class PageState(param.Parameterized):
+    """How the page is laid out (not what it computes)."""
+
+    view = param.Selector(
+        default="normal",
+        objects=["normal", "present"],
+        doc="normal, or present: the presentation view for a projector.",
+    )
+    data_card = param.Selector(
+        default="open", objects=["open", "closed"], doc="The 'Your data' card open or collapsed."
+    )
+    n_axis = param.Selector(
+        default="linear", objects=["linear", "log"], doc="Scale of the error map's N axis."
+    )
+    data = param.String(
+        default="", doc="The uploads the page's results need (empty: the reference models)."
+    )
+
+
+#: URL query keys of the page state.
+PAGE_URL_KEYS = {"view": "view", "data_card": "card", "n_axis": "naxis", "data": "data"}
+
+#: Larger type of the controls and cards in the presentation view.
+PRESENT_CSS = """
+body { font-size: 17px; }
+.card-title, .card-header { font-size: 1.15em !important; }
+.bk-input, .bk-btn, label { font-size: 16px !important; }
+"""
+
+#: Page-wide CSS (both views): an idle progress bar is not a text field.
+PAGE_CSS = """
+.page-bar { align-items: center; }
+"""
+
+#: Stylesheet of every card (inside its shadow root): a visible collapse control.
+CARD_CSS = """
+.card-button {
+  width: 24px !important; height: 24px !important; min-width: 24px;
+  border: 1px solid #495057 !important; border-radius: 4px; background: #ffffff !important;
+  color: #212529; margin-right: 0.6em !important; display: inline-flex;
+  align-items: center; justify-content: center;
+}
+.card-button svg { width: 16px; height: 16px; stroke: #212529; }
+"""
