@@ -24,6 +24,7 @@ from app.views import (
     UncoupledView,
     UploadView,
 )
+from app.views.analysis_base import analysis_card
 from app.views.plots import frequency_range, modes_range
 
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
@@ -153,6 +154,7 @@ def create_app(
                 360,
             )
         ),
+        pn.Row(analysis_card(results, freq)),  # issue 18: compare, phase, speed, contributions
         sizing_mode="stretch_width",
     )
     template = pn.template.BootstrapTemplate(
