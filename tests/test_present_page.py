@@ -235,3 +235,24 @@ def test_extra_cards_are_inserted_below_the_plots():
     assert made and made[0].results is app.results and made[0].page is app.page
     assert "extra-card" in main.objects[-1].css_classes
     app.results.close()
+
+
+# -- the data in use on every plot -------------------------------------------------------
+@pytest.mark.parametrize("key", ["mobility", "truncation", "scatter", "eigen", "uncoupled"])
+def test_every_plot_title_names_the_data_in_use(key):
+    import dataclasses
+
+    from app.datasource import Models
+    from app.report.live import view_title
+    from app.store import Snapshot
+
+    s = Snapshot.of(DashboardState())
+    tb, stem = view_title(key, s, "http://localhost:5006/main?h=1")
+    assert any(line.startswith("Data: reference models") for line in tb.lines)
+    assert "_upload" not in stem
+    up = Models(
+        tire=None, chassis=object(), key="tire=reference;chassis=abc123", chassis_name="rig.uff"
+    )
+    tb, stem = view_title(key, dataclasses.replace(s, models=up))
+    assert any(line.startswith("Data: uploaded chassis 'rig.uff'") for line in tb.lines)
+    assert "_upload" in stem  # the saved image's name says so too

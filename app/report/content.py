@@ -158,7 +158,7 @@ def _coupled_section(snap: Snapshot) -> Section:
     ref = snap.reference.sel(outputs=dof, inputs="patch") if snap.reference else None
     tr = snap.truncated.sel(outputs=dof, inputs="patch") if snap.truncated else None
     if ref is not None:
-        rows.append(_peak_row("all tire modes (reference)", ref.freq, ref.data[:, 0, 0], h))
+        rows.append(_peak_row("all tire modes", ref.freq, ref.data[:, 0, 0], h))
     if tr is not None:
         rows.append(_peak_row(f"N = {s['n_modes']} modes", tr.freq, tr.data[:, 0, 0], h))
     tables = [

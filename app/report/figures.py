@@ -114,7 +114,7 @@ def draw_coupled(snap: Snapshot):
         ax = _axes(fig, rect)
         handles = []
         for frf, label, color, style in (
-            (snap.reference, "all tire modes (reference)", COLORS["reference"], "-"),
+            (snap.reference, "all tire modes", COLORS["reference"], "-"),
             (snap.truncated, f"N = {n} modes", COLORS["truncated"], "--"),
         ):
             if frf is None:

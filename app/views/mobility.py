@@ -43,7 +43,7 @@ class MobilityView(LiveView):
             fig,
             "mobility.reference",
             color=COLORS["reference"],
-            legend="all modes (reference)",
+            legend="all tire modes",
             tooltips=level_tooltips("all modes"),
         )
         self._tr = add_line(
