@@ -200,21 +200,15 @@ class TireModel:
         Z = np.concatenate([R, Q], axis=2)
         Z.setflags(write=False)
         object.__setattr__(self, "_Z", Z)
-        clusters: list[tuple[Cluster, ...]] = []
         nodes: list[slice] = []
         for k in range(n_s - 1):
             nd = slice(k, k + 2)
             if self.interpolation == "cubic" and 1 <= k <= n_s - 3:
                 nd = slice(k - 1, k + 3)  # centred stencil; end intervals stay linear
             nodes.append(nd)
-            groups: list[np.ndarray] = []
-            if self.interpolation != "linear":
-                moving = interp.residue_change(Z[k, 0::2], Z[k + 1, 0::2]) > interp.TAU
-                groups = find_clusters(poles[k, 0::2], poles[k + 1, 0::2], moving=moving)
-            e = (k - nd.start, k + 1 - nd.start)
-            groups = [2 * g + par for g in groups for par in (0, 1)]
-            clusters.append(tuple(cluster_ends(groups, poles[nd], Z[nd], e)))
-        object.__setattr__(self, "_clusters", tuple(clusters))
+        # clusters of every interval, found when the interval is first used (_clusters_of)
+        clusters: list[tuple[Cluster, ...] | None] = [None] * (n_s - 1)
+        object.__setattr__(self, "_clusters", clusters)
         object.__setattr__(self, "_nodes", tuple(nodes))
         # truncation order at every operating point: pairs by eigenfrequency there
         pairs = np.argsort(poles[:, 0::2].imag, axis=1, kind="stable")
@@ -222,6 +216,27 @@ class TireModel:
         order.setflags(write=False)
         object.__setattr__(self, "_order", order)
         object.__setattr__(self, "_plans", {})  # cache of truncation plans (see _plan)
+
+    def _clusters_of(self, k: int) -> tuple[Cluster, ...]:
+        """Clusters of interval ``k`` (:mod:`.interp`), found on first use and kept.
+
+        Two threads may find them at once; both get the same tuple (deterministic), so
+        the race costs time, never correctness.
+        """
+        hit = self._clusters[k]
+        if hit is not None:
+            return hit
+        nd = self._nodes[k]
+        groups: list[np.ndarray] = []
+        if self.interpolation != "linear":
+            Z, poles = self._Z, self.poles
+            moving = interp.residue_change(Z[k, 0::2], Z[k + 1, 0::2]) > interp.TAU
+            groups = find_clusters(poles[k, 0::2], poles[k + 1, 0::2], moving=moving)
+        e = (k - nd.start, k + 1 - nd.start)
+        groups = [2 * g + par for g in groups for par in (0, 1)]
+        out = tuple(cluster_ends(groups, self.poles[nd], self._Z[nd], e))
+        self._clusters[k] = out
+        return out
 
     # -- basic information -----------------------------------------------------------
     @property
@@ -251,7 +266,7 @@ class TireModel:
         w = lagrange_weights(self.speeds[nd], v)
         lam: np.ndarray = w @ self.poles[nd]
         rows = np.arange(w.shape[0])[:, None, None]
-        for cl in self._clusters[k]:
+        for cl in self._clusters_of(k):
             p, _ = cluster_at(cl, w, np.arange(0))
             perm = np.argsort(np.abs(lam[:, cl.members].imag), axis=-1)
             lam[rows, np.take_along_axis(cl.members[None], perm, axis=-1)] = p
@@ -312,11 +327,11 @@ class TireModel:
         v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
         w = lagrange_weights(self.speeds[nd], v)
         T = 1.0 / (s[:, None] - w @ self.poles[nd])  # (n_l, n_m)
-        for cl in self._clusters[k]:
+        for cl in self._clusters_of(k):
             T[:, cl.members.ravel()] = 0.0
         Zn = self._Z[nd]  # (n_nodes, n_m, n_res), a view
         tot: np.ndarray = sum(w[:, i, None] * (T @ Zn[i]) for i in range(Zn.shape[0]))[:, cols]
-        for cl in self._clusters[k]:
+        for cl in self._clusters_of(k):
             tot = tot + cluster_sum(cl, w, s, cols)
         return tot
 
@@ -403,7 +418,7 @@ class TireModel:
         rank[order] = np.arange(order.size)
         block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
         plan = []
-        for cl in self._clusters[k]:
+        for cl in self._clusters_of(k):
             b = block[cl.members]
             whole = np.all(b == b[:, :1], axis=1)  # cluster inside one block
             w_sub = interp.subset(cl, whole) if whole.any() else None

@@ -210,7 +210,8 @@ def interpolation_quality(
     mob = np.full((len(hs), inner.size), np.nan)
     pat = np.full((len(hs), inner.size), np.nan)
     for j, i in enumerate(int(x) for x in inner):
-        keep = [q for q in range(max(0, i - 3), min(sp.size, i + 4)) if q != i]
+        # the stencil of the interval (i - 1, i + 1) without i: its cubic nodes i - 2 .. i + 2
+        keep = [q for q in range(max(0, i - 2), min(sp.size, i + 3)) if q != i]
         part = TireModel(
             sp[keep],
             tire.poles[keep],
@@ -225,10 +226,11 @@ def interpolation_quality(
             if not h.speed_range[0] <= v <= h.speed_range[1]:
                 continue
             f = np.array([v / 3.6 / h.wavelength])
-            Y, Yp = tire.hub_mobility(f, v).data, part.hub_mobility(f, v).data
+            hi = tire._harmonic_index(h)
+            Y, x = tire.synthesis(f, [v], hi)  # stored: exact at the operating point
+            Yp, xp = part.synthesis(f, [v], hi)
+            assert x is not None and xp is not None  # a harmonic index was given
             mob[a, j] = 20 * np.log10(1 + np.linalg.norm(Yp - Y) / np.linalg.norm(Y))
-            x = tire.patch_response(f, h, speed_kmh=v).data
-            xp = part.patch_response(f, h, speed_kmh=v).data
             pat[a, j] = 20 * np.log10(1 + np.linalg.norm(xp - x) / np.linalg.norm(x))
     both = np.fmax(mob, pat)
     worst = np.array([np.nanmax(r) if np.isfinite(r).any() else np.nan for r in both])
