@@ -208,8 +208,7 @@ class CampaignResult:
         """
         import h5py
 
-        from ..studies import scatter as _sc
-        from ..studies._rng import seed_key
+        from .work import BLOCK_KEYS, assemble_band
 
         c = self.case(name)
         if c.kind != "scatter":
@@ -222,61 +221,32 @@ class CampaignResult:
         d = self._cases[name]
         st = c.settings
         arr, dofs = self._inputs(d["attrs"]["inputs"])
-        parts: dict[str, list[AnyArray | None]] = {}
-        keys: tuple[str, ...] = ("lower", "upper", "argmin_round", "argmax_round", "percentiles")
-        keys += ("conv_lower", "conv_upper")
-        ck = None
+        blocks = []
         for (a, z), p in sorted(d["blocks"].items()):
             with h5py.File(p, "r") as h:
                 g = h["cases"][name]["blocks"][f"{a}_{z}"]
-                for k in keys:
-                    parts.setdefault(k, []).append(g[k][()] if k in g else None)
-                if "checkpoints" in g:
-                    ck = g["checkpoints"][()]
-        if any(v is None for v in parts["lower"]):
+                b = {k: (g[k][()] if k in g else None) for k in (*BLOCK_KEYS, "checkpoints")}
+            blocks.append(b | {"l0": a, "l1": z})
+        if any(b["lower"] is None for b in blocks):
             raise CampaignError(f"case {name} was stored without its band ([outputs] scatter)")
-
-        def cat(k: str, axis: int) -> AnyArray | None:
-            v = [x for x in parts[k] if x is not None]
-            return None if len(v) < len(parts[k]) else np.concatenate(v, axis=axis)
-
-        def edge(k: str) -> AnyArray:
-            v = cat(k, 0)
-            assert v is not None  # stored together with "lower" (checked above)
-            return v
-
-        nq = len(st["percentiles"])
-        ne = len(dofs)
-        pct = cat("percentiles", 1)
-        clo, chi = cat("conv_lower", 1), cat("conv_upper", 1)
-        nf = arr["freq"].size
-        if pct is None:
-            pct = np.full((nq, nf, ne), np.nan)
-        if clo is None or chi is None or ck is None:
-            ck = np.array([st["rounds"]], np.int64)
-            clo = edge("lower")[None]
-            chi = edge("upper")[None]
-        seed = int(st["seed"])
-        arrays = _sc._check_inputs(arr["YjjA"], arr["vj"], arr["YjjE"], arr["YejE"])
-        return _sc.ScatterBand(
-            freq=_sc._ro(arr["freq"]),
-            dofs=dofs,
-            reference=_sc._ro(arr["reference"]),
-            lower=_sc._ro(edge("lower")),
-            upper=_sc._ro(edge("upper")),
-            argmin_round=_sc._ro(edge("argmin_round")),
-            argmax_round=_sc._ro(edge("argmax_round")),
-            q=_sc._ro(np.asarray(st["percentiles"], float)),
-            percentiles=_sc._ro(pct),
-            convergence=_sc.Convergence(_sc._ro(ck), _sc._ro(clo), _sc._ro(chi)),
-            noise=float(st["noise"]),
-            target=str(st["target"]),
-            rounds=int(st["rounds"]),
-            frequency_dependent=bool(st["frequency_dependent"]),
-            seed=seed,
-            harmonic=int(st["harmonic"]),
-            _inputs=(arrays, seed_key(seed)),
+        band: ScatterBand = assemble_band(
+            arr["freq"],
+            dofs,
+            arr["reference"],
+            arr["YjjA"],
+            arr["vj"],
+            arr["YjjE"],
+            arr["YejE"],
+            blocks,
+            q=st["percentiles"],
+            noise=st["noise"],
+            target=st["target"],
+            rounds=st["rounds"],
+            frequency_dependent=st["frequency_dependent"],
+            seed=st["seed"],
+            harmonic=st["harmonic"],
         )
+        return band
 
     def truncation(self, name: str) -> TruncationEntry:
         """The stored truncation case (error map, suggested modes, the map when stored)."""

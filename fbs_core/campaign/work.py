@@ -49,9 +49,17 @@ from ..errors import FBSError
 
 if TYPE_CHECKING:
     from ..frf import FRF
+    from ..studies.scatter import ScatterBand
     from .spec import TruncationCase
 
-__all__ = ["BandInputs", "resolve_model", "prepare_inputs", "band_block", "truncation_case"]
+__all__ = [
+    "BandInputs",
+    "resolve_model",
+    "prepare_inputs",
+    "band_block",
+    "assemble_band",
+    "truncation_case",
+]
 
 
 class BandInputs:
@@ -278,6 +286,101 @@ def band_block(
         "seconds": time.perf_counter() - t0,
         **_where(),
     }
+
+
+BLOCK_KEYS: tuple[str, ...] = ("lower", "upper", "argmin_round", "argmax_round", "percentiles")
+BLOCK_KEYS += ("conv_lower", "conv_upper")
+
+
+def assemble_band(
+    freq: Any,
+    dofs: Sequence[str],
+    reference: Any,
+    YjjA: Any,
+    vj: Any,
+    YjjE: Any,
+    YejE: Any,
+    blocks: Sequence[dict[str, Any]],
+    *,
+    q: Any,
+    noise: float,
+    target: str,
+    rounds: int,
+    frequency_dependent: bool,
+    seed: int,
+    harmonic: Any,
+) -> ScatterBand:
+    """The :class:`~fbs_core.ScatterBand` of line blocks of :func:`band_block` (the one place
+    blocks become a band: the campaign file's browser and the dashboard's cluster bands).
+
+    ``blocks`` are dicts with the keys of :func:`band_block` (a statistic may be None when
+    it was not stored), covering the lines ``0 .. n_f - 1`` in ascending order. Without
+    percentiles they are NaN; without the convergence checkpoints the band edges are the one
+    checkpoint (all rounds).
+
+    Raises
+    ------
+    CampaignError
+        When the blocks do not cover the lines or hold no band edges.
+    SingularInterfaceError
+        When an edge is not finite (as :func:`fbs_core.scatter_band`).
+    """
+    from ..errors import CampaignError, SingularInterfaceError
+    from ..studies import scatter as _sc
+    from ..studies._rng import seed_key
+
+    blocks = sorted(blocks, key=lambda b: int(b["l0"]))
+    nf = int(np.asarray(freq).size)
+    ends = [0] + [int(b["l1"]) for b in blocks]
+    if [int(b["l0"]) for b in blocks] != ends[:-1] or ends[-1] != nf:
+        got = ", ".join(f"{b['l0']}..{b['l1']}" for b in blocks)
+        raise CampaignError(f"line blocks [{got}] do not cover the {nf} lines once")
+    if any(b.get("lower") is None for b in blocks):
+        raise CampaignError("blocks hold no band edges ([outputs] scatter without 'band')")
+
+    def cat(k: str, axis: int) -> Any:
+        v = [b[k] for b in blocks if b.get(k) is not None]
+        return None if len(v) < len(blocks) else np.concatenate(v, axis=axis)
+
+    ne = len(dofs)
+    qs = np.asarray(q, float)
+    pct = cat("percentiles", 1)
+    if pct is None:
+        pct = np.full((qs.size, nf, ne), np.nan)
+    clo, chi = cat("conv_lower", 1), cat("conv_upper", 1)
+    ck = next((b["checkpoints"] for b in blocks if b.get("checkpoints") is not None), None)
+    lo, hi = cat("lower", 0), cat("upper", 0)
+    if clo is None or chi is None or ck is None:
+        ck = np.array([rounds], np.int64)
+        clo, chi = lo[None], hi[None]
+    for what, x in (("upper edge", hi), ("lower edge", lo)):
+        if not np.all(np.isfinite(x)):
+            line = int(np.argwhere(~np.isfinite(x))[0][0])
+            raise SingularInterfaceError(
+                f"{what} of the scatter band is not finite at {freq[line]:g} Hz: the (noisy) "
+                "interface matrix Y_jj^A + Y_jj^E is singular there"
+            )
+    seed = int(seed)
+    arrays = _sc._check_inputs(YjjA, vj, YjjE, YejE)
+    return _sc.ScatterBand(
+        freq=_sc._ro(np.asarray(freq)),
+        dofs=tuple(dofs),
+        reference=_sc._ro(np.asarray(reference)),
+        lower=_sc._ro(lo),
+        upper=_sc._ro(hi),
+        argmin_round=_sc._ro(cat("argmin_round", 0)),
+        argmax_round=_sc._ro(cat("argmax_round", 0)),
+        q=_sc._ro(qs),
+        percentiles=_sc._ro(pct),
+        convergence=_sc.Convergence(_sc._ro(np.asarray(ck)), _sc._ro(clo), _sc._ro(chi)),
+        noise=float(noise),
+        target=str(target),
+        rounds=int(rounds),
+        frequency_dependent=bool(frequency_dependent),
+        seed=seed,
+        harmonic=None if harmonic is None else int(harmonic),
+        _inputs=(arrays, seed_key(seed)),
+    )
 
 
 def truncation_case(tire: Any, chassis: Any, case: TruncationCase) -> dict[str, Any]:
