@@ -37,7 +37,14 @@ from ..store import Result
 from .common import COLORS, FREQ_LABEL, MODES_LABEL, level_label
 from .live import download_button, served_document
 
-__all__ = ["CAMPAIGN_DIR_ENV", "CampaignBrowser", "campaign_dir", "list_campaigns", "case_rows"]
+__all__ = [
+    "CAMPAIGN_DIR_ENV",
+    "CampaignBrowser",
+    "campaign_dir",
+    "campaign_card",
+    "case_rows",
+    "list_campaigns",
+]
 
 CAMPAIGN_DIR_ENV = "FBS_CAMPAIGN_DIR"
 ALL = "all"
@@ -459,6 +466,20 @@ class CampaignBrowser(pn.viewable.Viewer):
             pn.Card(self._prov, title="Provenance", collapsed=True, sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
         )
+
+
+def campaign_card(parts):
+    """The page's card of the campaign browser (an entry of ``app.main.EXTRA_CARDS``):
+    collapsed, built with ``parts.card``; None when no campaign directory is configured."""
+    if campaign_dir() is None:
+        return None
+    return parts.card(
+        "Campaign results (FBS_CAMPAIGN_DIR)",
+        CampaignBrowser(),
+        None,
+        collapsed=True,
+        css_classes=["campaign-card"],
+    )
 
 
 def _frame(cols: dict[str, list]):
