@@ -90,7 +90,8 @@ async def measure(args, servers: dict) -> None:
             await p.change(SLIDER, v, TIMEOUT_S, 0.5)
     lat = {(n, c, k): [] for n in servers for c in ("idle", "hog") for k in ("first", "done")}
     still_busy = {n: [] for n in servers}
-    seed, i = 1000, 0
+    seed = 1000
+    turn = dict.fromkeys(servers, 0)  # each probe cycles through the values: always a change
     for sample in range(args.samples):
         for name, srv in servers.items():
             probe = probes[name]
@@ -106,8 +107,8 @@ async def measure(args, servers: dict) -> None:
                     if not await wait_busy(hog):
                         raise RuntimeError(f"[{name}] the hog's band never started")
                     await asyncio.sleep(1.0)  # well into the band
-                v = values[i % len(values)]
-                i += 1
+                v = values[turn[name] % len(values)]
+                turn[name] += 1
                 r = await probe.change(SLIDER, v, TIMEOUT_S, 0.5)
                 if r is None:
                     raise RuntimeError(f"[{name}] the probe's plots did not change")

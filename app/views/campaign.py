@@ -137,7 +137,7 @@ def _provenance(result, name: str) -> dict[str, Any]:
         "campaign seed": a.get("campaign_seed", ""),
         "seeds": a.get("seeds", ""),
         "case": name,
-        "case digest": result._cases[name]["attrs"].get("digest", ""),
+        "case digest": result.case_attrs(name).get("digest", ""),
     }
     meta.update({f"case {k}": v for k, v in c.settings.items() if k != "kind"})
     if result.runs:

@@ -179,6 +179,11 @@ class CampaignResult:
             f"no case {name!r} in {self.path}; cases: {', '.join(c.name for c in self.cases)}"
         )
 
+    def case_attrs(self, name: str) -> dict[str, Any]:
+        """Everything stored about a case (its settings, ``digest``, ``inputs`` ...)."""
+        self.case(name)  # an unknown name: CampaignError listing the cases
+        return dict(self._cases[name]["attrs"])
+
     def find(self, **settings: Any) -> tuple[CaseEntry, ...]:
         """The cases whose settings match all given values (e.g. ``harmonic=4, noise=0.1``)."""
         return tuple(
