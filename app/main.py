@@ -345,12 +345,30 @@ def create_app(
     template.state = state  # for tests and benchmarks
     template.results = results
     template.views = views
+    doc = pn.state.curdoc
+    if doc is not None:  # a served session, or a document built without one
+        doc.on_session_destroyed(lambda _ctx: close_page(template))
     if served():
         pn.state.onload(results.request_band)
-        pn.state.on_session_destroyed(lambda _ctx: results.close())
     else:
         results.request_band(wait=True)
     return template
+
+
+def close_page(page: pn.template.BootstrapTemplate) -> None:
+    """End a page of :func:`create_app`: its band is cancelled, nothing more is published,
+    and the watchers of its components are dropped.
+
+    Called with the document's session-destroyed callbacks. Panel drops the watchers of a
+    served session's components itself; a page built in a document without a browser
+    session (Panel's ``--liveness`` check, a warm-up, a test) is not among them, and
+    Panel's registry of JavaScript callbacks (``panel.links.Callback.registry``, used by
+    the editable sliders of the controls) would then keep the whole page, its results and
+    its data alive for the life of the process (finding 2 of issue 20).
+    """
+    page.results.close()
+    for obj in page.select():
+        obj.param.watchers = {}
 
 
 if pn.state.served:

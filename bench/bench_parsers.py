@@ -4,6 +4,8 @@ Prints, for the code of the working tree it is run from:
 
 * CSV files of 10k / 20k / 40k column pairs (outputs x one input, 4 lines): parse time
   and the ratio to the 10k file (2.0 and 4.0 for a linear reader);
+* CSV files of 75k / 150k / 300k lines (one column pair; 300k lines is the 6.4 MB file of
+  the attack suite): the same;
 * UFF files of 1k / 2k / 4k dataset-58 records: the same;
 * a 2.8 MB UFF file of ``-1`` lines (refused; the time it takes);
 * a ~300 KB compressed MAT file of 300 MB of zeros (refused by the sandbox's bound on
@@ -33,6 +35,13 @@ def wide_csv(n_pairs: int) -> bytes:
     )
     rows = [",".join([f"{f:.1f}"] + ["1e-3"] * (2 * n_pairs)) for f in (1.0, 2.0, 3.0, 4.0)]
     return (head + "\n" + "\n".join(rows) + "\n").encode()
+
+
+def tall_csv(n_rows: int) -> bytes:
+    """One column pair, ``n_rows`` lines (300,000 lines: the attack suite's 6.4 MB file)."""
+    head = "# quantity: mobility\n# units: m/(N s)\nfreq [Hz],Re(n0:z / s:z),Im(n0:z / s:z)\n"
+    body = "\n".join(f"{1.0 + k * 0.5},1.0e-3,1.0e-3" for k in range(n_rows))
+    return (head + body + "\n").encode()
 
 
 def many_records_uff(n_rec: int) -> bytes:
@@ -151,6 +160,12 @@ def main() -> None:
         wide_csv,
         (10_000, 20_000, 40_000),
         "wide.csv",
+    )
+    scaling(
+        "CSV, lines (one column pair):",
+        tall_csv,
+        (75_000, 150_000, 300_000),
+        "tall.csv",
     )
     scaling("UFF 58, records (8 lines each):", many_records_uff, (1000, 2000, 4000), "many.uff")
     from fbs_core.errors import FBSError

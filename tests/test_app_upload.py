@@ -445,3 +445,19 @@ def test_changed_settings_re_read_the_chassis_even_after_a_stale_click(chassis_f
     assert ds.models == before
     view.bushing.value = "nowhere"  # a wrong node name is reported, nothing else changes
     assert "no bushing node 'nowhere'" in ds.error and ds.models == before
+
+
+@pytest.mark.parametrize("which", ["chassis", "tire"])
+def test_an_empty_file_is_refused_with_a_message(which):
+    """An empty upload (issue 20: it was ignored silently) says so in the page and
+    changes nothing."""
+    ds = DataSource()
+    view = UploadView(data=ds)
+    view.__panel__().get_root()
+    widget = view.chassis_file if which == "chassis" else view.tire_file
+    name = "empty.uff" if which == "chassis" else "empty.h5"
+    widget.param.update(value=b"", filename=name)
+    err = view._error()
+    assert err.visible and "refused" in err.object
+    assert f"{name}" in err.object and "empty" in err.object
+    assert ds.models is REFERENCE

@@ -126,12 +126,13 @@ class UploadView(Viewer):
         for w in (self.chassis_file, self.tire_file, self.reread, self.reset):
             w.disabled = on
 
+    # an empty file (b"") is read too: the page says it is empty instead of ignoring it
     def _on_chassis(self, event):
-        if event.new:
+        if event.new is not None:
             self._run(self.data.load_chassis, event.new, self.chassis_file.filename)
 
     def _on_tire(self, event):
-        if event.new:
+        if event.new is not None:
             self._run(self.data.load_tire, event.new, self.tire_file.filename)
 
     # -- display -----------------------------------------------------------------------

@@ -15,10 +15,14 @@ import concurrent.futures
 import sys
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 from load_clients import BokehSession, column_digest  # noqa: E402
 
 from .conftest import SOURCES  # noqa: E402
+
+pytestmark = pytest.mark.browser
 
 TIMEOUT_S = 90.0
 
