@@ -46,6 +46,7 @@ __all__ = [
     "mobility_data",
     "single_round_data",
     "suggested_table",
+    "suggested_table_ready",
     "tire_quality",
     "uncoupled_data",
     "version",
@@ -271,9 +272,28 @@ def suggested_table(
     ``dof=None`` judges the maximum error over the 6 DOFs (as the thesis' table);
     ``residual``: judged on the residual-compensated responses.
     """
-    return _suggested_table(
-        float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual)
-    )
+    key = (float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual))
+    out = _suggested_table(*key)
+    _TABLES_DONE.add(key)
+    return out
+
+
+#: Argument tuples of suggested tables computed so far (a look-up, no computation).
+_TABLES_DONE: set = set()
+
+
+def suggested_table_ready(
+    threshold_pct: float,
+    f_max: float,
+    coupling: str,
+    dof: str | None = None,
+    models=None,
+    residual: bool = False,
+) -> bool:
+    """True when :func:`suggested_table` of these arguments has been computed before
+    (then it is a cache look-up, unless the cache has dropped it since)."""
+    key = (float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual))
+    return key in _TABLES_DONE
 
 
 @shared_cache(maxsize=64)

@@ -222,6 +222,7 @@ class Results(param.Parameterized):
     def __init__(self, state: DashboardState | None = None, **params):
         self._lock = threading.RLock()
         self._band_job: bands.Job | None = None
+        self._pending: set = set()  # residual tables being computed (see _residual_table)
         params["state"] = state if state is not None else DashboardState()
         params.setdefault("band_status", BandStatus())
         super().__init__(**params)
@@ -286,7 +287,31 @@ class Results(param.Parameterized):
         on_init=True,
     )
     def _suggested(self):
-        self._publish("suggested", suggested_result)
+        self._publish("suggested", lambda s: suggested_result(s, self._residual_table(s)))
+
+    def _residual_table(self, s: Snapshot) -> dict | None:
+        """The suggestion with residual compensation beside the plain one, or None while
+        it is computed on a thread of its own (served pages: its seven residual maps must
+        not delay the first page); the table is published again when it is ready."""
+        args = (s.threshold, s.f_max, s.coupling, s.map_dof, s.models, True)
+        background = bands.served() if self.background is None else self.background
+        if s.residual or not background or compute.suggested_table_ready(*args):
+            return compute.suggested_table(*args)
+        with self._lock:
+            if args in self._pending:
+                return None
+            self._pending.add(args)
+
+        def work():
+            try:
+                compute.suggested_table(*args)
+            finally:
+                with self._lock:
+                    self._pending.discard(args)
+            self._suggested()  # publish again (with the column if the state still wants it)
+
+        threading.Thread(target=work, name="residual-table", daemon=True).start()
+        return None
 
     @param.depends("state.case.models", watch=True, on_init=True)
     def _tire_quality(self):
@@ -587,11 +612,14 @@ def error_map_result(s: Snapshot) -> Result:
     )
 
 
-def suggested_result(s: Snapshot) -> Result:
+def suggested_result(s: Snapshot, tab_r: dict | None = None) -> Result:
+    """The suggested N for every harmonic, plain and (``tab_r``) with residuals; without
+    ``tab_r`` (still being computed) that column is NaN and the caption says so."""
     tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models)
-    tab_r = compute.suggested_table(
-        s.threshold, s.f_max, s.coupling, s.map_dof, s.models, residual=True
-    )
+    pending = tab_r is None
+    if pending:
+        nan = np.full(len(tab["harmonic"]), np.nan)
+        tab_r = {**tab, "n_modes": nan, "eigenfrequency": nan}
     where = f"bushing:{s.dof}" if s.map_dof else s.map_mode
     shown = "with residuals" if s.residual else "plain"
     return Result(
@@ -615,6 +643,7 @@ def suggested_result(s: Snapshot) -> Result:
             "n_modes_residual": "N modes + quasi-static part of the modes left out "
             "(residual compensation)",
             "shown in the error map": shown,
+            "with residuals": "being computed (NaN)" if pending else "computed",
             "models": s.models.describe(),
             **tire_meta(s, harmonics=tab["harmonic"]),
         },
@@ -624,6 +653,7 @@ def suggested_result(s: Snapshot) -> Result:
             f"to **{s.f_max:g} Hz** ({where}), plain and with residual compensation "
             f"(the error map and its dashed line: **{shown}**), and the highest "
             "eigenfrequency among those modes at 80 km/h."
+            + (" The column with residuals is being computed ..." if pending else "")
         ),
         draw={"table": tab, "table_residual": tab_r, "residual": s.residual},
     )

@@ -178,3 +178,24 @@ def test_speed_range_warning_for_a_tire_that_does_not_cover_the_bands():
     meta = tire_meta(s)
     assert "harmonic 3" in meta["tire speed range"].lower() or "40-100" in meta["tire speed range"]
     assert "no extrapolation" in meta["tire speed range"]
+
+
+def test_on_a_served_page_the_residual_column_follows_without_delaying_the_table():
+    import time
+
+    state = DashboardState()
+    state.truncation.param.update(threshold=17.0, f_max=140.0)  # a table nobody computed
+    r = Results(state, background=True)
+    first = r.suggested
+    assert np.isnan(first.columns["n_modes_residual"]).all()
+    assert first.meta["with residuals"].startswith("being computed")
+    t0 = time.monotonic()
+    while np.isnan(r.suggested.columns["n_modes_residual"]).any():
+        assert time.monotonic() - t0 < 900, "the residual column never arrived"
+        time.sleep(0.05)
+    s_on = studies.suggest_modes(
+        0.17, 140.0, residual=True, dof="bushing:z", n_modes=np.arange(10, 400, 10)
+    )
+    np.testing.assert_array_equal(r.suggested.columns["n_modes_residual"], s_on.n_modes)
+    assert r.suggested.meta["with residuals"] == "computed"
+    np.testing.assert_array_equal(r.suggested.columns["n_modes"], first.columns["n_modes"])
