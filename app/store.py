@@ -617,7 +617,7 @@ def suggested_result(s: Snapshot, tab_r: dict | None = None) -> Result:
     ``tab_r`` (still being computed) that column is NaN and the caption says so."""
     tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models)
     pending = tab_r is None
-    if pending:
+    if tab_r is None:
         nan = np.full(len(tab["harmonic"]), np.nan)
         tab_r = {**tab, "n_modes": nan, "eigenfrequency": nan}
     where = f"bushing:{s.dof}" if s.map_dof else s.map_mode
