@@ -310,7 +310,15 @@ class Results(param.Parameterized):
                     self._pending.discard(args)
             self._suggested()  # publish again (with the column if the state still wants it)
 
-        threading.Thread(target=work, name="residual-table", daemon=True).start()
+        def start():
+            threading.Thread(target=work, name="residual-table", daemon=True).start()
+
+        if bands.served():  # after the page is sent (its first build stays as fast)
+            import panel as pn
+
+            pn.state.onload(start)
+        else:
+            start()
         return None
 
     @param.depends("state.case.models", watch=True, on_init=True)

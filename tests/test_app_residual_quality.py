@@ -128,12 +128,13 @@ def test_interpolation_quality_is_shown_and_exported(results):
     q = r.tire_quality
     tire = fbs_core.reference_tire()
     want = interpolation_quality(tire)
-    np.testing.assert_allclose(q.columns["loo_error_dB"], want.worst_db)
+    # the shipped tire shows the estimate its build script stored (rounded to 0.001 dB)
+    np.testing.assert_allclose(q.columns["loo_error_dB"], want.worst_db, atol=5.1e-4)
     assert q.draw["warnings"] == [""] * 7 and q.meta["speed range warnings"] == "none"
     # every export of the case carries the estimate of its harmonic and the coverage
     for res in (r.response, r.error_map):
         assert res.meta["tire interpolation error (leave-one-out, worst)"] == (
-            f"h5: {want.worst_db[4]:.2f} dB"
+            f"h5: {q.columns['loo_error_dB'][4]:.2f} dB"
         )
         assert res.meta["tire speed range"].startswith("covered: 20-120 km/h")
     sug = r.suggested.meta["tire interpolation error (leave-one-out, worst)"]
@@ -141,7 +142,8 @@ def test_interpolation_quality_is_shown_and_exported(results):
     from app.views.quality import quality_html
 
     page = quality_html(q)
-    assert f"{np.nanmax(want.worst_db):.2f} dB" in page and "tire-speed-warning" not in page
+    assert f"{np.nanmax(q.columns['loo_error_dB']):.2f} dB" in page
+    assert "tire-speed-warning" not in page
 
 
 def test_quality_of_a_coarse_tire_against_the_physics():
