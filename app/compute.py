@@ -46,6 +46,8 @@ __all__ = [
     "mobility_data",
     "single_round_data",
     "suggested_table",
+    "suggested_table_ready",
+    "tire_quality",
     "uncoupled_data",
     "version",
 ]
@@ -146,30 +148,39 @@ def _n(models, n_modes):
 
 
 # -- truncation study and coupled response ---------------------------------------------------
-def error_map(harmonic: int, coupling: str, models=None):
+def error_map(harmonic: int, coupling: str, models=None, residual: bool = False):
     """Truncation error map of a harmonic (thesis figs. 5.3, 5.6, 5.7), cached.
 
     Holds the coupled responses for every N of the map and the all-modes reference too.
     The counts are 10, 20, ... below the tire's total (the total is the reference itself).
+    ``residual``: the N-mode responses compensated by the quasi-static part of the modes
+    left out (the reference stays the all-modes response).
     """
-    return _error_map(int(harmonic), coupling, _key(models))
+    return _error_map(int(harmonic), coupling, _key(models), bool(residual))
 
 
-@shared_cache(maxsize=24)
-def _error_map(harmonic: int, coupling: str, models):
+@shared_cache(maxsize=48)
+def _error_map(harmonic: int, coupling: str, models, residual: bool = False):
     n_total = int(_tire(models).n_modes)
     return studies.truncation_map(
-        harmonic, n_modes=np.arange(10, n_total, 10), coupling=coupling, **_models_kw(models)
+        harmonic,
+        n_modes=np.arange(10, n_total, 10),
+        coupling=coupling,
+        residual=residual,
+        **_models_kw(models),
     )
 
 
 @shared_cache(maxsize=64)
-def _bushing_response(harmonic: int, n_modes: int | None, coupling: str, models=None) -> np.ndarray:
+def _bushing_response(
+    harmonic: int, n_modes: int | None, coupling: str, models=None, residual: bool = False
+) -> np.ndarray:
     frf = fbs_core.bushing_response(
         harmonic,
         n_modes=n_modes,
         freq=frequencies(harmonic),
         coupling=coupling,
+        residual=residual,
         **_models_kw(models),
     )
     return np.stack(
@@ -178,29 +189,35 @@ def _bushing_response(harmonic: int, n_modes: int | None, coupling: str, models=
     )
 
 
-def coupled_response(harmonic: int, n_modes: int | None, coupling: str, models=None) -> np.ndarray:
+def coupled_response(
+    harmonic: int, n_modes: int | None, coupling: str, models=None, residual: bool = False
+) -> np.ndarray:
     """Bushing velocity v_e* (eq. 4.1), shape ``(n_freq, 6)`` for ``bushing:x`` ... ``rz``.
 
     ``n_modes=None`` is the all-modes reference. Read from the cached truncation map when it
     holds that N (:meth:`fbs_core.studies.TruncationMap.response_for`), else computed with
-    :func:`fbs_core.bushing_response`.
+    :func:`fbs_core.bushing_response`; ``residual`` compensates the modes left out.
     """
     models = _key(models)
-    m = error_map(harmonic, coupling, models)
-    order = [m.dofs.index(f"bushing:{d}") for d in DIRECTIONS]
     n = _n(models, n_modes)
+    residual = bool(residual) and n is not None  # all modes: nothing left out
+    m = error_map(harmonic, coupling, models, residual)
+    order = [m.dofs.index(f"bushing:{d}") for d in DIRECTIONS]
     row = m.response_for(n)
     if row is not None:
         return row[:, order]
-    return _bushing_response(harmonic, n, coupling, models)
+    return _bushing_response(harmonic, n, coupling, models, residual)
 
 
 def _dof_index(dof: str) -> int:
     return DIRECTIONS.index(dof)
 
 
-def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str, models=None) -> dict:
-    """Columns of the coupled-response view: reference (all modes) and truncated (N modes).
+def mobility_data(
+    harmonic: int, n_modes: int, dof: str, coupling: str, models=None, residual: bool = False
+) -> dict:
+    """Columns of the coupled-response view: reference (all modes) and truncated (N modes,
+    with ``residual`` compensated by the quasi-static part of the modes left out).
 
     Returns
     -------
@@ -210,7 +227,7 @@ def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str, models=N
     """
     j = _dof_index(dof)
     ref = coupled_response(harmonic, None, coupling, models)[:, j]
-    trunc = coupled_response(harmonic, int(n_modes), coupling, models)[:, j]
+    trunc = coupled_response(harmonic, int(n_modes), coupling, models, residual)[:, j]
     return {
         "freq": np.asarray(error_map(harmonic, coupling, models).freq, float),
         "reference": ref,
@@ -220,17 +237,20 @@ def mobility_data(harmonic: int, n_modes: int, dof: str, coupling: str, models=N
     }
 
 
-def error_map_data(harmonic: int, coupling: str, dof: str | None, models=None) -> dict:
+def error_map_data(
+    harmonic: int, coupling: str, dof: str | None, models=None, residual: bool = False
+) -> dict:
     """Error in percent over retained modes and centre frequency.
 
-    ``dof=None`` gives the maximum over the 6 bushing DOFs (fig. 5.6).
+    ``dof=None`` gives the maximum over the 6 bushing DOFs (fig. 5.6); ``residual``: the
+    N-mode responses with residual compensation.
 
     Returns
     -------
     dict
         ``centre_freq`` (n_c,), ``n_modes`` (n_N,), ``error_pct`` (n_N, n_c).
     """
-    m = error_map(harmonic, coupling, models)
+    m = error_map(harmonic, coupling, models, residual)
     err = m.max_error if dof is None else m.dof_error(f"bushing:{dof}")
     return {
         "centre_freq": np.asarray(m.centres, float),
@@ -240,18 +260,45 @@ def error_map_data(harmonic: int, coupling: str, dof: str | None, models=None) -
 
 
 def suggested_table(
-    threshold_pct: float, f_max: float, coupling: str, dof: str | None = None, models=None
+    threshold_pct: float,
+    f_max: float,
+    coupling: str,
+    dof: str | None = None,
+    models=None,
+    residual: bool = False,
 ) -> dict:
     """Suggested number of modes for all seven harmonics (thesis table 5.1).
 
-    ``dof=None`` judges the maximum error over the 6 DOFs (as the thesis' table).
+    ``dof=None`` judges the maximum error over the 6 DOFs (as the thesis' table);
+    ``residual``: judged on the residual-compensated responses.
     """
-    return _suggested_table(float(threshold_pct), float(f_max), coupling, dof, _key(models))
+    key = (float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual))
+    out = _suggested_table(*key)
+    _TABLES_DONE.add(key)
+    return out
+
+
+#: Argument tuples of suggested tables computed so far (a look-up, no computation).
+_TABLES_DONE: set = set()
+
+
+def suggested_table_ready(
+    threshold_pct: float,
+    f_max: float,
+    coupling: str,
+    dof: str | None = None,
+    models=None,
+    residual: bool = False,
+) -> bool:
+    """True when :func:`suggested_table` of these arguments has been computed before
+    (then it is a cache look-up, unless the cache has dropped it since)."""
+    key = (float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual))
+    return key in _TABLES_DONE
 
 
 @shared_cache(maxsize=64)
-def _suggested_table(threshold_pct, f_max, coupling, dof, models) -> dict:
-    maps = [error_map(k, coupling, models) for k in range(1, 8)]
+def _suggested_table(threshold_pct, f_max, coupling, dof, models, residual=False) -> dict:
+    maps = [error_map(k, coupling, models, residual) for k in range(1, 8)]
     s = studies.suggest_modes(
         threshold=threshold_pct / 100.0,
         f_max=f_max,
@@ -266,6 +313,64 @@ def _suggested_table(threshold_pct, f_max, coupling, dof, models) -> dict:
         "n_modes": np.asarray(s.n_modes, int),
         "eigenfrequency": np.asarray(s.eigenfrequency, float),
         "speed": float(s.speed),
+    }
+
+
+def tire_quality(models=None) -> dict:
+    """How far the session's tire can be trusted between and beyond its operating points.
+
+    Computed once per tire (cached by the models token): the leave-one-out interpolation
+    error per harmonic band (:func:`fbs_core.tire.quality.interpolation_quality`: every
+    interior operating point predicted from its neighbours, worst dB per harmonic) and
+    the speed coverage of every band (:func:`fbs_core.tire.quality.speed_coverage`,
+    whose :class:`~fbs_core.tire.quality.SpeedRangeWarning` texts are collected here).
+
+    Returns
+    -------
+    dict
+        ``harmonic`` (7,), ``loo_db`` (7,) worst leave-one-out error in dB (NaN: no
+        interior point in the band's speeds), ``covered`` (7,) bool, ``warnings`` list of
+        str (one per band needing speeds outside the stored ones), ``speeds`` (min, max)
+        km/h, ``n_points``, ``method`` (str).
+    """
+    return _tire_quality(_key(models))
+
+
+@shared_cache(maxsize=8)
+def _tire_quality(models) -> dict:
+    import warnings
+
+    from fbs_core.tire.quality import SpeedRangeWarning, interpolation_quality, speed_coverage
+    from fbs_core.vocabulary import HARMONIC_CASES
+
+    tire = _tire(models)
+    ks = tuple(HARMONIC_CASES)
+    stored = tire.meta.get("interpolation_quality", {}).get("worst_db", {})
+    if models is None and all(str(k) in stored for k in ks):
+        # the shipped tire: the estimate its build script stored (the same function on
+        # the same data, rounded to 0.001 dB), so that no page waits for it
+        loo = np.array([np.nan if stored[str(k)] is None else stored[str(k)] for k in ks])
+    elif tire.speeds.size >= 3:
+        loo = np.asarray(interpolation_quality(tire, ks).worst_db, float)
+    else:
+        loo = np.full(len(ks), np.nan)
+    covered, texts = [], []
+    for k in ks:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SpeedRangeWarning)
+            speed_coverage(tire, k)
+        msgs = [str(w.message) for w in caught if issubclass(w.category, SpeedRangeWarning)]
+        covered.append(not msgs)
+        texts += msgs
+    return {
+        "harmonic": readonly(np.asarray(ks, int)),
+        "loo_db": readonly(np.asarray(loo, float)),
+        "covered": readonly(np.asarray(covered, bool)),
+        "warnings": tuple(texts),
+        "speeds": (float(tire.speeds[0]), float(tire.speeds[-1])),
+        "n_points": int(tire.speeds.size),
+        "method": "leave one operating point out, predict it from its neighbours (twice "
+        "the spacing: an upper estimate); worst over the band's speeds",
     }
 
 

@@ -42,6 +42,7 @@ from app.views import (
 from app.views.analysis_base import analysis_card
 from app.views.campaign import campaign_card
 from app.views.plots import frequency_range, modes_range
+from app.views.quality import TireQualityView
 
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
 
@@ -222,7 +223,7 @@ def data_card(parts: PageParts) -> pn.Card:
     page = parts.page
     upload = parts.card(
         "Your data: chassis FRF and tire model for this session",
-        UploadView(data=parts.state.data),
+        pn.Column(UploadView(data=parts.state.data), TireQualityView(store=parts.results)),
         None,
         collapsed=page.view == "present" or page.data_card == "closed",
         css_classes=["upload-card"],

@@ -65,6 +65,12 @@ class CaseState(param.Parameterized):
         objects=list(DIRECTIONS),
         doc="Spindle input DOF of the uncoupled chassis spindle-to-bushing mobility.",
     )
+    residual = param.Boolean(
+        default=False,
+        doc="Residual compensation: the tire modes left out of N still enter with their "
+        "quasi-static part (upper residual flexibility, docs/tire-model.md); acts on the "
+        "coupled response, the error map and the suggested N it marks.",
+    )
     models = param.ClassSelector(
         class_=Models,
         default=REFERENCE,
@@ -184,6 +190,7 @@ URL_KEYS: dict[str, dict[str, str]] = {
         "coupling": "coupling",
         "show_uncoupled": "uncoupled",
         "spindle_input": "input",
+        "residual": "res",
     },
     "noise": {
         "noise": "noise",

@@ -93,6 +93,7 @@ class Snapshot:
     threshold: float
     f_max: float
     map_mode: str
+    residual: bool = False
 
     @classmethod
     def of(cls, state: DashboardState) -> Snapshot:
@@ -115,6 +116,7 @@ class Snapshot:
             threshold=float(t.threshold),
             f_max=float(t.f_max),
             map_mode=t.map_mode,
+            residual=bool(c.residual),
         )
 
     @property
@@ -194,6 +196,9 @@ class Results(param.Parameterized):
     error_map = param.ClassSelector(class_=Result, doc="Truncation error map (eq. 5.1).")
     suggested = param.ClassSelector(class_=Result, doc="Suggested modes (table 5.1).")
     eigen = param.ClassSelector(class_=Result, doc="Eigenfrequency vs N (fig. 5.8).")
+    tire_quality = param.ClassSelector(
+        class_=Result, doc="Leave-one-out interpolation error and speed coverage of the tire."
+    )
     uncoupled = param.ClassSelector(
         class_=Result, allow_None=True, doc="Uncoupled tire and chassis (None until shown)."
     )
@@ -217,6 +222,7 @@ class Results(param.Parameterized):
     def __init__(self, state: DashboardState | None = None, **params):
         self._lock = threading.RLock()
         self._band_job: bands.Job | None = None
+        self._pending: set = set()  # residual tables being computed (see _residual_table)
         params["state"] = state if state is not None else DashboardState()
         params.setdefault("band_status", BandStatus())
         super().__init__(**params)
@@ -246,6 +252,7 @@ class Results(param.Parameterized):
         "state.case.dof",
         "state.case.coupling",
         "state.case.models",
+        "state.case.residual",
         watch=True,
         on_init=True,
     )
@@ -261,6 +268,7 @@ class Results(param.Parameterized):
         "state.truncation.map_mode",
         "state.truncation.threshold",
         "state.truncation.f_max",
+        "state.case.residual",
         watch=True,
         on_init=True,
     )
@@ -274,11 +282,48 @@ class Results(param.Parameterized):
         "state.truncation.map_mode",
         "state.truncation.threshold",
         "state.truncation.f_max",
+        "state.case.residual",
         watch=True,
         on_init=True,
     )
     def _suggested(self):
-        self._publish("suggested", suggested_result)
+        self._publish("suggested", lambda s: suggested_result(s, self._residual_table(s)))
+
+    def _residual_table(self, s: Snapshot) -> dict | None:
+        """The suggestion with residual compensation beside the plain one, or None while
+        it is computed on a thread of its own (served pages: its seven residual maps must
+        not delay the first page); the table is published again when it is ready."""
+        args = (s.threshold, s.f_max, s.coupling, s.map_dof, s.models, True)
+        background = bands.served() if self.background is None else self.background
+        if s.residual or not background or compute.suggested_table_ready(*args):
+            return compute.suggested_table(*args)
+        with self._lock:
+            if args in self._pending:
+                return None
+            self._pending.add(args)
+
+        def work():
+            try:
+                compute.suggested_table(*args)
+            finally:
+                with self._lock:
+                    self._pending.discard(args)
+            self._suggested()  # publish again (with the column if the state still wants it)
+
+        def start():
+            threading.Thread(target=work, name="residual-table", daemon=True).start()
+
+        if bands.served():  # after the page is sent (its first build stays as fast)
+            import panel as pn
+
+            pn.state.onload(start)
+        else:
+            start()
+        return None
+
+    @param.depends("state.case.models", watch=True, on_init=True)
+    def _tire_quality(self):
+        self._publish("tire_quality", tire_quality_result)
 
     @param.depends("state.case.models", "state.case.n_modes", watch=True, on_init=True)
     def _eigen(self):
@@ -430,8 +475,72 @@ def _done_status(band: Band) -> BandStatus:
 
 
 # -- what each result holds -----------------------------------------------------------------
+def residual_meta(on: bool) -> str:
+    """The CSV header's word on residual compensation."""
+    if on:
+        return (
+            "on: the tire modes left out of N enter with their quasi-static part "
+            "(upper residual flexibility, docs/tire-model.md)"
+        )
+    return "off: plain truncation to N modes"
+
+
+def tire_meta(s: Snapshot, harmonics=None) -> dict:
+    """The tire's interpolation quality and speed coverage for a CSV header (issue 13)."""
+    q = compute.tire_quality(s.models)
+    ks = [s.harmonic] if harmonics is None else list(harmonics)
+    idx = [list(q["harmonic"]).index(k) for k in ks]
+    loo = "; ".join(
+        f"h{k}: " + ("n/a" if not np.isfinite(q["loo_db"][i]) else f"{q['loo_db'][i]:.2f} dB")
+        for k, i in zip(ks, idx, strict=True)
+    )
+    warn = [w for k, w in zip(q["harmonic"], _band_warnings(q), strict=True) if k in ks and w]
+    return {
+        "tire interpolation error (leave-one-out, worst)": loo,
+        "tire speed range": (
+            " | ".join(warn)
+            if warn
+            else f"covered: {q['speeds'][0]:g}-{q['speeds'][1]:g} km/h, "
+            f"{q['n_points']} operating points"
+        ),
+    }
+
+
+def _band_warnings(q: dict) -> list[str]:
+    """One warning text (or "") per harmonic of ``compute.tire_quality``'s table."""
+    texts = iter(q["warnings"])
+    return [("" if ok else next(texts, "outside the stored speeds")) for ok in q["covered"]]
+
+
+def tire_quality_result(s: Snapshot) -> Result:
+    q = compute.tire_quality(s.models)
+    warn = _band_warnings(q)
+    return Result(
+        columns={
+            "harmonic": np.asarray(q["harmonic"]),
+            "loo_error_dB": np.asarray(q["loo_db"]),
+            "speeds_covered": np.asarray(q["covered"], float),
+        },
+        meta={
+            "view": "tire interpolation quality (leave-one-out) and speed coverage",
+            "method": q["method"],
+            "operating points": f"{q['n_points']}, {q['speeds'][0]:g}-{q['speeds'][1]:g} km/h",
+            "speed range warnings": " | ".join(w for w in warn if w) or "none",
+            "models": s.models.describe(),
+        },
+        filename="tire_interpolation_quality.csv",
+        caption=(
+            f"Tire between its {q['n_points']} operating points "
+            f"({q['speeds'][0]:g}-{q['speeds'][1]:g} km/h): leave-one-out error per "
+            "harmonic band"
+        ),
+        draw={"quality": q, "warnings": warn, "harmonic": s.harmonic},
+    )
+
+
 def response_result(s: Snapshot) -> Result:
-    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models)
+    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models, s.residual)
+    res = " + residual" if s.residual else ""
     return Result(
         columns={
             "freq_Hz": d["freq"],
@@ -445,28 +554,38 @@ def response_result(s: Snapshot) -> Result:
             "harmonic": s.harmonic,
             "N (retained tire modes)": s.n_modes,
             "reference": "all tire modes",
+            "residual compensation": residual_meta(s.residual),
             "response DOF": f"bushing:{s.dof}",
             "coupling": s.coupling,
             "unit": compute.level_unit(s.dof),
             "models": s.models.describe(),
+            **tire_meta(s),
         },
-        filename=f"bushing_response_h{s.harmonic}_N{s.n_modes}_{s.dof}_{s.coupling}.csv",
-        caption=(
-            f"**Harmonic {s.harmonic}** &middot; bushing:{s.dof} &middot; N = {s.n_modes} "
-            f"&middot; {s.coupling} coupling"
+        filename=(
+            f"bushing_response_h{s.harmonic}_N{s.n_modes}{'_res' if s.residual else ''}"
+            f"_{s.dof}_{s.coupling}.csv"
         ),
-        draw={"dof": s.dof},
+        caption=(
+            f"**Harmonic {s.harmonic}** &middot; bushing:{s.dof} &middot; N = {s.n_modes}"
+            f"{res} &middot; {s.coupling} coupling"
+        ),
+        draw={
+            "dof": s.dof,
+            "truncated_label": f"N retained modes{' + residual' if s.residual else ''}",
+        },
     )
 
 
 def _suggested_n(s: Snapshot) -> int:
-    tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models)
+    tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models, s.residual)
     return int(tab["n_modes"][list(tab["harmonic"]).index(s.harmonic)])
 
 
 def error_map_result(s: Snapshot) -> Result:
-    d = compute.error_map_data(s.harmonic, s.coupling, s.map_dof, s.models)
+    d = compute.error_map_data(s.harmonic, s.coupling, s.map_dof, s.models, s.residual)
     what = f"bushing:{s.dof}" if s.map_dof else "max over 6 DOFs"
+    if s.residual:
+        what += ", with residuals"
     nn, ff = np.meshgrid(d["n_modes"], d["centre_freq"], indexing="ij")
     return Result(
         columns={
@@ -480,10 +599,15 @@ def error_map_result(s: Snapshot) -> Result:
             "coupling": s.coupling,
             "response DOF": what,
             "reference": "all tire modes",
+            "residual compensation": residual_meta(s.residual),
             "layout": "long: one row per (N, centre freq)",
             "models": s.models.describe(),
+            **tire_meta(s),
         },
-        filename=f"truncation_map_h{s.harmonic}_{s.map_dof or 'maxdof'}.csv",
+        filename=(
+            f"truncation_map_h{s.harmonic}_{s.map_dof or 'maxdof'}"
+            f"{'_res' if s.residual else ''}.csv"
+        ),
         draw={
             "map": d,
             "title": f"Harmonic {s.harmonic}, {what}",
@@ -496,16 +620,25 @@ def error_map_result(s: Snapshot) -> Result:
     )
 
 
-def suggested_result(s: Snapshot) -> Result:
+def suggested_result(s: Snapshot, tab_r: dict | None = None) -> Result:
+    """The suggested N for every harmonic, plain and (``tab_r``) with residuals; without
+    ``tab_r`` (still being computed) that column is NaN and the caption says so."""
     tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models)
+    pending = tab_r is None
+    if tab_r is None:
+        nan = np.full(len(tab["harmonic"]), np.nan)
+        tab_r = {**tab, "n_modes": nan, "eigenfrequency": nan}
     where = f"bushing:{s.dof}" if s.map_dof else s.map_mode
+    shown = "with residuals" if s.residual else "plain"
     return Result(
         columns={
             "harmonic": tab["harmonic"],
             "f_low_Hz": tab["f_low"],
             "f_high_Hz": tab["f_high"],
             "n_modes": tab["n_modes"],
+            "n_modes_residual": tab_r["n_modes"],
             "eigenfrequency_Hz": tab["eigenfrequency"],
+            "eigenfrequency_residual_Hz": tab_r["eigenfrequency"],
         },
         meta={
             "view": "suggested number of modes (thesis table 5.1)",
@@ -514,15 +647,23 @@ def suggested_result(s: Snapshot) -> Result:
             "coupling": s.coupling,
             "response DOF": f"bushing:{s.dof}" if s.map_dof else "max over 6 DOFs",
             "eigenfrequency": "highest retained eigenfrequency at 80 km/h",
+            "n_modes": "plain truncation to N modes",
+            "n_modes_residual": "N modes + quasi-static part of the modes left out "
+            "(residual compensation)",
+            "shown in the error map": shown,
+            "with residuals": "being computed (NaN)" if pending else "computed",
             "models": s.models.describe(),
+            **tire_meta(s, harmonics=tab["harmonic"]),
         },
         filename=f"suggested_modes_thr{s.threshold:g}_fmax{s.f_max:g}.csv",
         caption=(
             f"Smallest N from which the error stays below **{s.threshold:g} %** up "
-            f"to **{s.f_max:g} Hz** ({where}), and the highest eigenfrequency among "
-            "those modes at 80 km/h."
+            f"to **{s.f_max:g} Hz** ({where}), plain and with residual compensation "
+            f"(the error map and its dashed line: **{shown}**), and the highest "
+            "eigenfrequency among those modes at 80 km/h."
+            + (" The column with residuals is being computed ..." if pending else "")
         ),
-        draw={"table": tab},
+        draw={"table": tab, "table_residual": tab_r, "residual": s.residual},
     )
 
 

@@ -160,6 +160,10 @@ class Controls(Viewer):
                 "case.show_uncoupled": W.Checkbox.from_param(
                     c.param.show_uncoupled, name="Show uncoupled tire and chassis FRFs"
                 ),
+                "case.residual": W.Checkbox.from_param(
+                    c.param.residual,
+                    name="Residual compensation (modes left out: quasi-static part)",
+                ),
                 "truncation.threshold": self._typed("truncation.threshold"),
                 "truncation.f_max": self._typed("truncation.f_max"),
                 "truncation.map_mode": W.RadioButtonGroup.from_param(
@@ -213,6 +217,7 @@ class Controls(Viewer):
             m["truncation.f_max"],
             label("Error map of", margin=(0, 10)),
             w["truncation.map_mode"],
+            w["case.residual"],
             pn.layout.Divider(),
             label("#### Noise study", margin=(0, 5)),
             w["noise.noise"],

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import panel as pn
 import param
+from bokeh.core.property.vectorization import value
 
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
 from .live import LiveView
@@ -62,6 +63,10 @@ class MobilityView(LiveView):
         self._ref.data = {"freq": c["freq_Hz"], "level": c["reference_dB"]}
         self._tr.data = {"freq": c["freq_Hz"], "level": c["truncated_dB"]}
         self._fig.yaxis.axis_label = level_label(r.draw["dof"])
+        label = r.draw.get("truncated_label")
+        for item in self._fig.legend[0].items if label and self._fig.legend else ():
+            if item.renderers and item.renderers[0].data_source is self._tr:
+                item.label = value(label)  # "N retained modes" or "... + residual"
 
 
 class UncoupledView(LiveView):

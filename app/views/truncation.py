@@ -208,16 +208,20 @@ class SuggestedModesView(Viewer):
         import pandas as pd
 
         tab = r.draw["table"]
-        return pd.DataFrame(
-            {
-                "Harmonic": tab["harmonic"],
-                "Band (Hz)": [
-                    f"{a:.1f}-{b:.1f}" for a, b in zip(tab["f_low"], tab["f_high"], strict=True)
-                ],
-                "Suggested N": tab["n_modes"],
-                "Highest eigenfreq. (Hz)": tab["eigenfrequency"].round(1),
-            }
-        )
+        cols = {
+            "Harmonic": tab["harmonic"],
+            "Band (Hz)": [
+                f"{a:.1f}-{b:.1f}" for a, b in zip(tab["f_low"], tab["f_high"], strict=True)
+            ],
+            "Suggested N": tab["n_modes"],
+        }
+        res = r.draw.get("table_residual")
+        shown = tab
+        if res is not None:  # both columns; the caption says which one the map shows
+            cols["N with residuals"] = res["n_modes"]
+            shown = res if r.draw.get("residual") else tab
+        cols["Highest eigenfreq. (Hz)"] = shown["eigenfrequency"].round(1)
+        return pd.DataFrame(cols)
 
     @param.depends("store.suggested", watch=True)
     def _changed(self):
