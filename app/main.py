@@ -39,6 +39,7 @@ from app.views import (
     UncoupledView,
     UploadView,
 )
+from app.views.analysis_base import page_card as analysis_card
 from app.views.plots import frequency_range, modes_range
 
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
@@ -132,7 +133,7 @@ class PageParts:
 
 #: Further cards, below the built-in plots, in this order: ``builder(parts) -> panel object``
 #: (None: nothing). A view in its own module under ``app/views/`` adds its builder here.
-EXTRA_CARDS: list[Callable[[PageParts], Any]] = []
+EXTRA_CARDS: list[Callable[[PageParts], Any]] = [analysis_card]  # issue 18: Analysis card
 
 
 def extra_cards(parts: PageParts) -> list:

@@ -11,6 +11,7 @@ import param
 
 from fbs_core.vocabulary import COUPLINGS, DIRECTIONS
 
+from .analysis_state import AnalysisState
 from .datasource import REFERENCE, DataSource, Models
 
 __all__ = [
@@ -151,6 +152,9 @@ class DashboardState(param.Parameterized):
     case = param.ClassSelector(class_=CaseState, instantiate=False)
     noise = param.ClassSelector(class_=NoiseState, instantiate=False)
     truncation = param.ClassSelector(class_=TruncationState, instantiate=False)
+    analysis = param.ClassSelector(
+        class_=AnalysisState, instantiate=False, doc="The Analysis card (issue 18)."
+    )
     data = param.ClassSelector(
         class_=DataSource,
         instantiate=False,
@@ -162,6 +166,7 @@ class DashboardState(param.Parameterized):
         params.setdefault("noise", NoiseState())
         params.setdefault("truncation", TruncationState())
         params.setdefault("data", DataSource())
+        params.setdefault("analysis", AnalysisState())
         super().__init__(**params)
         self.case.models = self.data.models
         self.data.param.watch(self._use_models, "models")
@@ -190,4 +195,17 @@ URL_KEYS: dict[str, dict[str, str]] = {
         "percentile": "pct",
     },
     "truncation": {"threshold": "thr", "f_max": "fmax", "map_mode": "map"},
+    "analysis": {
+        "tab": "atab",
+        "frf": "afrf",
+        "phase_mode": "aphase",
+        "log_freq": "alog",
+        "cursor1": "c1",
+        "cursor2": "c2",
+        "picked_speed": "pv",
+        "picked_freq": "pf",
+        "contrib_mode": "acontrib",
+        "pins": "pins",
+        "compare_to": "cmp",
+    },
 }

@@ -225,6 +225,11 @@ class Results(param.Parameterized):
                 return
             setattr(self, name, make(Snapshot.of(self.state)))
 
+    @property
+    def lock(self) -> threading.RLock:
+        """The session's lock (publishers of other results of the session share it)."""
+        return self._lock
+
     def snapshot(self) -> Snapshot:
         """The current state as plain values."""
         return Snapshot.of(self.state)

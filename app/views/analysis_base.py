@@ -1,0 +1,130 @@
+"""Shared base of the Analysis card's views (issue 18) and the card itself.
+
+An :class:`AnalysisView` is a :class:`~app.views.live.LiveView` that draws a result of the
+session's :class:`~app.analysis_store.AnalysisResults` and shows the picked speed /
+frequency (``AnalysisResults.pick``) as markers. :func:`analysis_card` builds the card with
+one tab per view; the tab shown is ``state.analysis.tab`` (in the URL as ``atab``), and
+only the shown tab's results are computed.
+"""
+
+from __future__ import annotations
+
+import panel as pn
+import param
+
+from ..analysis_state import ANALYSIS_TABS
+from ..analysis_store import AnalysisResults
+from .live import LiveView
+
+__all__ = ["AnalysisView", "analysis_card", "page_card"]
+
+#: Colours of the six interface DOFs' terms (and of pins).
+TERM_COLORS = ("#1971c2", "#2b8a3e", "#e03131", "#f08c00", "#7048e8", "#0c8599")
+PICK_COLOR = "#c2255c"
+
+
+class AnalysisView(LiveView):
+    """A view of an analysis result; redrawn when its result or the pick changes."""
+
+    analysis = param.ClassSelector(class_=AnalysisResults, doc="The card's results.")
+    x_range = param.Parameter(default=None, doc="Shared frequency range (linked zoom).")
+    #: Name of the result in AnalysisResults.
+    result_name = ""
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self.analysis.param.watch(lambda _e: self.redraw(), [self.result_name, "pick"])
+
+    def result(self):
+        return getattr(self.analysis, self.result_name)
+
+    def _apply(self):
+        super()._apply()
+        if not self.store.closed and self.result() is not None:
+            self._draw_pick(self.analysis.pick.draw)
+
+    def _draw_pick(self, pick: dict) -> None:
+        """Show the picked speed / frequency (``None``: not picked)."""
+
+
+def _tab_names() -> dict[str, str]:
+    return {
+        "compare": "Compare",
+        "phase": "Phase and peaks",
+        "speed": "Across speed",
+        "contributions": "Contributions",
+    }
+
+
+def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
+    """The "Analysis" card: one tab per analysis view, computed only while shown.
+
+    ``tabs`` maps tab keys (:data:`~app.analysis_state.ANALYSIS_TABS`) to a function
+    ``(analysis_results, x_range) -> viewable``; default all views of the card.
+    """
+    from .analysis_contrib import ContributionsView
+    from .analysis_phase import PhaseView
+    from .analysis_speed import speed_tab
+
+    analysis = AnalysisResults(store=results)
+    results.analysis = analysis  # for the report, tests and benchmarks
+    state = results.state.analysis
+    if tabs is None:
+        tabs = {
+            "phase": lambda a, x: PhaseView(store=results, analysis=a, x_range=x),
+            "speed": lambda a, x: speed_tab(results, a),
+            "contributions": lambda a, x: ContributionsView(store=results, analysis=a, x_range=x),
+        }
+        try:
+            from .analysis_compare import CompareView
+
+            tabs = {
+                "compare": lambda a, x: CompareView(store=results, analysis=a, x_range=x),
+                **tabs,
+            }
+        except ImportError:
+            pass
+    keys = [k for k in ANALYSIS_TABS if k in tabs]
+    names = _tab_names()
+    panes = pn.Tabs(
+        *[(names[k], tabs[k](analysis, x_range)) for k in keys],
+        dynamic=True,
+        sizing_mode="stretch_both",
+        css_classes=["analysis-tabs"],
+    )
+    card = pn.Card(
+        panes,
+        title="Analysis: compare states, phase and peaks, across speed, contributions",
+        collapsible=True,
+        collapsed=state.tab == "",
+        height=720,
+        sizing_mode="stretch_width",
+        header_background="#e9ecef",
+        margin=(4, 4),
+        css_classes=["analysis-card"],
+    )
+    if state.tab in keys:
+        panes.active = keys.index(state.tab)
+
+    def shown(*_):
+        tab = "" if card.collapsed else keys[panes.active]
+        if state.tab != tab:
+            state.tab = tab
+
+    def from_state(*_):
+        if state.tab in keys:
+            card.collapsed = False
+            if panes.active != keys.index(state.tab):
+                panes.active = keys.index(state.tab)
+        elif not card.collapsed:
+            card.collapsed = True
+
+    card.param.watch(shown, "collapsed")
+    panes.param.watch(shown, "active")
+    state.param.watch(from_state, "tab")
+    return card
+
+
+def page_card(parts) -> pn.Card:
+    """The card for the page's ``EXTRA_CARDS`` (``app.main.PageParts``: store, shared axes)."""
+    return analysis_card(parts.results, parts.freq)

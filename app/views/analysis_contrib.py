@@ -1,0 +1,151 @@
+"""Contributions of the six interface forces to the bushing response (eq. 4.1 term by term).
+
+Lines: the level of each term ``Y_ej^E[bushing, spindle:d] g_d`` and of their sum (the
+coupled response). Stacked: each term's share of the total, ``Re(t conj(T)) / |T|^2`` in
+percent (the shares add up to 100 % at every line; a term in anti-phase with the total
+counts negative), answering "is it the vertical force or the wind-up moment?".
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import panel as pn
+from bokeh.models import ColumnDataSource, HoverTool, Span
+
+from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
+from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
+from .plots import add_line, fit_range, frequency_range, new_figure
+
+__all__ = ["ContributionsView"]
+
+DOFS = ("x", "y", "z", "rx", "ry", "rz")
+
+
+class ContributionsView(AnalysisView):
+    """Bushing response split into the contributions of the hub forces and moments."""
+
+    key = "contributions"
+    result_name = "contributions"
+    min_height = 420
+
+    def _controls(self):
+        return [
+            pn.widgets.RadioButtonGroup.from_param(
+                self.store.state.analysis.param.contrib_mode,
+                name="",
+                width=160,
+                css_classes=["ctl-analysis-contrib_mode"],
+            )
+        ]
+
+    def _build(self):
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        self._lines_fig = fig = new_figure(
+            x_label=FREQ_LABEL,
+            y_label=level_label("z"),
+            x_range=self.x_range,
+            name="contributions.figure",
+            min_height=400,
+        )
+        self._terms = {}
+        for d, color in zip(DOFS, TERM_COLORS, strict=True):
+            self._terms[d] = add_line(
+                fig,
+                f"contributions.hub_{d}",
+                color=color,
+                legend=f"hub:{d}",
+                width=1.6,
+                tooltips=level_tooltips(f"force at hub:{d}"),
+                legend_location="bottom_right",
+            )
+        self._total = add_line(
+            fig,
+            "contributions.total",
+            color=COLORS["reference"],
+            legend="total (eq. 4.1)",
+            width=2.6,
+            tooltips=level_tooltips("total"),
+            legend_location="bottom_right",
+        )
+        # stacked shares: one source, a varea per term between cumulative columns
+        self._stack = ColumnDataSource(
+            {"freq": np.zeros(0), **{f"c{k}": np.zeros(0) for k in range(len(DOFS) + 1)}},
+            name="contributions.stacked",
+        )
+        self._stack_fig = sf = new_figure(
+            x_label=FREQ_LABEL,
+            y_label="Share of the total (%)",
+            x_range=self.x_range,
+            name="contributions.stacked_figure",
+            min_height=400,
+        )
+        for k, (d, color) in enumerate(zip(DOFS, TERM_COLORS, strict=True)):
+            sf.varea(
+                "freq",
+                f"c{k}",
+                f"c{k + 1}",
+                source=self._stack,
+                fill_color=color,
+                fill_alpha=0.7,
+                legend_label=f"hub:{d}",
+            )
+        sf.add_tools(
+            HoverTool(
+                tooltips=[("Frequency", "@freq{0.0} Hz")]
+                + [(f"hub:{d}", f"@s{k}{{0.0}} %") for k, d in enumerate(DOFS)],
+                mode="vline",
+            )
+        )
+        sf.legend.location = "bottom_right"
+        sf.legend.click_policy = "hide"
+        self._picks = [
+            Span(
+                location=0,
+                dimension="height",
+                line_color=PICK_COLOR,
+                line_dash="dotted",
+                line_width=2,
+                visible=False,
+                name="contributions.pick",
+            )
+            for _ in range(2)
+        ]
+        fig.add_layout(self._picks[0])
+        sf.add_layout(self._picks[1])
+        sf.visible = False
+        from bokeh.layouts import column
+
+        return [column(fig, sf, sizing_mode="stretch_both")]
+
+    def _draw(self, r):
+        c, d = r.columns, r.draw
+        f = c["freq_Hz"]
+        fit_range(self.x_range, f)
+        interface = [j.split(":")[1] for j in d["interface"]]
+        empty = np.full(f.size, np.nan)
+        for dof, src in self._terms.items():
+            src.data = {
+                "freq": f,
+                "level": c[f"hub_{dof}_dB"] if dof in interface else empty,
+            }
+        self._total.data = {"freq": f, "level": c["total_dB"]}
+        cum = np.zeros(f.size)
+        stack = {"freq": f, "c0": cum.copy()}
+        for k, dof in enumerate(DOFS):
+            share = 100 * c[f"hub_{dof}_share"] if dof in interface else np.zeros(f.size)
+            stack[f"s{k}"] = share
+            cum = cum + share
+            stack[f"c{k + 1}"] = cum.copy()
+        self._stack.data = stack
+        stacked = d["mode"] == "stacked"
+        self._stack_fig.visible = stacked
+        self._lines_fig.visible = not stacked
+        self._lines_fig.yaxis.axis_label = level_label(d["dof"])
+
+    def _draw_pick(self, pick):
+        f = pick.get("freq")
+        for s in self._picks:
+            s.visible = f is not None
+            if f is not None:
+                s.location = f

@@ -1,0 +1,253 @@
+"""Phase and peaks: Bode (level and unwrapped phase) or real / imaginary parts of the coupled
+response, the tire's free hub velocity or the chassis mobility, with automatic peak labels
+(frequency, level, speed on the harmonic line and the coupled system's modes nearby, which
+arrive a moment later), two delta cursors and a logarithmic frequency option.
+
+A click in either plot places a cursor (1, then 2, then 1 ...); the cursors can also be
+typed (0 = off). The readout (df, dL, f2/f1) is in the caption and the CSV header.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import panel as pn
+from bokeh.events import Tap
+from bokeh.layouts import column
+from bokeh.models import (
+    ColumnDataSource,
+    HoverTool,
+    LabelSet,
+    LinearAxis,
+    LinearScale,
+    LogAxis,
+    LogScale,
+    Span,
+)
+
+from .analysis_base import PICK_COLOR, AnalysisView
+from .common import COLORS, FREQ_LABEL
+from .plots import fit_range, frequency_range, new_figure
+
+__all__ = ["PhaseView"]
+
+CURSOR_COLOR = "#5f3dc4"
+
+
+class PhaseView(AnalysisView):
+    """Bode or real/imaginary view with peak labels and delta cursors."""
+
+    key = "phase"
+    result_name = "phase"
+    min_height = 520
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._next_cursor = 1
+        self.analysis.param.watch(lambda _e: self.redraw(), ["peak_modes"])
+
+    def _controls(self):
+        a = self.store.state.analysis
+        W = pn.widgets
+        return [
+            W.Select.from_param(a.param.frf, name="", width=110, css_classes=["ctl-analysis-frf"]),
+            W.RadioButtonGroup.from_param(
+                a.param.phase_mode, name="", width=150, css_classes=["ctl-analysis-phase_mode"]
+            ),
+            W.Checkbox.from_param(
+                a.param.log_freq, name="log f", width=70, css_classes=["ctl-analysis-log_freq"]
+            ),
+            W.FloatInput.from_param(
+                a.param.cursor1, name="", width=80, step=0.5, css_classes=["ctl-analysis-cursor1"]
+            ),
+            W.FloatInput.from_param(
+                a.param.cursor2, name="", width=80, step=0.5, css_classes=["ctl-analysis-cursor2"]
+            ),
+        ]
+
+    def _build(self):
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        self._top = top = new_figure(
+            x_label=FREQ_LABEL,
+            y_label="Level (dB)",
+            x_range=self.x_range,
+            name="phase.top",
+            min_height=260,
+        )
+        self._bottom = bottom = new_figure(
+            x_label=FREQ_LABEL,
+            y_label="Phase (deg)",
+            x_range=self.x_range,
+            name="phase.bottom",
+            min_height=200,
+        )
+        self._src = {}
+        styles = {
+            "a": (COLORS["reference"], "solid", "all modes"),
+            "b": (COLORS["truncated"], "dashed", "N modes"),
+        }
+        for key, (color, dash, label) in styles.items():
+            src = ColumnDataSource(
+                {"freq": np.zeros(0), "top": np.zeros(0), "bottom": np.zeros(0)},
+                name=f"phase.{key}",
+            )
+            self._src[key] = src
+            for fig, col in ((top, "top"), (bottom, "bottom")):
+                r = fig.line(
+                    "freq",
+                    col,
+                    source=src,
+                    line_color=color,
+                    line_width=2,
+                    line_dash=dash,
+                    legend_label=label,
+                )
+                fig.add_tools(
+                    HoverTool(
+                        renderers=[r],
+                        mode="vline",
+                        tooltips=[
+                            ("", label),
+                            ("Frequency", "@freq{0.00} Hz"),
+                            ("Value", f"@{col}{{0.00}}"),
+                        ],
+                    )
+                )
+        for fig in (top, bottom):
+            fig.legend.location = "bottom_left"
+            fig.legend.click_policy = "hide"
+            fig.legend.label_text_font_size = "9pt"
+        self._peaks = ColumnDataSource({"freq": [], "level": [], "text": []}, name="phase.peaks")
+        top.scatter(
+            "freq",
+            "level",
+            source=self._peaks,
+            size=8,
+            marker="inverted_triangle",
+            color=COLORS["truncated"],
+        )
+        self._labels = LabelSet(
+            x="freq",
+            y="level",
+            text="text",
+            source=self._peaks,
+            x_offset=6,
+            y_offset=4,
+            text_font_size="8pt",
+            background_fill_color="white",
+            background_fill_alpha=0.7,
+        )
+        top.add_layout(self._labels)
+        self._cursor_spans = []
+        for fig in (top, bottom):
+            spans = [
+                Span(
+                    location=0,
+                    dimension="height",
+                    line_color=CURSOR_COLOR,
+                    line_width=1.5,
+                    line_dash=dash,
+                    visible=False,
+                    name=f"phase.cursor{k + 1}",
+                )
+                for k, dash in enumerate(("solid", "dashed"))
+            ]
+            for s in spans:
+                fig.add_layout(s)
+            self._cursor_spans.append(spans)
+        self._cursors = ColumnDataSource({"freq": [], "level": []}, name="phase.cursors")
+        top.scatter("freq", "level", source=self._cursors, size=9, color=CURSOR_COLOR)
+        self._pick_spans = []
+        for fig in (top, bottom):
+            s = Span(
+                location=0,
+                dimension="height",
+                line_color=PICK_COLOR,
+                line_dash="dotted",
+                line_width=2,
+                visible=False,
+                name="phase.pick",
+            )
+            fig.add_layout(s)
+            self._pick_spans.append(s)
+        top.on_event(Tap, self._tapped)
+        bottom.on_event(Tap, self._tapped)
+        self._log = False
+        return [column(top, bottom, sizing_mode="stretch_both")]
+
+    def _tapped(self, event):
+        if event.x is None:
+            return
+        a = self.store.state.analysis
+        f = float(np.clip(round(event.x, 2), 0.01, 1000.0))
+        if self._next_cursor == 1:
+            a.cursor1 = f
+            self._next_cursor = 2
+        else:
+            a.cursor2 = f
+            self._next_cursor = 1
+
+    def _set_log(self, log: bool) -> None:
+        if log == self._log:
+            return
+        self._log = log
+        for fig in (self._top, self._bottom):
+            fig.x_scale = LogScale() if log else LinearScale()
+            old = fig.below[0]
+            new = (LogAxis if log else LinearAxis)(axis_label=old.axis_label)
+            fig.below = [new]
+
+    def _draw(self, r):
+        d = r.draw
+        f = d["freq"]
+        fit_range(self.x_range, f)
+        bode = d["mode"] == "bode"
+        curves = d["curves"]
+        names = list(curves)
+        slots = {"a": names[0], "b": names[1] if len(names) > 1 else None}
+        for key, name in slots.items():
+            if name is None:
+                self._src[key].data = {
+                    "freq": np.zeros(0),
+                    "top": np.zeros(0),
+                    "bottom": np.zeros(0),
+                }
+                continue
+            c = curves[name]
+            self._src[key].data = {
+                "freq": f,
+                "top": c["level"] if bode else c["re"],
+                "bottom": c["phase"] if bode else c["im"],
+            }
+        unit = d["y_label"]
+        self._top.yaxis.axis_label = unit if bode else "Real part"
+        self._bottom.yaxis.axis_label = "Phase (deg, unwrapped)" if bode else "Imaginary part"
+        labels = list(d["labels"])
+        pm = self.analysis.peak_modes
+        if pm is not None and pm[0] is r:
+            labels = list(pm[1])
+        peaks = d["peaks"]
+        self._peaks.data = {
+            "freq": [p["freq"] for p in peaks] if bode else [],
+            "level": [p["level"] for p in peaks] if bode else [],
+            "text": labels if bode else [],
+        }
+        cur = d["cursors"]
+        for spans in self._cursor_spans:
+            for k, s in enumerate(spans):
+                fk = d["c1"] if k == 0 else d["c2"]
+                s.visible = fk > 0
+                if fk > 0:
+                    s.location = fk
+        if cur is not None and bode:
+            self._cursors.data = {"freq": [cur["f1"], cur["f2"]], "level": [cur["l1"], cur["l2"]]}
+        else:
+            self._cursors.data = {"freq": [], "level": []}
+        self._set_log(bool(d["log"]))
+
+    def _draw_pick(self, pick):
+        f = pick.get("freq")
+        for s in self._pick_spans:
+            s.visible = f is not None
+            if f is not None:
+                s.location = f

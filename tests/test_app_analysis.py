@@ -1,0 +1,169 @@
+"""The Analysis card's views rendered in-process (no server): their plotted data against
+independent computations (the interface forces solved here with numpy from the subsystem
+FRFs, the coupled response of fbs_core.bushing_response, the tire's eigenfrequencies, the
+closed-form order lines), lazy computation, picking, CSV provenance."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import fbs_core
+from app.analysis_store import AnalysisResults
+from app.export import read_csv, to_csv
+from app.store import Results
+from app.views.analysis_contrib import ContributionsView
+from app.views.analysis_phase import PhaseView
+from app.views.analysis_speed import CampbellView, SpeedMapView
+
+DIRS = ("x", "y", "z", "rx", "ry", "rz")
+
+
+@pytest.fixture()
+def store():
+    r = Results()
+    r.state.case.param.update(harmonic=2, n_modes=60)
+    return r, AnalysisResults(store=r)
+
+
+def _terms_by_hand(harmonic, n_modes, coupling):
+    """Eq. 4.1 term by term, solved here: g = (Y_jj^A + Y_jj^E)^-1 Y_ja^A F_a over the
+    coupled DOFs, term k = Y_ej^E[:, k] g_k."""
+    tire, chassis = fbs_core.reference_tire(), fbs_core.reference_chassis()
+    h = fbs_core.harmonic(harmonic)
+    f = h.frequencies()
+    Yjj, vj = tire.truncations(f, h, [n_modes])
+    Y = chassis.mobility(f)
+    sp = [Y.outputs.index(f"spindle:{d}") for d in DIRS]
+    bu = [Y.outputs.index(f"bushing:{d}") for d in DIRS]
+    hub = [tire.hub_dofs.index(f"hub:{d}") for d in DIRS]
+    keep = [k for k, d in enumerate(DIRS) if not (coupling == "5dof" and d == "ry")]
+    A = Yjj[0][:, hub][:, :, hub] + Y.data[:, sp, :]
+    A = A[:, keep][:, :, keep]
+    g = np.linalg.solve(A, vj[0][:, hub][:, keep, None])[..., 0]
+    Yej = Y.data[:, bu, :][:, :, keep]
+    return f, Yej * g[:, None, :], [DIRS[k] for k in keep]
+
+
+@pytest.mark.parametrize("coupling", ["6dof", "5dof"])
+def test_contributions_view_equals_the_terms_solved_by_hand(store, coupling):
+    r, a = store
+    r.state.case.coupling = coupling
+    r.state.analysis.tab = "contributions"
+    view = ContributionsView(store=r, analysis=a)
+    view.__panel__()
+    f, terms, kept = _terms_by_hand(2, 60, coupling)
+    z = DIRS.index("z")
+    for k, d in enumerate(kept):
+        plotted = view._terms[d].data["level"]
+        np.testing.assert_allclose(plotted, 20 * np.log10(np.abs(terms[:, z, k])), atol=1e-8)
+    if coupling == "5dof":
+        assert np.isnan(view._terms["ry"].data["level"]).all()  # released: no term
+    # their sum is the coupled response
+    want = fbs_core.bushing_response(2, n_modes=60, coupling=coupling)
+    want = want.sel(outputs="bushing:z").data[:, 0, 0]
+    np.testing.assert_allclose(terms[:, z].sum(-1), want, rtol=1e-9)
+    np.testing.assert_allclose(view._total.data["level"], 20 * np.log10(np.abs(want)), atol=1e-9)
+    # stacked: shares of the total add up to 100 % at every line
+    r.state.analysis.contrib_mode = "stacked"
+    assert view._stack_fig.visible and not view._lines_fig.visible
+    np.testing.assert_allclose(view._stack.data["c6"], 100.0, atol=1e-8)
+    # CSV: the columns and the provenance of the same state
+    res = a.contributions
+    meta, cols = read_csv(to_csv(res.columns, res.meta, "contributions"))
+    assert meta["coupling"] == coupling and meta["harmonic"] == "2"
+    np.testing.assert_allclose(
+        cols["hub_z_re"], terms[:, z, kept.index("z")].real, rtol=1e-9, atol=1e-14
+    )
+
+
+def test_phase_view_bode_real_imag_and_cursors(store):
+    r, a = store
+    r.state.analysis.tab = "phase"
+    view = PhaseView(store=r, analysis=a)
+    view.__panel__()
+    want = fbs_core.bushing_response(2, n_modes=60).sel(outputs="bushing:z").data[:, 0, 0]
+    ref = fbs_core.bushing_response(2).sel(outputs="bushing:z").data[:, 0, 0]
+    np.testing.assert_allclose(view._src["b"].data["top"], 20 * np.log10(abs(want)), atol=1e-9)
+    np.testing.assert_allclose(view._src["a"].data["top"], 20 * np.log10(abs(ref)), atol=1e-9)
+    # unwrapped: consecutive lines never jump by more than 180 degrees
+    ph = view._src["b"].data["bottom"]
+    assert np.all(np.abs(np.diff(ph)) < 180)
+    np.testing.assert_allclose(np.exp(1j * np.radians(ph)), want / abs(want), atol=1e-9)
+    # cursors on grid lines read the plotted level there
+    f = view._src["b"].data["freq"]
+    r.state.analysis.param.update(cursor1=float(f[3]), cursor2=float(f[10]))
+    np.testing.assert_allclose(
+        view._cursors.data["level"], 20 * np.log10(abs(want[[3, 10]])), atol=1e-9
+    )
+    assert "df = " in a.phase.caption and "cursors" in a.phase.meta
+    # the coupled modes near each peak (computed after the labels): near the peak
+    pm = a.peak_modes
+    assert pm is not None and pm[0] is a.phase
+    assert all("modes" in t for t in view._peaks.data["text"])
+    # real / imaginary parts
+    r.state.analysis.phase_mode = "real/imag"
+    np.testing.assert_allclose(view._src["b"].data["top"], want.real, rtol=1e-9, atol=1e-13)
+    np.testing.assert_allclose(view._src["b"].data["bottom"], want.imag, rtol=1e-9, atol=1e-13)
+    # the uncoupled tire: its free hub velocity Y_ja F_a
+    r.state.analysis.frf = "tire"
+    hub = fbs_core.reference_tire().patch_response(
+        fbs_core.harmonic(2).frequencies(), fbs_core.harmonic(2), 60
+    )
+    np.testing.assert_allclose(
+        view._src["b"].data["top"], hub.sel(outputs="hub:z").data[:, 0, 0].real, rtol=1e-9
+    )
+    # a log frequency axis
+    r.state.analysis.log_freq = True
+    assert type(view._top.x_scale).__name__ == "LogScale"
+
+
+def test_campbell_and_speed_map_views_and_picking(store):
+    r, a = store
+    r.state.analysis.tab = "speed"
+    cv, sv = CampbellView(store=r, analysis=a), SpeedMapView(store=r, analysis=a)
+    cv.__panel__(), sv.__panel__()
+    tire = fbs_core.reference_tire()
+    eig = tire.eigenfrequencies(80.0)
+    n = 0
+    for d in ("forward", "backward", "standing"):
+        src = cv._branches[d].data
+        for xs, ys in zip(src["xs"], src["ys"], strict=True):
+            k = int(np.argmin(np.abs(xs - 80.0)))
+            assert abs(xs[k] - 80.0) < 1e-9 and np.min(np.abs(eig - ys[k])) < 1e-6
+            n += 1
+    assert n > 20
+    o = cv._orders.data
+    for h, xs, ys in zip(o["harmonic"], o["xs"], o["ys"], strict=True):
+        np.testing.assert_allclose(ys, xs / 3.6 / fbs_core.harmonic(h).wavelength, rtol=1e-12)
+    # the map: a row is the coupled response with the tire at that fixed speed
+    img = sv._img.data["image"][0]  # (freq, speed)
+    sm = fbs_core.analysis.speed_map(2, 60)
+    row = list(sm.speeds).index(60.0)
+    want = fbs_core.bushing_response(2, n_modes=60, freq=sm.freq, speed_kmh=60.0)
+    np.testing.assert_allclose(
+        img[:, row], 20 * np.log10(abs(want.sel(outputs="bushing:z").data[:, 0, 0])), atol=1e-8
+    )
+    # picking: a point in the map; on an order line in the Campbell: that harmonic
+    a.pick_point(70.0, 45.0)
+    assert [s.visible for s in sv._spans] == [True, True]
+    assert [s.location for s in sv._spans] == [70.0, 45.0]
+    assert r.state.case.harmonic == 2
+    a.pick_campbell(50.0, 5.0)  # below every order line: the harmonic stays
+    assert r.state.case.harmonic == 2
+    lam5 = fbs_core.harmonic(5).wavelength
+    a.pick_campbell(90.0, 90.0 / 3.6 / lam5 * 1.01)
+    assert r.state.case.harmonic == 5
+    assert r.state.analysis.picked_speed == 90.0
+
+
+def test_nothing_is_computed_while_the_card_is_collapsed_or_another_tab_is_shown(store):
+    r, a = store
+    r.state.case.n_modes = 80
+    assert a.contributions is None and a.phase is None and a.speed_map is None
+    r.state.analysis.tab = "speed"
+    first = a.speed_map
+    assert first is not None and a.contributions is None
+    r.state.analysis.tab = "phase"
+    r.state.case.n_modes = 90  # not shown: the speed map stays as it was
+    assert a.speed_map is first and a.phase.meta["N (retained tire modes)"] == 90
