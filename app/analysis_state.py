@@ -11,7 +11,9 @@ loaded), see :func:`encode_pins` / :func:`decode_pins`.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import param
 
@@ -111,7 +113,7 @@ class PinSettings:
         )
 
 
-_FIELDS = {
+_FIELDS: dict[str, tuple[str, Callable[[str], Any]]] = {
     "h": ("harmonic", int),
     "N": ("n_modes", int),
     "d": ("dof", str),
