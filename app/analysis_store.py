@@ -23,12 +23,14 @@ from typing import Any
 import numpy as np
 import param
 
-from fbs_core.analysis import delta_cursor, phase_deg
+from fbs_core.analysis import add_pin, delta_cursor, phase_deg, pin_state, remove_pin
 from fbs_core.errors import FBSError
 from fbs_core.vocabulary import magnitude_db
 
 from . import analysis_compute as ac
 from . import bands, compute
+from .analysis_pins import build_pin, compare_result, pin_settings
+from .analysis_state import check_pin_name, decode_pins, encode_pins
 from .store import Result, Results, Snapshot, chassis_label
 
 __all__ = ["AnalysisResults", "AnalysisSnapshot"]
@@ -79,6 +81,9 @@ class AnalysisResults(param.Parameterized):
     campbell = param.ClassSelector(class_=Result, allow_None=True)
     speed_map = param.ClassSelector(class_=Result, allow_None=True)
     pick = param.ClassSelector(class_=Result, doc="The picked speed and frequency.")
+    pins = param.Parameter(default=(), doc="The pinned baselines (tuple of app.analysis_pins.Pin).")
+    compare = param.ClassSelector(class_=Result, allow_None=True)
+    message = param.String(default="", doc="The last pin action's problem ('' if none).")
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -160,6 +165,70 @@ class AnalysisResults(param.Parameterized):
     )
     def _speed_map(self):
         self._publish("speed_map", "speed", speed_map_result)
+
+    @param.depends("store.state.analysis.pins", watch=True, on_init=True)
+    def _sync_pins(self):
+        """Build the pins the URL / the state lists (keeping those already built)."""
+        with self.store.lock:
+            if self.store.closed:
+                return
+            try:
+                wanted = decode_pins(self.state.analysis.pins)
+            except FBSError as e:
+                self.message = str(e)
+                return
+            have = {p.settings: p for p in self.pins}
+            current = Snapshot.of(self.state)
+            self.pins = tuple(have.get(ps) or build_pin(ps, current) for ps in wanted)
+
+    @param.depends(
+        "store.state.analysis.tab",
+        "store.state.analysis.compare_to",
+        "pins",
+        "store.band",
+        "store.state.case.harmonic",
+        "store.state.case.n_modes",
+        "store.state.case.dof",
+        "store.state.case.coupling",
+        "store.state.case.models",
+        "store.state.noise.percentile",
+        "store.state.truncation.map_mode",
+        watch=True,
+        on_init=True,
+    )
+    def _compare(self):
+        self._publish(
+            "compare",
+            "compare",
+            lambda s: compare_result(s.base, self.pins, self.state.analysis.compare_to),
+        )
+
+    def pin(self, name: str) -> None:
+        """Pin the current state as ``name`` (up to four; a taken name is refused)."""
+        with self.store.lock:
+            try:
+                name = check_pin_name(name)
+                ps = pin_settings(name, Snapshot.of(self.state))
+                add_pin(self.pins, pin_state(name, {}))  # the core's rules: unique, at most 4
+            except FBSError as e:
+                self.message = str(e)
+                return
+            self.message = ""
+            self.state.analysis.pins = encode_pins([p.settings for p in self.pins] + [ps])
+
+    def unpin(self, name: str) -> None:
+        """Remove the pin named ``name``."""
+        with self.store.lock:
+            try:
+                remove_pin([p.data or pin_state(p.name, {}) for p in self.pins], name)
+            except FBSError as e:
+                self.message = str(e)
+                return
+            self.message = ""
+            a = self.state.analysis
+            a.pins = encode_pins([p.settings for p in self.pins if p.name != name])
+            if a.compare_to == name:
+                a.compare_to = ""
 
     # -- the modes near the peaks: after the labels, off the session's threads ----------------
     def _find_modes(self, r: Result) -> None:

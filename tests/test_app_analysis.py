@@ -167,3 +167,94 @@ def test_nothing_is_computed_while_the_card_is_collapsed_or_another_tab_is_shown
     r.state.analysis.tab = "phase"
     r.state.case.n_modes = 90  # not shown: the speed map stays as it was
     assert a.speed_map is first and a.phase.meta["N (retained tire modes)"] == 90
+
+
+# -- compare: pinned baselines ----------------------------------------------------------------
+def _db_direct(harmonic, n_modes, dof="z", coupling="6dof"):
+    v = fbs_core.bushing_response(harmonic, n_modes=n_modes, coupling=coupling)
+    return 20 * np.log10(np.abs(v.sel(outputs=f"bushing:{dof}").data[:, 0, 0]))
+
+
+def test_compare_pins_overlay_difference_band_and_map(store):
+    from app.views.analysis_compare import CompareView
+
+    r, a = store
+    r.state.noise.param.update(rounds=200, seed=4, noise=5.0)
+    r.request_band(wait=True)
+    a.pin("base")
+    assert a.message == "" and [p.name for p in a.pins] == ["base"]
+    assert a.pins[0].data.sources["models"] == "reference"
+    r.state.case.n_modes = 100
+    r.state.analysis.tab = "compare"
+    view = CompareView(store=r, analysis=a)
+    view.__panel__()
+    # overlay and difference: current (N = 100) minus the pin (N = 60), from the core directly
+    np.testing.assert_allclose(view._curves[0][0].data["level"], _db_direct(2, 100), atol=1e-9)
+    np.testing.assert_allclose(view._curves[1][0].data["level"], _db_direct(2, 60), atol=1e-9)
+    np.testing.assert_allclose(
+        view._diffs[0][0].data["diff"], _db_direct(2, 100) - _db_direct(2, 60), atol=1e-9
+    )
+    # the pin's band edges: the band of its settings, computed here by the core
+    sb = fbs_core.studies.scatter_band(
+        2, noise=0.05, target="both", rounds=200, seed=4, n_modes=60, percentiles=(5, 95)
+    )
+    j = sb.dofs.index("bushing:z")
+    np.testing.assert_allclose(
+        view._bands[1][0].data["high"], 20 * np.log10(sb.percentiles[1, :, j]), atol=1e-9
+    )
+    # the error map as a difference map: the current map minus the pinned state's map
+    r.state.case.coupling = "5dof"
+    a.pin("five")
+    r.state.case.coupling = "6dof"
+    r.state.analysis.compare_to = "five"
+    from app import compute
+
+    want = (
+        compute.error_map_data(2, "6dof", "z")["error_pct"]
+        - compute.error_map_data(2, "5dof", "z")["error_pct"]
+    )
+    np.testing.assert_allclose(view._img.data["image"][0], want, atol=1e-9)
+    # another harmonic: no difference on another grid, said so in the CSV header
+    r.state.case.harmonic = 3
+    assert np.isnan(view._diffs[0][0].data["diff"]).all()
+    res = a.compare
+    meta, cols = read_csv(to_csv(res.columns, res.meta, "compare"))
+    assert "different frequency grids" in meta["curve 1 difference"]
+    assert "pin 'base'" in meta["curve 1"] and "seed 4" in meta["curve 1"]
+    assert set(np.unique(cols["curve"])) == {0.0, 1.0, 2.0}
+    np.testing.assert_allclose(cols["level_dB"][cols["curve"] == 1], _db_direct(2, 60), atol=1e-9)
+
+
+def test_pins_in_the_url_are_rebuilt_in_a_new_session_and_names_are_checked(store):
+    r, a = store
+    a.pin("base")
+    r.state.case.n_modes = 120
+    a.pin("n120")
+    link = r.state.analysis.pins
+    assert link.count("|") == 1
+    # a new session restoring the link: the same pins, the same data
+    r2 = Results()
+    r2.state.analysis.pins = link
+    a2 = AnalysisResults(store=r2)
+    assert [p.name for p in a2.pins] == ["base", "n120"]
+    for p, q in zip(a.pins, a2.pins, strict=True):
+        np.testing.assert_array_equal(p.data.frfs["response"].data, q.data.frfs["response"].data)
+    # names: taken, malformed, too many
+    a.pin("base")
+    assert "already named" in a.message
+    a.pin("bad|name")
+    assert "pin name" in a.message
+    a.pin("c")
+    a.pin("d")
+    a.pin("e")
+    assert "at most 4" in a.message and len(a.pins) == 4
+    a.unpin("c")
+    assert [p.name for p in a.pins] == ["base", "n120", "d"]
+    # a malformed link is refused with a message, the pins stay
+    r.state.analysis.pins = "x~h9"
+    assert "malformed pin" in a.message and len(a.pins) == 3
+    # a pin of an upload that is not loaded here: listed, without data
+    r3 = Results()
+    r3.state.analysis.pins = link.replace("mreference", "mdeadbeef")
+    a3 = AnalysisResults(store=r3)
+    assert all(p.data is None and "not loaded" in p.note for p in a3.pins)

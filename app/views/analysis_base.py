@@ -21,6 +21,8 @@ __all__ = ["AnalysisView", "analysis_card", "page_card"]
 #: Colours of the six interface DOFs' terms (and of pins).
 TERM_COLORS = ("#1971c2", "#2b8a3e", "#e03131", "#f08c00", "#7048e8", "#0c8599")
 PICK_COLOR = "#c2255c"
+#: Height of the opened Analysis card (px).
+CARD_HEIGHT = 760
 
 
 class AnalysisView(LiveView):
@@ -62,6 +64,7 @@ def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
     ``tabs`` maps tab keys (:data:`~app.analysis_state.ANALYSIS_TABS`) to a function
     ``(analysis_results, x_range) -> viewable``; default all views of the card.
     """
+    from .analysis_compare import CompareView
     from .analysis_contrib import ContributionsView
     from .analysis_phase import PhaseView
     from .analysis_speed import speed_tab
@@ -75,53 +78,64 @@ def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
             "speed": lambda a, x: speed_tab(results, a),
             "contributions": lambda a, x: ContributionsView(store=results, analysis=a, x_range=x),
         }
-        try:
-            from .analysis_compare import CompareView
-
-            tabs = {
-                "compare": lambda a, x: CompareView(store=results, analysis=a, x_range=x),
-                **tabs,
-            }
-        except ImportError:
-            pass
+        tabs = {
+            "compare": lambda a, x: CompareView(store=results, analysis=a, x_range=x),
+            **tabs,
+        }
     keys = [k for k in ANALYSIS_TABS if k in tabs]
     names = _tab_names()
-    panes = pn.Tabs(
-        *[(names[k], tabs[k](analysis, x_range)) for k in keys],
-        dynamic=True,
-        sizing_mode="stretch_both",
-        css_classes=["analysis-tabs"],
-    )
+    body = pn.Column(sizing_mode="stretch_both", css_classes=["analysis-body"])
     card = pn.Card(
-        panes,
+        body,
         title="Analysis: compare states, phase and peaks, across speed, contributions",
         collapsible=True,
-        collapsed=state.tab == "",
-        height=720,
+        collapsed=True,
         sizing_mode="stretch_width",
         header_background="#e9ecef",
         margin=(4, 4),
         css_classes=["analysis-card"],
     )
-    if state.tab in keys:
-        panes.active = keys.index(state.tab)
+    panes: list[pn.Tabs] = []  # built when the card is first opened (a page load builds none)
+
+    def build() -> pn.Tabs:
+        if not panes:
+            tabs_ = pn.Tabs(
+                *[(names[k], tabs[k](analysis, x_range)) for k in keys],
+                dynamic=True,
+                sizing_mode="stretch_both",
+                css_classes=["analysis-tabs"],
+            )
+            if state.tab in keys:
+                tabs_.active = keys.index(state.tab)
+            tabs_.param.watch(shown, "active")
+            panes.append(tabs_)
+            body.append(tabs_)
+        return panes[0]
 
     def shown(*_):
-        tab = "" if card.collapsed else keys[panes.active]
+        if not card.collapsed:
+            tabs_ = build()
+            card.height = CARD_HEIGHT
+            tab = keys[tabs_.active]
+        else:
+            card.height = None
+            tab = ""
         if state.tab != tab:
             state.tab = tab
 
     def from_state(*_):
         if state.tab in keys:
-            card.collapsed = False
-            if panes.active != keys.index(state.tab):
-                panes.active = keys.index(state.tab)
+            tabs_ = build()
+            if tabs_.active != keys.index(state.tab):
+                tabs_.active = keys.index(state.tab)
+            if card.collapsed:
+                card.collapsed = False
         elif not card.collapsed:
             card.collapsed = True
 
     card.param.watch(shown, "collapsed")
-    panes.param.watch(shown, "active")
     state.param.watch(from_state, "tab")
+    from_state()
     return card
 
 

@@ -202,3 +202,40 @@ def _spans(page, prefix):
              m => [m.name, [m.visible, m.location]]))""",
         prefix,
     )
+
+
+def test_compare_pin_change_and_difference(page, dashboard):
+    _tab(page, "Compare")
+    page.wait_for_function("() => window.location.search.includes('atab=compare')")
+    wait_loaded(page, ["compare.curve0", "mobility.truncated"])
+    before = source(page, "mobility.truncated")
+    box = page.locator(".ctl-analysis-pin_name input").first
+    box.fill("base")
+    box.press("Enter")
+    page.locator(".ctl-analysis-pin button").first.click()
+    page.wait_for_function("() => window.location.search.includes('pins=base')")
+    wait_loaded(page, ["compare.curve1"])
+    # change N: the difference is the current main-view curve minus the pinned one
+    fp = fingerprint(page, "compare.diff1")
+    from .conftest import set_model_value
+
+    set_model_value(page, "ctl-case-n_modes", 14, "Slider")  # N = 150
+    page.wait_for_function("() => window.location.search.includes('N=150')")
+    wait_changed(page, "compare.diff1", fp)
+    page.wait_for_function(
+        """() => { const d = [...Bokeh.documents[0].all_models].filter(
+             m => m.name === 'compare.diff1')[0].data.diff;
+           return Array.from(d).some(x => Math.abs(x) > 0); }"""
+    )
+    now = source(page, "mobility.truncated")
+    diff = source(page, "compare.diff1")
+    np.testing.assert_allclose(diff["freq"], before["freq"])
+    np.testing.assert_allclose(
+        diff["diff"], np.asarray(now["level"]) - np.asarray(before["level"]), atol=1e-9
+    )
+    with page.expect_download() as info:
+        page.locator(".download-compare").first.click()
+    meta, cols = read_csv(open(info.value.path()).read())
+    assert "pin 'base'" in meta["curve 1"] and "fbs_core version" in meta
+    np.testing.assert_allclose(cols["diff_dB"][cols["curve"] == 1], diff["diff"], atol=1e-12)
+    assert page.errors == [] and dashboard.errors() == []

@@ -1,0 +1,281 @@
+"""Compare: pin the current state as a named baseline (up to four), change anything, and see
+the pinned coupled responses overlaid on the current one with the difference in dB, the
+scatter bands' percentile edges, and the truncation error map as a difference map (current
+minus a chosen pin, percentage points). Pins are in the URL (``pins=``), the CSV (one row
+per curve and line, each curve's settings and provenance in the header) and the report.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import panel as pn
+from bokeh.layouts import column, row
+from bokeh.models import ColumnDataSource, HoverTool
+from bokeh.palettes import RdBu11
+
+from fbs_core.analysis import MAX_PINS
+
+from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
+from .analysis_speed import _pick_spans
+from .common import COLORS, FREQ_LABEL, level_label
+from .plots import add_image, fit_range, frequency_range, new_figure
+
+__all__ = ["CompareView"]
+
+CURVE_COLORS = (COLORS["truncated"],) + TERM_COLORS[:MAX_PINS]
+
+
+class CompareView(AnalysisView):
+    """Pinned baselines against the current state."""
+
+    key = "compare"
+    result_name = "compare"
+    min_height = 560
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self.analysis.param.watch(lambda _e: self._sync_widgets(), ["pins", "message"])
+
+    def _controls(self):
+        a = self.store.state.analysis
+        self._name = pn.widgets.TextInput(
+            placeholder="name of the pin", width=150, css_classes=["ctl-analysis-pin_name"]
+        )
+        self._pin_btn = pn.widgets.Button(
+            label="Pin current state", width=140, css_classes=["ctl-analysis-pin"]
+        )
+        self._unpin = pn.widgets.Select(options=[], width=120, css_classes=["ctl-analysis-unpin"])
+        self._unpin_btn = pn.widgets.Button(
+            label="Unpin", width=70, css_classes=["ctl-analysis-unpin_btn"]
+        )
+        self._against = pn.widgets.Select(
+            options=[], width=140, css_classes=["ctl-analysis-compare_to"]
+        )
+        self._msg = pn.pane.HTML(
+            "", styles={"color": "#c92a2a"}, width=220, css_classes=["analysis-pin-message"]
+        )
+        self._pin_btn.on_click(lambda _e: self.analysis.pin(self._name.value or ""))
+        self._unpin_btn.on_click(
+            lambda _e: self._unpin.value and self.analysis.unpin(self._unpin.value)
+        )
+
+        def chosen(e):
+            if e.new is not None and a.compare_to != e.new:
+                a.compare_to = e.new
+
+        self._against.param.watch(chosen, "value")
+        self._sync_widgets()
+        return [self._name, self._pin_btn, self._unpin, self._unpin_btn, self._against, self._msg]
+
+    def _sync_widgets(self):
+        if not hasattr(self, "_unpin"):
+            return
+        names = [p.name for p in self.analysis.pins]
+
+        def update():
+            self._unpin.options = names
+            self._against.options = names
+            want = self.store.state.analysis.compare_to
+            if names:
+                self._against.value = want if want in names else names[0]
+            self._msg.object = self.analysis.message
+
+        doc = self._doc
+        if doc is None:
+            update()
+        else:
+            pn.state.execute(update, schedule=True)
+
+    def _build(self):
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        self._lv = lv = new_figure(
+            x_label=FREQ_LABEL,
+            y_label=level_label("z"),
+            x_range=self.x_range,
+            name="compare.levels",
+            min_height=250,
+        )
+        self._df = df = new_figure(
+            x_label=FREQ_LABEL,
+            y_label="Current minus pin (dB)",
+            x_range=self.x_range,
+            name="compare.diff",
+            min_height=200,
+        )
+        self._bd = bd = new_figure(
+            x_label=FREQ_LABEL,
+            y_label=level_label("z", "Band level"),
+            x_range=self.x_range,
+            name="compare.band",
+            min_height=250,
+        )
+        self._mp = mp = new_figure(
+            x_label=FREQ_LABEL,
+            y_label="Retained modes N",
+            x_range=self.x_range,
+            name="compare.map_figure",
+            min_height=200,
+            title="Error map: current minus pin",
+        )
+        self._curves, self._diffs, self._bands = [], [], []
+        for i, color in enumerate(CURVE_COLORS):
+            label = "current" if i == 0 else f"pin {i}"
+            src = ColumnDataSource({"freq": [], "level": []}, name=f"compare.curve{i}")
+            r = lv.line(
+                "freq",
+                "level",
+                source=src,
+                line_color=color,
+                line_width=2.4 if i == 0 else 1.8,
+                line_dash="solid" if i == 0 else "dashed",
+                legend_label=label,
+            )
+            lv.add_tools(
+                HoverTool(
+                    renderers=[r],
+                    mode="vline",
+                    tooltips=[
+                        ("", label),
+                        ("Frequency", "@freq{0.0} Hz"),
+                        ("Level", "@level{0.0} dB"),
+                    ],
+                )
+            )
+            self._curves.append((src, lv.legend.items[-1]))
+            b = ColumnDataSource({"freq": [], "low": [], "high": []}, name=f"compare.band{i}")
+            if i == 0:
+                bd.varea(
+                    "freq",
+                    "low",
+                    "high",
+                    source=b,
+                    fill_color=COLORS["band"],
+                    fill_alpha=0.4,
+                    legend_label="current",
+                )
+            else:
+                bd.line(
+                    "freq",
+                    "low",
+                    source=b,
+                    line_color=color,
+                    line_dash="dashed",
+                    legend_label=label,
+                )
+                bd.line(
+                    "freq",
+                    "high",
+                    source=b,
+                    line_color=color,
+                    line_dash="dashed",
+                    legend_label=label,
+                )
+            self._bands.append((b, bd.legend.items[-1]))
+            if i:
+                d = ColumnDataSource({"freq": [], "diff": []}, name=f"compare.diff{i}")
+                r = df.line(
+                    "freq", "diff", source=d, line_color=color, line_width=1.8, legend_label=label
+                )
+                df.add_tools(
+                    HoverTool(
+                        renderers=[r],
+                        mode="vline",
+                        tooltips=[
+                            ("", label),
+                            ("Frequency", "@freq{0.0} Hz"),
+                            ("Difference", "@diff{0.00} dB"),
+                        ],
+                    )
+                )
+                self._diffs.append((d, df.legend.items[-1]))
+        for fig in (lv, df, bd):
+            fig.legend.location = "bottom_left"
+            fig.legend.click_policy = "hide"
+            fig.legend.label_text_font_size = "8pt"
+        self._img, self._mapper, self._bar = add_image(
+            mp,
+            "compare.map",
+            tooltips=[("Centre", "$x{0.0} Hz"), ("N", "$y{0}"), ("Difference", "@image{0.0} pp")],
+            colorbar_title="pp",
+        )
+        self._mapper.palette = tuple(reversed(RdBu11))
+        self._spans = [
+            _pick_spans(f, f"compare.{k}")[0]
+            for k, f in (("levels", lv), ("diff", df), ("band", bd))
+        ]
+        for s in self._spans:
+            s.line_color = PICK_COLOR
+        return [
+            row(
+                column(lv, df, sizing_mode="stretch_both"),
+                column(bd, mp, sizing_mode="stretch_both"),
+                sizing_mode="stretch_both",
+            )
+        ]
+
+    def _draw(self, r):
+        d = r.draw
+        curves = d["curves"]
+        fit_range(self.x_range, curves[0]["freq"])
+        empty = {"freq": np.zeros(0), "level": np.zeros(0)}
+        for i, (src, item) in enumerate(self._curves):
+            c = curves[i] if i < len(curves) else None
+            src.data = {"freq": c["freq"], "level": c["level"]} if c else empty
+            item.label = {"value": c["name"] if c else ("current" if i == 0 else f"pin {i}")}
+            item.visible = c is not None
+        for i, (src, item) in enumerate(self._bands):
+            c = curves[i] if i < len(curves) else None
+            if c is not None and c["band"] is not None:
+                src.data = {
+                    "freq": c["freq"],
+                    "low": 20 * np.log10(c["band"][0]),
+                    "high": 20 * np.log10(c["band"][1]),
+                }
+            else:
+                src.data = {"freq": np.zeros(0), "low": np.zeros(0), "high": np.zeros(0)}
+            item.visible = c is not None and c["band"] is not None
+        for i, (src, item) in enumerate(self._diffs, start=1):
+            c = curves[i] if i < len(curves) else None
+            src.data = (
+                {"freq": c["freq"], "diff": c["diff"]}
+                if c is not None
+                else {"freq": np.zeros(0), "diff": np.zeros(0)}
+            )
+            item.visible = c is not None
+            if c is not None:
+                item.label = {"value": c["name"]}
+        m = d["map"]
+        if m is not None:
+            e = m["diff_pct"]
+            c, n = m["centres"], m["n_modes"]
+            dc = float(c[1] - c[0]) if c.size > 1 else 1.0
+            dn = float(n[1] - n[0]) if n.size > 1 else 10.0
+            self._img.data = {
+                "image": [np.ascontiguousarray(e)],
+                "x": [float(c[0] - dc / 2)],
+                "y": [float(n[0] - dn / 2)],
+                "dw": [float(c[-1] - c[0] + dc)],
+                "dh": [float(n[-1] - n[0] + dn)],
+            }
+            lim = float(np.nanmax(np.abs(e))) if np.isfinite(e).any() else 1.0
+            lim = max(lim, 1e-6)
+            self._mapper.update(low=-lim, high=lim)
+            self._mp.title.text = f"Error map: current minus pin {m['pin']!r} ({m['what']})"
+        else:
+            self._img.data = {
+                "image": [np.zeros((1, 1))],
+                "x": [0.0],
+                "y": [0.0],
+                "dw": [1.0],
+                "dh": [1.0],
+            }
+            self._mp.title.text = "Error map: no difference map (pin a state of this harmonic)"
+        self._lv.yaxis.axis_label = level_label(d["dof"])
+
+    def _draw_pick(self, pick):
+        f = pick.get("freq")
+        for s in self._spans:
+            s.visible = f is not None
+            if f is not None:
+                s.location = f
