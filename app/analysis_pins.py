@@ -35,7 +35,7 @@ from .analysis_state import PinSettings
 from .datasource import REFERENCE
 from .store import Result, Snapshot
 
-__all__ = ["Pin", "build_pin", "compare_result", "pin_settings"]
+__all__ = ["Pin", "build_pin", "compare_result", "pin_result", "pin_settings"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -233,6 +233,41 @@ def compare_result(s: Snapshot, pins: tuple[Pin, ...], compare_to: str) -> Resul
             f"bushing:{s.dof}, {s.coupling}" + (f" &middot; {map_note}" if map_note else "")
         ),
         draw={"curves": curves, "map": dmap, "dof": s.dof, "pins": [p.name for p in pins]},
+    )
+
+
+def pin_result(s: Snapshot, p: Pin) -> Result | None:
+    """One pin against the current state, for the report and the CSV of a pin: its level,
+    the current level and their difference (the current one and the difference only on
+    the same frequency grid). None for a pin without data."""
+    if p.data is None:
+        return None
+    resp = p.data.frfs["response"]
+    cols: dict[str, np.ndarray] = {
+        "freq_Hz": np.asarray(resp.freq, float),
+        f"pin_{p.name.replace(' ', '_')}_dB": magnitude_db(resp.data[:, 0, 0]),
+    }
+    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models)
+    cur = FRF(d["freq"], d["truncated"][:, None, None], [f"bushing:{s.dof}"], ["patch"])
+    meta: dict[str, Any] = {
+        "view": f"pinned state {p.name!r} against the current state",
+        "pin": _describe(p),
+        "pin sources": ", ".join(f"{k}={v}" for k, v in p.data.sources.items()),
+        "current": f"h{s.harmonic} N={s.n_modes} bushing:{s.dof} {s.coupling}; "
+        f"{s.models.describe()}",
+        "unit": compute.level_unit(p.settings.dof),
+    }
+    try:
+        diff = db_difference(cur, _relabel(resp, cur))
+        cols["current_dB"] = magnitude_db(cur.data[:, 0, 0])
+        cols["current_minus_pin_dB"] = np.asarray(diff.db[:, 0, 0], float)
+    except FBSError as e:
+        meta["difference"] = f"none: {e}"
+    return Result(
+        columns=cols,
+        meta=meta,
+        filename=f"pin_{p.name.replace(' ', '_')}.csv",
+        caption=f"Pin **{p.name}**: {_describe(p)}",
     )
 
 

@@ -29,7 +29,7 @@ from fbs_core.vocabulary import magnitude_db
 
 from . import analysis_compute as ac
 from . import bands, compute
-from .analysis_pins import build_pin, compare_result, pin_settings
+from .analysis_pins import build_pin, compare_result, pin_result, pin_settings
 from .analysis_state import check_pin_name, decode_pins, encode_pins
 from .store import Result, Results, Snapshot, chassis_label
 
@@ -202,6 +202,27 @@ class AnalysisResults(param.Parameterized):
             "compare",
             lambda s: compare_result(s.base, self.pins, self.state.analysis.compare_to),
         )
+
+    @param.depends(
+        "pins",
+        "store.state.case.harmonic",
+        "store.state.case.n_modes",
+        "store.state.case.dof",
+        "store.state.case.coupling",
+        "store.state.case.models",
+        watch=True,
+        on_init=True,
+    )
+    def _pinned(self):
+        """Each pin against the current state, published in the session's store (where the
+        report finds every published result), whichever tab is shown."""
+        with self.store.lock:
+            if self.store.closed:
+                return
+            s = Snapshot.of(self.state)
+            out = tuple(r for r in (pin_result(s, p) for p in self.pins) if r is not None)
+            if out or self.store.pinned:
+                self.store.pinned = out
 
     def pin(self, name: str) -> None:
         """Pin the current state as ``name`` (up to four; a taken name is refused)."""

@@ -202,6 +202,11 @@ class Results(param.Parameterized):
         class_=Result, allow_None=True, doc="The band's curves at the selected DOF."
     )
     band_status = param.ClassSelector(class_=BandStatus, doc="Band computation status.")
+    pinned = param.Parameter(
+        default=(),
+        doc="The Analysis card's pinned baselines against the current state: a tuple of "
+        "Result, one per pin (app.analysis_store; the report shows each).",
+    )
     closed = param.Boolean(default=False, doc="The session has ended: nothing is drawn.")
     background = param.Boolean(
         default=None,

@@ -7,12 +7,18 @@ document (the named ColumnDataSource of the view):
 
 - retained modes N, harmonic and response DOF: median and 95th percentile;
 - the scatter band with R rounds (default 10,000): a new seed until the band's data change;
-- server start: process launch to "app running", and to the first rendered plot.
+- server start: process launch to "app running", and to the first rendered plot;
+- with ``--analysis``: the Analysis card's views (issue 18), each in a fresh page opened on
+  its tab (``?atab=...``): N, harmonic and DOF changes until the view's own source changes
+  (phase: ``phase.b``; contributions: ``contributions.total``; across speed:
+  ``speedmap.image``; compare, one pin made first: ``compare.diff1``), and the time to
+  open each tab in a loaded page. ``--only-analysis`` skips the other measurements.
 
 Usage::
 
     .venv/bin/python bench/bench_dashboard.py [--rounds 10000] [--samples 20]
     .venv/bin/python bench/bench_dashboard.py --tree /path/to/old/checkout --tree .
+    .venv/bin/python bench/bench_dashboard.py --only-analysis --samples 14
 
 With several ``--tree`` (source checkouts of the project), one server per tree runs at the
 same time and the samples alternate between them: a before/after comparison under the same
@@ -165,12 +171,88 @@ def wait_band_idle(page, timeout=300_000):
     )
 
 
+JS_PIN = """() => { const ms = [...Bokeh.documents[0].all_models];
+  const box = ms.filter(m => m.css_classes && m.css_classes.includes('ctl-analysis-pin_name')
+                        && 'value' in m)[0];
+  box.value = 'bench'; }"""
+
+JS_TAB_OPEN = """async ([tab, name, timeout]) => {
+  const t0 = performance.now();
+  const ms = () => [...Bokeh.documents[0].all_models];
+  const tabs = ms().filter(m => m.css_classes && m.css_classes.includes('analysis-tabs'))[0];
+  const names = tabs.tabs.map(t => t.title);
+  tabs.active = names.indexOf(tab);
+  return await new Promise((resolve, reject) => { const c = () => {
+    const s = ms().filter(m => m.name === name && m.type === 'ColumnDataSource')[0];
+    const dt = performance.now() - t0;
+    if (s) { const k = Object.keys(s.data)[0];
+             const v = k === 'image' ? s.data.image[0] : s.data[k];
+             if (v && v.length > 1) { resolve(dt); return; } }
+    if (dt > timeout) reject(new Error('no data in ' + name)); else setTimeout(c, 5); }; c(); });
+}"""
+
+
+def analysis_bench(servers, measure, modes, n, rounds):
+    """Latency of the Analysis card's views (issue 18), printed like the others."""
+    harmonics = [int(h) for h in np.resize([2, 3, 4, 5, 6, 7, 1], n)]
+    dofs = [int(d) for d in np.resize([0, 1, 3, 4, 5, 2], n)]
+    views = {
+        "phase": "phase.b",
+        "contributions": "contributions.total",
+        "speed": "speedmap.image",
+        "compare": "compare.diff1",
+    }
+    for tab, name in views.items():
+        for _tree, page, _proc, port, *_ in servers:
+            page.goto(
+                f"http://127.0.0.1:{port}/main?rounds={rounds}&atab={tab}",
+                timeout=300_000,
+                wait_until="commit",
+            )
+            page.wait_for_function(JS_READY, arg="mobility.truncated", timeout=300_000)
+            if tab == "compare":  # one pin, then the difference to it is what changes
+                page.wait_for_function(JS_READY, arg="compare.curve0", timeout=300_000)
+                page.evaluate(JS_PIN)
+                page.locator(".ctl-analysis-pin button").first.click()
+                page.wait_for_function(JS_READY, arg="compare.curve1", timeout=300_000)
+            page.wait_for_function(JS_READY, arg=name, timeout=300_000)
+            wait_band_idle(page)
+        res = {
+            f"{tab}: modes N ({name})": measure("value", "ctl-case-n_modes", modes, name),
+            f"{tab}: harmonic ({name})": measure("value", "ctl-case-harmonic", harmonics, name),
+        }
+        res[f"{tab}: response DOF ({name})"] = measure("active", "ctl-case-dof", dofs, name)
+        for k, v in res.items():
+            for tree, ms in v.items():
+                print(f"[{tree.name}] {k:46s} {stats(ms)}")
+    # opening a tab in a loaded page (the card open on another tab, caches warm)
+    order = [
+        ("Phase and peaks", "phase.b"),
+        ("Contributions", "contributions.total"),
+        ("Across speed", "speedmap.image"),
+        ("Compare", "compare.curve0"),
+    ]
+    for tree, page, _proc, port, *_ in servers:
+        page.goto(
+            f"http://127.0.0.1:{port}/main?rounds={rounds}&atab=compare",
+            timeout=300_000,
+            wait_until="commit",
+        )
+        page.wait_for_function(JS_READY, arg="compare.curve0", timeout=300_000)
+        wait_band_idle(page)
+        for title, name in order:
+            ms = page.evaluate(JS_TAB_OPEN, [title, name, 120_000])
+            print(f"[{tree.name}] open tab {title!r:34s} {ms:7.0f} ms (first view of the tab)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=10_000)
     ap.add_argument("--samples", type=int, default=20)
     ap.add_argument("--threads", type=int, default=4)
     ap.add_argument("--no-warm", action="store_true")
+    ap.add_argument("--analysis", action="store_true", help="also the Analysis card's views")
+    ap.add_argument("--only-analysis", action="store_true", help="only the Analysis card")
     ap.add_argument(
         "--tree",
         action="append",
@@ -225,6 +307,10 @@ def main():
 
             n = args.samples
             modes = [int(i) for i in np.resize(np.arange(1, 20), n)]  # index: N = 20 ... 200
+            if args.analysis or args.only_analysis:
+                analysis_bench(servers, measure, modes, n, args.rounds)
+            if args.only_analysis:
+                return
             res = {
                 "modes N (mobility.truncated)": measure(
                     "value", "ctl-case-n_modes", modes, "mobility.truncated"

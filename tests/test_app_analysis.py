@@ -258,3 +258,21 @@ def test_pins_in_the_url_are_rebuilt_in_a_new_session_and_names_are_checked(stor
     r3.state.analysis.pins = link.replace("mreference", "mdeadbeef")
     a3 = AnalysisResults(store=r3)
     assert all(p.data is None and "not loaded" in p.note for p in a3.pins)
+
+
+def test_each_pin_is_published_in_the_store_against_the_current_state(store):
+    r, a = store
+    assert r.pinned == ()
+    a.pin("base")  # N = 60
+    r.state.case.n_modes = 90  # whatever tab is shown (here: none)
+    (res,) = r.pinned
+    np.testing.assert_allclose(res.columns["pin_base_dB"], _db_direct(2, 60), atol=1e-9)
+    np.testing.assert_allclose(
+        res.columns["current_minus_pin_dB"], _db_direct(2, 90) - _db_direct(2, 60), atol=1e-9
+    )
+    assert "seed" in res.meta["pin"] and "models=reference" in res.meta["pin sources"]
+    r.state.case.harmonic = 4  # another grid: the pin alone, the reason in its header
+    (res,) = r.pinned
+    assert "current_dB" not in res.columns and "different frequency grids" in res.meta["difference"]
+    a.unpin("base")
+    assert r.pinned == ()

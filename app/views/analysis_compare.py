@@ -34,6 +34,7 @@ class CompareView(AnalysisView):
 
     def __init__(self, **params):
         super().__init__(**params)
+        self._unpin: pn.widgets.Select | None = None  # the header's widgets, once built
         self.analysis.param.watch(lambda _e: self._sync_widgets(), ["pins", "message"])
 
     def _controls(self):
@@ -68,7 +69,7 @@ class CompareView(AnalysisView):
         return [self._name, self._pin_btn, self._unpin, self._unpin_btn, self._against, self._msg]
 
     def _sync_widgets(self):
-        if not hasattr(self, "_unpin"):
+        if self._unpin is None:
             return
         names = [p.name for p in self.analysis.pins]
 
