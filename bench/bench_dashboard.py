@@ -284,7 +284,11 @@ def main():
                 t_ready = ready.get(timeout=900)
                 if t_ready is None:
                     raise RuntimeError(f"server of {tree} did not start")
-                page.goto(f"http://127.0.0.1:{port}/main?rounds={args.rounds}")
+                page.goto(
+                    f"http://127.0.0.1:{port}/main?rounds={args.rounds}",
+                    timeout=300_000,
+                    wait_until="commit",
+                )
                 page.wait_for_function(JS_READY, arg="mobility.truncated", timeout=300_000)
                 t_plot = time.perf_counter()
                 page.wait_for_function(JS_READY, arg="scatter.minmax", timeout=600_000)
@@ -359,7 +363,10 @@ def main():
         finally:
             for _, _, proc, *_ in servers:
                 proc.terminate()
-                proc.wait(timeout=20)
+                try:
+                    proc.wait(timeout=60)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
             browser.close()
     print(f"load average at the end: {os.getloadavg()[0]:.1f}")
 
