@@ -177,7 +177,7 @@ def test_across_speed_campbell_speed_map_and_picking(page, dashboard):
     lam = fbs_core.harmonic(5).wavelength
     x, y = _screen(page, "campbell.figure", 90.0, 90.0 / 3.6 / lam)
     page.mouse.click(x, y)
-    page.wait_for_function("() => window.location.search.includes('h=5')")
+    page.wait_for_function("() => window.location.search.includes('h=5')", timeout=180_000)
     assert page.errors == [] and dashboard.errors() == []
 
 
@@ -206,7 +206,7 @@ def _spans(page, prefix):
 
 def test_compare_pin_change_and_difference(page, dashboard):
     _tab(page, "Compare")
-    page.wait_for_function("() => window.location.search.includes('atab=compare')")
+    page.wait_for_function("() => window.location.search.includes('atab=compare')", timeout=180_000)
     wait_loaded(page, ["compare.curve0", "mobility.truncated"])
     before = source(page, "mobility.truncated")
     box = page.locator(".ctl-analysis-pin_name input").first
