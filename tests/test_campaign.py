@@ -309,3 +309,24 @@ def test_progress_bar_shows_done_total_rate_and_time_left_from_the_work():
     left = line.split("left ")[1].strip()
     h, m, s = (int(x) for x in left.split(":"))
     assert 29 <= 3600 * h + 60 * m + s <= 31  # 75 work units left at 2.5 per second
+
+
+
+def test_run_in_process_gives_the_signal_handlers_back(tmp_path):
+    """``run`` called in-process (a notebook, a test runner) restores the caller's SIGINT
+    and SIGTERM handlers when it returns (else a later SIGTERM of the caller raised the
+    campaign's KeyboardInterrupt)."""
+
+    def mine(signum, frame):  # pragma: no cover - never called
+        pass
+
+    before = {s: signal.signal(s, mine) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        camp = tmp_path / "c.toml"
+        camp.write_text(_toml(tmp_path / "c.h5", rounds=50))
+        assert cli(["run", str(camp), "--quiet"]) == 0
+        assert signal.getsignal(signal.SIGINT) is mine
+        assert signal.getsignal(signal.SIGTERM) is mine
+    finally:
+        for s, h in before.items():
+            signal.signal(s, h)

@@ -74,18 +74,24 @@ def _run(args: argparse.Namespace) -> int:
         if not WRITING.is_set():
             raise KeyboardInterrupt
 
+    previous = {}
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, interrupt)
-        signal.signal(signal.SIGTERM, interrupt)
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            previous[sig] = signal.signal(sig, interrupt)
     print(f"campaign {c.name!r}: {len(c.cases)} cases -> {args.output or c.output}")
-    report = run_campaign(
-        c,
-        scheduler=args.scheduler,
-        workers=args.workers,
-        output=args.output,
-        progress=not args.quiet,
-        stop=stop,
-    )
+    try:
+        report = run_campaign(
+            c,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            output=args.output,
+            progress=not args.quiet,
+            stop=stop,
+        )
+    finally:
+        # the caller's handlers again (main() called in-process must not leave its own)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     print()
     print(
         f"{report.status}: {report.tasks_done} tasks done this run, {report.tasks_skipped} "
