@@ -29,7 +29,7 @@ import panel as pn
 
 from fbs_core.errors import FBSError, StudyCancelled
 
-from . import compute
+from . import compute, offload
 
 __all__ = ["Job", "Turnstile", "TURNSTILE", "run", "served", "start"]
 
@@ -140,6 +140,8 @@ def run(job: Job, done: Done, context=None, turnstile: Turnstile | None = None) 
     turns = TURNSTILE if turnstile is None else turnstile
     try:
         res = compute.cached_band(job.key)
+        if res is None and offload.wanted(job.key):  # heavy: on the Dask cluster
+            res = offload.band(job.key, lambda: job.cancelled, job.report)
         if res is None:
             res = compute.band(
                 *job.key, cancel=lambda: not turns.next_turn(job), progress=job.report

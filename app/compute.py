@@ -394,12 +394,17 @@ def band(*args, cancel=None, progress=None, **kwargs):
         progress=progress,
         **_models_kw(models),
     )
+    remember_band(key, res)
+    return res
+
+
+def remember_band(key: tuple, res) -> None:
+    """Cache the band ``res`` of :func:`band_key` ``key`` (computed here or on a cluster)."""
     with _bands_lock:
         _bands[key] = res
         _bands.move_to_end(key)
         while len(_bands) > BAND_CACHE_SIZE:
             _bands.popitem(last=False)
-    return res
 
 
 def band_data(result, dof: str, percentile: float = 90) -> dict:

@@ -429,7 +429,7 @@ def wait_http(url: str, timeout_s: float, alive=lambda: True) -> None:
 class LocalServer:
     """``panel serve`` through the container's entrypoint, on a loopback port."""
 
-    def __init__(self, threads: int, cpuset: set[int] | None = None):
+    def __init__(self, threads: int, cpuset: set[int] | None = None, start_s: float = 60):
         self.port = free_port()
         self.log = tempfile.NamedTemporaryFile("w+", suffix=".log", delete=False)
         env = {
@@ -448,7 +448,7 @@ class LocalServer:
             preexec_fn=pin,
         )
         self.url = f"http://127.0.0.1:{self.port}/"
-        wait_http(self.url + "liveness", 60, lambda: self.proc.poll() is None)
+        wait_http(self.url + "liveness", start_s, lambda: self.proc.poll() is None)
 
     def logs(self) -> str:
         self.log.seek(0)

@@ -28,11 +28,16 @@ once by complex modes and every FRF is an exact modal sum (no truncation).
 from __future__ import annotations
 
 import functools
+import os
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
+from numpy.typing import ArrayLike
 
+from ._typing import ComplexArray, FloatArray, IntArray
 from .direct import SecondOrderSystem
 from .dofs import DIRECTIONS, index_of, node_labels
 from .errors import DataFormatError, FrequencyGridError, QuantityError
@@ -95,7 +100,7 @@ class ChassisParameters:
 STEEL_E, STEEL_NU, STEEL_RHO = 210e9, 0.3, 7850.0
 
 
-def _n_el(p, q, h) -> int:
+def _n_el(p: ArrayLike, q: ArrayLike, h: float) -> int:
     return max(1, round(float(np.linalg.norm(np.subtract(q, p))) / h))
 
 
@@ -163,7 +168,9 @@ def build_chassis(p: ChassisParameters) -> FEModel:
 
 
 @functools.lru_cache(maxsize=8)
-def _modal(p: ChassisParameters):
+def _modal(
+    p: ChassisParameters,
+) -> tuple[SecondOrderSystem, ComplexArray, ComplexArray, ComplexArray]:
     """Complex modes of ``M^-1 K`` (hysteretic K): ``K V = M V diag(lam)``."""
     s = build_chassis(p).system()
     K, M = s.K.toarray(), s.M.toarray()
@@ -218,20 +225,26 @@ class ChassisModel:
         ``spindle:*`` and ``bushing:*``; no viscous damping)."""
         return _modal(self._p)[0]
 
-    def eigenvalues(self) -> np.ndarray:
+    def eigenvalues(self) -> ComplexArray:
         """Complex eigenvalues ``lam_r = omega_r^2 (1 + j eta_r)``, sorted by real part."""
         return _modal(self._p)[1]
 
-    def eigenfrequencies(self) -> np.ndarray:
+    def eigenfrequencies(self) -> FloatArray:
         """Natural frequencies ``sqrt(Re lam_r) / 2 pi`` in Hz, ascending."""
         return np.sqrt(self.eigenvalues().real) / (2 * np.pi)
 
-    def loss_factors(self) -> np.ndarray:
+    def loss_factors(self) -> FloatArray:
         """Modal loss factors ``Im lam_r / Re lam_r``."""
         lam = self.eigenvalues()
         return lam.imag / lam.real
 
-    def mobility(self, freq, outputs=None, inputs=None, quantity: str = "mobility") -> FRF:
+    def mobility(
+        self,
+        freq: ArrayLike,
+        outputs: Iterable[str] | None = None,
+        inputs: Iterable[str] | None = None,
+        quantity: str = "mobility",
+    ) -> FRF:
         """FRFs by exact complex-mode synthesis on any grid.
 
         ``H(omega) = V_o diag(1 / (lam_r - omega^2)) (V^-1 M^-1)_i`` is the
@@ -260,7 +273,7 @@ class ChassisModel:
         jw = 1j * 2 * np.pi * f
         return FRF(f, data * (jw ** QUANTITIES[quantity])[:, None, None], outputs, inputs, quantity)
 
-    def driving_point(self, freq) -> FRF:
+    def driving_point(self, freq: ArrayLike) -> FRF:
         """``Y_jj^E``: spindle mobility, 6 x 6 (``spindle:*`` to ``spindle:*``).
 
         Parameters
@@ -270,7 +283,7 @@ class ChassisModel:
         """
         return self.mobility(freq, outputs=SPINDLE, inputs=SPINDLE)
 
-    def transfer(self, freq) -> FRF:
+    def transfer(self, freq: ArrayLike) -> FRF:
         """``Y_ej^E``: spindle-to-bushing mobility, 6 x 6 (``spindle:*`` to ``bushing:*``).
 
         Parameters
@@ -280,13 +293,15 @@ class ChassisModel:
         """
         return self.mobility(freq, outputs=BUSHING, inputs=SPINDLE)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """The parameters as a plain dict (for storage)."""
         return asdict(self._p)
 
 
 @functools.lru_cache(maxsize=32)
-def _synth(p: ChassisParameters, fbytes: bytes, outputs: tuple, inputs: tuple) -> np.ndarray:
+def _synth(
+    p: ChassisParameters, fbytes: bytes, outputs: tuple[str, ...], inputs: tuple[str, ...]
+) -> ComplexArray:
     s, lam, V, W = _modal(p)
     oi = index_of(s.dofs, outputs, "chassis output DOF")
     ii = index_of(s.dofs, inputs, "chassis input DOF")
@@ -298,7 +313,7 @@ def _synth(p: ChassisParameters, fbytes: bytes, outputs: tuple, inputs: tuple) -
     return H
 
 
-def read_chassis_frf(path) -> FRF:
+def read_chassis_frf(path: str | os.PathLike[str]) -> FRF:
     """Read the FRF stored by ``scripts/build_reference_chassis.py`` (HDF5, no pickle).
 
     The file follows the project's HDF5 layout (``fbs_core.io.hdf5``), so
@@ -324,7 +339,7 @@ def read_chassis_frf(path) -> FRF:
             )
         g = h["frf"]
 
-        def labels(key):
+        def labels(key: str) -> list[str]:
             return [v.decode() if isinstance(v, bytes) else str(v) for v in g.attrs[key]]
 
         return FRF(
@@ -347,7 +362,7 @@ def reference_chassis() -> ChassisModel:
     return ChassisModel()
 
 
-def modal_energy(chassis: ChassisModel, node: str = "spindle") -> np.ndarray:
+def modal_energy(chassis: ChassisModel, node: str = "spindle") -> FloatArray:
     """Share of each mode's kinetic energy in the six DOFs of ``node``.
 
     Returns
@@ -356,10 +371,11 @@ def modal_energy(chassis: ChassisModel, node: str = "spindle") -> np.ndarray:
         ``Re(conj(v_d) (M v)_d) / Re(v^H M v)`` for d = x .. rz.
     """
     s, lam, V, _ = _modal(chassis.params)
-    MV = s.M @ V
+    MV: ComplexArray = s.M @ V  # s.M is scipy.sparse (untyped)
     e = np.real(np.conj(V) * MV)
     idx = index_of(s.dofs, node_labels(node), "chassis DOF")
-    return (e[idx] / e.sum(axis=0)).T
+    share: FloatArray = (e[idx] / e.sum(axis=0)).T
+    return share
 
 
 def carrier_mode_table(chassis: ChassisModel, fmax: float = 100.0) -> dict[str, float]:
@@ -374,7 +390,7 @@ def carrier_mode_table(chassis: ChassisModel, fmax: float = 100.0) -> dict[str, 
     return {d: float(f[keep][np.argmax(e[keep, k])]) for k, d in enumerate(DIRECTIONS)}
 
 
-def match_grid(available, wanted, rtol: float = 1e-9) -> np.ndarray | None:
+def match_grid(available: ArrayLike, wanted: ArrayLike, rtol: float = 1e-9) -> IntArray | None:
     """Positions of the ``wanted`` frequencies in the sorted grid ``available``.
 
     A line matches when it lies within ``rtol * max(1, |f|)`` Hz of a wanted frequency
@@ -439,11 +455,11 @@ class FRFChassis:
     def __repr__(self) -> str:
         return f"FRFChassis({self.frf!r}, interpolate={self.interpolate})"
 
-    def needs_interpolation(self, freq) -> bool:
+    def needs_interpolation(self, freq: ArrayLike) -> bool:
         """True when some of ``freq`` (Hz) is not a line of the FRF."""
         return match_grid(self.frf.freq, freq) is None
 
-    def on_grid(self, freq) -> FRF:
+    def on_grid(self, freq: ArrayLike) -> FRF:
         """The whole FRF on ``freq`` (Hz): its own lines, else interpolated if allowed.
 
         Raises
@@ -469,7 +485,13 @@ class FRFChassis:
             "interpolate it explicitly (linear in real and imaginary part)"
         )
 
-    def mobility(self, freq, outputs=None, inputs=None, quantity: str = "mobility") -> FRF:
+    def mobility(
+        self,
+        freq: ArrayLike,
+        outputs: Iterable[str] | None = None,
+        inputs: Iterable[str] | None = None,
+        quantity: str = "mobility",
+    ) -> FRF:
         """The FRF on ``freq`` (Hz), same signature as :meth:`ChassisModel.mobility`."""
         Y = self.on_grid(freq)
         Y = Y.sel(

@@ -13,6 +13,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from . import kernels
+from ._typing import ComplexArray, FloatArray, IntArray
 from .dofs import index_of, parse_label
 from .errors import DataFormatError, DOFError, QuantityError
 from .frf import FRF
@@ -27,16 +28,18 @@ __all__ = [
 ]
 
 Pair = tuple[str, str]
+#: Interface DOFs: one label, or labels and ``(label_in_a, label_in_b)`` pairs.
+Interface = str | Sequence[str | Sequence[str]]
 
 
-def _is_pair(item) -> bool:
+def _is_pair(item: object) -> bool:
     return isinstance(item, Sequence) and len(item) == 2 and all(isinstance(s, str) for s in item)
 
 
-def _pairs(interface) -> list[Pair]:
+def _pairs(interface: Interface) -> list[Pair]:
     if isinstance(interface, str):
         interface = [interface]
-    pairs = []
+    pairs: list[Pair] = []
     for item in interface:
         if isinstance(item, str):
             pairs.append((item, item))
@@ -69,7 +72,7 @@ def _require_square(Y: FRF, name: str) -> None:
         )
 
 
-def _split(Y: FRF, iface: list[str], name: str):
+def _split(Y: FRF, iface: list[str], name: str) -> tuple[IntArray, IntArray, IntArray, IntArray]:
     """Indices of internal outputs/inputs and of interface outputs/inputs."""
     jo = index_of(Y.outputs, iface, f"interface output DOF of {name}")
     ji = index_of(Y.inputs, iface, f"interface input DOF of {name}")
@@ -94,7 +97,7 @@ def _check_unique(*groups: Sequence[str]) -> None:
 def couple_receptance(
     a: FRF,
     b: FRF,
-    interface,
+    interface: Interface,
     *,
     rcond: float | None = None,
     max_cond: float | None = kernels.MAX_COND,
@@ -154,7 +157,7 @@ def couple_receptance(
     return FRF(a.freq, data, outs, ins, a.quantity)
 
 
-def couple_impedance(a: FRF, b: FRF, interface) -> FRF:
+def couple_impedance(a: FRF, b: FRF, interface: Interface) -> FRF:
     """Impedance coupling of two subsystems, thesis eqs. 2.18-2.19.
 
     Both FRFs must be square over all their DOFs. Three matrix inversions per
@@ -206,7 +209,9 @@ def _qualified(subsystems: Mapping[str, FRF]) -> tuple[list[str], list[FRF]]:
     return labels, frfs
 
 
-def _connection_pairs(labels: list[str], connections) -> list[tuple[int, int]]:
+def _connection_pairs(
+    labels: list[str], connections: Sequence[Sequence[str]]
+) -> list[tuple[int, int]]:
     idx = []
     for c in connections:
         if not _is_pair(c) or isinstance(c, str):
@@ -327,7 +332,7 @@ def couple_generalized(
     return FRF(frfs[0].freq, data, labels, labels, frfs[0].quantity)
 
 
-def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
+def _block_diag(blocks: list[ComplexArray]) -> ComplexArray:
     nf = blocks[0].shape[0]
     n = sum(b.shape[1] for b in blocks)
     out = np.zeros((nf, n, n), complex)
@@ -339,7 +344,7 @@ def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
     return out
 
 
-def _interface_pairs(tire: FRF, chassis: FRF, interface) -> list[Pair]:
+def _interface_pairs(tire: FRF, chassis: FRF, interface: Interface | None) -> list[Pair]:
     if interface is not None:
         return _pairs(interface)
     if len(tire.inputs) != len(chassis.inputs):
@@ -363,7 +368,7 @@ def couple_response(
     Y_jj_E: FRF,
     v_j: FRF,
     *,
-    interface=None,
+    interface: Interface | None = None,
     couple: Sequence[str] | None = None,
     rcond: float | None = None,
     max_cond: float | None = kernels.MAX_COND,
@@ -420,7 +425,7 @@ def couple_response(
     return FRF(Y_ej.freq, data, Y_ej.outputs, v_j.inputs, Y_ej.quantity)
 
 
-def interface_condition(a: FRF, b: FRF, interface=None) -> np.ndarray:
+def interface_condition(a: FRF, b: FRF, interface: Interface | None = None) -> FloatArray:
     """Condition number of ``Y_jj^A + Y_jj^B`` at every line, shape ``(n_freq,)``.
 
     This is the matrix inverted by receptance coupling (eq. 2.44) and by the

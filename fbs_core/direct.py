@@ -11,22 +11,28 @@ would couple them, so that FBS results can be checked against it.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any, TypeAlias
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from numpy.typing import ArrayLike
 
+from ._typing import ComplexArray
 from .dofs import index_of, validate_labels
 from .errors import DataFormatError
 from .frf import FRF, QUANTITIES, check_grid
 
 __all__ = ["SecondOrderSystem", "assemble"]
 
+#: A dense ndarray or a scipy.sparse matrix (scipy ships no type stubs, so this is Any).
+Matrix: TypeAlias = Any
 
-def _as_matrix(a, n: int, name: str):
+
+def _as_matrix(a: Matrix, n: int, name: str) -> Matrix:
     if sp.issparse(a):
         a = sp.csc_matrix(a)
     else:
@@ -49,12 +55,12 @@ class SecondOrderSystem:
         DOF labels.
     """
 
-    M: object
-    C: object
-    K: object
+    M: Matrix
+    C: Matrix
+    K: Matrix
     dofs: tuple[str, ...] = field(default=())
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         dofs = validate_labels(self.dofs)
         n = len(dofs)
         object.__setattr__(self, "dofs", dofs)
@@ -70,10 +76,10 @@ class SecondOrderSystem:
     def n(self) -> int:
         return len(self.dofs)
 
-    def _dense(self, a):
+    def _dense(self, a: Matrix) -> ComplexArray:
         return a.toarray() if sp.issparse(a) else np.asarray(a)
 
-    def dynamic_stiffness(self, omega: float):
+    def dynamic_stiffness(self, omega: float) -> Matrix:
         """``K - omega^2 M + j omega C`` at one angular frequency (eq. 2.2)."""
         if any(sp.issparse(a) for a in (self.M, self.C, self.K)):
             return (
@@ -85,11 +91,11 @@ class SecondOrderSystem:
 
     def frf(
         self,
-        freq,
+        freq: ArrayLike,
         outputs: Iterable[str] | None = None,
         inputs: Iterable[str] | None = None,
         quantity: str = "mobility",
-        loads: dict[str, np.ndarray] | None = None,
+        loads: Mapping[str, ArrayLike] | None = None,
     ) -> FRF:
         """FRFs by direct solution at every line.
 
@@ -164,7 +170,7 @@ def assemble(
     # map every global DOF onto a reduced DOF (union-find on connections)
     parent = list(range(len(labels)))
 
-    def find(i):
+    def find(i: int) -> int:
         while parent[i] != i:
             parent[i] = parent[parent[i]]
             i = parent[i]
@@ -178,12 +184,12 @@ def assemble(
     roots = sorted({find(i) for i in range(len(labels))})
     col = {r: k for k, r in enumerate(roots)}
     rows = np.arange(len(labels))
-    cols = [col[find(i)] for i in rows]
+    cols = [col[find(int(i))] for i in rows]
     L = sp.csr_matrix(
         (np.ones(len(labels)), (rows, cols)),
         shape=(len(labels), len(roots)),
     )
-    blocks = {k: [] for k in "MCK"}
+    blocks: dict[str, list[Matrix]] = {k: [] for k in "MCK"}
     for s in systems.values():
         for k in "MCK":
             a = getattr(s, k)
@@ -192,4 +198,4 @@ def assemble(
     dense = not any(sp.issparse(getattr(s, k)) for s in systems.values() for k in "MCK")
     if dense:
         mats = {k: v.toarray() for k, v in mats.items()}
-    return SecondOrderSystem(mats["M"], mats["C"], mats["K"], [labels[r] for r in roots])
+    return SecondOrderSystem(mats["M"], mats["C"], mats["K"], tuple(labels[r] for r in roots))

@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
+from ._typing import AnyArray, ComplexArray, FloatArray
 from .direct import SecondOrderSystem
 from .dofs import DIRECTIONS, parse_label
 from .errors import DataFormatError, DOFError
@@ -59,7 +61,7 @@ class Material:
     rho: float
     eta: float = 0.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.E <= 0 or self.rho <= 0 or not -1 < self.nu < 0.5 or self.eta < 0:
             raise DataFormatError(
                 f"invalid material E={self.E}, nu={self.nu}, rho={self.rho}, eta={self.eta}; "
@@ -85,7 +87,7 @@ class Section:
     Iz: float
     J: float
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if min(self.A, self.Iy, self.Iz, self.J) <= 0:
             raise DataFormatError(f"section properties must be positive, got {self}")
 
@@ -131,7 +133,7 @@ class Section:
 
 def beam_local_matrices(
     length: float, section: Section, material: Material
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[ComplexArray, FloatArray]:
     """Stiffness and consistent mass of a 3D Euler-Bernoulli beam in local axes.
 
     DOF order: ``u1 v1 w1 tx1 ty1 tz1 u2 v2 w2 tx2 ty2 tz2`` with x along the
@@ -159,7 +161,7 @@ def beam_local_matrices(
         M[idx] += m * bar_m
     # bending: (v, tz) uses Iz with +L terms; (w, ty) uses Iy with -L terms
     for I, dofs, s in ((Iz, [1, 5, 7, 11], 1.0), (Iy, [2, 4, 8, 10], -1.0)):
-        k = (
+        kb = (
             E
             * I
             / L**3
@@ -172,7 +174,7 @@ def beam_local_matrices(
                 ]
             )
         )
-        m = (
+        mb = (
             rho
             * A
             * L
@@ -186,14 +188,16 @@ def beam_local_matrices(
                 ]
             )
         )
-        K[np.ix_(dofs, dofs)] += k
-        M[np.ix_(dofs, dofs)] += m
+        K[np.ix_(dofs, dofs)] += kb
+        M[np.ix_(dofs, dofs)] += mb
     return K * (1 + 1j * material.eta), M
 
 
 def beam_rotation(
-    p1: Sequence[float], p2: Sequence[float], up: Sequence[float] | None = None
-) -> np.ndarray:
+    p1: Sequence[float] | FloatArray,
+    p2: Sequence[float] | FloatArray,
+    up: Sequence[float] | FloatArray | None = None,
+) -> FloatArray:
     """Direction cosines of a beam's local axes.
 
     Parameters
@@ -217,31 +221,35 @@ def beam_rotation(
     ex = d / L
     if up is None:
         up = [0.0, 0.0, 1.0] if abs(ex[2]) < 0.99 else [0.0, 1.0, 0.0]
-    up = np.asarray(up, float)
-    ey = np.cross(up, ex)
-    if np.linalg.norm(ey) < 1e-9 * np.linalg.norm(up):
-        raise DataFormatError(f"'up' vector {tuple(up)} is parallel to the beam axis")
+    upv = np.asarray(up, float)
+    ey = np.cross(upv, ex)
+    if np.linalg.norm(ey) < 1e-9 * np.linalg.norm(upv):
+        raise DataFormatError(f"'up' vector {tuple(upv)} is parallel to the beam axis")
     ey /= np.linalg.norm(ey)
     ez = np.cross(ex, ey)
     return np.vstack([ex, ey, ez])
 
 
 def beam_element(
-    p1, p2, section: Section, material: Material, up=None
-) -> tuple[np.ndarray, np.ndarray]:
+    p1: Sequence[float] | FloatArray,
+    p2: Sequence[float] | FloatArray,
+    section: Section,
+    material: Material,
+    up: Sequence[float] | FloatArray | None = None,
+) -> tuple[ComplexArray, FloatArray]:
     """Global 12x12 stiffness and mass ``T^T K_local T`` of one beam element."""
     R = beam_rotation(p1, p2, up)
     T = np.kron(np.eye(4), R)
-    K, M = beam_local_matrices(np.linalg.norm(np.subtract(p2, p1)), section, material)
+    K, M = beam_local_matrices(float(np.linalg.norm(np.subtract(p2, p1))), section, material)
     return T.T @ K @ T, T.T @ M @ T
 
 
-def _skew(r) -> np.ndarray:
+def _skew(r: FloatArray) -> FloatArray:
     x, y, z = r
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
-def offset_transform(offset: Sequence[float]) -> np.ndarray:
+def offset_transform(offset: Sequence[float] | FloatArray) -> FloatArray:
     """Rigid-link map from a reference node's 6 DOFs to a point at ``offset``.
 
     ``u_point = u_ref + theta x r`` (small rotations), ``theta_point = theta_ref``.
@@ -255,7 +263,9 @@ def offset_transform(offset: Sequence[float]) -> np.ndarray:
     return T
 
 
-def rigid_body_mass(mass: float, inertia, offset: Sequence[float] = (0.0, 0.0, 0.0)) -> np.ndarray:
+def rigid_body_mass(
+    mass: float, inertia: ArrayLike, offset: Sequence[float] | FloatArray = (0.0, 0.0, 0.0)
+) -> FloatArray:
     """6x6 mass matrix of a rigid body referred to a node.
 
     Parameters
@@ -300,20 +310,20 @@ class FEModel:
     """
 
     def __init__(self) -> None:
-        self._xyz: dict[str, np.ndarray] = {}
-        self._blocks: list[tuple[list[str], np.ndarray, np.ndarray]] = []
+        self._xyz: dict[str, FloatArray] = {}
+        self._blocks: list[tuple[list[str], AnyArray, AnyArray]] = []
 
     @property
     def nodes(self) -> tuple[str, ...]:
         return tuple(self._xyz)
 
-    def xyz(self, node: str) -> np.ndarray:
+    def xyz(self, node: str) -> FloatArray:
         """Coordinates of a node."""
         if node not in self._xyz:
             raise DOFError(f"unknown node {node!r}; available: {', '.join(self._xyz)}")
         return self._xyz[node].copy()
 
-    def add_node(self, name: str, xyz: Sequence[float]) -> str:
+    def add_node(self, name: str, xyz: Sequence[float] | FloatArray) -> str:
         """Add a node (its label must be valid, see :func:`fbs_core.dofs.parse_label`)."""
         if parse_label(name)[1] is not None:
             raise DOFError(f"node name {name!r} must not contain a direction")
@@ -325,16 +335,18 @@ class FEModel:
         self._xyz[name] = p
         return name
 
-    def add_block(self, nodes: Sequence[str], K=None, M=None) -> None:
+    def add_block(
+        self, nodes: Sequence[str], K: ArrayLike | None = None, M: ArrayLike | None = None
+    ) -> None:
         """Add dense stiffness / mass blocks of size ``6 len(nodes)``."""
         for n in nodes:
             self.xyz(n)
         size = 6 * len(nodes)
-        K = np.zeros((size, size)) if K is None else np.asarray(K)
-        M = np.zeros((size, size)) if M is None else np.asarray(M)
-        if K.shape != (size, size) or M.shape != (size, size):
+        Ka = np.zeros((size, size)) if K is None else np.asarray(K)
+        Ma = np.zeros((size, size)) if M is None else np.asarray(M)
+        if Ka.shape != (size, size) or Ma.shape != (size, size):
             raise DataFormatError(f"blocks on {len(nodes)} nodes must be {size}x{size}")
-        self._blocks.append((list(nodes), K, M))
+        self._blocks.append((list(nodes), Ka, Ma))
 
     def add_beam(
         self,
@@ -343,7 +355,7 @@ class FEModel:
         section: Section,
         material: Material,
         n_elements: int,
-        up=None,
+        up: Sequence[float] | FloatArray | None = None,
         prefix: str | None = None,
     ) -> list[str]:
         """Mesh a straight beam from node ``start`` to ``end`` with equal elements.
@@ -370,13 +382,19 @@ class FEModel:
             self.add_block([a, b], K, M)
         return names
 
-    def add_mass(self, node: str, mass6) -> None:
+    def add_mass(self, node: str, mass6: ArrayLike) -> None:
         """Add a 6x6 mass block (e.g. :func:`rigid_body_mass`) at a node."""
         self.add_block([node], M=mass6)
 
     def add_spring(
-        self, a: str, b: str | None, k, eta: float = 0.0, offset_a=None, offset_b=None
-    ) -> np.ndarray:
+        self,
+        a: str,
+        b: str | None,
+        k: ArrayLike,
+        eta: float = 0.0,
+        offset_a: Sequence[float] | FloatArray | None = None,
+        offset_b: Sequence[float] | FloatArray | None = None,
+    ) -> ComplexArray:
         """Add a 6x6 spring (``k`` diagonal of 6 or 6x6) between nodes or to ground.
 
         The spring acts between a point rigidly attached to ``a`` (at
@@ -388,11 +406,11 @@ class FEModel:
         ndarray
             The complex stiffness block that was added.
         """
-        k = np.asarray(k, float)
-        k = np.diag(k) if k.shape == (6,) else k
-        if k.shape != (6, 6):
-            raise DataFormatError(f"spring stiffness must be 6 values or 6x6, got {k.shape}")
-        kc = k * (1 + 1j * eta)
+        ka = np.asarray(k, float)
+        ka = np.diag(ka) if ka.shape == (6,) else ka
+        if ka.shape != (6, 6):
+            raise DataFormatError(f"spring stiffness must be 6 values or 6x6, got {ka.shape}")
+        kc = ka * (1 + 1j * eta)
         Ta = offset_transform(np.zeros(3) if offset_a is None else offset_a)
         if b is None:
             blk = Ta.T @ kc @ Ta

@@ -9,13 +9,19 @@ method returns a new :class:`FRF`.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
+from typing import Any, TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike
 
+from ._typing import AnyArray, ComplexArray, FloatArray, IntArray
 from .dofs import index_of, validate_labels
 from .errors import DataFormatError, FrequencyGridError, QuantityError
 
 __all__ = ["FRF", "QUANTITIES", "UNITS", "check_grid"]
+
+#: A position selector of :meth:`FRF.isel`: int, slice, index list or boolean mask.
+_Index: TypeAlias = "slice | ArrayLike | None"
 
 #: FRF quantities (thesis table 2.1) and the power of ``j omega`` that turns a
 #: receptance into each of them.
@@ -25,7 +31,9 @@ QUANTITIES: dict[str, int] = {"receptance": 0, "mobility": 1, "accelerance": 2}
 UNITS: dict[str, str] = {"receptance": "m/N", "mobility": "m/(N s)", "accelerance": "m/(N s^2)"}
 
 
-def _check_kinds(kinds, outs, ins) -> dict[str, str] | None:
+def _check_kinds(
+    kinds: Mapping[str, str] | None, outs: Sequence[str], ins: Sequence[str]
+) -> dict[str, str] | None:
     if not kinds:
         return None
     from .units import INPUT_KINDS, OUTPUT_KINDS
@@ -42,13 +50,13 @@ def _check_kinds(kinds, outs, ins) -> dict[str, str] | None:
     return out or None
 
 
-def _frozen(a: np.ndarray) -> np.ndarray:
+def _frozen(a: ArrayLike) -> AnyArray:
     a = np.array(a, copy=True)
     a.setflags(write=False)
     return a
 
 
-def check_grid(freq: np.ndarray) -> np.ndarray:
+def check_grid(freq: ArrayLike) -> FloatArray:
     """Validate a frequency grid in Hz: 1-D, finite, non-negative, strictly increasing.
 
     Raises
@@ -109,11 +117,17 @@ class FRF:
     """
 
     __slots__ = ("_freq", "_data", "_outputs", "_inputs", "_quantity", "_kinds")
+    _freq: FloatArray
+    _data: ComplexArray
+    _outputs: tuple[str, ...]
+    _inputs: tuple[str, ...]
+    _quantity: str
+    _kinds: dict[str, str] | None
 
     def __init__(
         self,
-        freq: Sequence[float] | np.ndarray,
-        data: np.ndarray,
+        freq: ArrayLike,
+        data: ArrayLike,
         outputs: Iterable[str],
         inputs: Iterable[str],
         quantity: str = "mobility",
@@ -146,22 +160,22 @@ class FRF:
         object.__setattr__(self, "_quantity", quantity)
         object.__setattr__(self, "_kinds", _check_kinds(kinds, outs, ins))
 
-    def __setattr__(self, name, value):
+    def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError("FRF objects are immutable; methods return new objects")
 
     # -- properties ----------------------------------------------------------------
     @property
-    def freq(self) -> np.ndarray:
+    def freq(self) -> FloatArray:
         """Frequencies in Hz, shape ``(n_freq,)`` (read-only)."""
         return self._freq
 
     @property
-    def omega(self) -> np.ndarray:
+    def omega(self) -> FloatArray:
         """Angular frequencies ``2 pi f`` in rad/s, shape ``(n_freq,)``."""
         return 2 * np.pi * self._freq
 
     @property
-    def data(self) -> np.ndarray:
+    def data(self) -> ComplexArray:
         """Complex data, shape ``(n_freq, n_out, n_in)`` (read-only)."""
         return self._data
 
@@ -202,7 +216,7 @@ class FRF:
         return tuple(input_kind(i, self._kinds) for i in self._inputs)
 
     @property
-    def units(self) -> np.ndarray:
+    def units(self) -> AnyArray:
         """SI unit of every entry, shape ``(n_out, n_in)`` of str (e.g. ``m/(N s)``)."""
         from .units import frf_unit
 
@@ -242,9 +256,9 @@ class FRF:
         )
 
     # -- construction helpers ------------------------------------------------------
-    def replace(self, **changes) -> FRF:
+    def replace(self, **changes: Any) -> FRF:
         """A new FRF with some of ``freq, data, outputs, inputs, quantity`` replaced."""
-        kw = dict(
+        kw: dict[str, Any] = dict(
             freq=self._freq,
             data=self._data,
             outputs=self._outputs,
@@ -273,10 +287,10 @@ class FRF:
         ii = None if inputs is None else index_of(self._inputs, inputs, "input DOF")
         return self.isel(outputs=oi, inputs=ii)
 
-    def isel(self, freq=None, outputs=None, inputs=None) -> FRF:
+    def isel(self, freq: _Index = None, outputs: _Index = None, inputs: _Index = None) -> FRF:
         """Select by 0-based position (ints, slices or index lists); ``None`` keeps all."""
 
-        def norm(k, n):
+        def norm(k: _Index, n: int) -> IntArray:
             if k is None:
                 return np.arange(n)
             if isinstance(k, slice):
@@ -356,7 +370,7 @@ class FRF:
                 "silently: call .interpolate(freq) explicitly"
             )
 
-    def interpolate(self, freq: Sequence[float] | np.ndarray) -> FRF:
+    def interpolate(self, freq: ArrayLike) -> FRF:
         """Linear interpolation of real and imaginary parts onto ``freq``.
 
         This is the explicit way to put FRFs on a common grid; nothing in
@@ -395,7 +409,7 @@ class FRF:
             data=np.swapaxes(self._data, 1, 2), outputs=self._inputs, inputs=self._outputs
         )
 
-    def magnitude_db(self, ref: float = 1.0) -> np.ndarray:
+    def magnitude_db(self, ref: float = 1.0) -> FloatArray:
         """``20 log10(|data| / ref)``, shape ``(n_freq, n_out, n_in)``."""
         with np.errstate(divide="ignore"):
             return 20 * np.log10(np.abs(self._data) / ref)

@@ -10,8 +10,12 @@ internal DOFs a, subsystem E (chassis) with internal DOFs e, interface j.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import NoReturn, TypedDict, Unpack
+
 import numpy as np
 
+from ._typing import AnyArray, BoolArray, ComplexArray, FloatArray, IndexLike
 from .errors import FBSError, SingularInterfaceError
 
 __all__ = [
@@ -29,7 +33,15 @@ __all__ = [
 MAX_COND = 1e13
 
 
-def condition_number(A: np.ndarray) -> np.ndarray:
+class SolveOptions(TypedDict, total=False):
+    """Keyword options of :func:`solve_interface` that coupling functions pass through."""
+
+    rcond: float | None
+    max_cond: float | None
+    freq: FloatArray | None
+
+
+def condition_number(A: AnyArray) -> FloatArray:
     """2-norm condition number of every matrix in a stack ``(..., n, n)``.
 
     ``inf`` where a matrix is exactly singular.
@@ -39,23 +51,24 @@ def condition_number(A: np.ndarray) -> np.ndarray:
         return np.where(s[..., -1] > 0, s[..., 0] / s[..., -1], np.inf)
 
 
-def _tsvd_solve(A: np.ndarray, B: np.ndarray, rcond: float) -> np.ndarray:
+def _tsvd_solve(A: AnyArray, B: AnyArray, rcond: float) -> ComplexArray:
     """Truncated-SVD solution of ``A X = B`` on a stack: singular values below
     ``rcond * s_max`` are discarded (a regularised pseudo-inverse)."""
     U, s, Vh = np.linalg.svd(A)
     keep = s > rcond * s[..., :1]
     s_inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
     UhB = np.conj(np.swapaxes(U, -1, -2)) @ B
-    return np.conj(np.swapaxes(Vh, -1, -2)) @ (s_inv[..., :, None] * UhB)
+    X: ComplexArray = np.conj(np.swapaxes(Vh, -1, -2)) @ (s_inv[..., :, None] * UhB)
+    return X
 
 
 def solve_interface(
-    A: np.ndarray,
-    B: np.ndarray,
+    A: ComplexArray,
+    B: ComplexArray,
     rcond: float | None = None,
     max_cond: float | None = None,
-    freq: np.ndarray | None = None,
-) -> np.ndarray:
+    freq: FloatArray | None = None,
+) -> ComplexArray:
     """Solve ``A X = B`` for a stack of interface matrices ``A (..., n, n)``.
 
     Parameters
@@ -101,7 +114,9 @@ def solve_interface(
         raise  # pragma: no cover - solve failed although no matrix looks singular
 
 
-def _raise_singular(bad, c, freq, max_cond):
+def _raise_singular(
+    bad: BoolArray, c: FloatArray, freq: FloatArray | None, max_cond: float | None
+) -> NoReturn:
     idx = np.argwhere(bad)[0]
     line = int(idx[-1]) if idx.size else 0
     where = f"{freq[line]:g} Hz" if freq is not None and bad.ndim >= 1 else f"line {line}"
@@ -114,7 +129,19 @@ def _raise_singular(bad, c, freq, max_cond):
     )
 
 
-def receptance_coupling(YA, YB, a_o, a_i, ja_o, ja_i, b_o, b_i, jb_o, jb_i, **solve_kw):
+def receptance_coupling(
+    YA: ComplexArray,
+    YB: ComplexArray,
+    a_o: IndexLike,
+    a_i: IndexLike,
+    ja_o: IndexLike,
+    ja_i: IndexLike,
+    b_o: IndexLike,
+    b_i: IndexLike,
+    jb_o: IndexLike,
+    jb_i: IndexLike,
+    **solve_kw: Unpack[SolveOptions],
+) -> ComplexArray:
     """Receptance coupling of two subsystems, thesis eq. 2.44 in general form.
 
     No reciprocity is assumed (eq. 2.45 is not used): the right factor is built
@@ -139,7 +166,10 @@ def receptance_coupling(YA, YB, a_o, a_i, ja_o, ja_i, b_o, b_i, jb_o, jb_i, **so
     nf = YA.shape[0]
     nao, nj, nbo = len(a_o), len(ja_o), len(b_o)
     nai, nbi = len(a_i), len(b_i)
-    sub = lambda Y, r, c: Y[:, r][:, :, c]  # noqa: E731
+
+    def sub(Y: ComplexArray, r: IndexLike, c: IndexLike) -> ComplexArray:
+        return Y[:, r][:, :, c]
+
     Y0 = np.zeros((nf, nao + nj + nbo, nai + nj + nbi), complex)
     Y0[:, : nao + nj, : nai + nj] = sub(YA, np.r_[a_o, ja_o], np.r_[a_i, ja_i])
     Y0[:, nao + nj :, nai + nj :] = sub(YB, b_o, b_i)
@@ -149,7 +179,14 @@ def receptance_coupling(YA, YB, a_o, a_i, ja_o, ja_i, b_o, b_i, jb_o, jb_i, **so
     return Y0 - left @ solve_interface(Yjj, right, **solve_kw)
 
 
-def impedance_coupling(YA, YB, a, ja, b, jb):
+def impedance_coupling(
+    YA: ComplexArray,
+    YB: ComplexArray,
+    a: IndexLike,
+    ja: IndexLike,
+    b: IndexLike,
+    jb: IndexLike,
+) -> ComplexArray:
     """Impedance coupling of two subsystems, thesis eqs. 2.18-2.19.
 
     ``YA`` and ``YB`` must be square over all their DOFs (outputs == inputs in
@@ -176,7 +213,7 @@ def impedance_coupling(YA, YB, a, ja, b, jb):
     return _inv(Z, "the assembled impedance matrix")
 
 
-def _inv(M: np.ndarray, what: str) -> np.ndarray:
+def _inv(M: ComplexArray, what: str) -> ComplexArray:
     """Inverse of every matrix of a stack; SingularInterfaceError naming the first
     singular line instead of numpy's LinAlgError."""
     try:
@@ -192,7 +229,7 @@ def _inv(M: np.ndarray, what: str) -> np.ndarray:
         ) from None
 
 
-def lm_fbs(Y: np.ndarray, B: np.ndarray, **solve_kw) -> np.ndarray:
+def lm_fbs(Y: ComplexArray, B: AnyArray, **solve_kw: Unpack[SolveOptions]) -> ComplexArray:
     """LM-FBS with a general signed Boolean matrix (de Klerk, Rixen & Voormeeren 2008).
 
     ``Y* = Y - Y B^T (B Y B^T)^-1 B Y``, with ``Y`` the block-diagonal FRF of all
@@ -201,10 +238,13 @@ def lm_fbs(Y: np.ndarray, B: np.ndarray, **solve_kw) -> np.ndarray:
     BY = np.einsum("cn,fnm->fcm", B, Y)  # (n_freq, n_c, n)
     YBt = np.einsum("fnm,cm->fnc", Y, B)  # (n_freq, n, n_c)
     BYBt = np.einsum("fcm,dm->fcd", BY, B)  # (n_freq, n_c, n_c)
-    return Y - YBt @ solve_interface(BYBt, BY, **solve_kw)
+    out: ComplexArray = Y - YBt @ solve_interface(BYBt, BY, **solve_kw)
+    return out
 
 
-def lm_fbs_pairs(Y: np.ndarray, plus: np.ndarray, minus: np.ndarray, **solve_kw) -> np.ndarray:
+def lm_fbs_pairs(
+    Y: ComplexArray, plus: IndexLike, minus: IndexLike, **solve_kw: Unpack[SolveOptions]
+) -> ComplexArray:
     """LM-FBS where every row of ``B`` has one +1 (``plus``) and one -1 (``minus``).
 
     Same result as :func:`lm_fbs`, with ``B Y`` formed by row differences
@@ -216,7 +256,13 @@ def lm_fbs_pairs(Y: np.ndarray, plus: np.ndarray, minus: np.ndarray, **solve_kw)
     return Y - YBt @ solve_interface(BYBt, BY, **solve_kw)
 
 
-def generalized_receptance(Ys, internal, interfaces, Mbool, **solve_kw):
+def generalized_receptance(
+    Ys: Sequence[ComplexArray],
+    internal: Sequence[IndexLike],
+    interfaces: Sequence[Sequence[IndexLike]],
+    Mbool: AnyArray,
+    **solve_kw: Unpack[SolveOptions],
+) -> ComplexArray:
     """Jetmundsen's generalized receptance coupling, thesis eq. 2.46.
 
     Parameters
@@ -267,7 +313,13 @@ def generalized_receptance(Ys, internal, interfaces, Mbool, **solve_kw):
     return Yaa - Yag @ solve_interface(S, Yga, **solve_kw)
 
 
-def couple_response_kernel(Yej, YjjA, YjjE, vj, **solve_kw):
+def couple_response_kernel(
+    Yej: ComplexArray,
+    YjjA: ComplexArray,
+    YjjE: ComplexArray,
+    vj: ComplexArray,
+    **solve_kw: Unpack[SolveOptions],
+) -> ComplexArray:
     """The response at E's internal DOFs, thesis eq. 4.1 (and 2.37).
 
     ``v_e* = Y_ej^E (Y_jj^A + Y_jj^E)^-1 (Y_ja^A F_a)``, by one batched solve

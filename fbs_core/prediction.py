@@ -22,13 +22,18 @@ from __future__ import annotations
 
 import functools
 import warnings
+from collections.abc import Sequence
+from typing import Any, Protocol
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from numpy.typing import ArrayLike
 
+from ._typing import ComplexArray, FloatArray, IntArray
 from .chassis import BUSHING, SPINDLE, ChassisModel, reference_chassis
 from .coupling import couple_response
+from .direct import SecondOrderSystem
 from .dofs import DIRECTIONS, node_labels
 from .errors import CouplingOptionError
 from .frf import FRF, check_grid
@@ -48,7 +53,36 @@ COUPLED_DOFS: dict[str, tuple[str, ...]] = dict(
 )
 
 
-def __getattr__(name: str):
+class ModalTire(Protocol):
+    """What the prediction needs of a tire model (:class:`fbs_core.tire.TireModel`)."""
+
+    @property
+    def n_modes(self) -> int: ...
+
+    def truncations(
+        self, freq: Any, harmonic: Any = ..., n_modes_list: Any = ..., *, residual: bool = ...
+    ) -> tuple[ComplexArray, ComplexArray]: ...
+
+    def hub_mobility(
+        self, freq: Any, speed_kmh: float, n_modes: int | None = ..., *, residual: bool = ...
+    ) -> FRF: ...
+
+    def patch_response(
+        self,
+        freq: Any,
+        harmonic: Any = ...,
+        n_modes: int | None = ...,
+        speed_kmh: float | None = ...,
+        *,
+        residual: bool = ...,
+    ) -> FRF: ...
+
+    def system(self, speed_kmh: float) -> SecondOrderSystem: ...
+
+    def patch_load(self, speed_kmh: float, wavelength: float) -> ComplexArray: ...
+
+
+def __getattr__(name: str) -> dict[str, tuple[str, ...]]:
     if name == "COUPLINGS":  # the old name of COUPLED_DOFS (one release)
         warnings.warn(
             "fbs_core.prediction.COUPLINGS is deprecated: the option names are "
@@ -84,9 +118,16 @@ def _interface() -> list[tuple[str, str]]:
     return [(f"hub:{d}", f"spindle:{d}") for d in DIRECTIONS]
 
 
-def _tire_frfs(tire, h: Harmonic, f: np.ndarray, n_modes, speed_kmh, residual=False):
+def _tire_frfs(
+    tire: ModalTire,
+    h: Harmonic,
+    f: FloatArray,
+    n_modes: int | None,
+    speed_kmh: float | None,
+    residual: bool = False,
+) -> tuple[FRF, FRF]:
     """Y_jj^A and Y_ja^A F_a as FRFs (along the harmonic line, or at a fixed speed)."""
-    kw = {"residual": True} if residual else {}
+    kw: dict[str, bool] = {"residual": True} if residual else {}
     if speed_kmh is None:
         n = [tire.n_modes if n_modes is None else n_modes]
         Yjj, vj = tire.truncations(f, h, n, **kw)
@@ -99,7 +140,14 @@ def _tire_frfs(tire, h: Harmonic, f: np.ndarray, n_modes, speed_kmh, residual=Fa
 
 
 @functools.lru_cache(maxsize=64)
-def _cached(k: int, n_modes, fbytes: bytes, coupling: str, speed_kmh, residual=False) -> FRF:
+def _cached(
+    k: int,
+    n_modes: int | None,
+    fbytes: bytes,
+    coupling: str,
+    speed_kmh: float | None,
+    residual: bool = False,
+) -> FRF:
     from . import reference_tire  # the tire package registers it at import
 
     return _compute(
@@ -115,8 +163,15 @@ def _cached(k: int, n_modes, fbytes: bytes, coupling: str, speed_kmh, residual=F
 
 
 def _compute(
-    tire, chassis: ChassisModel, h: Harmonic, f, n_modes, coupling, speed_kmh, residual=False
-):
+    tire: ModalTire,
+    chassis: ChassisModel,
+    h: Harmonic,
+    f: FloatArray,
+    n_modes: int | None,
+    coupling: str,
+    speed_kmh: float | None,
+    residual: bool = False,
+) -> FRF:
     Y_A, v_A = _tire_frfs(tire, h, f, n_modes, speed_kmh, residual)
     Y_E = chassis.mobility(f, outputs=SPINDLE + BUSHING, inputs=SPINDLE)
     return couple_response(
@@ -129,14 +184,17 @@ def _compute(
     )
 
 
-def _assembled_index(tire_dofs, chassis_dofs, coupled):
+def _assembled_index(
+    tire_dofs: list[str], chassis_dofs: Sequence[str], coupled: Sequence[str]
+) -> tuple[IntArray, IntArray, int]:
     """Primal assembly by index maps: global index of every tire and chassis DOF.
 
     Chassis ``spindle:d`` is merged into tire ``hub:d`` for every coupled ``hub:d``
     (the same DOF merging as :func:`fbs_core.direct.assemble`).
     """
     n_a = len(tire_dofs)
-    g_e, nxt = [], n_a
+    g_e: list[int] = []
+    nxt = n_a
     for d in chassis_dofs:
         node, _, direction = d.partition(":")
         hub = f"hub:{direction}"
@@ -149,12 +207,12 @@ def _assembled_index(tire_dofs, chassis_dofs, coupled):
 
 
 def direct_bushing_response(
-    harmonic,
-    freq=None,
+    harmonic: int | Harmonic,
+    freq: ArrayLike | None = None,
     coupling: str = "6dof",
     *,
     speed_kmh: float | None = None,
-    tire=None,
+    tire: ModalTire | None = None,
     chassis: ChassisModel | None = None,
 ) -> FRF:
     """Ground truth of :func:`bushing_response`: the assembled matrices solved line by line.
@@ -200,11 +258,13 @@ def direct_bushing_response(
     keep = [list(cs.dofs).index(d) for d in SPINDLE + BUSHING]  # 12 chassis DOFs kept
     out = np.empty((f.size, len(BUSHING), 1), complex)
     load = tire.patch_load(float(speeds[0]), h.wavelength)  # space-fixed: speed independent
-    ia = ie = None
+    ia: IntArray | None = None
+    ie: IntArray | None = None
     for i, (fi, v) in enumerate(zip(f, speeds, strict=True)):
         ts = tire.system(float(v))
         if ia is None:
             ia, ie, n = _assembled_index(list(ts.dofs), SPINDLE + BUSHING, coupled)
+        assert ia is not None and ie is not None  # set on the first line
         w = 2 * np.pi * fi
         # block elimination of the chassis' inner DOFs (exact: Gaussian elimination of
         # the assembled matrix in another order): Z_E condensed onto spindle + bushing
@@ -222,16 +282,16 @@ def direct_bushing_response(
 
 
 def bushing_response(
-    harmonic=None,
+    harmonic: int | Harmonic | None = None,
     n_modes: int | None = None,
-    freq=None,
+    freq: ArrayLike | None = None,
     coupling: str = "6dof",
     *,
     speed_kmh: float | None = None,
-    tire=None,
+    tire: ModalTire | None = None,
     chassis: ChassisModel | None = None,
     residual: bool = False,
-    harmonic_case=None,
+    harmonic_case: int | Harmonic | None = None,
 ) -> FRF:
     """Velocity at the chosen bushing for the patch load of a harmonic case (eq. 4.1).
 
@@ -305,7 +365,9 @@ def bushing_response(
 _HARMONIC_SET = {_harmonic(k) for k in range(1, 8)}
 
 
-def _renamed(harmonic, harmonic_case):
+def _renamed(
+    harmonic: int | Harmonic | None, harmonic_case: int | Harmonic | None
+) -> int | Harmonic:
     """The harmonic given under its name or its deprecated one (``harmonic_case``)."""
     if harmonic_case is None:
         if harmonic is None:

@@ -15,6 +15,7 @@ from fbs_core.errors import DataFormatError, FrequencyGridError
 from fbs_core.harmonics import Harmonic, HarmonicError
 from fbs_core.tire import (
     HUB_DOFS,
+    OPERATING_POINTS,
     ModeCountError,
     OperatingPointError,
     TireModel,
@@ -34,7 +35,10 @@ def tire():
 def test_public_entry_points(tire):
     assert fbs_core.reference_tire() is tire  # cached
     assert isinstance(tire, fbs_core.TireModel)
-    np.testing.assert_allclose(tire.speeds, np.arange(20.0, 120.1, 2.5))
+    # every 2.5 km/h from 20 to 120, plus midpoints where the refinement added them
+    assert set(np.arange(20.0, 120.1, 2.5)) <= set(tire.speeds)
+    assert set(tire.speeds) <= set(np.arange(20.0, 120.1, 1.25))
+    assert tire.meta["refinement"]["added_kmh"] == sorted(set(tire.speeds) - set(OPERATING_POINTS))
     assert tire.n_modes == 400 and tire.hub_dofs == HUB_DOFS
     assert not tire.poles.flags.writeable
 
@@ -233,7 +237,7 @@ def test_shipped_file_is_reproducible(tmp_path):
     data/reference_tire.h5 (poles, and the all-modes synthesis, which does not depend on
     how the modes are ordered or scaled)."""
     shipped = load_tire_model(DATA_FILE)
-    assert DATA_FILE.stat().st_size < 6e6
+    assert DATA_FILE.stat().st_size < 7e6
     speeds = (65.0, 67.5)
     new = build_modal_model(shipped.params, speeds=speeds)
     again = load_tire_model(save_tire_model(new, tmp_path / "tire.h5"))

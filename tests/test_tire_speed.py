@@ -18,13 +18,14 @@ from fbs_core.tire.quality import level_errors
 
 def _lines(k: int) -> np.ndarray:
     """A dozen lines across the band plus the lines where the former 20 km/h model was
-    worst (issue 13) and where cubic weights without clusters miss by 2 dB."""
+    worst (issue 13), where cubic weights without clusters miss by 2 dB, and where the
+    2.5 km/h points without refinement missed by 3.5 dB (case 7, 116.3 km/h)."""
     h = harmonic(k)
     lo, hi = h.freq_range
     extra = {
         4: [110.0 / 3.6 / h.wavelength],
         5: [90.0 / 3.6 / h.wavelength],
-        7: [232.0, 236.0, 238.5, 239.5, 240.0, 241.0],
+        7: [232.0, 236.0, 238.5, 239.5, 240.0, 241.0, 409.0, 409.5, 410.0],
     }.get(k, [])
     f = np.r_[np.linspace(lo * 1.001, hi * 0.999, 12), extra]
     return np.unique(np.round(f, 3))
@@ -196,3 +197,22 @@ def test_speed_coverage_warns_outside_the_operating_points():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert speed_coverage(tire, h) == pytest.approx(h.freq_range)
+
+
+def test_refinement_adds_points_where_the_interpolation_misses_the_physics():
+    """``build_modal_model(refine_tol=...)`` halves exactly the intervals whose interpolated
+    model misses the direct solution by more than the tolerance; at the operating points
+    the check itself is exact (all-modes synthesis = direct solution of the matrices)."""
+    from fbs_core.tire.build import build_modal_model, interval_errors
+
+    params = reference_tire().params
+    coarse = build_modal_model(params, speeds=(100.0, 110.0, 120.0))
+    assert np.all(interval_errors(coarse, fractions=(0.0, 1.0)) < 1e-6)
+    err = interval_errors(coarse)
+    assert err.max() > 0.01  # 10 km/h steps at high speed: too coarse
+    fine = build_modal_model(params, speeds=(100.0, 110.0, 120.0), refine_tol=0.01, min_step=5.0)
+    want = [v for v, e in zip((105.0, 115.0), err, strict=True) if e > 0.01]
+    assert fine.meta["refinement"]["added_kmh"] == want
+    np.testing.assert_array_equal(fine.speeds, sorted({100.0, 110.0, 120.0, *want}))
+    new = interval_errors(fine)
+    assert new.max() < err.max()

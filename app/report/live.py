@@ -25,6 +25,11 @@ VIEW_OF_KEY = {
     "eigen": "eigenfrequency",
     "uncoupled": "uncoupled",
     "suggested": "suggested-modes",
+    "compare": "compare",
+    "contributions": "contributions",
+    "phase": "phase",
+    "campbell": "campbell",
+    "speedmap": "speed-map",
 }
 
 

@@ -37,6 +37,11 @@ VIEWS: dict[str, str] = {
     "scatter-band": "Noise scatter band of v_e* (eqs. 5.2-5.4)",
     "eigenfrequency": "Highest retained eigenfrequency vs N (thesis fig. 5.8)",
     "uncoupled": "Uncoupled subsystems: free hub velocity Y_ja^A F_a and chassis mobility",
+    "compare": "Compare pinned states: coupled response and difference in dB",
+    "contributions": "Contributions of the six hub forces to the bushing response (eq. 4.1)",
+    "phase": "Coupled response: magnitude and phase, peaks and the coupled modes near them",
+    "campbell": "Campbell diagram: tire eigenfrequencies vs speed, harmonic order lines",
+    "speed-map": "Bushing level over speed and frequency for the harmonic",
 }
 
 _NOISE_EQ = {"tire": "5.2", "vehicle": "5.3", "both": "5.4"}
@@ -203,6 +208,11 @@ _SHORT_WHAT = {
     "eigenfrequency": "Highest retained eigenfrequency (fig. 5.8)",
     "uncoupled": "Uncoupled subsystems",
     "suggested-modes": "Suggested number of modes (table 5.1)",
+    "compare": "Pinned states compared",
+    "contributions": "Hub-force contributions (eq. 4.1)",
+    "phase": "Magnitude and phase, peaks",
+    "campbell": "Campbell diagram",
+    "speed-map": "Bushing level over speed",
     "report": "tire-fbs",
 }
 _SHORT_COUPLING = {"6dof": "6-DOF hub (braked)", "5dof": "5-DOF hub (spin free)"}

@@ -16,7 +16,7 @@ from ..analysis_state import ANALYSIS_TABS
 from ..analysis_store import AnalysisResults
 from .live import LiveView, served_document
 
-__all__ = ["AnalysisView", "analysis_card", "page_card"]
+__all__ = ["AnalysisView", "analysis_card"]
 
 #: Colours of the six interface DOFs' terms (and of pins).
 TERM_COLORS = ("#1971c2", "#2b8a3e", "#e03131", "#f08c00", "#7048e8", "#0c8599")
@@ -153,7 +153,3 @@ def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
     from_state()
     return card
 
-
-def page_card(parts) -> pn.Card:
-    """The card for the page's ``EXTRA_CARDS`` (``app.main.PageParts``: store, shared axes)."""
-    return analysis_card(parts.results, parts.freq)

@@ -45,6 +45,16 @@ from ..report.bokeh import TitleBlockModels, style_figure
 from ..report.live import page_url, view_title
 from ..store import Result, Results
 
+
+def _plots_in(obj) -> list:
+    """The Bokeh plots of ``obj``: itself if it is one, else those of its layout in order."""
+    from bokeh.models import Plot
+
+    if isinstance(obj, Plot):
+        return [obj]
+    return list(obj.select({"type": Plot})) if hasattr(obj, "select") else []
+
+
 __all__ = ["LiveView", "download_button", "export_meta", "inline_html", "served_document"]
 
 
@@ -209,8 +219,12 @@ class LiveView(Viewer):
     def __panel__(self):
         if self._layout is None:
             self._doc = served_document()
-            figures = self._figures = self._build()
-            self._titles = [TitleBlockModels(f) for f in figures]
+            figures = self._build()
+            # the plots to style; a view may build a layout of plots (its first one carries
+            # the title block)
+            per_object = [_plots_in(f) for f in figures]
+            self._figures = [p for plots in per_object for p in plots]
+            self._titles = [TitleBlockModels(plots[0]) for plots in per_object if plots]
             self._restyle()
             header = self._header()
             plots = [

@@ -12,6 +12,8 @@ import argparse
 import signal
 import sys
 import threading
+from collections.abc import Sequence
+from types import FrameType
 
 from .browse import open_campaign
 from .run import SCHEDULER_ENV, WRITING, n_lines, plan, run_campaign
@@ -62,11 +64,11 @@ def _plan(path: str) -> int:
     return 0
 
 
-def _run(args) -> int:
+def _run(args: argparse.Namespace) -> int:
     c = load_campaign(args.campaign)
     stop = threading.Event()
 
-    def interrupt(signum, frame):
+    def interrupt(signum: int, frame: FrameType | None) -> None:
         # Ctrl-C / SIGTERM: stop; a task result being written is finished first
         stop.set()
         if not WRITING.is_set():
@@ -100,7 +102,7 @@ def _run(args) -> int:
     return 1 if report.errors else 0
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         if args.cmd == "summary":

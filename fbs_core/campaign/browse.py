@@ -11,18 +11,25 @@ responses were stored) or as the error map alone.
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._typing import AnyArray, FloatArray, IntArray
 from .spec import CampaignError
 from .store import CampaignStore
+
+if TYPE_CHECKING:
+    from ..studies.scatter import ScatterBand
+    from ..studies.truncation import TruncationMap
 
 __all__ = ["open_campaign", "CampaignResult", "CaseEntry", "TruncationEntry"]
 
 
-def _attr(v):
+def _attr(v: Any) -> Any:
     if isinstance(v, bytes):
         v = v.decode()
     if isinstance(v, np.generic):
@@ -30,7 +37,7 @@ def _attr(v):
     return v
 
 
-def _json(v):
+def _json(v: Any) -> Any:
     v = _attr(v)
     if isinstance(v, str) and v[:1] in "[{":
         return json.loads(v)
@@ -54,7 +61,7 @@ class CaseEntry:
 
     name: str
     kind: str
-    settings: dict
+    settings: dict[str, Any]
     lines_done: int
     n_lines: int
 
@@ -94,20 +101,20 @@ class TruncationEntry:
         The full map when the responses were stored.
     """
 
-    n_modes: np.ndarray
-    centres: np.ndarray
-    dofs: tuple
-    error: np.ndarray | None
-    suggested: np.ndarray | None
-    thresholds: tuple
-    f_max: tuple
-    map: object
+    n_modes: IntArray
+    centres: FloatArray
+    dofs: tuple[str, ...]
+    error: FloatArray | None
+    suggested: IntArray | None
+    thresholds: tuple[float, ...]
+    f_max: tuple[float, ...]
+    map: TruncationMap | None
 
 
 class CampaignResult:
     """A campaign result file opened for reading (see :func:`open_campaign`)."""
 
-    def __init__(self, path) -> None:
+    def __init__(self, path: str | os.PathLike[str]) -> None:
         import h5py
 
         self.path = Path(path)
@@ -115,9 +122,9 @@ class CampaignResult:
         files = self._store.files()
         if not files:
             raise CampaignError(f"{self.path}: no campaign result file (nor parts of a run)")
-        self.attrs: dict = {}
-        self.runs: list[dict] = []
-        cases: dict[str, dict] = {}
+        self.attrs: dict[str, Any] = {}
+        self.runs: list[dict[str, Any]] = []
+        cases: dict[str, dict[str, Any]] = {}
         self._where: dict[str, Path] = {}  # unit path -> file
         for p in files:
             try:
@@ -172,13 +179,18 @@ class CampaignResult:
             f"no case {name!r} in {self.path}; cases: {', '.join(c.name for c in self.cases)}"
         )
 
-    def find(self, **settings) -> tuple[CaseEntry, ...]:
+    def case_attrs(self, name: str) -> dict[str, Any]:
+        """Everything stored about a case (its settings, ``digest``, ``inputs`` ...)."""
+        self.case(name)  # an unknown name: CampaignError listing the cases
+        return dict(self._cases[name]["attrs"])
+
+    def find(self, **settings: Any) -> tuple[CaseEntry, ...]:
         """The cases whose settings match all given values (e.g. ``harmonic=4, noise=0.1``)."""
         return tuple(
             c for c in self.cases if all(c.settings.get(k) == v for k, v in settings.items())
         )
 
-    def _inputs(self, name: str):
+    def _inputs(self, name: str) -> tuple[dict[str, AnyArray], tuple[str, ...]]:
         import h5py
 
         p = self._where.get(f"inputs/{name}")
@@ -190,7 +202,7 @@ class CampaignResult:
             dofs = tuple(_json(g.attrs["dofs"]))
         return arr, dofs
 
-    def band(self, name: str):
+    def band(self, name: str) -> ScatterBand:
         """The :class:`~fbs_core.ScatterBand` of a complete scatter case.
 
         Raises
@@ -201,8 +213,7 @@ class CampaignResult:
         """
         import h5py
 
-        from ..studies import scatter as _sc
-        from ..studies._rng import seed_key
+        from .work import BLOCK_KEYS, assemble_band
 
         c = self.case(name)
         if c.kind != "scatter":
@@ -215,56 +226,32 @@ class CampaignResult:
         d = self._cases[name]
         st = c.settings
         arr, dofs = self._inputs(d["attrs"]["inputs"])
-        parts: dict[str, list] = {}
-        keys = ("lower", "upper", "argmin_round", "argmax_round", "percentiles")
-        keys += ("conv_lower", "conv_upper")
-        ck = None
+        blocks = []
         for (a, z), p in sorted(d["blocks"].items()):
             with h5py.File(p, "r") as h:
                 g = h["cases"][name]["blocks"][f"{a}_{z}"]
-                for k in keys:
-                    parts.setdefault(k, []).append(g[k][()] if k in g else None)
-                if "checkpoints" in g:
-                    ck = g["checkpoints"][()]
-        if any(v is None for v in parts["lower"]):
+                b = {k: (g[k][()] if k in g else None) for k in (*BLOCK_KEYS, "checkpoints")}
+            blocks.append(b | {"l0": a, "l1": z})
+        if any(b["lower"] is None for b in blocks):
             raise CampaignError(f"case {name} was stored without its band ([outputs] scatter)")
-
-        def cat(k, axis):
-            v = parts[k]
-            return None if any(x is None for x in v) else np.concatenate(v, axis=axis)
-
-        nq = len(st["percentiles"])
-        ne = len(dofs)
-        pct = cat("percentiles", 1)
-        clo, chi = cat("conv_lower", 1), cat("conv_upper", 1)
-        nf = arr["freq"].size
-        if pct is None:
-            pct = np.full((nq, nf, ne), np.nan)
-        if clo is None or ck is None:
-            ck = np.array([st["rounds"]], np.int64)
-            clo = cat("lower", 0)[None]
-            chi = cat("upper", 0)[None]
-        seed = int(st["seed"])
-        arrays = _sc._check_inputs(arr["YjjA"], arr["vj"], arr["YjjE"], arr["YejE"])
-        return _sc.ScatterBand(
-            freq=_sc._ro(arr["freq"]),
-            dofs=dofs,
-            reference=_sc._ro(arr["reference"]),
-            lower=_sc._ro(cat("lower", 0)),
-            upper=_sc._ro(cat("upper", 0)),
-            argmin_round=_sc._ro(cat("argmin_round", 0)),
-            argmax_round=_sc._ro(cat("argmax_round", 0)),
-            q=_sc._ro(np.asarray(st["percentiles"], float)),
-            percentiles=_sc._ro(pct),
-            convergence=_sc.Convergence(_sc._ro(ck), _sc._ro(clo), _sc._ro(chi)),
-            noise=float(st["noise"]),
-            target=str(st["target"]),
-            rounds=int(st["rounds"]),
-            frequency_dependent=bool(st["frequency_dependent"]),
-            seed=seed,
-            harmonic=int(st["harmonic"]),
-            _inputs=(arrays, seed_key(seed)),
+        band: ScatterBand = assemble_band(
+            arr["freq"],
+            dofs,
+            arr["reference"],
+            arr["YjjA"],
+            arr["vj"],
+            arr["YjjE"],
+            arr["YejE"],
+            blocks,
+            q=st["percentiles"],
+            noise=st["noise"],
+            target=st["target"],
+            rounds=st["rounds"],
+            frequency_dependent=st["frequency_dependent"],
+            seed=st["seed"],
+            harmonic=st["harmonic"],
         )
+        return band
 
     def truncation(self, name: str) -> TruncationEntry:
         """The stored truncation case (error map, suggested modes, the map when stored)."""
@@ -355,7 +342,7 @@ class CampaignResult:
         return "\n".join(out)
 
 
-def open_campaign(path) -> CampaignResult:
+def open_campaign(path: str | os.PathLike[str]) -> CampaignResult:
     """Open a campaign result file (and the parts of an unfinished run) for browsing.
 
     Raises

@@ -24,7 +24,9 @@ import os
 import threading
 import time
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +35,9 @@ import fbs_core
 from . import work
 from .spec import BandCase, Campaign, CampaignError, TruncationCase
 from .store import CampaignStore, file_sha256
+
+if TYPE_CHECKING:
+    from ..frf import FRF
 
 __all__ = ["Task", "plan", "run_campaign", "RunReport", "make_client", "SCHEDULER_ENV"]
 
@@ -49,7 +54,7 @@ class Task:
 
     kind: str
     unit: str
-    case: object = None
+    case: BandCase | TruncationCase
     l0: int = 0
     l1: int = 0
     inputs: str = ""
@@ -68,7 +73,7 @@ class RunReport:
     tasks_done: int
     rounds_done: float
     seconds: float
-    errors: list = field(default_factory=list)
+    errors: list[tuple[str, str]] = field(default_factory=list)
     scheduler: str = ""
     workers: int = 0
     task_seconds: float = 0.0  # compute time of the finished tasks, summed (on the workers)
@@ -123,8 +128,8 @@ def plan(campaign: Campaign, done: set[str] | None = None) -> tuple[list[Task], 
     for u in done:
         parts = u.split("/")
         if len(parts) == 4 and parts[0] == "cases" and parts[2] == "blocks":
-            a, b = parts[3].split("_")
-            covered.setdefault(parts[1], []).append((int(a), int(b)))
+            sa, sb = parts[3].split("_")
+            covered.setdefault(parts[1], []).append((int(sa), int(sb)))
     tasks: list[Task] = []
     for c in campaign.cases:
         if isinstance(c, TruncationCase):
@@ -156,7 +161,7 @@ def plan(campaign: Campaign, done: set[str] | None = None) -> tuple[list[Task], 
     return tasks, n_done
 
 
-def make_client(scheduler: str | None = None, workers: int | None = None):
+def make_client(scheduler: str | None = None, workers: int | None = None) -> tuple[Any, Any]:
     """``(client, cluster)``: join ``scheduler`` (or ``$FBS_DASK_SCHEDULER``), else start a
     LocalCluster (in-process with one worker thread, or ``workers`` worker processes);
     ``cluster`` is None when joining an existing one."""
@@ -182,7 +187,7 @@ def make_client(scheduler: str | None = None, workers: int | None = None):
     return Client(cluster), cluster
 
 
-def _versions() -> dict:
+def _versions() -> dict[str, str]:
     import h5py
     import numba
     import scipy
@@ -207,7 +212,7 @@ def _versions() -> dict:
     return out
 
 
-def _root_attrs(campaign: Campaign) -> dict:
+def _root_attrs(campaign: Campaign) -> dict[str, Any]:
     return {
         "campaign_name": campaign.name,
         "campaign_seed": campaign.seed,
@@ -233,8 +238,8 @@ def _model_units(campaign: Campaign, store: CampaignStore, done: set[str]) -> No
             store.write_unit(unit, {}, {"source": src, "sha256": sha})
 
 
-def _case_attrs(c) -> dict:
-    attrs = {
+def _case_attrs(c: BandCase | TruncationCase) -> dict[str, Any]:
+    attrs: dict[str, Any] = {
         "kind": c.kind,
         "name": c.name,
         "digest": c.digest(),
@@ -279,19 +284,25 @@ def _write_inputs(store: CampaignStore, name: str, c: BandCase, inp: work.BandIn
     store.write_unit(f"inputs/{name}", data, attrs)
 
 
-def _write(store: CampaignStore, campaign: Campaign, t: Task, res) -> None:
+def _write(store: CampaignStore, campaign: Campaign, t: Task, res: dict[str, Any]) -> None:
     parents = {f"cases/{t.case.name}": _case_attrs(t.case)}
-    prov = {k: res.pop(k) for k in ("worker", "host", "pid", "seconds") if k in res}
+    prov: dict[str, Any] = {k: res.pop(k) for k in ("worker", "host", "pid", "seconds") if k in res}
     if t.kind == "band":
+        assert isinstance(t.case, BandCase)
         out = campaign.outputs["scatter"]
-        keys = []
+        keys: list[str] = []
         if "band" in out:
             keys += ["lower", "upper", "argmin_round", "argmax_round"]
         if "percentiles" in out:
             keys += ["percentiles"]
         if "convergence" in out:
             keys += ["checkpoints", "conv_lower", "conv_upper"]
-        attrs = {"l0": res["l0"], "l1": res["l1"], "q": list(t.case.percentiles), **prov}
+        attrs: dict[str, Any] = {
+            "l0": res["l0"],
+            "l1": res["l1"],
+            "q": list(t.case.percentiles),
+            **prov,
+        }
         store.write_unit(t.unit, {k: res[k] for k in keys}, attrs, parents)
     else:
         out = campaign.outputs["truncation"]
@@ -303,6 +314,7 @@ def _write(store: CampaignStore, campaign: Campaign, t: Task, res) -> None:
         if "responses" in out:
             keys += ["freq", "response", "reference"]
         c = t.case
+        assert isinstance(c, TruncationCase)
         attrs = {
             "dofs": list(res["dofs"]),
             "n_modes_total": res["n_modes_total"],
@@ -323,7 +335,9 @@ class Progress:
     rounds: a round of a harmonic with many lines costs more than one with few.
     """
 
-    def __init__(self, total: int, work_total: float, stream=None, every: float = 0.5):
+    def __init__(
+        self, total: int, work_total: float, stream: IO[str] | None = None, every: float = 0.5
+    ) -> None:
         import sys
 
         self.total, self.work_total = total, work_total
@@ -365,11 +379,11 @@ class Progress:
 def run_campaign(
     campaign: Campaign,
     *,
-    client=None,
+    client: Any = None,
     scheduler: str | None = None,
     workers: int | None = None,
-    output=None,
-    progress=None,
+    output: str | os.PathLike[str] | None = None,
+    progress: Callable[[int, int, float], object] | bool | None = None,
     stop: threading.Event | None = None,
     max_tasks: int | None = None,
     numba_threads: int | None = None,
@@ -437,7 +451,8 @@ def run_campaign(
             chassis_src = {n: work.load_model("chassis", s) for n, s in campaign.chassis.items()}
             # the chassis on each harmonic's grid and the subsystem arrays of the scatter
             # cases: computed here once (see fbs_core.campaign.work), stored, scattered
-            grids, inputs_f = {}, {}
+            grids: dict[tuple[int, float, str], FRF] = {}
+            inputs_f: dict[str, Any] = {}
             for t in tasks:
                 c = t.case
                 g = (c.harmonic, c.df, c.chassis)
@@ -445,6 +460,7 @@ def run_campaign(
                     f = fbs_core.harmonic(c.harmonic).frequencies(c.df)
                     grids[g] = work.chassis_on(chassis_src[c.chassis], f)
                 if t.kind == "band" and t.inputs not in inputs_f:
+                    assert isinstance(c, BandCase)
                     inp = work.prepare_inputs(
                         tire_objs[c.tire],
                         grids[g],
@@ -457,13 +473,14 @@ def run_campaign(
                         _write_inputs(store, t.inputs, c, inp)
                     inputs_f[t.inputs] = client.scatter(inp)
             grids_f = {g: client.scatter(work.frf_payload(v)) for g, v in grids.items()}
-            futures = {}
+            futures: dict[Any, Task] = {}
             token = uuid.uuid4().hex[:12]
             t_submit = time.perf_counter()
             for t in tasks:
                 c = t.case
                 if t.kind == "band":
-                    f = client.submit(
+                    assert isinstance(c, BandCase)
+                    fut = client.submit(
                         work.band_block,
                         inputs_f[t.inputs],
                         c.noise,
@@ -480,7 +497,7 @@ def run_campaign(
                         pure=False,
                     )
                 else:
-                    f = client.submit(
+                    fut = client.submit(
                         work.truncation_case,
                         tires[c.tire],
                         grids_f[(c.harmonic, c.df, c.chassis)],
@@ -488,7 +505,7 @@ def run_campaign(
                         key=f"trunc-{c.name}-{token}",
                         pure=False,
                     )
-                futures[f] = t
+                futures[fut] = t
             ac = as_completed(list(futures))
             try:
                 for fut in ac:

@@ -32,10 +32,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import tomllib
 import zlib
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -79,7 +82,7 @@ class BandCase:
     percentiles: tuple[float, ...]
     df: float
 
-    kind = "scatter"
+    kind: ClassVar[str] = "scatter"
 
     @property
     def name(self) -> str:
@@ -97,7 +100,7 @@ class BandCase:
         nm = "all" if self.n_modes is None else str(self.n_modes)
         return f"h{self.harmonic}_N{nm}_{self.coupling}_{self.tire}_{self.chassis}_df{self.df:g}"
 
-    def settings(self) -> dict:
+    def settings(self) -> dict[str, Any]:
         return {"kind": self.kind, **asdict(self)}
 
     def digest(self) -> str:
@@ -119,13 +122,13 @@ class TruncationCase:
     f_max: tuple[float, ...]
     df: float
 
-    kind = "truncation"
+    kind: ClassVar[str] = "truncation"
 
     @property
     def name(self) -> str:
         return f"trunc_h{self.harmonic}_{self.coupling}_{self.tire}_{self.chassis}"
 
-    def settings(self) -> dict:
+    def settings(self) -> dict[str, Any]:
         return {"kind": self.kind, **asdict(self)}
 
     def digest(self) -> str:
@@ -161,10 +164,10 @@ class Campaign:
     seed: int
     seeds: str
     output: Path
-    tires: dict
-    chassis: dict
-    cases: tuple
-    outputs: dict
+    tires: dict[str, str]
+    chassis: dict[str, str]
+    cases: tuple[BandCase | TruncationCase, ...]
+    outputs: dict[str, tuple[str, ...]]
     task_round_lines: int
     max_chunk_bytes: float
     text: str = field(repr=False, default="")
@@ -178,7 +181,7 @@ class Campaign:
         return tuple(c for c in self.cases if isinstance(c, TruncationCase))
 
 
-def _digest(settings: dict) -> str:
+def _digest(settings: dict[str, Any]) -> str:
     text = json.dumps(settings, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -200,31 +203,31 @@ def _err(where: str, msg: str) -> CampaignError:
     return CampaignError(f"campaign file, {where}: {msg}")
 
 
-def _table(d, key: str, where: str) -> dict:
+def _table(d: dict[str, Any], key: str, where: str) -> dict[str, Any]:
     v = d.get(key, {})
     if not isinstance(v, dict):
         raise _err(where, f"[{key}] must be a table, got {type(v).__name__}")
     return v
 
 
-def _known(d: dict, allowed, where: str) -> None:
+def _known(d: dict[str, Any], allowed: Sequence[str], where: str) -> None:
     bad = sorted(set(d) - set(allowed))
     if bad:
         raise _err(where, f"unknown key(s) {bad}; allowed: {', '.join(allowed)}")
 
 
-def _list(v, where: str) -> list:
+def _list(v: Any, where: str) -> list[Any]:
     return list(v) if isinstance(v, list) else [v]
 
 
-def _int(v, where: str, lo: int, hi: int | None = None) -> int:
+def _int(v: Any, where: str, lo: int, hi: int | None = None) -> int:
     if isinstance(v, bool) or not isinstance(v, int) or v < lo or (hi is not None and v > hi):
         rng = f"{lo}..{hi}" if hi is not None else f">= {lo}"
         raise _err(where, f"must be an integer {rng}, got {v!r}")
     return int(v)
 
 
-def _float(v, where: str, lo: float, hi: float, hi_open: bool = False) -> float:
+def _float(v: Any, where: str, lo: float, hi: float, hi_open: bool = False) -> float:
     if isinstance(v, bool) or not isinstance(v, int | float):
         raise _err(where, f"must be a number, got {v!r}")
     x = float(v)
@@ -233,7 +236,7 @@ def _float(v, where: str, lo: float, hi: float, hi_open: bool = False) -> float:
     return x
 
 
-def _choice(v, allowed, where: str) -> str:
+def _choice(v: Any, allowed: Sequence[str], where: str) -> str:
     if not isinstance(v, str) or v not in allowed:
         raise _err(where, f"{v!r} is not allowed; allowed: {', '.join(allowed)}")
     return v
@@ -245,9 +248,9 @@ def _name(v: str, where: str) -> str:
     return v
 
 
-def _models(d: dict, base: Path, kind: str) -> dict:
+def _models(d: dict[str, Any], base: Path, kind: str) -> dict[str, str]:
     where = f"[models.{kind}]"
-    out = {}
+    out: dict[str, str] = {}
     for name, src in d.items():
         _name(name, where)
         if not isinstance(src, str) or not src:
@@ -262,7 +265,7 @@ def _models(d: dict, base: Path, kind: str) -> dict:
     return out or {"reference": "reference"}
 
 
-def _variants(d: dict, key: str, models: dict, where: str) -> list[str]:
+def _variants(d: dict[str, Any], key: str, models: dict[str, str], where: str) -> list[str]:
     names = [str(x) for x in _list(d.get(key, list(models)), where)]
     for n in names:
         if n not in models:
@@ -270,21 +273,21 @@ def _variants(d: dict, key: str, models: dict, where: str) -> list[str]:
     return names
 
 
-def _couplings(d: dict, where: str) -> list[str]:
+def _couplings(d: dict[str, Any], where: str) -> list[str]:
     return [
         _choice(c, COUPLINGS, f"{where} couplings")
         for c in _list(d.get("couplings", "6dof"), where)
     ]
 
 
-def _harmonics(d: dict, where: str) -> list[int]:
+def _harmonics(d: dict[str, Any], where: str) -> list[int]:
     hs = [_int(h, f"{where} harmonics", 1, 7) for h in _list(d.get("harmonics", [1]), where)]
     if len(set(hs)) != len(hs):
         raise _err(f"{where} harmonics", f"duplicates in {hs}")
     return hs
 
 
-def _unique(xs: list, where: str) -> list:
+def _unique(xs: list[Any], where: str) -> list[Any]:
     if len(set(xs)) != len(xs):
         raise _err(where, f"duplicate values in {xs}")
     return xs
@@ -326,7 +329,7 @@ def parse_campaign(text: str, base: Path | str = ".") -> Campaign:
     _known(g, ("df",), "[grid]")
     df = _float(g.get("df", 0.5), "[grid] df", 0.01, 10.0)
 
-    cases: list = []
+    cases: list[BandCase | TruncationCase] = []
     s = _table(d, "scatter", "top level")
     if s:
         w = "[scatter]"
@@ -437,23 +440,23 @@ def parse_campaign(text: str, base: Path | str = ".") -> Campaign:
 
     o = _table(d, "outputs", "top level")
     _known(o, tuple(OUTPUTS), "[outputs]")
-    outputs = {}
+    outputs: dict[str, tuple[str, ...]] = {}
     for kind, allowed in OUTPUTS.items():
         sel = _list(
             o.get(kind, list(allowed if kind == "scatter" else ("error", "suggested"))), "[outputs]"
         )
         outputs[kind] = tuple(_choice(x, allowed, f"[outputs] {kind}") for x in sel)
 
-    e = _table(d, "execution", "top level")
-    _known(e, ("task_round_lines", "max_chunk_bytes"), "[execution]")
-    trl = _int(e.get("task_round_lines", 20_000_000), "[execution] task_round_lines", 1)
-    mcb = _float(e.get("max_chunk_bytes", 64e6), "[execution] max_chunk_bytes", 1e5, 1e11)
+    ex = _table(d, "execution", "top level")
+    _known(ex, ("task_round_lines", "max_chunk_bytes"), "[execution]")
+    trl = _int(ex.get("task_round_lines", 20_000_000), "[execution] task_round_lines", 1)
+    mcb = _float(ex.get("max_chunk_bytes", 64e6), "[execution] max_chunk_bytes", 1e5, 1e11)
     return Campaign(
         name, seed, seeds, output, tires, chassis, tuple(cases), outputs, trl, mcb, text
     )
 
 
-def load_campaign(path) -> Campaign:
+def load_campaign(path: str | os.PathLike[str]) -> Campaign:
     """Read and check a campaign file (TOML); relative paths are relative to its folder.
 
     Raises

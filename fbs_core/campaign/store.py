@@ -36,10 +36,17 @@ import os
 import shutil
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
 from .spec import CampaignError
+
+if TYPE_CHECKING:
+    from .spec import Campaign
+
+#: An h5py File, Group or Dataset (h5py ships no type stubs).
+H5: TypeAlias = Any
 
 __all__ = ["CampaignStore", "FORMAT_VERSION"]
 
@@ -50,7 +57,7 @@ def _now() -> str:
     return time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
 
 
-def file_sha256(path) -> str:
+def file_sha256(path: str | os.PathLike[str]) -> str:
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for b in iter(lambda: f.read(1 << 20), b""):
@@ -58,7 +65,7 @@ def file_sha256(path) -> str:
     return h.hexdigest()
 
 
-def _set_attrs(obj, attrs: dict) -> None:
+def _set_attrs(obj: H5, attrs: dict[str, Any]) -> None:
     for k, v in attrs.items():
         if isinstance(v, bool | int | float | str | np.integer | np.floating):
             obj.attrs[k] = v
@@ -68,7 +75,7 @@ def _set_attrs(obj, attrs: dict) -> None:
             obj.attrs[k] = json.dumps(v, default=str)
 
 
-def _put(g, name: str, v) -> None:
+def _put(g: H5, name: str, v: Any) -> None:
     import h5py
 
     a = np.asarray(v)
@@ -78,11 +85,11 @@ def _put(g, name: str, v) -> None:
         g.create_dataset(name, data=a)
 
 
-def _is_unit(obj) -> bool:
+def _is_unit(obj: H5) -> bool:
     return int(obj.attrs.get("unit", 0)) == 1
 
 
-def _merge(src, dst) -> None:
+def _merge(src: H5, dst: H5) -> None:
     """Copy what ``dst`` lacks from ``src``: attributes, datasets, whole units."""
     import h5py
 
@@ -100,10 +107,10 @@ def _merge(src, dst) -> None:
             _merge(obj, dst.create_group(name))
 
 
-def _units(h, prefix: str = "") -> set[str]:
+def _units(h: H5, prefix: str = "") -> set[str]:
     import h5py
 
-    out = set()
+    out: set[str] = set()
     for name, obj in h.items():
         if isinstance(obj, h5py.Group):
             p = f"{prefix}{name}"
@@ -123,7 +130,7 @@ class CampaignStore:
         The HDF5 result file; the journal of finished tasks is ``<output>.parts/``.
     """
 
-    def __init__(self, output) -> None:
+    def __init__(self, output: str | os.PathLike[str]) -> None:
         self.output = Path(output)
         self.parts = self.output.with_name(self.output.name + ".parts")
 
@@ -152,7 +159,13 @@ class CampaignStore:
                 p.unlink()  # a part is complete or absent (renamed atomically); never here
         return out
 
-    def write_unit(self, path: str, data: dict, attrs: dict, parents: dict | None = None) -> Path:
+    def write_unit(
+        self,
+        path: str,
+        data: dict[str, Any],
+        attrs: dict[str, Any],
+        parents: dict[str, dict[str, Any]] | None = None,
+    ) -> Path:
         """Write one finished task atomically as a part file.
 
         Parameters
@@ -184,7 +197,7 @@ class CampaignStore:
         os.replace(tmp, final)
         return final
 
-    def commit(self, root_attrs: dict | None = None) -> int:
+    def commit(self, root_attrs: dict[str, Any] | None = None) -> int:
         """Merge the parts into the result file (atomically); returns the units merged."""
         import h5py
 
@@ -229,7 +242,7 @@ class CampaignStore:
             self.parts.rmdir()
         return n
 
-    def unit_attrs(self, path: str) -> dict | None:
+    def unit_attrs(self, path: str) -> dict[str, Any] | None:
         """Attributes of a stored unit (result file or parts), None when absent."""
         import h5py
 
@@ -252,7 +265,7 @@ class CampaignStore:
                         out.setdefault(name, str(g.attrs["digest"]))
         return out
 
-    def check(self, campaign) -> None:
+    def check(self, campaign: Campaign) -> None:
         """Refuse to mix results of different settings under the same case name.
 
         Raises

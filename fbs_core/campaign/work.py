@@ -38,12 +38,28 @@ from __future__ import annotations
 import os
 import socket
 import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
+from .._typing import ComplexArray, FloatArray
 from ..errors import FBSError
 
-__all__ = ["BandInputs", "resolve_model", "prepare_inputs", "band_block", "truncation_case"]
+if TYPE_CHECKING:
+    from ..frf import FRF
+    from ..studies.scatter import ScatterBand
+    from .spec import TruncationCase
+
+__all__ = [
+    "BandInputs",
+    "resolve_model",
+    "prepare_inputs",
+    "band_block",
+    "assemble_band",
+    "truncation_case",
+]
 
 
 class BandInputs:
@@ -60,7 +76,16 @@ class BandInputs:
     n_modes_total : int
     """
 
-    def __init__(self, freq, dofs, YjjA, vj, YjjE, YejE, n_modes_total):
+    def __init__(
+        self,
+        freq: ArrayLike,
+        dofs: Sequence[str],
+        YjjA: ArrayLike,
+        vj: ArrayLike,
+        YjjE: ArrayLike,
+        YejE: ArrayLike,
+        n_modes_total: int,
+    ) -> None:
         from ..studies import scatter as _sc
 
         self.freq = _sc._ro(freq)
@@ -73,7 +98,7 @@ class BandInputs:
         )
         self.reference = _sc._ro(ref[0])
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: dict[str, Any]) -> None:
         # arrays arrive writeable from pickling: read-only again, so that the compiled
         # kernels see the one signature they were compiled (and cached) for
         for v in state.values():
@@ -88,7 +113,7 @@ class BandInputs:
         return int(self.freq.size)
 
 
-def resolve_model(kind: str, spec):
+def resolve_model(kind: str, spec: Any) -> Any:
     """A model from its campaign spec: ``"reference"`` or an already loaded object."""
     if isinstance(spec, str):
         if spec != "reference":
@@ -99,7 +124,7 @@ def resolve_model(kind: str, spec):
     return spec
 
 
-def load_model(kind: str, source: str):
+def load_model(kind: str, source: str) -> Any:
     """Load a model variant from a file (on the client; the object is then scattered).
 
     Tire: a modal tire model (:func:`fbs_core.io.load_tire_model`). Chassis: an FRF file
@@ -115,7 +140,7 @@ def load_model(kind: str, source: str):
     return io.load_frf(source).frf
 
 
-def chassis_on(chassis, f):
+def chassis_on(chassis: Any, f: FloatArray) -> FRF:
     """The chassis FRF on the grid ``f``: a model's exact synthesis, or an FRF (from a file)
     interpolated onto ``f`` (never extrapolated; an FRF already on ``f`` as it is)."""
     from ..frf import FRF
@@ -125,15 +150,18 @@ def chassis_on(chassis, f):
         if chassis.freq.shape == f.shape and np.array_equal(chassis.freq, f):
             return chassis
         return chassis.interpolate(f)
-    return chassis.mobility(f)
+    Y: FRF = chassis.mobility(f)
+    return Y
 
 
-def frf_payload(frf) -> tuple:
+def frf_payload(
+    frf: FRF,
+) -> tuple[FloatArray, ComplexArray, tuple[str, ...], tuple[str, ...], str]:
     """An FRF as plain arrays and labels, to send to a worker (FRF objects do not pickle)."""
     return (np.asarray(frf.freq), np.asarray(frf.data), frf.outputs, frf.inputs, frf.quantity)
 
 
-def frf_from(payload):
+def frf_from(payload: Any) -> Any:
     """The FRF of :func:`frf_payload` (or the object itself when it is not a payload)."""
     from ..frf import FRF
 
@@ -142,7 +170,9 @@ def frf_from(payload):
     return payload
 
 
-def prepare_inputs(tire, chassis, harmonic: int, n_modes, coupling: str, df: float) -> BandInputs:
+def prepare_inputs(
+    tire: Any, chassis: Any, harmonic: int, n_modes: int | None, coupling: str, df: float
+) -> BandInputs:
     """The arrays of :func:`fbs_core.scatter_band` for one harmonic, model pair and coupling."""
     from ..studies import _models
 
@@ -159,7 +189,7 @@ def prepare_inputs(tire, chassis, harmonic: int, n_modes, coupling: str, df: flo
     return BandInputs(f, resp, YjjA[0], vj[0], YjjE, YejE, n_total)
 
 
-def _where() -> dict:
+def _where() -> dict[str, Any]:
     try:
         from distributed import get_worker
 
@@ -176,12 +206,12 @@ def band_block(
     rounds: int,
     frequency_dependent: bool,
     seed: int,
-    percentiles,
+    percentiles: ArrayLike,
     l0: int,
     l1: int,
     max_chunk_bytes: float = 64e6,
     numba_threads: int | None = None,
-) -> dict:
+) -> dict[str, Any]:
     """Band statistics of lines ``l0 .. l1 - 1`` over all ``rounds`` (exactly the numbers of
     :func:`fbs_core.studies.scatter_band_arrays` for those lines).
 
@@ -201,7 +231,8 @@ def band_block(
     if numba_threads:
         import numba
 
-        numba.set_num_threads(max(1, min(int(numba_threads), numba.config.NUMBA_NUM_THREADS)))
+        n_max = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # not in numba's stubs
+        numba.set_num_threads(max(1, min(int(numba_threads), n_max)))
     nf, ne = inputs.n_lines, len(inputs.dofs)
     if not 0 <= l0 < l1 <= nf:
         raise FBSError(f"line block {l0}..{l1} outside 0..{nf}")
@@ -257,7 +288,102 @@ def band_block(
     }
 
 
-def truncation_case(tire, chassis, case) -> dict:
+BLOCK_KEYS: tuple[str, ...] = ("lower", "upper", "argmin_round", "argmax_round", "percentiles")
+BLOCK_KEYS += ("conv_lower", "conv_upper")
+
+
+def assemble_band(
+    freq: Any,
+    dofs: Sequence[str],
+    reference: Any,
+    YjjA: Any,
+    vj: Any,
+    YjjE: Any,
+    YejE: Any,
+    blocks: Sequence[dict[str, Any]],
+    *,
+    q: Any,
+    noise: float,
+    target: str,
+    rounds: int,
+    frequency_dependent: bool,
+    seed: int,
+    harmonic: Any,
+) -> ScatterBand:
+    """The :class:`~fbs_core.ScatterBand` of line blocks of :func:`band_block` (the one place
+    blocks become a band: the campaign file's browser and the dashboard's cluster bands).
+
+    ``blocks`` are dicts with the keys of :func:`band_block` (a statistic may be None when
+    it was not stored), covering the lines ``0 .. n_f - 1`` in ascending order. Without
+    percentiles they are NaN; without the convergence checkpoints the band edges are the one
+    checkpoint (all rounds).
+
+    Raises
+    ------
+    CampaignError
+        When the blocks do not cover the lines or hold no band edges.
+    SingularInterfaceError
+        When an edge is not finite (as :func:`fbs_core.scatter_band`).
+    """
+    from ..errors import CampaignError, SingularInterfaceError
+    from ..studies import scatter as _sc
+    from ..studies._rng import seed_key
+
+    blocks = sorted(blocks, key=lambda b: int(b["l0"]))
+    nf = int(np.asarray(freq).size)
+    ends = [0] + [int(b["l1"]) for b in blocks]
+    if [int(b["l0"]) for b in blocks] != ends[:-1] or ends[-1] != nf:
+        got = ", ".join(f"{b['l0']}..{b['l1']}" for b in blocks)
+        raise CampaignError(f"line blocks [{got}] do not cover the {nf} lines once")
+    if any(b.get("lower") is None for b in blocks):
+        raise CampaignError("blocks hold no band edges ([outputs] scatter without 'band')")
+
+    def cat(k: str, axis: int) -> Any:
+        v = [b[k] for b in blocks if b.get(k) is not None]
+        return None if len(v) < len(blocks) else np.concatenate(v, axis=axis)
+
+    ne = len(dofs)
+    qs = np.asarray(q, float)
+    pct = cat("percentiles", 1)
+    if pct is None:
+        pct = np.full((qs.size, nf, ne), np.nan)
+    clo, chi = cat("conv_lower", 1), cat("conv_upper", 1)
+    ck = next((b["checkpoints"] for b in blocks if b.get("checkpoints") is not None), None)
+    lo, hi = cat("lower", 0), cat("upper", 0)
+    if clo is None or chi is None or ck is None:
+        ck = np.array([rounds], np.int64)
+        clo, chi = lo[None], hi[None]
+    for what, x in (("upper edge", hi), ("lower edge", lo)):
+        if not np.all(np.isfinite(x)):
+            line = int(np.argwhere(~np.isfinite(x))[0][0])
+            raise SingularInterfaceError(
+                f"{what} of the scatter band is not finite at {freq[line]:g} Hz: the (noisy) "
+                "interface matrix Y_jj^A + Y_jj^E is singular there"
+            )
+    seed = int(seed)
+    arrays = _sc._check_inputs(YjjA, vj, YjjE, YejE)
+    return _sc.ScatterBand(
+        freq=_sc._ro(np.asarray(freq)),
+        dofs=tuple(dofs),
+        reference=_sc._ro(np.asarray(reference)),
+        lower=_sc._ro(lo),
+        upper=_sc._ro(hi),
+        argmin_round=_sc._ro(cat("argmin_round", 0)),
+        argmax_round=_sc._ro(cat("argmax_round", 0)),
+        q=_sc._ro(qs),
+        percentiles=_sc._ro(pct),
+        convergence=_sc.Convergence(_sc._ro(np.asarray(ck)), _sc._ro(clo), _sc._ro(chi)),
+        noise=float(noise),
+        target=str(target),
+        rounds=int(rounds),
+        frequency_dependent=bool(frequency_dependent),
+        seed=seed,
+        harmonic=None if harmonic is None else int(harmonic),
+        _inputs=(arrays, seed_key(seed)),
+    )
+
+
+def truncation_case(tire: Any, chassis: Any, case: TruncationCase) -> dict[str, Any]:
     """Error map (eq. 5.1) and suggested mode counts (table 5.1) of a
     :class:`~fbs_core.campaign.spec.TruncationCase`.
 
@@ -285,6 +411,7 @@ def truncation_case(tire, chassis, case) -> dict:
         coupling=case.coupling,
     )
     sugg = np.array([[m.suggest(t, fm) for fm in case.f_max] for t in case.thresholds], np.int64)
+    assert m.n_modes_total is not None  # truncation_map always sets it
     return {
         "n_modes": np.asarray(m.n_modes),
         "n_modes_total": int(m.n_modes_total),

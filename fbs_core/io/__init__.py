@@ -18,9 +18,11 @@ anything but private temporary files. File formats: ``docs/file-formats.md``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import os
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeAlias, overload
 
 from ..errors import DataFormatError
 from ..frf import FRF
@@ -39,6 +41,14 @@ from .checks import (
     require_dofs,
 )
 from .results import ResultData, as_result_data
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+#: A file path, or the content of an upload.
+SourceLike: TypeAlias = "str | os.PathLike[str] | bytes | bytearray | memoryview"
+#: Where to write; None returns the content as bytes.
+PathLike: TypeAlias = "str | os.PathLike[str]"
 
 __all__ = [
     "DEFAULT_MAX_BYTES",
@@ -83,12 +93,12 @@ class ImportResult:
     frf: FRF | None
     summary: str
     notes: tuple[str, ...] = ()
-    metadata: dict = field(default_factory=dict)
+    metadata: dict[str, Any] = field(default_factory=dict)
     source: str = ""
     format: str = ""
     model: object | None = None
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Any]:
         """Unpack as ``frf, summary = load_frf(...)``."""
         return iter((self.frf if self.model is None else self.model, self.summary))
 
@@ -96,11 +106,11 @@ class ImportResult:
 def _finish(
     frf: FRF,
     notes: list[str],
-    meta: dict,
+    meta: dict[str, Any],
     name: str,
     fmt: str,
-    require_outputs=(),
-    require_inputs=(),
+    require_outputs: Iterable[str] = (),
+    require_inputs: Iterable[str] = (),
 ) -> ImportResult:
     require_dofs(frf, require_outputs, require_inputs, what=f"{name!r}")
     notes = list(notes) + quantity_notes(frf)
@@ -111,16 +121,16 @@ def _finish(
 
 
 def load_frf(
-    source,
+    source: SourceLike,
     *,
     filename: str | None = None,
     format: str | None = None,
-    nodes: Mapping | None = None,
+    nodes: Mapping[Any, Any] | None = None,
     quantity: str | None = None,
-    freq=None,
+    freq: ArrayLike | None = None,
     name: str | None = None,
-    require_outputs=(),
-    require_inputs=(),
+    require_outputs: Iterable[str] = (),
+    require_inputs: Iterable[str] = (),
     max_bytes: int = DEFAULT_MAX_BYTES,
     timeout: float = DEFAULT_TIMEOUT,
 ) -> ImportResult:
@@ -213,7 +223,7 @@ def load_frf(
     return _finish(frf, notes, meta, src.name, label, require_outputs, require_inputs)
 
 
-def _format_for(path, format: str | None) -> str:
+def _format_for(path: PathLike | None, format: str | None) -> str:
     if format is not None:
         if format not in FORMATS:
             raise DataFormatError(f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
@@ -230,7 +240,11 @@ def _format_for(path, format: str | None) -> str:
     )
 
 
-def _deliver(raw: bytes, path):
+@overload
+def _deliver(raw: bytes, path: None) -> bytes: ...
+@overload
+def _deliver(raw: bytes, path: PathLike) -> Path: ...
+def _deliver(raw: bytes, path: PathLike | None) -> bytes | Path:
     if path is None:
         return raw
     p = Path(path)
@@ -238,17 +252,41 @@ def _deliver(raw: bytes, path):
     return p
 
 
+@overload
 def save_frf(
     frf: FRF,
-    path=None,
+    path: None = None,
     *,
     format: str | None = None,
-    metadata: Mapping | None = None,
-    nodes: Mapping | None = None,
+    metadata: Mapping[str, Any] | None = None,
+    nodes: Mapping[Any, Any] | None = None,
     mat_version: str = "5",
     binary: bool = False,
     round_abscissa: bool = False,
-):
+) -> bytes: ...
+@overload
+def save_frf(
+    frf: FRF,
+    path: PathLike,
+    *,
+    format: str | None = None,
+    metadata: Mapping[str, Any] | None = None,
+    nodes: Mapping[Any, Any] | None = None,
+    mat_version: str = "5",
+    binary: bool = False,
+    round_abscissa: bool = False,
+) -> Path: ...
+def save_frf(
+    frf: FRF,
+    path: PathLike | None = None,
+    *,
+    format: str | None = None,
+    metadata: Mapping[str, Any] | None = None,
+    nodes: Mapping[Any, Any] | None = None,
+    mat_version: str = "5",
+    binary: bool = False,
+    round_abscissa: bool = False,
+) -> bytes | Path:
     """Write an FRF as UFF 58, MATLAB, CSV or HDF5 in the documented layouts.
 
     Parameters
@@ -301,15 +339,35 @@ def save_frf(
     return _deliver(raw, path)
 
 
+@overload
 def export_result(
-    result,
-    path=None,
+    result: Any,
+    path: None = None,
     *,
     format: str | None = None,
-    metadata: Mapping | None = None,
-    nodes: Mapping | None = None,
+    metadata: Mapping[str, Any] | None = None,
+    nodes: Mapping[Any, Any] | None = None,
     round_abscissa: bool = False,
-):
+) -> bytes: ...
+@overload
+def export_result(
+    result: Any,
+    path: PathLike,
+    *,
+    format: str | None = None,
+    metadata: Mapping[str, Any] | None = None,
+    nodes: Mapping[Any, Any] | None = None,
+    round_abscissa: bool = False,
+) -> Path: ...
+def export_result(
+    result: Any,
+    path: PathLike | None = None,
+    *,
+    format: str | None = None,
+    metadata: Mapping[str, Any] | None = None,
+    nodes: Mapping[Any, Any] | None = None,
+    round_abscissa: bool = False,
+) -> bytes | Path:
     """Export a coupled or study result as CSV, UFF 58 or HDF5, with metadata.
 
     Parameters
@@ -355,7 +413,7 @@ def export_result(
 
 
 def load_result(
-    source,
+    source: SourceLike,
     *,
     filename: str | None = None,
     max_bytes: int = DEFAULT_MAX_BYTES,
@@ -388,7 +446,7 @@ def load_result(
 
 
 def load_tire_model(
-    source,
+    source: SourceLike,
     *,
     filename: str | None = None,
     format: str | None = None,
@@ -443,7 +501,7 @@ def load_tire_model(
     )
 
 
-def describe_tire(model) -> str:
+def describe_tire(model: Any) -> str:
     """Short summary of a tire model: operating points, modes, frequencies, wavelengths."""
     import numpy as np
 

@@ -19,6 +19,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+from typing import Any, overload
 
 import numpy as np
 
@@ -42,10 +43,10 @@ _WORKER = Path(__file__).with_name("_worker.py")
 class _Worker:
     def __init__(self) -> None:
         self.lock = threading.Lock()
-        self.proc: subprocess.Popen | None = None
+        self.proc: subprocess.Popen[bytes] | None = None
         self.owner = os.getpid()
 
-    def _start(self) -> subprocess.Popen:
+    def _start(self) -> subprocess.Popen[bytes]:
         if self.owner != os.getpid():
             # a forked copy of this process: the pipes belong to the parent, leave them
             self.proc, self.owner = None, os.getpid()
@@ -67,9 +68,15 @@ class _Worker:
             self.proc.wait()
         self.proc = None
 
-    def _read(self, fd: int, n: int, deadline: float, into: memoryview | None = None):
+    @overload
+    def _read(self, fd: int, n: int, deadline: float, into: None = None) -> bytes: ...
+    @overload
+    def _read(self, fd: int, n: int, deadline: float, into: memoryview) -> None: ...
+    def _read(
+        self, fd: int, n: int, deadline: float, into: memoryview | None = None
+    ) -> bytes | None:
         """``n`` bytes from the pipe, as bytes or straight into ``into``."""
-        buf = bytearray() if into is None else into
+        buf = bytearray()
         got = 0
         while got < n:
             left = deadline - time.monotonic()
@@ -87,7 +94,9 @@ class _Worker:
                 got += len(chunk)
         return bytes(buf) if into is None else None
 
-    def request(self, kind: str, raw: bytes, timeout: float, mem_bytes: int, limit: int):
+    def request(
+        self, kind: str, raw: bytes, timeout: float, mem_bytes: int, limit: int
+    ) -> tuple[int, bytes | tuple[dict[str, Any], list[np.ndarray]]]:
         """Send one file; returns ``(0, (meta, arrays))`` or ``(status, message bytes)``.
 
         The arrays are read from the pipe straight into arrays allocated here (one copy
@@ -96,6 +105,7 @@ class _Worker:
         """
         with self.lock:
             proc = self._start()
+            assert proc.stdin is not None and proc.stdout is not None  # both PIPE
             head = kind.ljust(8).encode() + b"".join(
                 _U64.pack(v) for v in (int(timeout * 1000), int(mem_bytes), int(limit), len(raw))
             )
@@ -124,7 +134,7 @@ class _Worker:
                 arrays = []
                 for (dt, shape), size in zip(specs, sizes, strict=True):
                     a = np.empty(shape, dt)
-                    self._read(fd, size, deadline, memoryview(a.reshape(-1).view(np.uint8)))
+                    self._read(fd, size, deadline, a.reshape(-1).view(np.uint8).data)
                     arrays.append(a)
                 return 0, (meta, arrays)
             except (OSError, EOFError, TimeoutError):
@@ -156,7 +166,7 @@ def parse_isolated(
     timeout: float = DEFAULT_TIMEOUT,
     mem_bytes: int | None = None,
     max_result_bytes: int | None = None,
-) -> tuple[dict, list[np.ndarray]]:
+) -> tuple[dict[str, Any], list[np.ndarray]]:
     """Parse ``raw`` with handler ``kind`` ("mat5", "hdf5", "uff" or "csv") in the sandbox.
 
     Parameters
@@ -194,7 +204,9 @@ def parse_isolated(
     limit = MAX_RESULT_BYTES if max_result_bytes is None else int(max_result_bytes)
     status, payload = _worker.request(kind, raw, float(timeout), int(mem_bytes), limit)
     if status == 0:
+        assert not isinstance(payload, bytes)
         return payload
+    assert isinstance(payload, bytes)
     msg = payload.decode("utf-8", "replace")
     if status == 1:
         raise DataFormatError(f"{what} cannot be read: {msg}")

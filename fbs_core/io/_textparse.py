@@ -24,6 +24,8 @@ from __future__ import annotations
 import csv
 import io
 import re
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -64,8 +66,9 @@ def _float(s: str, what: str) -> float:
         raise ParseError(f"{what}: {s.strip()!r} is not a number") from None
 
 
-def _fields(line: str, widths, what: str) -> list[str]:
-    out, p = [], 0
+def _fields(line: str, widths: Sequence[int], what: str) -> list[str]:
+    out: list[str] = []
+    p = 0
     for w in widths:
         out.append(line[p : p + w])
         p += w
@@ -99,8 +102,8 @@ _FUNC_TYPES = {
 }
 
 
-def _header58(lines: list[str], where: str) -> dict:
-    d: dict = {}
+def _header58(lines: list[str], where: str) -> dict[str, Any]:
+    d: dict[str, Any] = {}
     for k in range(5):
         d[f"id{k + 1}"] = lines[k].rstrip()
     f = _fields(lines[5], (5, 10, 5, 10, 11, 10, 4, 11, 10, 4), where)
@@ -151,13 +154,14 @@ def _header58(lines: list[str], where: str) -> dict:
     return d
 
 
-def _values_count(d: dict) -> int:
+def _values_count(d: dict[str, Any]) -> int:
     n = d["num_pts"]
     per = 2 if d["ord_data_type"] in (5, 6) else 1
-    return n * (per + (1 if d["abscissa_spacing"] == 0 else 0))
+    count: int = n * (per + (1 if d["abscissa_spacing"] == 0 else 0))
+    return count
 
 
-def _ascii_values(body: bytes, d: dict, where: str, line0: int) -> np.ndarray:
+def _ascii_values(body: bytes, d: dict[str, Any], where: str, line0: int) -> np.ndarray:
     want = _values_count(d)
     text = body.replace(b"D", b"E").replace(b"d", b"e")
     vals = np.fromstring(text, dtype=float, sep=" ") if text.strip() else np.empty(0)
@@ -165,11 +169,13 @@ def _ascii_values(body: bytes, d: dict, where: str, line0: int) -> np.ndarray:
         return vals
     # numbers written without spaces between them: fixed-width fields
     double = d["ord_data_type"] in (4, 6)
+    widths: tuple[int, ...]
     if d["abscissa_spacing"] == 0 and double:
         widths = (13, 20, 20) if d["ord_data_type"] == 6 else (13, 20)
     else:
         widths = (20,) if double else (13,)
-    out = []
+    out: list[float] = []
+    bad = False  # a cell that is not a number: not fixed-width data
     for ln in text.splitlines():
         p = 0
         s = ln.decode("latin-1")
@@ -181,13 +187,13 @@ def _ascii_values(body: bytes, d: dict, where: str, line0: int) -> np.ndarray:
                     try:
                         out.append(float(cell))
                     except ValueError:
-                        out = None
+                        bad = True
                         break
-            if out is None:
+            if bad:
                 break
-        if out is None:
+        if bad:
             break
-    if out is not None and len(out) == want:
+    if not bad and len(out) == want:
         return np.asarray(out, dtype=float)
     n_lines = body.count(b"\n")
     raise ParseError(
@@ -197,7 +203,7 @@ def _ascii_values(body: bytes, d: dict, where: str, line0: int) -> np.ndarray:
     )
 
 
-def _split58(vals: np.ndarray, d: dict) -> tuple[np.ndarray, np.ndarray]:
+def _split58(vals: np.ndarray, d: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
     n = d["num_pts"]
     cplx = d["ord_data_type"] in (5, 6)
     if d["abscissa_spacing"] == 0:
@@ -211,7 +217,7 @@ def _split58(vals: np.ndarray, d: dict) -> tuple[np.ndarray, np.ndarray]:
     return x, y
 
 
-def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict, list[np.ndarray]]:
+def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any], list[np.ndarray]]:
     """Split a Universal File into datasets and read 58/58b, 164 and 151.
 
     Parameters
@@ -227,7 +233,7 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict, list[np.
         For a file that ends inside a dataset, damaged headers, data shorter or longer
         than record 7 announces, unknown binary formats, and text outside datasets.
     """
-    sets: list[dict] = []
+    sets: list[dict[str, Any]] = []
     arrays: list[np.ndarray] = []
     pos = 0
     n = len(raw)
@@ -307,8 +313,8 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict, list[np.
                         f"{where}: the file ends at its line {_line_no(raw, n)} inside the "
                         "header of this dataset; it is truncated"
                     )
-                ln, q = _next_line(raw, q)
-                lines.append(_text(ln))
+                hl, q = _next_line(raw, q)
+                lines.append(_text(hl))
             if n_ascii < 11:
                 raise ParseError(f"{where}: the 58b header has {n_ascii} of 11 lines")
             d58 = _header58(lines[:11], where)
@@ -334,15 +340,15 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict, list[np.
                 f"{_line_no(raw, n)} (byte {n}) inside it; the file is truncated (nothing of "
                 "it is read rather than losing this dataset silently)"
             )
-        entry: dict = {"type": dtype, "binary": int(binary), "line": line}
+        entry: dict[str, Any] = {"type": dtype, "binary": int(binary), "line": line}
         if dtype == 58:
             hdr_end = body_start
             lines = []
             for _ in range(11):
                 if hdr_end >= (bin_range[0] if bin_range else e.start()):
                     break
-                ln, hdr_end = _next_line(raw, hdr_end)
-                lines.append(_text(ln))
+                hl, hdr_end = _next_line(raw, hdr_end)
+                lines.append(_text(hl))
             if len(lines) < 11:
                 raise ParseError(f"{where}: the header has {len(lines)} of 11 records")
             d = _header58(lines, where)
@@ -379,19 +385,19 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict, list[np.
             first = _text(body[0])
             nums = _text(b" ".join(body[1:])).replace("D", "E").replace("d", "e").split()
             try:
-                vals = [float(v) for v in nums[:4]]
+                factors = [float(v) for v in nums[:4]]
             except ValueError:
                 raise ParseError(f"{where}: damaged unit factors {nums[:4]}") from None
-            if len(vals) < 3:
+            if len(factors) < 3:
                 raise ParseError(f"{where}: needs length, force and temperature factors")
             entry.update(
                 units_code=_int(first[:10], where),
                 units_description=first[10:30].strip(),
                 temp_mode=_int(first[30:40], where) if first[30:40].strip() else 0,
-                length=vals[0],
-                force=vals[1],
-                temp=vals[2],
-                temp_offset=vals[3] if len(vals) > 3 else 0.0,
+                length=factors[0],
+                force=factors[1],
+                temp=factors[2],
+                temp_offset=factors[3] if len(factors) > 3 else 0.0,
             )
         elif dtype == 151:
             body = raw[body_start : e.start()].splitlines()
@@ -409,7 +415,7 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict, list[np.
 
 
 # -- CSV ---------------------------------------------------------------------------------
-def parse_csv(raw: bytes, max_values: int | None = None) -> tuple[dict, list[np.ndarray]]:
+def parse_csv(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any], list[np.ndarray]]:
     """The ``#`` header lines, the column-header row and the data rows of a CSV file.
 
     Returns

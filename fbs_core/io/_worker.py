@@ -40,6 +40,9 @@ import select  # noqa: E402
 import signal  # noqa: E402
 import struct  # noqa: E402
 import time  # noqa: E402
+from collections.abc import Callable  # noqa: E402
+from types import ModuleType  # noqa: E402
+from typing import IO, Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -53,7 +56,7 @@ class ParseError(Exception):
 
 
 # -- encoding ------------------------------------------------------------------------
-def encode(meta: dict, arrays: list[np.ndarray]) -> bytes:
+def encode(meta: dict[str, Any], arrays: list[np.ndarray]) -> bytes:
     """JSON header (with dtype and shape of every array) + the arrays' raw bytes."""
     arrays = [np.ascontiguousarray(a) for a in arrays]
     for a in arrays:
@@ -64,7 +67,7 @@ def encode(meta: dict, arrays: list[np.ndarray]) -> bytes:
     return _U64.pack(len(head)) + head + b"".join(a.tobytes() for a in arrays)
 
 
-def array_specs(meta: dict) -> list[tuple[np.dtype, tuple[int, ...]]]:
+def array_specs(meta: dict[str, Any]) -> list[tuple[np.dtype[Any], tuple[int, ...]]]:
     """Checked dtypes and shapes of the arrays announced by a dump's header."""
     specs = []
     for e in meta.pop("_arrays"):
@@ -76,12 +79,12 @@ def array_specs(meta: dict) -> list[tuple[np.dtype, tuple[int, ...]]]:
     return specs
 
 
-def decode(payload: bytes) -> tuple[dict, list[np.ndarray]]:
+def decode(payload: bytes) -> tuple[dict[str, Any], list[np.ndarray]]:
     """Inverse of :func:`encode`."""
     (n,) = _U64.unpack_from(payload, 0)
     meta = json.loads(payload[8 : 8 + n].decode())
     pos = 8 + n
-    arrays = []
+    arrays: list[np.ndarray] = []
     for dt, shape in array_specs(meta):
         size = dt.itemsize * int(np.prod(shape, dtype=np.int64))
         arrays.append(np.frombuffer(payload, dt, size // dt.itemsize, pos).reshape(shape).copy())
@@ -89,7 +92,7 @@ def decode(payload: bytes) -> tuple[dict, list[np.ndarray]]:
     return meta, arrays
 
 
-def _jsonable(v):
+def _jsonable(v: Any) -> Any:
     if isinstance(v, bytes):
         return v.decode("utf-8", "replace")
     if isinstance(v, np.ndarray):
@@ -123,7 +126,7 @@ _MAT_NUMERIC = {
 }
 
 
-def _strings(a) -> list[str]:
+def _strings(a: Any) -> list[str]:
     """Char array or cell array of char arrays -> list of str."""
     a = np.asarray(a)
     if a.dtype.kind == "U":
@@ -146,11 +149,12 @@ def _too_big(limit: int) -> ParseError:
     )
 
 
-def parse_mat5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
+def parse_mat5(raw: bytes, limit: int) -> tuple[dict[str, Any], list[np.ndarray]]:
     import scipy.io
 
     info = scipy.io.whosmat(io.BytesIO(raw))
-    variables, arrays = {}, []
+    variables: dict[str, dict[str, Any]] = {}
+    arrays: list[np.ndarray] = []
     # announced sizes first (8 bytes per element), before anything is decompressed
     if sum(8 * int(np.prod(shape, dtype=np.int64)) for _, shape, _ in info) > limit:
         raise _too_big(limit)
@@ -190,7 +194,7 @@ def parse_mat5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
 
 
 # -- HDF5 (and MATLAB v7.3) ------------------------------------------------------------
-def _complex_fields(dt):
+def _complex_fields(dt: np.dtype[Any]) -> tuple[str, str] | None:
     names = dt.names or ()
     for re, im in (("real", "imag"), ("r", "i"), ("re", "im")):
         if names == (re, im):
@@ -198,18 +202,20 @@ def _complex_fields(dt):
     return None
 
 
-def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
+def parse_hdf5(raw: bytes, limit: int) -> tuple[dict[str, Any], list[np.ndarray]]:
     import h5py
 
-    datasets, groups, arrays = {}, {}, []
+    datasets: dict[str, dict[str, Any]] = {}
+    groups: dict[str, dict[str, Any]] = {}
+    arrays: list[np.ndarray] = []
     total = [0]
     with h5py.File(io.BytesIO(raw), "r") as f:
         errors: list[Exception] = []
 
-        def guarded(func):
+        def guarded(func: Callable[[str, Any], None]) -> Callable[[str, Any], bool | None]:
             # an exception raised inside an h5py visitor comes out mangled; stop the
             # visit by returning a value and re-raise afterwards
-            def call(name, obj):
+            def call(name: str, obj: Any) -> bool | None:
                 try:
                     func(name, obj)
                 except Exception as e:
@@ -219,7 +225,7 @@ def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
 
             return call
 
-        def check_link(name, link):
+        def check_link(name: str, link: Any) -> None:
             if not isinstance(link, h5py.HardLink):
                 raise ParseError(
                     f"object {name!r} is a {type(link).__name__}; links to other objects or "
@@ -231,8 +237,8 @@ def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
             raise errors[0]
         count = [0]
 
-        def attrs_of(obj):
-            out = {}
+        def attrs_of(obj: Any) -> dict[str, Any]:
+            out: dict[str, Any] = {}
             for k in list(obj.attrs.keys())[:200]:
                 try:
                     out[k] = _jsonable(obj.attrs[k])
@@ -240,7 +246,7 @@ def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
                     out[k] = "<unsupported>"
             return out
 
-        def visit(name, obj):
+        def visit(name: str, obj: Any) -> None:
             count[0] += 1
             if count[0] > MAX_OBJECTS:
                 raise ParseError(f"more than {MAX_OBJECTS} objects in the file")
@@ -256,7 +262,7 @@ def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
             total[0] += int(obj.size or 0) * max(dt.itemsize, 8)
             if total[0] > limit:  # announced size, checked before the data are read
                 raise _too_big(limit)
-            entry = {"attrs": attrs_of(obj), "shape": list(obj.shape)}
+            entry: dict[str, Any] = {"attrs": attrs_of(obj), "shape": list(obj.shape)}
             if h5py.check_string_dtype(dt) is not None:
                 a = obj[()]
                 a = np.asarray(a, dtype=object)
@@ -275,8 +281,8 @@ def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
                 a = np.asarray(obj[()])
                 entry["array"] = len(arrays)
                 arrays.append(a)
-            elif dt.kind == "V" and _complex_fields(dt):
-                re, im = _complex_fields(dt)
+            elif dt.kind == "V" and (fields := _complex_fields(dt)):
+                re, im = fields
                 a = obj[()]
                 c = np.asarray(a[re], dtype=float) + 1j * np.asarray(a[im], dtype=float)
                 entry["array"] = len(arrays)
@@ -292,36 +298,44 @@ def parse_hdf5(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
     return {"format": "hdf5", "datasets": datasets, "groups": groups}, arrays
 
 
-_TEXT = []
+_TEXT: list[ModuleType] = []
 
 
-def _textparse():
+def _textparse() -> ModuleType:
     """:mod:`fbs_core.io._textparse`, loaded by path (never through ``fbs_core``)."""
     if not _TEXT:
         import importlib.util
 
         path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_textparse.py")
         spec = importlib.util.spec_from_file_location("_fbs_textparse", path)
+        assert spec is not None and spec.loader is not None  # a .py file path
         mod = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(mod)
         _TEXT.append(mod)
     return _TEXT[0]
 
 
-def parse_uff(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
-    return _textparse().parse_uff(raw, max_values=limit // 16)
+def parse_uff(raw: bytes, limit: int) -> tuple[dict[str, Any], list[np.ndarray]]:
+    out: tuple[dict[str, Any], list[np.ndarray]] = _textparse().parse_uff(
+        raw, max_values=limit // 16
+    )
+    return out
 
 
-def parse_csv(raw: bytes, limit: int) -> tuple[dict, list[np.ndarray]]:
-    return _textparse().parse_csv(raw, max_values=limit // 8)
+def parse_csv(raw: bytes, limit: int) -> tuple[dict[str, Any], list[np.ndarray]]:
+    out: tuple[dict[str, Any], list[np.ndarray]] = _textparse().parse_csv(
+        raw, max_values=limit // 8
+    )
+    return out
 
 
 HANDLERS = {"mat5": parse_mat5, "hdf5": parse_hdf5, "uff": parse_uff, "csv": parse_csv}
 
 
 # -- process plumbing ------------------------------------------------------------------
-def _read_exact(stream, n: int) -> bytes:
-    chunks, got = [], 0
+def _read_exact(stream: IO[bytes], n: int) -> bytes:
+    chunks: list[bytes] = []
+    got = 0
     while got < n:
         b = stream.read(n - got)
         if not b:

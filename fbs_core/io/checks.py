@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..dofs import DIRECTIONS, parse_label
 from ..errors import (
@@ -41,6 +43,9 @@ from .units import (  # noqa: F401  (re-exported: the importers take them from h
     units_note,
 )
 
+if TYPE_CHECKING:
+    from ..coupling import Interface
+
 __all__ = [
     "DEFAULT_MAX_BYTES",
     "FORMATS",
@@ -61,6 +66,14 @@ __all__ = [
     "interface_check",
     "prepare_chassis",
     "describe",
+    # re-exported from .units for the importers
+    "check_quantity_arg",
+    "frequency_from_units",
+    "kinds_text",
+    "parse_kinds",
+    "reconcile_quantity",
+    "units_line",
+    "units_note",
 ]
 
 #: Default upper limit of a file's size in bytes (100 MiB).
@@ -87,7 +100,11 @@ class Source:
         return Path(self.name).suffix.lower()
 
 
-def read_source(source, filename: str | None = None, max_bytes: int = DEFAULT_MAX_BYTES) -> Source:
+def read_source(
+    source: str | os.PathLike[str] | bytes | bytearray | memoryview,
+    filename: str | None = None,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+) -> Source:
     """Read a path, or take bytes (an upload) with the file name they came with.
 
     Parameters
@@ -283,7 +300,7 @@ def normalize_label(text: str, what: str = "DOF") -> tuple[str, int]:
     return s, sign
 
 
-def rename_node(label: str, nodes: Mapping | None) -> str:
+def rename_node(label: str, nodes: Mapping[Any, Any] | None) -> str:
     """Apply a user node map (e.g. ``{1: "spindle", "101": "bushing"}``) to a label."""
     if not nodes:
         return label
@@ -296,7 +313,9 @@ def rename_node(label: str, nodes: Mapping | None) -> str:
     return label
 
 
-def missing_pairs(outputs, inputs, present) -> tuple[int, list[tuple[str, str]]]:
+def missing_pairs(
+    outputs: Collection[str], inputs: Collection[str], present: Collection[tuple[str, str]]
+) -> tuple[int, list[tuple[str, str]]]:
     """How many output/input pairs of the full matrix are not in ``present`` (a set or
     dict of pairs), and the first eight of them.
 
@@ -346,7 +365,7 @@ def require_dofs(
         raise DOFError(f"{what} lacks " + "; ".join(parts))
 
 
-def common_grid(frfs: Sequence[FRF], freq=None) -> list[FRF]:
+def common_grid(frfs: Sequence[FRF], freq: ArrayLike | None = None) -> list[FRF]:
     """Put FRFs on one grid, explicitly.
 
     With ``freq=None`` the FRFs must already share their grid (else
@@ -362,7 +381,9 @@ def common_grid(frfs: Sequence[FRF], freq=None) -> list[FRF]:
     return [f.interpolate(freq) for f in frfs]
 
 
-def interface_check(a: FRF, b: FRF, interface=None, max_cond: float = 1e8) -> np.ndarray:
+def interface_check(
+    a: FRF, b: FRF, interface: Interface | None = None, max_cond: float = 1e8
+) -> np.ndarray:
     """Condition of the interface matrix ``Y_jj^A + Y_jj^B`` (eq. 2.44) at every line.
 
     Calls :func:`fbs_core.coupling.interface_condition`.
@@ -483,7 +504,7 @@ def describe(frf: FRF, operating_points: Sequence[float] | None = None) -> str:
 MIN_TIRE_MODES = 20
 
 
-def check_tire(tire) -> list[str]:
+def check_tire(tire: Any) -> list[str]:
     """Refuse a tire model that cannot run every study of the thesis; return notes.
 
     The model must have the hub DOFs ``hub:x`` ... ``hub:rz``, at least
@@ -539,7 +560,7 @@ def check_tire(tire) -> list[str]:
     return notes
 
 
-def check_pair(tire=None, chassis=None, max_cond: float = 1e8) -> None:
+def check_pair(tire: Any = None, chassis: Any = None, max_cond: float = 1e8) -> None:
     """The pair couples on every harmonic's grid: the chassis has (or may interpolate)
     the lines and the interface ``Y_jj^A + Y_jj^E`` (eq. 2.44) is well conditioned.
 

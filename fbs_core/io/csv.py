@@ -29,6 +29,7 @@ import csv as _csv
 import io
 import re
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +38,7 @@ from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import (
     Source,
+    Units,
     frequency_from_units,
     kinds_text,
     missing_pairs,
@@ -71,10 +73,10 @@ def _split_pair(text: str, where: str) -> tuple[str, str]:
 def read_csv(
     src: Source,
     *,
-    nodes: Mapping | None = None,
+    nodes: Mapping[Any, Any] | None = None,
     quantity: str | None = None,
     timeout: float = DEFAULT_TIMEOUT,
-) -> tuple[FRF, list[str], dict]:
+) -> tuple[FRF, list[str], dict[str, Any]]:
     """Read an FRF from CSV in the documented layout.
 
     The numbers are parsed in the sandbox process (:func:`._textparse.parse_csv`, under
@@ -241,7 +243,7 @@ def read_csv(
     return frf, notes, extra
 
 
-def _parse_column_unit(item: tuple[tuple[str, str], str], name: str):
+def _parse_column_unit(item: tuple[tuple[str, str], str], name: str) -> Units:
     (o, i), text = item
     u = parse_units(text)
     if u is None or u.quantity is None:
@@ -253,7 +255,15 @@ def _parse_column_unit(item: tuple[tuple[str, str], str], name: str):
     return u
 
 
-def _column_factors(entry_units, factors, frf: FRF, q: str, o_pos, i_pos, name: str):
+def _column_factors(
+    entry_units: Mapping[tuple[str, str], str],
+    factors: np.ndarray | None,
+    frf: FRF,
+    q: str,
+    o_pos: Mapping[str, int],
+    i_pos: Mapping[str, int],
+    name: str,
+) -> tuple[np.ndarray, list[str]]:
     """SI factors from the unit written after each column name, checked against the kind
     of each entry (a rotation is not in m). Where the file has a unit line, that line
     governs the scale (a file whose unit line was edited by hand reads as the line says);
@@ -284,7 +294,7 @@ def _column_factors(entry_units, factors, frf: FRF, q: str, o_pos, i_pos, name: 
     return out, differ
 
 
-def _header(metadata: Mapping | None, title: str) -> list[str]:
+def _header(metadata: Mapping[str, Any] | None, title: str) -> list[str]:
     from .. import __version__
 
     lines = [f"# tire-fbs {title}"]
@@ -316,7 +326,7 @@ def safe_text(text: str) -> str:
     return "".join(p if k % 2 else safe_cell(p) for k, p in enumerate(parts))
 
 
-def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
+def write_csv(frf: FRF, *, metadata: Mapping[str, Any] | None = None) -> bytes:
     """An FRF as CSV in the documented ``re-im`` layout (full double precision)."""
     lines = _header(metadata, "FRF") + [
         f"# quantity: {frf.quantity}",
@@ -342,7 +352,7 @@ def write_csv(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
 
 def write_csv_tables(
     tables: list[tuple[str, list[str], np.ndarray]],
-    metadata: Mapping | None = None,
+    metadata: Mapping[str, Any] | None = None,
     title: str = "result",
 ) -> bytes:
     """Several tables in one CSV text, each introduced by ``# table: <name>``.

@@ -21,12 +21,16 @@ import io
 import json
 import time
 from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import DataFormatError
 from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
+
+if TYPE_CHECKING:
+    from .results import ResultData
 from .checks import (
     Source,
     check_finite,
@@ -47,7 +51,7 @@ __all__ = ["read_hdf5", "read_hdf5_result", "write_hdf5", "write_hdf5_result", "
 FORMAT_VERSION = 1
 
 
-def root_attrs(metadata: Mapping | None, kind: str) -> dict:
+def root_attrs(metadata: Mapping[str, Any] | None, kind: str) -> dict[str, Any]:
     """Attributes every file written here carries, for traceability."""
     from .. import __version__
 
@@ -62,7 +66,7 @@ def root_attrs(metadata: Mapping | None, kind: str) -> dict:
     }
 
 
-def _put_frf(g, frf: FRF) -> None:
+def _put_frf(g: Any, frf: FRF) -> None:
     import h5py
 
     g.create_dataset("freq", data=np.asarray(frf.freq, dtype=float))
@@ -77,13 +81,13 @@ def _put_frf(g, frf: FRF) -> None:
     g.attrs.create("inputs", np.array(frf.inputs, dtype=object), dtype=s)
 
 
-def _set_attrs(obj, attrs: Mapping) -> None:
+def _set_attrs(obj: Any, attrs: Mapping[str, Any]) -> None:
     for k, v in attrs.items():
         if isinstance(v, bool | int | float | str | np.number):
             obj.attrs[k] = v
 
 
-def write_hdf5(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
+def write_hdf5(frf: FRF, *, metadata: Mapping[str, Any] | None = None) -> bytes:
     """An FRF as HDF5 content in the documented layout (group ``/frf``)."""
     import h5py
 
@@ -94,7 +98,7 @@ def write_hdf5(frf: FRF, *, metadata: Mapping | None = None) -> bytes:
     return b.getvalue()
 
 
-def write_hdf5_result(result, metadata: Mapping) -> bytes:
+def write_hdf5_result(result: ResultData, metadata: Mapping[str, Any]) -> bytes:
     """A :class:`~fbs_core.io.results.ResultData` as HDF5 content."""
     import h5py
 
@@ -123,7 +127,7 @@ def write_hdf5_result(result, metadata: Mapping) -> bytes:
     return b.getvalue()
 
 
-def _strings(v, what: str) -> list[str]:
+def _strings(v: Any, what: str) -> list[str]:
     if isinstance(v, str):
         return [v]
     if isinstance(v, list) and all(isinstance(x, str) for x in v):
@@ -134,11 +138,11 @@ def _strings(v, what: str) -> list[str]:
 def read_hdf5(
     src: Source,
     *,
-    nodes: Mapping | None = None,
+    nodes: Mapping[Any, Any] | None = None,
     quantity: str | None = None,
     name: str | None = None,
     timeout: float = DEFAULT_TIMEOUT,
-) -> tuple[FRF, list[str], dict]:
+) -> tuple[FRF, list[str], dict[str, Any]]:
     """Read an FRF group (``/frf``, ``/frfs/<name>`` or ``name``) from HDF5 content.
 
     Raises
@@ -183,12 +187,13 @@ def read_hdf5(
         raise DataFormatError(f"{what}: {base}/freq must be a real vector, got {freq.shape}")
     freq = frequency_from_units(freq, fe["attrs"].get("unit"), what)
 
-    def labels(key):
+    def labels(key: str) -> list[str]:
         if key in attrs:
             return _strings(attrs[key], f"{what} {base} attribute {key!r}")
         e = ds.get(f"{base}/{key}")
         if e and "strings" in e:
-            return e["strings"]
+            strings: list[str] = e["strings"]  # the sandbox's parsed text
+            return strings
         raise DataFormatError(f"{what}: {base} lacks the DOF labels {key!r}")
 
     raw_o, raw_i = labels("outputs"), labels("inputs")
@@ -202,9 +207,9 @@ def read_hdf5(
         zip(*(normalize_label(x, w) for x in lab), strict=True)
         for lab, w in ((raw_o, "output"), (raw_i, "input"))
     )
-    outs = [rename_node(x, nodes) for x in outs]
-    ins = [rename_node(x, nodes) for x in ins]
-    notes = []
+    outs = tuple(rename_node(x, nodes) for x in outs)
+    ins = tuple(rename_node(x, nodes) for x in ins)
+    notes: list[str] = []
     ul = attrs.get("units")
     units = parse_units(ul if isinstance(ul, str) else None)
     if isinstance(ul, str) and ul.strip() and units is None:
@@ -224,7 +229,7 @@ def read_hdf5(
     if units is not None and not units.is_si:
         frf = frf.replace(data=frf.data * si_factors(units, outs, ins, frf.kinds, q)[None])
         notes.append(f"converted from {units.label} to SI ({frf.unit()})")
-    md = {}
+    md: dict[str, Any] = {}
     root = groups.get("/", {})
     if isinstance(root.get("metadata"), str):
         try:
@@ -237,7 +242,7 @@ def read_hdf5(
     return frf, notes, md
 
 
-def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
+def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT) -> ResultData:
     """Read a result written by :func:`write_hdf5_result` back as ``ResultData``.
 
     Raises
@@ -259,7 +264,7 @@ def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
         raise DataFormatError(f"{what}: the metadata attribute is not JSON") from None
     res = ResultData(str(root.get("content", "result")), metadata=md)
 
-    def values(e):
+    def values(e: dict[str, Any]) -> np.ndarray:
         return arrays[e["array"]] if "array" in e else np.asarray(e.get("strings", []))
 
     for path, e in ds.items():

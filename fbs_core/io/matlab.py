@@ -28,7 +28,8 @@ from __future__ import annotations
 import io
 import json
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -71,13 +72,13 @@ _NUMERIC = {
 H_NAMES = ("H", "Y", "FRF", "frf")
 
 
-def _attr_str(v) -> str:
+def _attr_str(v: Any) -> str:
     if isinstance(v, list):
         v = "".join(str(x) for x in v)
     return str(v)
 
 
-def _mat73_vars(meta: dict, arrays: list[np.ndarray], name: str) -> MatVars:
+def _mat73_vars(meta: dict[str, Any], arrays: list[np.ndarray], name: str) -> MatVars:
     ds = meta["datasets"]
     out: MatVars = {}
     for path, attrs in meta["groups"].items():
@@ -176,16 +177,17 @@ def _labels(v: MatVars, key: str, name: str) -> list[str]:
     return s
 
 
-def _vector(a, key: str, name: str) -> np.ndarray:
+def _vector(a: np.ndarray | list[str], key: str, name: str) -> np.ndarray:
     if isinstance(a, list):
         raise DataFormatError(f"MATLAB file {name!r}: {key!r} must be numeric, got text")
     a = np.asarray(a)
     if sum(n > 1 for n in a.shape) > 1:
         raise DataFormatError(f"MATLAB file {name!r}: {key!r} must be a vector, got {a.shape}")
-    return a.ravel()
+    flat: np.ndarray = a.ravel()
+    return flat
 
 
-def _strip1(shape) -> tuple:
+def _strip1(shape: Sequence[int]) -> tuple[int, ...]:
     s = list(shape)
     while len(s) > 1 and s[-1] == 1:
         s.pop()
@@ -193,8 +195,12 @@ def _strip1(shape) -> tuple:
 
 
 def frf_from_vars(
-    v: MatVars, name: str, *, nodes: Mapping | None = None, quantity: str | None = None
-) -> tuple[FRF, list[str], dict]:
+    v: MatVars,
+    name: str,
+    *,
+    nodes: Mapping[Any, Any] | None = None,
+    quantity: str | None = None,
+) -> tuple[FRF, list[str], dict[str, Any]]:
     """Build the FRF from MAT-file variables in the documented layout."""
     notes: list[str] = []
     if "freq" not in v:
@@ -229,8 +235,8 @@ def frf_from_vars(
     H = H.reshape(expected).astype(complex)
     outs, so = zip(*(normalize_label(s, "output") for s in raw_o), strict=True)
     ins, si = zip(*(normalize_label(s, "input") for s in raw_i), strict=True)
-    outs = [rename_node(s, nodes) for s in outs]
-    ins = [rename_node(s, nodes) for s in ins]
+    outs = tuple(rename_node(s, nodes) for s in outs)
+    ins = tuple(rename_node(s, nodes) for s in ins)
     sign = np.outer(so, si)
     if np.any(sign < 0):
         notes.append("labels with a '-' direction: their sign was flipped")
@@ -247,7 +253,7 @@ def frf_from_vars(
     if units is not None and not units.is_si:
         frf = frf.replace(data=frf.data * si_factors(units, outs, ins, frf.kinds, q)[None])
         notes.append(f"converted from {units.label} to SI ({frf.unit()})")
-    meta = {}
+    meta: dict[str, Any] = {}
     mtext = _text(v, "metadata", name)
     if mtext:
         try:
@@ -258,8 +264,13 @@ def frf_from_vars(
 
 
 def read_mat(
-    src: Source, kind: str, *, nodes=None, quantity=None, timeout: float = DEFAULT_TIMEOUT
-) -> tuple[FRF, list[str], dict]:
+    src: Source,
+    kind: str,
+    *,
+    nodes: Mapping[Any, Any] | None = None,
+    quantity: str | None = None,
+    timeout: float = DEFAULT_TIMEOUT,
+) -> tuple[FRF, list[str], dict[str, Any]]:
     """Read an FRF from a MAT-file in the documented layout."""
     return frf_from_vars(
         read_mat_vars(src, kind, timeout=timeout), src.name, nodes=nodes, quantity=quantity
@@ -267,7 +278,7 @@ def read_mat(
 
 
 # -- writing ---------------------------------------------------------------------------
-def _mat_vars(frf: FRF, metadata: Mapping | None) -> dict:
+def _mat_vars(frf: FRF, metadata: Mapping[str, Any] | None) -> dict[str, Any]:
     return {
         "freq": np.asarray(frf.freq, dtype=float),
         "H": np.asarray(frf.data),
@@ -281,12 +292,12 @@ def _mat_vars(frf: FRF, metadata: Mapping | None) -> dict:
     }
 
 
-def write_mat(frf: FRF, *, version: str = "5", metadata: Mapping | None = None) -> bytes:
+def write_mat(frf: FRF, *, version: str = "5", metadata: Mapping[str, Any] | None = None) -> bytes:
     """An FRF as MAT-file content (``version`` ``"5"`` or ``"7.3"``), documented layout."""
     return write_mat_vars(_mat_vars(frf, metadata), version=version)
 
 
-def write_mat_vars(variables: Mapping, *, version: str = "5") -> bytes:
+def write_mat_vars(variables: Mapping[str, Any], *, version: str = "5") -> bytes:
     """Write numeric arrays, strings and lists of strings as a MAT-file.
 
     Vectors are written as columns; strings as char rows; lists of strings as
@@ -297,7 +308,7 @@ def write_mat_vars(variables: Mapping, *, version: str = "5") -> bytes:
     if version == "5":
         import scipy.io
 
-        out = {}
+        out: dict[str, Any] = {}
         for k, val in variables.items():
             if isinstance(val, list):
                 width = max((len(s) for s in val), default=0)
@@ -310,7 +321,7 @@ def write_mat_vars(variables: Mapping, *, version: str = "5") -> bytes:
     return _write_mat73(variables)
 
 
-def _write_mat73(variables: Mapping) -> bytes:
+def _write_mat73(variables: Mapping[str, Any]) -> bytes:
     import h5py
 
     b = io.BytesIO()

@@ -23,6 +23,7 @@ MATLAB variable layout (``docs/file-formats.md``; the arrays of
 from __future__ import annotations
 
 import json
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,6 +31,9 @@ from ..errors import DataFormatError, FBSError
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import Source, check_finite, normalize_label
 from .matlab import MatVars, read_mat_vars, write_mat_vars
+
+if TYPE_CHECKING:
+    from ..tire.model import TireModel
 
 __all__ = ["tire_from_vars", "read_tire_mat", "write_tire_mat", "TIRE_VARIABLES"]
 
@@ -48,9 +52,9 @@ def _num(v: MatVars, key: str, name: str) -> np.ndarray:
     return check_finite(np.asarray(a), f"tire model {name!r} variable {key!r}")
 
 
-def _shaped(a: np.ndarray, shape: tuple, key: str, name: str, meaning: str) -> np.ndarray:
-    def strip(s):
-        s = list(s)
+def _shaped(a: np.ndarray, shape: tuple[int, ...], key: str, name: str, meaning: str) -> np.ndarray:
+    def strip(shp: tuple[int, ...]) -> tuple[int, ...]:
+        s = list(shp)
         while len(s) > 1 and s[-1] == 1:
             s.pop()
         return tuple(s)
@@ -63,7 +67,7 @@ def _shaped(a: np.ndarray, shape: tuple, key: str, name: str, meaning: str) -> n
     return a.reshape(shape)
 
 
-def tire_from_vars(v: MatVars, name: str):
+def tire_from_vars(v: MatVars, name: str) -> TireModel:
     """Build a :class:`~fbs_core.tire.model.TireModel` from MAT-file variables."""
     from ..tire.model import TireModel
 
@@ -106,12 +110,12 @@ def tire_from_vars(v: MatVars, name: str):
         raise DataFormatError(f"tire model {name!r}: {e}") from None
 
 
-def read_tire_mat(src: Source, kind: str, **kw):
+def read_tire_mat(src: Source, kind: str, *, timeout: float = DEFAULT_TIMEOUT) -> TireModel:
     """Read a tire model from a MAT-file (v5 or v7.3) in the documented layout."""
-    return tire_from_vars(read_mat_vars(src, kind, **kw), src.name)
+    return tire_from_vars(read_mat_vars(src, kind, timeout=timeout), src.name)
 
 
-def write_tire_mat(model, *, version: str = "5") -> bytes:
+def write_tire_mat(model: TireModel, *, version: str = "5") -> bytes:
     """A tire model as MAT-file content in the documented layout."""
     return write_mat_vars(
         {
@@ -128,7 +132,7 @@ def write_tire_mat(model, *, version: str = "5") -> bytes:
     )
 
 
-def read_tire_native(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
+def read_tire_native(src: Source, *, timeout: float = DEFAULT_TIMEOUT) -> TireModel:
     """Read a tire model in the project's format (``fbs_core.tire.storage``, HDF5).
 
     The file is parsed completely in the sandbox (every dataset and attribute, refusing
@@ -155,7 +159,7 @@ def read_tire_native(src: Source, *, timeout: float = DEFAULT_TIMEOUT):
                 f"{what} is not a {storage.FORMAT!r} file (its format attribute is {fmt!r}); "
                 "tire models are read from that format or from MATLAB (.mat)"
             )
-        data = {}
+        data: dict[str, Any] = {}
         for path, e in datasets.items():
             name = path.lstrip("/")
             if "/" in name:

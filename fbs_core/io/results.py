@@ -19,8 +19,9 @@ from __future__ import annotations
 import dataclasses
 import re
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -59,17 +60,17 @@ class ResultData:
     """
 
     kind: str
-    arrays: dict = field(default_factory=dict)
-    coords: dict = field(default_factory=dict)
-    frfs: dict = field(default_factory=dict)
-    metadata: dict = field(default_factory=dict)
+    arrays: dict[str, tuple[tuple[str, ...], np.ndarray]] = field(default_factory=dict)
+    coords: dict[str, np.ndarray] = field(default_factory=dict)
+    frfs: dict[str, FRF] = field(default_factory=dict)
+    metadata: dict[str, Any] = field(default_factory=dict)
 
 
 _SHAPE_DOC = re.compile(r"^\s*([\w ,]+?)\s*:[^\n]*?\b(?:shape|length)\s*\(?([\w ,]*)\)?", re.M)
 
 
-def _doc_dims(cls) -> dict[str, tuple[str, ...]]:
-    dims = {}
+def _doc_dims(cls: type) -> dict[str, tuple[str, ...]]:
+    dims: dict[str, tuple[str, ...]] = {}
     for m in _SHAPE_DOC.finditer(cls.__doc__ or ""):
         syms = tuple(s.strip() for s in m.group(2).split(",") if s.strip())
         for nm in m.group(1).split(","):
@@ -77,19 +78,19 @@ def _doc_dims(cls) -> dict[str, tuple[str, ...]]:
     return dims
 
 
-def _is_numeric(v) -> bool:
+def _is_numeric(v: object) -> bool:
     return isinstance(v, np.ndarray) and v.dtype.kind in "biufc"
 
 
-def _labels(v) -> bool:
-    return isinstance(v, tuple | list) and v and all(isinstance(x, str) for x in v)
+def _labels(v: object) -> bool:
+    return isinstance(v, tuple | list) and bool(v) and all(isinstance(x, str) for x in v)
 
 
-def _scalar(v) -> bool:
+def _scalar(v: object) -> bool:
     return isinstance(v, bool | int | float | str | np.number) or v is None
 
 
-def _jsonable(v):
+def _jsonable(v: Any) -> Any:
     if isinstance(v, np.generic):
         return v.item()
     if isinstance(v, tuple | list):
@@ -101,7 +102,9 @@ def _jsonable(v):
     return v if _scalar(v) else str(v)
 
 
-def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -> None:
+def _flatten(
+    obj: Any, prefix: str, out: ResultData, inherited: dict[str, str] | None = None
+) -> None:
     if isinstance(obj, FRF):
         out.frfs[prefix.rstrip("/") or "frf"] = obj
         return
@@ -138,7 +141,7 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
     # an undocumented tuple of numbers or labels ahead of that field labels an axis when
     # its length fits exactly one symbol (SuggestedModes.harmonics for n_h)
     order = list(items)
-    sizes: dict[str, set] = {}
+    sizes: dict[str, set[int]] = {}
     for k, syms in docdims.items():
         v = items.get(k)
         if isinstance(v, np.ndarray) and v.ndim == len(syms):
@@ -207,7 +210,9 @@ def _flatten(obj, prefix: str, out: ResultData, inherited: dict | None = None) -
                 )
 
 
-def as_result_data(obj, metadata: Mapping | None = None, kind: str | None = None) -> ResultData:
+def as_result_data(
+    obj: Any, metadata: Mapping[str, Any] | None = None, kind: str | None = None
+) -> ResultData:
     """Flatten a result object into :class:`ResultData`, adding traceability metadata.
 
     Parameters
@@ -248,7 +253,9 @@ def as_result_data(obj, metadata: Mapping | None = None, kind: str | None = None
     return out
 
 
-def _long_table(name: str, dims, values, coords) -> tuple[str, list[str], list[list]]:
+def _long_table(
+    name: str, dims: Sequence[str], values: Any, coords: Mapping[str, np.ndarray]
+) -> tuple[str, list[str], list[list[Any]]]:
     v = np.asarray(values)
     cols = list(dims) + (["re", "im"] if np.iscomplexobj(v) else ["value"])
     axes = [coords.get(d, np.arange(n)) for d, n in zip(dims, v.shape, strict=True)]
@@ -311,7 +318,7 @@ def result_to_hdf5(res: ResultData) -> bytes:
 
 
 def result_to_uff(
-    res: ResultData, *, nodes: Mapping | None = None, round_abscissa: bool = False
+    res: ResultData, *, nodes: Mapping[Any, Any] | None = None, round_abscissa: bool = False
 ) -> bytes:
     """The functions of frequency in a result as UFF dataset-58 records.
 
@@ -371,7 +378,7 @@ def result_to_uff(
             if label:
                 nn, dr = parse_label(label)
                 node = _node_numbers([label], nodes)[nn]
-                code, ent = DIR_CODES.get(dr, 0), _ent(nn)
+                code, ent = (DIR_CODES.get(dr, 0) if dr is not None else 0), _ent(nn)
             y = moved[ix]
             recs.append(
                 dict(

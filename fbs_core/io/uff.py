@@ -19,8 +19,10 @@ import time
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..dofs import DIRECTIONS, parse_label
 from ..errors import DataFormatError, DOFError, FBSError, FrequencyGridError, QuantityError
@@ -77,11 +79,11 @@ _REQUIRED = (
 )
 
 
-def _read_sets(src: Source, timeout: float) -> tuple[list[dict], dict]:
+def _read_sets(src: Source, timeout: float) -> tuple[list[dict[str, Any]], dict[str, int]]:
     """All datasets of the file, parsed in the sandbox (:func:`._textparse.parse_uff`):
     dataset 58 as pyuff-style dictionaries with ``x`` and ``data`` arrays."""
     meta, arrays = parse_isolated("uff", src.raw, f"Universal File {src.name!r}", timeout=timeout)
-    sets = []
+    sets: list[dict[str, Any]] = []
     for s in meta["sets"]:
         if s.get("type") == 58:
             y = arrays[s["data"]]
@@ -99,7 +101,14 @@ def _read_sets(src: Source, timeout: float) -> tuple[list[dict], dict]:
     return sets, meta.get("contents", {})
 
 
-def _dof(node, code, ent, what: str, nodes: Mapping | None, ent_names: dict) -> tuple[str, int]:
+def _dof(
+    node: Any,
+    code: Any,
+    ent: Any,
+    what: str,
+    nodes: Mapping[Any, Any] | None,
+    ent_names: dict[int, str],
+) -> tuple[str, int]:
     try:
         node, code = int(node), int(code)
     except (TypeError, ValueError):
@@ -122,9 +131,9 @@ def _dof(node, code, ent, what: str, nodes: Mapping | None, ent_names: dict) -> 
     return label, (-1 if code < 0 else 1)
 
 
-def _entity_names(frf_sets: list[dict]) -> dict[int, str]:
+def _entity_names(frf_sets: list[dict[str, Any]]) -> dict[int, str]:
     """Node number -> entity name, used only when the names map one-to-one to nodes."""
-    by_node: dict[int, set] = {}
+    by_node: dict[int, set[str]] = {}
     for s in frf_sets:
         for nk, ek in (("rsp_node", "rsp_ent_name"), ("ref_node", "ref_ent_name")):
             ent = str(s.get(ek, "") or "").strip()
@@ -132,7 +141,7 @@ def _entity_names(frf_sets: list[dict]) -> dict[int, str]:
                 by_node.setdefault(int(s[nk]), set()).add(ent)
             except (TypeError, ValueError):
                 return {}
-    names = {}
+    names: dict[int, str] = {}
     for node, ents in by_node.items():
         if len(ents) != 1:
             return {}
@@ -149,7 +158,7 @@ def _entity_names(frf_sets: list[dict]) -> dict[int, str]:
     return names
 
 
-def _quantity_of(s: dict, what: str) -> str | None:
+def _quantity_of(s: dict[str, Any], what: str) -> str | None:
     num = int(s.get("ordinate_spec_data_type", 0) or 0)
     den = int(s.get("orddenom_spec_data_type", 0) or 0)
     if num in _FORCE_TYPES and den in _SPEC_QUANTITY:
@@ -174,11 +183,11 @@ def _quantity_of(s: dict, what: str) -> str | None:
 
 
 @functools.lru_cache(maxsize=256)
-def _parse_units_cached(label: str):
+def _parse_units_cached(label: str) -> Units | None:
     return parse_units(label)
 
 
-def _units_label(s: dict) -> str:
+def _units_label(s: dict[str, Any]) -> str:
     """The FRF units of a record: record 9's label, over record 10's (the excitation)
     unless record 9 already is a whole FRF unit such as ``m/s/N``."""
     num = str(s.get("ordinate_axis_units_lab", "") or "").strip()
@@ -199,11 +208,11 @@ def _units_label(s: dict) -> str:
 def read_uff(
     src: Source,
     *,
-    nodes: Mapping | None = None,
+    nodes: Mapping[Any, Any] | None = None,
     quantity: str | None = None,
-    freq=None,
+    freq: ArrayLike | None = None,
     timeout: float = DEFAULT_TIMEOUT,
-) -> tuple[FRF, list[str], dict]:
+) -> tuple[FRF, list[str], dict[str, Any]]:
     """Read the FRF records (dataset 58, function type 4) of a Universal File.
 
     Parameters
@@ -248,10 +257,10 @@ def read_uff(
     if other:
         notes.append(f"ignored datasets of type {', '.join(map(str, other))}")
     for k, s in enumerate(f58):
-        missing = [key for key in _REQUIRED if key not in s]
-        if missing:
+        lacks = [key for key in _REQUIRED if key not in s]
+        if lacks:
             raise DataFormatError(
-                f"{src.name!r}: dataset 58 number {k + 1} lacks {', '.join(missing)}"
+                f"{src.name!r}: dataset 58 number {k + 1} lacks {', '.join(lacks)}"
             )
     frf_sets = [s for s in f58 if int(s["func_type"]) == 4]
     if len(frf_sets) < len(f58):
@@ -270,10 +279,10 @@ def read_uff(
         )
     ent_names = {} if nodes else _entity_names(frf_sets)
 
-    entries: dict[tuple[str, str], np.ndarray] = {}
+    entries: dict[tuple[str, str], tuple[np.ndarray, np.ndarray]] = {}
     outputs: dict[str, None] = {}
     inputs: dict[str, None] = {}
-    grid = None
+    grid: np.ndarray | None = None
     declared: set[str] = set()
     unit_labels: set[str] = set()
     rec_labels: dict[tuple[str, str], str] = {}
@@ -348,8 +357,9 @@ def read_uff(
             f"{src.name!r}: {n_missing} of {len(outputs) * len(inputs)} output/input "
             f"pairs have no record: {shown}{more}; a full matrix of outputs x inputs is needed"
         )
+    assert grid is not None  # there is at least one FRF record
     target = grid if freq is None else np.asarray(freq, dtype=float)
-    data = np.empty((len(target), len(outputs), len(inputs)), dtype=complex)
+    data: np.ndarray = np.empty((len(target), len(outputs), len(inputs)), dtype=complex)
     o_pos = {o: k for k, o in enumerate(outputs)}
     i_pos = {i: k for k, i in enumerate(inputs)}
     for (o, i), (x, y) in entries.items():
@@ -382,16 +392,16 @@ def read_uff(
     units = next((u for u in understood if u.quantity), understood[0] if understood else None)
     sys164 = None
     if units164:
-        u = units164[0]
+        u164 = units164[0]
         try:
-            lf, ff = float(u["length"]), float(u["force"])
+            lf, ff = float(u164["length"]), float(u164["force"])
         except (KeyError, TypeError, ValueError):
             raise DataFormatError(f"{src.name!r}: damaged units dataset 164") from None
         if not (lf > 0 and ff > 0 and math.isfinite(lf) and math.isfinite(ff)):
             raise DataFormatError(f"{src.name!r}: dataset 164 has invalid unit factors")
         # dataset 164 gives the factors that turn SI into file units (1000 for mm)
         sys164 = Units(
-            f"dataset 164 ({str(u.get('units_description', '')).strip()})",
+            f"dataset 164 ({str(u164.get('units_description', '')).strip()})",
             None,
             1.0 / lf,
             1.0 / ff,
@@ -424,7 +434,11 @@ def read_uff(
             notes.append(f"{sys164.label}: {sys164.summary()} (converted to SI)")
     if np.any(fac != 1.0):
         frf = frf.replace(data=frf.data * fac[None])
-        label = units.label if units is not None and any_labels else sys164.label
+        if units is not None and any_labels:
+            label = units.label
+        else:
+            assert sys164 is not None  # factors != 1 without labels come from dataset 164
+            label = sys164.label
         notes.append(f"converted from {label} to SI ({frf.unit()})")
     first = frf_sets[0]
     meta = {f"id{k}": str(first.get(f"id{k}", "")).strip() for k in range(1, 6)}
@@ -455,7 +469,7 @@ def _abscissa(freq: np.ndarray, round_abscissa: bool) -> int:
     return int(even)
 
 
-def _node_numbers(labels: Sequence[str], nodes: Mapping | None) -> dict[str, int]:
+def _node_numbers(labels: Sequence[str], nodes: Mapping[Any, Any] | None) -> dict[str, int]:
     """Node name -> UFF node number, from ``nodes`` (number -> name) or in order."""
     names = list(dict.fromkeys(parse_label(lab)[0] for lab in labels))
     given = {str(v): int(k) for k, v in (nodes or {}).items()}
@@ -479,7 +493,7 @@ def _ent(name: str) -> str:
     return name if len(name) <= 10 and " " not in name else "NONE"
 
 
-def write_uff_records(records: list[dict], *, binary: bool = False) -> bytes:
+def write_uff_records(records: list[dict[str, Any]], *, binary: bool = False) -> bytes:
     """Write dataset-58 records given as pyuff dictionaries; returns the file content."""
     import pyuff
 
@@ -504,10 +518,10 @@ def write_uff_records(records: list[dict], *, binary: bool = False) -> bytes:
 def frf_records(
     frf: FRF,
     *,
-    nodes: Mapping | None = None,
+    nodes: Mapping[Any, Any] | None = None,
     id_lines: Sequence[str] = (),
     round_abscissa: bool = False,
-) -> list[dict]:
+) -> list[dict[str, Any]]:
     """pyuff dictionaries of one dataset 58 per output/input pair of ``frf``."""
     even = _abscissa(frf.freq, round_abscissa)
     numbers = _node_numbers(frf.outputs + frf.inputs, nodes)
@@ -528,10 +542,10 @@ def frf_records(
                     id4=ids[2][:80],
                     id5=ids[3][:80],
                     rsp_node=numbers[no],
-                    rsp_dir=DIR_CODES.get(do, 0),
+                    rsp_dir=DIR_CODES.get(do, 0) if do is not None else 0,
                     rsp_ent_name=_ent(no),
                     ref_node=numbers[ni],
-                    ref_dir=DIR_CODES.get(di, 0),
+                    ref_dir=DIR_CODES.get(di, 0) if di is not None else 0,
                     ref_ent_name=_ent(ni),
                     data=np.array(frf.data[:, o, i], dtype=complex),
                     x=np.array(frf.freq),
@@ -554,8 +568,8 @@ def frf_records(
 def write_uff(
     frf: FRF,
     *,
-    nodes: Mapping | None = None,
-    metadata: Mapping | None = None,
+    nodes: Mapping[Any, Any] | None = None,
+    metadata: Mapping[str, Any] | None = None,
     binary: bool = False,
     round_abscissa: bool = False,
 ) -> bytes:
@@ -576,7 +590,7 @@ def write_uff(
     )
 
 
-def id_lines(metadata: Mapping | None) -> list[str]:
+def id_lines(metadata: Mapping[str, Any] | None) -> list[str]:
     """ID lines 2-5: producer and date, then ``key=value`` pairs of ``metadata``."""
     from .. import __version__
 

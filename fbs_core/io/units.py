@@ -54,7 +54,7 @@ def kinds_text(kinds: Mapping[str, str]) -> str:
     return "; ".join(f"{k}={v}" for k, v in kinds.items())
 
 
-def parse_kinds(text, where: str) -> dict[str, str] | None:
+def parse_kinds(text: object, where: str) -> dict[str, str] | None:
     """Inverse of :func:`kinds_text` (None for an empty text)."""
     from ..units import INPUT_KINDS, OUTPUT_KINDS
 
@@ -159,7 +159,7 @@ def reconcile_quantity(
     """
     check_quantity_arg(given)
     from_units = units.quantity if units is not None else None
-    if declared and from_units and declared != from_units:
+    if declared and units is not None and from_units and declared != from_units:
         raise QuantityError(
             f"{where} declares a {declared} but its units {units.label!r} are those of a "
             f"{from_units}"

@@ -31,14 +31,26 @@ so that row exchanges, which cannot be vectorised, are rare in the noisy lanes.
 
 from __future__ import annotations
 
+from typing import Literal, TypedDict
+
 import numpy as np
 from numba import njit, prange
+from numpy.typing import ArrayLike, NDArray
 
+from .._typing import ComplexArray, FloatArray, IntArray
 from ._rng import GOLDEN, mix64, mix64_np, stream_base
+
 
 # nogil: a band computed for one dashboard session must not stall the event loop that
 # serves all the others
-_JIT = dict(cache=True, fastmath=False, error_model="numpy", nogil=True)
+class _JitOptions(TypedDict):
+    cache: bool
+    fastmath: bool
+    error_model: Literal["python", "numpy"]
+    nogil: bool
+
+
+_JIT = _JitOptions(cache=True, fastmath=False, error_model="numpy", nogil=True)
 
 #: Rounds solved together in one vectorised block.
 LANES = 64
@@ -58,7 +70,17 @@ def n_elements(nj: int, ne: int) -> int:
 
 
 @njit(**_JIT)
-def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
+def _lane_factors(
+    key: np.uint64,
+    rids: IntArray,
+    nv: int,
+    line: int,
+    p: float,
+    k0: int,
+    k1: int,
+    s: FloatArray,
+    base: NDArray[np.uint64],
+) -> None:
     """Factors of words ``k0 .. k1-1`` of the ``LANES`` rounds ``rids`` at stream line ``line``
     into ``s (n_el, LANES)``; ``nv`` (valid lanes) is unused: padded lanes cost nothing extra."""
     n_el = s.shape[0]
@@ -80,8 +102,28 @@ def _lane_factors(key, rids, nv, line, p, k0, k1, s, base):
 
 @njit(**_JIT)
 def _lane_solve(
-    Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, s, nv, Wr, Wi, xr, xi, Pr, Pi, piv, pm, yr, yi
-):
+    Ar: FloatArray,
+    Ai: FloatArray,
+    ar: FloatArray,
+    ai: FloatArray,
+    Er: FloatArray,
+    Ei: FloatArray,
+    Br: FloatArray,
+    Bi: FloatArray,
+    order: IntArray,
+    s: FloatArray,
+    nv: int,
+    Wr: FloatArray,
+    Wi: FloatArray,
+    xr: FloatArray,
+    xi: FloatArray,
+    Pr: FloatArray,
+    Pi: FloatArray,
+    piv: IntArray,
+    pm: FloatArray,
+    yr: FloatArray,
+    yi: FloatArray,
+) -> None:
     """Noisy eq. 4.1 at one line for all lanes: ``y (n_e, LANES)`` from factors ``s``.
 
     Rows enter in ``order`` (the partial-pivoting order of the noise-free matrix),
@@ -190,7 +232,11 @@ def _lane_solve(
 
 
 @njit(**_JIT)
-def _workspace(nj, ne, n_el):
+def _workspace(
+    nj: int, ne: int, n_el: int
+) -> tuple[
+    FloatArray, NDArray[np.uint64], FloatArray, FloatArray, FloatArray, IntArray, FloatArray
+]:
     s = np.ones((n_el, LANES))
     base = np.empty(LANES, np.uint64)
     W = np.empty((2, nj, nj, LANES))
@@ -203,8 +249,26 @@ def _workspace(nj, ne, n_el):
 
 @njit(parallel=True, **_JIT)
 def noisy_block_run(
-    Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p, tire, vehicle, freq_dep, mag, cplx
-):
+    Ar: FloatArray,
+    Ai: FloatArray,
+    ar: FloatArray,
+    ai: FloatArray,
+    Er: FloatArray,
+    Ei: FloatArray,
+    Br: FloatArray,
+    Bi: FloatArray,
+    order: IntArray,
+    l0: int,
+    l1: int,
+    key: np.uint64,
+    rids: IntArray,
+    p: float,
+    tire: bool,
+    vehicle: bool,
+    freq_dep: bool,
+    mag: FloatArray,
+    cplx: ComplexArray,
+) -> None:
     """Noisy responses of rounds ``rids`` at lines ``l0 .. l1-1``.
 
     ``order (n_f, n_j)`` is the row order of each line (:func:`pivot_order`).
@@ -271,7 +335,7 @@ def noisy_block_run(
                         cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
 
 
-def pivot_order(A, E):
+def pivot_order(A: ComplexArray, E: ComplexArray) -> IntArray:
     """Row order of partial pivoting (pivot ``|Re| + |Im|``) of ``A + E`` at every line.
 
     ``A, E`` complex ``(n_f, n, n)``; returns ``(n_f, n)`` int64: row ``i`` of the
@@ -294,7 +358,16 @@ def pivot_order(A, E):
     return order
 
 
-def noise_factors(key, rounds, lines, p, nj, ne, tire, vehicle):
+def noise_factors(
+    key: int | np.uint64,
+    rounds: ArrayLike,
+    lines: ArrayLike,
+    p: float,
+    nj: int,
+    ne: int,
+    tire: bool,
+    vehicle: bool,
+) -> FloatArray:
     """The scaling factors of ``(rounds[i], lines[i])``, shape ``(n, n_elements)``.
 
     Plain numpy (uint64 arithmetic wraps modulo 2**64), bit-identical to the factors
@@ -325,7 +398,7 @@ def noise_factors(key, rounds, lines, p, nj, ne, tire, vehicle):
 
 
 @njit(**_JIT)
-def _select(buf, k, lo):
+def _select(buf: FloatArray, k: int, lo: int) -> None:
     """Partially sort ``buf[lo:]`` in place so that ``buf[k]`` is its k-th smallest (Hoare);
     ``buf[:lo]`` must already hold the ``lo`` smallest values."""
     hi = buf.size - 1
@@ -353,7 +426,7 @@ def _select(buf, k, lo):
 
 
 @njit(**_JIT)
-def _order_stat_pair(buf, k):
+def _order_stat_pair(buf: FloatArray, k: int) -> tuple[float, float]:
     """``(x_(k), x_(k+1))``, 0-based order statistics of ``buf`` (reordered in place)."""
     _select(buf, k, 0)
     lo = buf[k]
@@ -371,7 +444,9 @@ _SLACK = 16  # sample ranks on either side of the target (about sqrt(_SAMPLE))
 
 
 @njit(**_JIT)
-def _order_stat_pair_sampled(col, k, sample, mid):
+def _order_stat_pair_sampled(
+    col: FloatArray, k: int, sample: FloatArray, mid: FloatArray
+) -> tuple[float, float]:
     """``(x_(k), x_(k+1))`` of ``col`` (unchanged) by sample-bracketed selection.
 
     A sorted stride sample of ``col`` gives bounds that bracket ranks ``k`` and
@@ -404,7 +479,9 @@ _BINS = 4096
 
 
 @njit(**_JIT)
-def _order_stats_histogram(col, mn, mx, ranks, out):
+def _order_stats_histogram(
+    col: FloatArray, mn: float, mx: float, ranks: IntArray, out: FloatArray
+) -> bool:
     """Order statistics ``x_(ranks[i])`` (0-based) of ``col`` (unchanged) into ``out``.
 
     One pass sorts the values into ``_BINS`` equal bins over ``[mn, mx]`` (the bin index
@@ -460,7 +537,19 @@ def _order_stats_histogram(col, mn, mx, ranks, out):
 
 
 @njit(parallel=True, **_JIT)
-def band_stats(mag, qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_hi, l0):
+def band_stats(
+    mag: FloatArray,
+    qs: FloatArray,
+    checkpoints: IntArray,
+    lo: FloatArray,
+    hi: FloatArray,
+    arg_lo: IntArray,
+    arg_hi: IntArray,
+    pct: FloatArray,
+    conv_lo: FloatArray,
+    conv_hi: FloatArray,
+    l0: int,
+) -> None:
     """Band statistics over the rounds of ``mag (n_l, n_e, R)`` (rounds last).
 
     Writes, for lines ``l0 .. l0 + n_l - 1`` of the outputs: minimum and maximum

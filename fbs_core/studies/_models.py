@@ -17,16 +17,19 @@ explicit sequence of directions; released DOFs transmit no force.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
+from .._typing import ComplexArray, FloatArray, IndexLike
 from ..dofs import DIRECTIONS, parse_label
 from ..errors import DOFError, FBSError, FrequencyGridError
 from ..frf import FRF
+from ..harmonics import Harmonic
 from ..vocabulary import COUPLINGS
 
 
-def coupled_directions(coupling) -> tuple[str, ...]:
+def coupled_directions(coupling: str | Sequence[str]) -> tuple[str, ...]:
     """Directions coupled at the hub for ``coupling`` ("6dof", "5dof" or a sequence)."""
     if isinstance(coupling, str):
         if coupling == "6dof":
@@ -46,7 +49,7 @@ def coupled_directions(coupling) -> tuple[str, ...]:
     return tuple(d for d in DIRECTIONS if d in dirs)
 
 
-def resolve_tire(tire):
+def resolve_tire(tire: Any) -> Any:
     if tire is None:
         from .. import reference_tire
 
@@ -59,13 +62,13 @@ def resolve_tire(tire):
     return tire
 
 
-def resolve_harmonic(h):
+def resolve_harmonic(h: int | Harmonic) -> Harmonic:
     from ..harmonics import harmonic
 
     return harmonic(h)
 
 
-def total_modes(tire) -> int:
+def total_modes(tire: Any) -> int:
     """Number of (complex) modes of the tire model: the reference of the truncation study."""
     n = getattr(tire, "n_modes", None)
     if n is None:
@@ -73,7 +76,9 @@ def total_modes(tire) -> int:
     return int(n)
 
 
-def chassis_arrays(chassis, freq: np.ndarray, dirs: Sequence[str]):
+def chassis_arrays(
+    chassis: Any, freq: FloatArray, dirs: Sequence[str]
+) -> tuple[ComplexArray, ComplexArray, tuple[str, ...]]:
     """``(Y_jj^E (n_f, n_c, n_c), Y_ej^E (n_f, n_e, n_c), response labels)``.
 
     ``chassis`` is a model with ``mobility(freq)`` (default: the reference chassis)
@@ -115,7 +120,14 @@ def chassis_arrays(chassis, freq: np.ndarray, dirs: Sequence[str]):
     return np.ascontiguousarray(YjjE), np.ascontiguousarray(YejE), tuple(resp)
 
 
-def tire_arrays(tire, freq: np.ndarray, h, n_modes_list, dirs: Sequence[str], residual=False):
+def tire_arrays(
+    tire: Any,
+    freq: FloatArray,
+    h: Harmonic,
+    n_modes_list: IndexLike,
+    dirs: Sequence[str],
+    residual: bool = False,
+) -> tuple[ComplexArray, ComplexArray]:
     """``(Y_jj^A (n_N, n_f, n_c, n_c), v_j (n_N, n_f, n_c))`` in the coupled directions.
 
     ``residual``: the tire compensates the modes left out (``truncations(...,

@@ -20,8 +20,11 @@ half, element ``2k + 1`` from the low half.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
 from ..errors import FBSError
 
@@ -39,7 +42,7 @@ _ONE = np.uint64(1)
 _INV32 = 2.0**-32
 
 
-def mix64_np(z):
+def mix64_np(z: NDArray[np.uint64]) -> NDArray[np.uint64]:
     """:func:`mix64` on numpy ``uint64`` arrays (call under ``np.errstate(over="ignore")``)."""
     z = (z ^ (z >> _S30)) * _M1
     z = (z ^ (z >> _S27)) * _M2
@@ -47,7 +50,7 @@ def mix64_np(z):
 
 
 @njit(cache=True)
-def mix64(z):
+def mix64(z: np.uint64) -> np.uint64:
     """SplitMix64 output function (a bijection of the 64-bit integers)."""
     z = (z ^ (z >> _S30)) * _M1
     z = (z ^ (z >> _S27)) * _M2
@@ -64,13 +67,13 @@ def seed_key(seed: int) -> np.uint64:
 
 
 @njit(cache=True)
-def stream_base(key, r, line):
+def stream_base(key: np.uint64, r: int, line: int) -> np.uint64:
     """The base counter of round ``r`` at frequency line ``line``."""
     a = mix64(key + (np.uint64(r) + _ONE) * GOLDEN)
     return mix64(a + (np.uint64(line) + _ONE) * GOLDEN)
 
 
-def as_seed(seed) -> int:
+def as_seed(seed: int | np.integer[Any] | np.random.Generator) -> int:
     """An integer seed in ``[0, 2**64)`` from an int or a :class:`numpy.random.Generator`.
 
     A generator contributes one draw, so that ``scatter_band(..., seed=rng)`` is

@@ -23,7 +23,9 @@ they are proportional to the band integrals).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
+from .._typing import FloatArray, IntArray
 from ..errors import DataFormatError, FBSError
 from ..frf import check_grid
 
@@ -44,7 +46,9 @@ def _check_band(width: float, step: float, edges: str) -> None:
         raise FBSError(f"unknown band-edge treatment {edges!r}; allowed: {', '.join(EDGES)}")
 
 
-def band_centres(freq, width: float = 12.0, step: float = 1.0, edges: str = "clip") -> np.ndarray:
+def band_centres(
+    freq: ArrayLike, width: float = 12.0, step: float = 1.0, edges: str = "clip"
+) -> FloatArray:
     """Default centre frequencies of the floating band: multiples of ``step`` in range.
 
     Parameters
@@ -71,7 +75,9 @@ def band_centres(freq, width: float = 12.0, step: float = 1.0, edges: str = "cli
     return np.arange(k0, k1 + 1) * step + 0.0 if k1 >= k0 else np.empty(0)
 
 
-def _band_bounds(f: np.ndarray, centres: np.ndarray, width: float, edges: str):
+def _band_bounds(
+    f: FloatArray, centres: FloatArray, width: float, edges: str
+) -> tuple[IntArray, IntArray]:
     half = width / 2
     i0 = np.searchsorted(f, centres - half - _TOL, side="left")
     i1 = np.searchsorted(f, centres + half + _TOL, side="right")
@@ -86,7 +92,14 @@ def _band_bounds(f: np.ndarray, centres: np.ndarray, width: float, edges: str):
     return i0, i1
 
 
-def band_power_sums(freq, v_ref, v_mod, centres, width: float = 12.0, edges: str = "clip"):
+def band_power_sums(
+    freq: ArrayLike,
+    v_ref: ArrayLike,
+    v_mod: ArrayLike,
+    centres: ArrayLike,
+    width: float = 12.0,
+    edges: str = "clip",
+) -> tuple[FloatArray, FloatArray]:
     """Numerator and denominator of eq. 5.1 for every centre (the array kernel).
 
     Parameters
@@ -130,50 +143,57 @@ def band_power_sums(freq, v_ref, v_mod, centres, width: float = 12.0, edges: str
 
 
 def floating_band_error(
-    freq, v_ref, v_mod, width: float = 12.0, step: float = 1.0, edges: str = "clip", centres=None
-):
+    freq: ArrayLike,
+    v_ref: ArrayLike,
+    v_mod: ArrayLike,
+    width: float = 12.0,
+    step: float = 1.0,
+    edges: str = "clip",
+    centres: ArrayLike | None = None,
+) -> tuple[FloatArray, FloatArray]:
     """Thesis eq. 5.1 over a floating band: error versus centre frequency.
 
-    Parameters
-    ----------
-    freq : array_like, shape (n_f,)
-        Frequency lines in Hz (strictly increasing).
-    v_ref : array_like, shape (n_f, ...)
-        True (reference) response ``v_T``, complex or real, frequency first.
-    v_mod : array_like, shape (..., n_f, ...)
-        Modified response ``v_M``; broadcasts against ``v_ref`` from the right, so
-        e.g. ``(n_N, n_f, n_dof)`` against ``(n_f, n_dof)``.
-    width, step : float
-        Band width and step in Hz (thesis: 12 Hz and 1 Hz).
-    edges : {"clip", "valid"}
-        Band-edge treatment at the ends of the range (module docstring).
-    centres : array_like, optional
-        Centre frequencies in Hz; default :func:`band_centres`.
+        Parameters
+        ----------
+        freq : array_like, shape (n_f,)
+            Frequency lines in Hz (strictly increasing).
+        v_ref : array_like, shape (n_f, ...)
+            True (reference) response ``v_T``, complex or real, frequency first.
+        v_mod : array_like, shape (..., n_f, ...)
+            Modified response ``v_M``; broadcasts against ``v_ref`` from the right, so
+            e.g. ``(n_N, n_f, n_dof)`` against ``(n_f, n_dof)``.
+        width, step : float
+            Band width and step in Hz (thesis: 12 Hz and 1 Hz).
+        edges : {"clip", "valid"}
+            Band-edge treatment at the ends of the range (module docstring).
+        centres : array_like, optional
+            Centre frequencies in Hz; default :func:`band_centres`.
 
-    Returns
-    -------
-    centres : ndarray, shape (n_c,)
-    error : ndarray, shape (..., n_c, ...)
-        Relative error (0.2 = 20 %); the frequency axis of the inputs becomes the
-        centre axis. Where the reference has no power in a band the error is 0 if
-        the modified curve has none either, else ``inf``.
+        Returns
+        -------
+        centres : ndarray, shape (n_c,)
+        error : ndarray, shape (..., n_c, ...)
+            Relative error (0.2 = 20 %); the frequency axis of the inputs becomes the
+            centre axis. Where the reference has no power in a band the error is 0 if
+            the modified curve has none either, else ``inf``.
 
-    Raises
-    ------
-    FBSError
-        For a non-positive width or step, an unknown ``edges``, or (``"valid"``)
-        explicit centres whose band leaves the range.
-    FrequencyGridError, DataFormatError
-        For a bad grid or shapes that do not match it.
+        Raises
+        ------
+        FBSError
+            For a non-positive width or step, an unknown ``edges``, or (``"valid"``)
+            explicit centres whose band leaves the range.
+        FrequencyGridError, DataFormatError
+            For a bad grid or shapes that do not match it.
 
-    Examples
-    --------
-    >>> import numpy as np
-    >>> f = np.arange(0.0, 50.0, 0.5)
-    >>> v = 1 / (1 + 1j * (f - 20))
-    >>> c, e = floating_band_error(f, v, 1.1 * v)
-    >>> bool(np.allclose(e, 0.21))
-    True
+        Examples
+        --------
+        >>> import numpy as np
+    from numpy.typing import ArrayLike
+        >>> f = np.arange(0.0, 50.0, 0.5)
+        >>> v = 1 / (1 + 1j * (f - 20))
+        >>> c, e = floating_band_error(f, v, 1.1 * v)
+        >>> bool(np.allclose(e, 0.21))
+        True
     """
     f = check_grid(freq)
     _check_band(width, step, edges)

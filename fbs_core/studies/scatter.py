@@ -29,12 +29,17 @@ rounds are processed in chunks of lines whose size is bounded by ``max_chunk_byt
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
 
+from .._typing import AnyArray, ComplexArray, FloatArray, IntArray
 from ..errors import DataFormatError, FBSError, SingularInterfaceError, StudyCancelled
 from ..frf import check_grid
+from ..harmonics import Harmonic
 from . import _kernels, _models
 from ._rng import as_seed, seed_key
 
@@ -53,14 +58,29 @@ _EMPTY_MAG = np.empty((0, 0, 0))
 _LOCK = threading.Lock()
 _EMPTY_CPLX = np.empty((0, 0, 0), np.complex128)
 
+#: The kernel inputs of a band (real and imaginary parts of the four matrices and the
+#: pivot order, see :func:`_check_inputs`) and its 64-bit key.
+_KernelArrays = tuple[
+    FloatArray,
+    FloatArray,
+    FloatArray,
+    FloatArray,
+    FloatArray,
+    FloatArray,
+    FloatArray,
+    FloatArray,
+    IntArray,
+]
+_Inputs = tuple[_KernelArrays, np.uint64]
 
-def _ro(a, dtype=None):
+
+def _ro(a: ArrayLike, dtype: DTypeLike | None = None) -> AnyArray:
     a = np.array(a, dtype=dtype, copy=True)
     a.setflags(write=False)
     return a
 
 
-def _db(x):
+def _db(x: FloatArray) -> FloatArray:
     with np.errstate(divide="ignore", invalid="ignore"):
         return 20 * np.log10(x)
 
@@ -80,26 +100,28 @@ class Convergence:
         Running minimum and maximum of ``|v_e|``.
     """
 
-    rounds: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
+    rounds: IntArray
+    lower: FloatArray
+    upper: FloatArray
 
     @property
-    def upper_change_db(self) -> np.ndarray:
+    def upper_change_db(self) -> FloatArray:
         """Largest gap (dB, over lines and DOFs) between the upper edge at each
         checkpoint and the final one, shape ``(n_k,)``; 0 at the last checkpoint."""
-        return np.nanmax(_db(self.upper[-1] / self.upper), axis=(1, 2))
+        gap: FloatArray = np.nanmax(_db(self.upper[-1] / self.upper), axis=(1, 2))
+        return gap
 
     @property
-    def lower_change_db(self) -> np.ndarray:
+    def lower_change_db(self) -> FloatArray:
         """Largest gap (dB) between the lower edge at each checkpoint and the final one."""
-        return np.nanmax(_db(self.lower / self.lower[-1]), axis=(1, 2))
+        gap: FloatArray = np.nanmax(_db(self.lower / self.lower[-1]), axis=(1, 2))
+        return gap
 
     @property
-    def step_change_db(self) -> np.ndarray:
+    def step_change_db(self) -> FloatArray:
         """Largest change (dB) of either edge from one checkpoint to the next, ``(n_k - 1,)``."""
-        up = np.nanmax(_db(self.upper[1:] / self.upper[:-1]), axis=(1, 2))
-        lo = np.nanmax(_db(self.lower[:-1] / self.lower[1:]), axis=(1, 2))
+        up: FloatArray = np.nanmax(_db(self.upper[1:] / self.upper[:-1]), axis=(1, 2))
+        lo: FloatArray = np.nanmax(_db(self.lower[:-1] / self.lower[1:]), axis=(1, 2))
         return np.maximum(up, lo)
 
     def summary(self) -> str:
@@ -135,15 +157,15 @@ class ScatterBand:
         The settings.
     """
 
-    freq: np.ndarray
+    freq: FloatArray
     dofs: tuple[str, ...]
-    reference: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    argmin_round: np.ndarray
-    argmax_round: np.ndarray
-    q: np.ndarray
-    percentiles: np.ndarray
+    reference: ComplexArray
+    lower: FloatArray
+    upper: FloatArray
+    argmin_round: IntArray
+    argmax_round: IntArray
+    q: FloatArray
+    percentiles: FloatArray
     convergence: Convergence
     noise: float
     target: str
@@ -151,9 +173,9 @@ class ScatterBand:
     frequency_dependent: bool
     seed: int
     harmonic: int | None
-    _inputs: tuple
+    _inputs: _Inputs
 
-    def _dof(self, dof) -> int:
+    def _dof(self, dof: str | int) -> int:
         if isinstance(dof, str):
             if dof not in self.dofs:
                 from ..errors import DOFError
@@ -162,7 +184,7 @@ class ScatterBand:
             return self.dofs.index(dof)
         return int(dof)
 
-    def round(self, r: int) -> np.ndarray:
+    def round(self, r: int) -> ComplexArray:
         """The complex response of round ``r``, shape ``(n_f, n_dof)``, regenerated alone.
 
         Identical (bit for bit) to the round inside the batch.
@@ -172,9 +194,10 @@ class ScatterBand:
         FBSError
             For ``r`` outside ``0 .. rounds - 1``.
         """
-        return self.rounds_response([r])[0]
+        v: ComplexArray = self.rounds_response([r])[0]
+        return v
 
-    def rounds_response(self, rounds) -> np.ndarray:
+    def rounds_response(self, rounds: ArrayLike) -> ComplexArray:
         """Complex responses of several rounds, shape ``(n, n_f, n_dof)``."""
         rids = np.atleast_1d(np.asarray(rounds, np.int64))
         if rids.ndim != 1 or np.any((rids < 0) | (rids >= self.rounds)):
@@ -183,7 +206,7 @@ class ScatterBand:
         tire, vehicle = _flags(self.target)
         return _run_complex(arrays, key, rids, self.noise, tire, vehicle, self.frequency_dependent)
 
-    def peak_round(self, freq: float, dof, which: str = "max") -> int:
+    def peak_round(self, freq: float, dof: str | int, which: str = "max") -> int:
         """The round giving the highest (``"max"``) or lowest (``"min"``) ``|v_e|`` at the
         line nearest ``freq`` (the curves of thesis figs. 5.10-5.11)."""
         if which not in ("max", "min"):
@@ -192,7 +215,7 @@ class ScatterBand:
         arr = self.argmax_round if which == "max" else self.argmin_round
         return int(arr[line, self._dof(dof)])
 
-    def factors(self, r: int, line: int = 0) -> dict[str, np.ndarray]:
+    def factors(self, r: int, line: int = 0) -> dict[str, FloatArray]:
         """The scaling factors of round ``r`` at line index ``line``:
         ``{"Yjj_A": (n_j, n_j), "vj_A": (n_j,), "Yjj_E": (n_j, n_j), "Yej_E": (n_e, n_j)}``
         (1 where no noise is applied; ``line`` is ignored without frequency dependence)."""
@@ -206,7 +229,7 @@ class ScatterBand:
         return split_factors(s, nj, ne)
 
 
-def split_factors(s: np.ndarray, nj: int, ne: int) -> dict[str, np.ndarray]:
+def split_factors(s: FloatArray, nj: int, ne: int) -> dict[str, FloatArray]:
     """Split one stream of factors into the four scaling arrays (layout of :mod:`._kernels`)."""
     o1, o2, o3 = nj * nj, nj * nj + nj, 2 * nj * nj + nj
     return {
@@ -223,12 +246,20 @@ def _flags(target: str) -> tuple[bool, bool]:
     return target in ("tire", "both"), target in ("vehicle", "both")
 
 
-def _split(z):
+def _split(z: ComplexArray) -> tuple[FloatArray, FloatArray]:
     # read-only, C-contiguous: one compiled signature for the band and single rounds
     return _ro(np.ascontiguousarray(z.real, float)), _ro(np.ascontiguousarray(z.imag, float))
 
 
-def _run_complex(arrays, key, rids, p, tire, vehicle, freq_dep):
+def _run_complex(
+    arrays: _KernelArrays,
+    key: np.uint64,
+    rids: IntArray,
+    p: float,
+    tire: bool,
+    vehicle: bool,
+    freq_dep: bool,
+) -> ComplexArray:
     nf, ne = arrays[0].shape[0], arrays[6].shape[1]
     out = np.empty((rids.size, nf, ne), np.complex128)
     with _LOCK:
@@ -238,9 +269,9 @@ def _run_complex(arrays, key, rids, p, tire, vehicle, freq_dep):
     return out
 
 
-def default_checkpoints(rounds: int) -> np.ndarray:
+def default_checkpoints(rounds: int) -> IntArray:
     """1-2-5 steps from 10 up to ``rounds`` (always ending at ``rounds``)."""
-    out = []
+    out: list[int] = []
     dec = 10
     while dec < rounds:
         out += [m * dec for m in (1, 2, 5) if m * dec < rounds]
@@ -248,8 +279,10 @@ def default_checkpoints(rounds: int) -> np.ndarray:
     return np.array(out + [rounds], np.int64)
 
 
-def _check_inputs(YjjA, vj, YjjE, YejE):
-    YjjA, vj, YjjE, YejE = (np.asarray(x) for x in (YjjA, vj, YjjE, YejE))
+def _check_inputs(
+    YjjA_in: ArrayLike, vj_in: ArrayLike, YjjE_in: ArrayLike, YejE_in: ArrayLike
+) -> _KernelArrays:
+    YjjA, vj, YjjE, YejE = (np.asarray(x) for x in (YjjA_in, vj_in, YjjE_in, YejE_in))
     if YjjA.ndim != 3 or YjjA.shape[1] != YjjA.shape[2]:
         raise DataFormatError(f"YjjA must have shape (n_f, n_j, n_j), got {YjjA.shape}")
     nf, nj = YjjA.shape[:2]
@@ -269,24 +302,24 @@ def _check_inputs(YjjA, vj, YjjE, YejE):
 
 
 def scatter_band_arrays(
-    YjjA,
-    vj,
-    YjjE,
-    YejE,
+    YjjA: ArrayLike,
+    vj: ArrayLike,
+    YjjE: ArrayLike,
+    YejE: ArrayLike,
     noise: float = 0.1,
     target: str = "both",
     rounds: int = 10_000,
     frequency_dependent: bool = False,
-    seed=0,
+    seed: int | np.integer[Any] | np.random.Generator = 0,
     *,
-    freq=None,
-    dofs=None,
-    harmonic=None,
-    percentiles=(5.0, 95.0),
-    checkpoints=None,
+    freq: ArrayLike | None = None,
+    dofs: Sequence[str] | None = None,
+    harmonic: int | None = None,
+    percentiles: ArrayLike = (5.0, 95.0),
+    checkpoints: ArrayLike | None = None,
     max_chunk_bytes: float = 64e6,
-    cancel=None,
-    progress=None,
+    cancel: Callable[[], bool] | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> ScatterBand:
     """The scatter band from arrays (the kernel behind :func:`scatter_band`).
 
@@ -443,24 +476,24 @@ def scatter_band_arrays(
 
 
 def scatter_band(
-    harmonic,
+    harmonic: int | Harmonic,
     noise: float = 0.1,
     target: str = "both",
     rounds: int = 10_000,
     frequency_dependent: bool = False,
-    seed=0,
+    seed: int | np.integer[Any] | np.random.Generator = 0,
     *,
-    n_modes=None,
-    freq=None,
+    n_modes: int | None = None,
+    freq: ArrayLike | None = None,
     df: float = 0.5,
-    tire=None,
-    chassis=None,
-    coupling="6dof",
-    percentiles=(5.0, 95.0),
-    checkpoints=None,
+    tire: Any = None,
+    chassis: Any = None,
+    coupling: str | Sequence[str] = "6dof",
+    percentiles: ArrayLike = (5.0, 95.0),
+    checkpoints: ArrayLike | None = None,
     max_chunk_bytes: float = 64e6,
-    cancel=None,
-    progress=None,
+    cancel: Callable[[], bool] | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> ScatterBand:
     """Noise scatter band of the bushing response for one harmonic (thesis 5.2, eqs. 5.2-5.4).
 

@@ -13,13 +13,18 @@ Public entry points: :func:`truncation_map` (thesis figs. 5.3, 5.6, 5.7),
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
 
 from .. import kernels
-from ..errors import DOFError, FBSError
+from .._typing import AnyArray, ComplexArray, FloatArray, IntArray
+from ..errors import DOFError, FBSError, HarmonicError
 from ..frf import check_grid
+from ..harmonics import Harmonic
 from . import _models
 from .metric import floating_band_error
 
@@ -35,7 +40,7 @@ __all__ = [
 ]
 
 
-def _ro(a, dtype=None):
+def _ro(a: ArrayLike, dtype: DTypeLike | None = None) -> AnyArray:
     a = np.array(a, dtype=dtype, copy=True)
     a.setflags(write=False)
     return a
@@ -70,24 +75,25 @@ class TruncationMap:
     """
 
     harmonic: int | None
-    n_modes: np.ndarray
+    n_modes: IntArray
     n_modes_total: int | None
-    centres: np.ndarray
+    centres: FloatArray
     dofs: tuple[str, ...]
-    error: np.ndarray
-    freq: np.ndarray
-    response: np.ndarray
-    reference: np.ndarray
+    error: FloatArray
+    freq: FloatArray
+    response: ComplexArray
+    reference: ComplexArray
     width: float
     step: float
     edges: str
 
     @property
-    def max_error(self) -> np.ndarray:
+    def max_error(self) -> FloatArray:
         """Maximum error over the response DOFs, shape ``(n_N, n_c)`` (thesis fig. 5.6)."""
-        return self.error.max(axis=-1)
+        m: FloatArray = self.error.max(axis=-1)
+        return m
 
-    def dof_error(self, dof: str) -> np.ndarray:
+    def dof_error(self, dof: str) -> FloatArray:
         """Error of one response DOF, shape ``(n_N, n_c)`` (e.g. ``"bushing:z"``, fig. 5.7).
 
         Raises
@@ -99,7 +105,7 @@ class TruncationMap:
             raise DOFError(f"unknown response DOF {dof!r}; available: {', '.join(self.dofs)}")
         return self.error[:, :, self.dofs.index(dof)]
 
-    def response_for(self, n_modes: int | None) -> np.ndarray | None:
+    def response_for(self, n_modes: int | None) -> ComplexArray | None:
         """The coupled response with ``n_modes`` retained modes, if the map holds it.
 
         Parameters
@@ -118,7 +124,7 @@ class TruncationMap:
         hit = np.flatnonzero(self.n_modes == int(n_modes))
         return self.response[hit[0]] if hit.size else None
 
-    def suggest(self, threshold: float = 0.2, f_max: float = 160.0, dof: str | None = None):
+    def suggest(self, threshold: float = 0.2, f_max: float = 160.0, dof: str | None = None) -> int:
         """Smallest retained-mode count from which the error stays below ``threshold``.
 
         See :func:`suggest_n_modes`; ``dof=None`` uses the maximum over DOFs.
@@ -130,9 +136,9 @@ class TruncationMap:
 
 
 def suggest_n_modes(
-    error,
-    centres,
-    n_modes,
+    error: ArrayLike,
+    centres: ArrayLike,
+    n_modes: ArrayLike,
     threshold: float = 0.2,
     f_max: float = 160.0,
     n_total: int | None = None,
@@ -185,22 +191,22 @@ def suggest_n_modes(
 
 
 def truncation_map_arrays(
-    freq,
-    YjjA,
-    vj,
-    YjjA_ref,
-    vj_ref,
-    YjjE,
-    YejE,
-    n_modes,
+    freq: ArrayLike,
+    YjjA: ComplexArray,
+    vj: ComplexArray,
+    YjjA_ref: ComplexArray,
+    vj_ref: ComplexArray,
+    YjjE: ComplexArray,
+    YejE: ComplexArray,
+    n_modes: ArrayLike,
     *,
-    dofs=None,
-    harmonic=None,
-    n_modes_total=None,
+    dofs: Sequence[str] | None = None,
+    harmonic: int | None = None,
+    n_modes_total: int | None = None,
     width: float = 12.0,
     step: float = 1.0,
     edges: str = "clip",
-    centres=None,
+    centres: ArrayLike | None = None,
 ) -> TruncationMap:
     """The error map from arrays (the kernel behind :func:`truncation_map`).
 
@@ -260,24 +266,24 @@ def truncation_map_arrays(
     )
 
 
-def default_n_modes(n_total: int, step: int = 10) -> np.ndarray:
+def default_n_modes(n_total: int, step: int = 10) -> IntArray:
     """``step, 2 step, ...`` up to ``n_total`` (thesis: 10, 20, ..., 400)."""
     return np.arange(step, n_total + 1, step)
 
 
 def truncation_map(
-    harmonic,
-    n_modes=None,
+    harmonic: int | Harmonic,
+    n_modes: ArrayLike | None = None,
     *,
-    freq=None,
+    freq: ArrayLike | None = None,
     df: float = 0.5,
     width: float = 12.0,
     step: float = 1.0,
     edges: str = "clip",
-    centres=None,
-    tire=None,
-    chassis=None,
-    coupling="6dof",
+    centres: ArrayLike | None = None,
+    tire: Any = None,
+    chassis: Any = None,
+    coupling: str | Sequence[str] = "6dof",
     residual: bool = False,
 ) -> TruncationMap:
     """Truncation error map of one harmonic (thesis figs. 5.3, 5.6, 5.7).
@@ -361,32 +367,38 @@ class ModeFrequencies:
         Highest eigenfrequency in Hz among ``N`` retained modes (``N / 2`` pairs).
     """
 
-    n_modes: np.ndarray
-    speeds: np.ndarray
-    frequency: np.ndarray
+    n_modes: IntArray
+    speeds: FloatArray
+    frequency: FloatArray
 
 
-def _highest_retained(tire, speed: float, n: np.ndarray) -> np.ndarray:
+def _highest_retained(tire: Any, speed: float, n: ArrayLike) -> FloatArray:
     """Highest eigenfrequency (Hz) among the first ``n`` modes at ``speed``, per count.
 
     With ``tire.poles_at`` the retained modes are taken in the model's own order
     (the order of truncation); otherwise the ``n / 2``-th positive eigenfrequency.
     """
     n = np.asarray(n, int)
+    run: FloatArray
+    eig: FloatArray
     if hasattr(tire, "poles_at"):
         p = np.asarray(tire.poles_at(float(speed)))
         if n.max() > p.size:
             raise FBSError(f"{int(n.max())} modes requested, the tire has {p.size}")
         run = np.maximum.accumulate(np.abs(p.imag)) / (2 * np.pi)
-        return run[np.maximum(n, 1) - 1]
+        out: FloatArray = run[np.maximum(n, 1) - 1]
+        return out
     eig = np.sort(np.asarray(tire.eigenfrequencies(float(speed))))
     pairs = np.maximum(n // 2, 1)
     if pairs.max() > eig.size:
         raise FBSError(f"{int(n.max())} modes requested, the tire has {2 * eig.size}")
-    return eig[pairs - 1]
+    out = eig[pairs - 1]
+    return out
 
 
-def mode_frequencies(speeds=(20.0, 80.0, 120.0), n_modes=None, tire=None) -> ModeFrequencies:
+def mode_frequencies(
+    speeds: ArrayLike = (20.0, 80.0, 120.0), n_modes: ArrayLike | None = None, tire: Any = None
+) -> ModeFrequencies:
     """Eigenfrequency versus number of retained modes at some speeds (thesis fig. 5.8).
 
     ``N`` modes are ``N / 2`` pairs of positive and negative eigenfrequencies, lowest
@@ -436,9 +448,9 @@ class SuggestedModes:
     """
 
     harmonics: tuple[int, ...]
-    n_modes: np.ndarray
-    eigenfrequency: np.ndarray
-    freq_range: np.ndarray
+    n_modes: IntArray
+    eigenfrequency: FloatArray
+    freq_range: FloatArray
     threshold: float
     f_max: float
     speed: float
@@ -461,18 +473,18 @@ def suggest_modes(
     threshold: float = 0.2,
     f_max: float = 160.0,
     *,
-    harmonics=(1, 2, 3, 4, 5, 6, 7),
+    harmonics: Sequence[int] = (1, 2, 3, 4, 5, 6, 7),
     dof: str | None = None,
     speed: float = 80.0,
-    maps=None,
-    n_modes=None,
+    maps: Sequence[TruncationMap] | None = None,
+    n_modes: ArrayLike | None = None,
     df: float = 0.5,
     width: float = 12.0,
     step: float = 1.0,
     edges: str = "clip",
-    tire=None,
-    chassis=None,
-    coupling="6dof",
+    tire: Any = None,
+    chassis: Any = None,
+    coupling: str | Sequence[str] = "6dof",
     residual: bool = False,
 ) -> SuggestedModes:
     """Suggested number of tire modes for every harmonic (thesis table 5.1).
@@ -517,7 +529,13 @@ def suggest_modes(
         )
     else:
         maps = tuple(maps)
-        harmonics = tuple(m.harmonic for m in maps)
+        for m in maps:
+            if m.harmonic is None:  # a map of user arrays (truncation_map_arrays)
+                raise HarmonicError(
+                    "unknown harmonic None; allowed: 1, 2, 3, 4, 5, 6, 7 (thesis table 5.1): "
+                    "maps need a harmonic case (from truncation_map)"
+                )
+        harmonics = tuple(m.harmonic for m in maps if m.harmonic is not None)
     n = np.array([m.suggest(threshold, f_max, dof) for m in maps], int)
     ef = np.full(n.size, np.nan)
     if np.any(n > 0):

@@ -25,9 +25,11 @@ plain linear interpolation, and at the operating points it is exact.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = [
     "Cluster",
@@ -78,19 +80,22 @@ class Cluster:
     z: np.ndarray
 
 
-def residue_change(R0, R1) -> np.ndarray:
+def residue_change(R0: np.ndarray, R1: np.ndarray) -> np.ndarray:
     """``|R1 - R0| / max(|R0|, |R1|)`` per mode (rows), 0 for modes without residues."""
     n0 = np.linalg.norm(R0, axis=-1)
     n1 = np.linalg.norm(R1, axis=-1)
     d = np.linalg.norm(R1 - R0, axis=-1)
-    return d / np.maximum(np.maximum(n0, n1), np.finfo(float).tiny)
+    rel: np.ndarray = d / np.maximum(np.maximum(n0, n1), np.finfo(float).tiny)
+    return rel
 
 
-def _components(lam0, lam1, idx, kappa, moving) -> list[np.ndarray]:
+def _components(
+    lam0: np.ndarray, lam1: np.ndarray, idx: np.ndarray, kappa: float, moving: np.ndarray
+) -> list[np.ndarray]:
     n = idx.size
     parent = np.arange(n)
 
-    def find(i):
+    def find(i: int) -> int:
         while parent[i] != i:
             parent[i] = parent[parent[i]]
             i = parent[i]
@@ -102,7 +107,7 @@ def _components(lam0, lam1, idx, kappa, moving) -> list[np.ndarray]:
         mv = moving[idx]
         near = (d < w) & (mv[:, None] | mv[None, :])
         for i, j in zip(*np.nonzero(np.triu(near, 1)), strict=True):
-            a, b = find(i), find(j)
+            a, b = find(int(i)), find(int(j))
             if a != b:
                 parent[max(a, b)] = min(a, b)
     roots = np.array([find(i) for i in range(n)])
@@ -110,8 +115,12 @@ def _components(lam0, lam1, idx, kappa, moving) -> list[np.ndarray]:
 
 
 def find_clusters(
-    lam0, lam1, kappa: float | None = None, kmax: int | None = None, moving=None
-) -> list:
+    lam0: ArrayLike,
+    lam1: ArrayLike,
+    kappa: float | None = None,
+    kmax: int | None = None,
+    moving: ArrayLike | None = None,
+) -> list[np.ndarray]:
     """Groups (size 2..kmax) of modes whose poles are close at either end.
 
     Parameters
@@ -136,7 +145,8 @@ def find_clusters(
     kmax = KMAX if kmax is None else kmax
     lam0, lam1 = np.asarray(lam0), np.asarray(lam1)
     moving = np.ones(lam0.size, bool) if moving is None else np.asarray(moving, bool)
-    out, todo = [], [(np.arange(lam0.size), kappa)]
+    out: list[np.ndarray] = []
+    todo = [(np.arange(lam0.size), kappa)]
     if kappa <= 0:
         return out
     while todo:
@@ -151,30 +161,35 @@ def find_clusters(
     return sorted(out, key=lambda g: g[0])
 
 
-def lagrange_weights(nodes, v) -> np.ndarray:
+def lagrange_weights(nodes: ArrayLike, v: ArrayLike) -> np.ndarray:
     """Lagrange interpolation weights of the speeds ``v`` on ``nodes``, shape (n_v, n_nodes)."""
     x = np.asarray(nodes, float)
-    v = np.atleast_1d(np.asarray(v, float))
-    w = np.ones((v.size, x.size))
+    vs = np.atleast_1d(np.asarray(v, float))
+    w = np.ones((vs.size, x.size))
     for i in range(x.size):
         for j in range(x.size):
             if i != j:
-                w[:, i] *= (v - x[j]) / (x[i] - x[j])
+                w[:, i] *= (vs - x[j]) / (x[i] - x[j])
     return w
 
 
-def _poly(z) -> np.ndarray:
+def _poly(z: np.ndarray) -> np.ndarray:
     """Coefficients of ``prod_r (x - z_r)`` over the last axis (leading 1)."""
-    a = np.ones(z.shape[:-1] + (1,), complex)
+    a: np.ndarray = np.ones(z.shape[:-1] + (1,), complex)
     for r in range(z.shape[-1]):
-        nxt = np.zeros(z.shape[:-1] + (a.shape[-1] + 1,), complex)
+        nxt: np.ndarray = np.zeros(z.shape[:-1] + (a.shape[-1] + 1,), complex)
         nxt[..., :-1] += a
         nxt[..., 1:] -= z[..., r, None] * a
         a = nxt
     return a
 
 
-def cluster_ends(groups, lam, R, ends=(0, -1)) -> list[Cluster]:
+def cluster_ends(
+    groups: Sequence[np.ndarray],
+    lam: np.ndarray,
+    R: np.ndarray,
+    ends: tuple[int, int] = (0, -1),
+) -> list[Cluster]:
     """Interpolation data of clusters from their poles and residues at the nodes.
 
     Parameters
@@ -194,7 +209,7 @@ def cluster_ends(groups, lam, R, ends=(0, -1)) -> list[Cluster]:
         One batch per cluster size.
     """
     e0, e1 = ends
-    out = []
+    out: list[Cluster] = []
     for k in sorted({len(g) for g in groups}):
         mem = np.array([g for g in groups if len(g) == k])  # (n_c, k)
         avg = np.abs(lam[e0][mem].imag + lam[e1][mem].imag)
@@ -210,13 +225,14 @@ def cluster_ends(groups, lam, R, ends=(0, -1)) -> list[Cluster]:
     return out
 
 
-def _coefficients(cl: Cluster, w) -> np.ndarray:
+def _coefficients(cl: Cluster, w: np.ndarray) -> np.ndarray:
     """``P``'s coefficients at the lines: ``(n_l, n_c, k + 1)``, linear in the weights."""
     n_l, n_nodes = w.shape
-    return (w @ cl.a.reshape(n_nodes, -1)).reshape(n_l, *cl.a.shape[1:])
+    a: np.ndarray = (w @ cl.a.reshape(n_nodes, -1)).reshape(n_l, *cl.a.shape[1:])
+    return a
 
 
-def _partials(a, z) -> np.ndarray:
+def _partials(a: np.ndarray, z: np.ndarray) -> np.ndarray:
     """Horner partial sums ``b_i = sum_(i' <= i) a_i' z^(i - i')``, shape ``z.shape + (k + 1,)``.
 
     ``b_k = P(z)``, and the numerator of the partial fractions regrouped by the
@@ -232,14 +248,20 @@ def _partials(a, z) -> np.ndarray:
     return b
 
 
-def subset(cl: Cluster, mask) -> Cluster:
+def subset(cl: Cluster, mask: np.ndarray) -> Cluster:
     """The clusters ``mask`` (boolean or index array over ``n_c``) of a batch."""
     return Cluster(
         cl.members[mask], cl.c[mask], cl.rho[mask], cl.a[:, mask], cl.m[mask], cl.z[:, mask]
     )
 
 
-def cluster_sum(cl: Cluster, w, s, cols=None, per_cluster: bool = False) -> np.ndarray:
+def cluster_sum(
+    cl: Cluster,
+    w: ArrayLike,
+    s: ArrayLike,
+    cols: Sequence[int] | np.ndarray | None = None,
+    per_cluster: bool = False,
+) -> np.ndarray:
     """Total receptance contribution of all clusters, ``sum_c N_c(z) / (rho_c P_c(z))``.
 
     No roots are needed for the sum over a whole cluster; the moments enter
@@ -259,24 +281,26 @@ def cluster_sum(cl: Cluster, w, s, cols=None, per_cluster: bool = False) -> np.n
     -------
     ndarray, shape (n_l, n_cols) or (n_l, n_c, n_cols)
     """
-    w = np.asarray(w, float)
-    n_l, n_nodes = w.shape
-    a = _coefficients(cl, w)
+    wa = np.asarray(w, float)
+    n_l, n_nodes = wa.shape
+    a = _coefficients(cl, wa)
     k = a.shape[-1] - 1
     zs = (np.asarray(s)[:, None] - cl.c[None, :]) / cl.rho[None, :]  # (n_l, n_c)
     b = _partials(a, zs)  # (n_l, n_c, k + 1); b_k = P(z)
     h = b[..., k - 1 :: -1] / (cl.rho[None, :, None] * b[..., k, None])  # (n_l, n_c, k) by q
-    g = w[:, None, :, None] * h[:, :, None, :]  # (n_l, n_c, n_nodes, k)
+    g = wa[:, None, :, None] * h[:, :, None, :]  # (n_l, n_c, n_nodes, k)
     if per_cluster:
         n_c = cl.members.shape[0]
         g = np.moveaxis(g.reshape(n_l, n_c, -1), 1, 0)  # (n_c, n_l, n_nodes k)
-        tot = np.moveaxis(g @ cl.m.reshape(n_c, n_nodes * k, -1), 0, 1)
+        tot: np.ndarray = np.moveaxis(g @ cl.m.reshape(n_c, n_nodes * k, -1), 0, 1)
         return tot if cols is None else tot[..., cols]
     tot = g.reshape(n_l, -1) @ cl.m.reshape(-1, cl.m.shape[-1])
     return tot if cols is None else tot[:, cols]
 
 
-def cluster_at(cl: Cluster, w, cols=None) -> tuple[np.ndarray, np.ndarray]:
+def cluster_at(
+    cl: Cluster, w: ArrayLike, cols: Sequence[int] | np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Poles and residues of a batch of clusters at lines with node weights ``w``.
 
     Parameters
@@ -294,10 +318,10 @@ def cluster_at(cl: Cluster, w, cols=None) -> tuple[np.ndarray, np.ndarray]:
         gets column ``i`` (and a conjugate cluster gets the conjugate poles).
     residues : ndarray, shape (n_l, n_c, k, n_cols)
     """
-    w = np.asarray(w, float)
-    n_l, n_nodes = w.shape
+    wa = np.asarray(w, float)
+    n_l, n_nodes = wa.shape
     n_c, k = cl.members.shape
-    a = _coefficients(cl, w)
+    a = _coefficients(cl, wa)
     if k == 2:  # roots of z^2 + a1 z + a0 in closed form
         d = np.sqrt(a[..., 1] ** 2 / 4 - a[..., 2])
         z = np.stack([-a[..., 1] / 2 + d, -a[..., 1] / 2 - d], axis=-1)
@@ -313,7 +337,7 @@ def cluster_at(cl: Cluster, w, cols=None) -> tuple[np.ndarray, np.ndarray]:
     diff[..., np.arange(k), np.arange(k)] = 1.0
     dp = np.prod(diff, axis=-1)  # P'(z_r)
     h = b[..., k - 1 :: -1] / dp[..., None]  # (n_l, n_c, k_root, k_q)
-    g = w[:, None, None, :, None] * h[:, :, :, None, :]  # (n_l, n_c, k_root, n_nodes, k_q)
+    g = wa[:, None, None, :, None] * h[:, :, :, None, :]  # (n_l, n_c, k_root, n_nodes, k_q)
     g = np.moveaxis(g, 1, 0).reshape(n_c, n_l * k, n_nodes * k)
     r = g @ cl.m.reshape(n_c, n_nodes * k, -1)  # (n_c, n_l * k_root, n_res)
     r = np.moveaxis(r.reshape(n_c, n_l, k, -1), 0, 1)

@@ -14,7 +14,9 @@ behind each difference is measured, not assumed (``scripts/print_landmarks.py``,
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -30,7 +32,7 @@ __all__ = [
 ]
 
 #: The thesis' landmarks (section 4.1.2, figs. 4.6-4.9, table 5.1, fig. 5.3).
-THESIS: dict = {
+THESIS: dict[str, object] = {
     "hub_peaks_hz": "17, 38",
     "bushing_z_peaks_hz": "14, 38",
     "bushing_translation_largest": "z",
@@ -42,7 +44,7 @@ THESIS: dict = {
 }
 
 #: Variants of the reference tire, each with one physics addition switched off.
-VARIANTS: dict[str, dict] = {
+VARIANTS: dict[str, dict[str, Any]] = {
     "no asymmetry": {"camber": 0.0, "toe": 0.0, "mu_y0": 0.0},
     # tread sticking to the road; the last family gets its order 10 back (400 modes)
     "no slip": {"slip_zones": 0, "orders": (16, 6, 14, 14, 12, 11, 10, 10)},
@@ -51,7 +53,7 @@ VARIANTS: dict[str, dict] = {
 _DOFS = ("x", "y", "z", "rx", "ry", "rz")
 
 
-def _peaks(f, a, floor=0.1):
+def _peaks(f: np.ndarray, a: np.ndarray, floor: float = 0.1) -> tuple[float, ...]:
     """Local maxima of ``a`` above ``floor`` times its maximum."""
     i = np.flatnonzero((a[1:-1] > a[:-2]) & (a[1:-1] >= a[2:])) + 1
     return tuple(float(x) for x in f[i[a[i] >= floor * a.max()]])
@@ -76,11 +78,11 @@ class Landmarks:
         Suggested modes for case 5, bushing z only, up to 160 Hz (fig. 5.3).
     """
 
-    hub_peaks: dict
-    bushing_peaks: dict
-    bushing_level_db: dict
-    table_130: tuple
-    table_160: tuple
+    hub_peaks: dict[str, tuple[float, ...]]
+    bushing_peaks: dict[str, tuple[float, ...]]
+    bushing_level_db: dict[str, float]
+    table_130: tuple[int, ...]
+    table_160: tuple[int, ...]
     case5_z_160: int
 
     def rows(self) -> list[tuple[str, str]]:
@@ -89,7 +91,7 @@ class Landmarks:
         tr = max(("x", "y", "z"), key=lambda d: lv[d])
         rot = max(("rx", "ry", "rz"), key=lambda d: lv[d])
 
-        def fmt(p):
+        def fmt(p: tuple[float, ...]) -> str:
             return ", ".join(f"{x:.1f}" for x in p) if p else "-"
 
         return [
@@ -111,7 +113,7 @@ class Landmarks:
         ]
 
 
-def landmarks(tire=None, chassis=None) -> Landmarks:
+def landmarks(tire: Any = None, chassis: Any = None) -> Landmarks:
     """Measure the thesis' landmarks on ``tire`` (default: the shipped reference tire).
 
     Parameters
@@ -170,10 +172,10 @@ class LandmarkTable:
         Column name -> :class:`Landmarks`.
     """
 
-    keys: tuple
-    thesis: tuple
-    columns: dict
-    measured: dict
+    keys: tuple[str, ...]
+    thesis: tuple[str, ...]
+    columns: dict[str, tuple[str, ...]]
+    measured: dict[str, Landmarks]
 
     def text(self) -> str:
         """Plain-text table, one landmark per block of lines."""
@@ -187,7 +189,9 @@ class LandmarkTable:
 
 
 def landmark_table(
-    params: TireParameters = DEFAULT_PARAMETERS, variants=None, chassis=None
+    params: TireParameters = DEFAULT_PARAMETERS,
+    variants: Mapping[str, Mapping[str, Any]] | None = None,
+    chassis: Any = None,
 ) -> LandmarkTable:
     """Landmarks of the tire built from ``params`` and of its :data:`VARIANTS`.
 

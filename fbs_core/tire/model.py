@@ -22,7 +22,9 @@ the gyroscopic tire) through their characteristic polynomial and moments
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal, TypeAlias, overload
 
 import numpy as np
 
@@ -37,6 +39,18 @@ from .params import TireParameters
 from .ring import HUB_DOFS, build_tire_system
 from .ring import patch_load as _patch_load
 
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from .interp import Cluster
+
+#: A truncation plan of :meth:`TireModel._plan`: the truncation order and, per cluster
+#: batch, its members, the clusters whole inside a block and those split by a block edge
+#: (with their members ranked).
+_Plan: TypeAlias = (
+    "tuple[np.ndarray, list[tuple[np.ndarray, Cluster | None, Cluster | None, np.ndarray | None]]]"
+)
+
 __all__ = ["TireModel", "OperatingPointError", "ModeCountError", "INTERPOLATIONS"]
 
 #: Interpolation schemes between operating points.
@@ -47,7 +61,9 @@ INTERPOLATIONS = ("cubic", "cluster", "linear")
 _CHUNK = 48
 
 
-def _renamed(harmonic, harmonic_case):
+def _renamed(
+    harmonic: int | Harmonic | None, harmonic_case: int | Harmonic | None
+) -> int | Harmonic:
     """The keyword ``harmonic_case`` was renamed ``harmonic`` (kept for one release)."""
     if harmonic_case is not None:
         warnings.warn(
@@ -63,7 +79,7 @@ def _renamed(harmonic, harmonic_case):
     return harmonic
 
 
-def _ro(a) -> np.ndarray:
+def _ro(a: ArrayLike) -> np.ndarray:
     a = np.array(a, copy=True)
     a.setflags(write=False)
     return a
@@ -115,12 +131,18 @@ class TireModel:
     wavelengths: np.ndarray
     participation: np.ndarray
     params: TireParameters | None = None
-    meta: dict = field(default_factory=dict)
+    meta: dict[str, Any] = field(default_factory=dict)
     hub_dofs: tuple[str, ...] = HUB_DOFS
     interpolation: str = "cubic"
     residual: np.ndarray | None = None
+    if TYPE_CHECKING:  # set in __post_init__; not dataclass fields at run time
+        _Z: np.ndarray = field(init=False)
+        _clusters: tuple[tuple[Cluster, ...], ...] = field(init=False)
+        _nodes: tuple[slice, ...] = field(init=False)
+        _order: np.ndarray = field(init=False)
+        _plans: dict[tuple[int, int, tuple[int, ...]], _Plan] = field(init=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.interpolation not in INTERPOLATIONS:
             raise FBSError(
                 f"unknown interpolation {self.interpolation!r}; allowed: "
@@ -178,20 +200,15 @@ class TireModel:
         Z = np.concatenate([R, Q], axis=2)
         Z.setflags(write=False)
         object.__setattr__(self, "_Z", Z)
-        clusters, nodes = [], []
+        nodes: list[slice] = []
         for k in range(n_s - 1):
             nd = slice(k, k + 2)
             if self.interpolation == "cubic" and 1 <= k <= n_s - 3:
                 nd = slice(k - 1, k + 3)  # centred stencil; end intervals stay linear
             nodes.append(nd)
-            groups = []
-            if self.interpolation != "linear":
-                moving = interp.residue_change(Z[k, 0::2], Z[k + 1, 0::2]) > interp.TAU
-                groups = find_clusters(poles[k, 0::2], poles[k + 1, 0::2], moving=moving)
-            e = (k - nd.start, k + 1 - nd.start)
-            groups = [2 * g + par for g in groups for par in (0, 1)]
-            clusters.append(tuple(cluster_ends(groups, poles[nd], Z[nd], e)))
-        object.__setattr__(self, "_clusters", tuple(clusters))
+        # clusters of every interval, found when the interval is first used (_clusters_of)
+        clusters: list[tuple[Cluster, ...] | None] = [None] * (n_s - 1)
+        object.__setattr__(self, "_clusters", clusters)
         object.__setattr__(self, "_nodes", tuple(nodes))
         # truncation order at every operating point: pairs by eigenfrequency there
         pairs = np.argsort(poles[:, 0::2].imag, axis=1, kind="stable")
@@ -200,13 +217,34 @@ class TireModel:
         object.__setattr__(self, "_order", order)
         object.__setattr__(self, "_plans", {})  # cache of truncation plans (see _plan)
 
+    def _clusters_of(self, k: int) -> tuple[Cluster, ...]:
+        """Clusters of interval ``k`` (:mod:`.interp`), found on first use and kept.
+
+        Two threads may find them at once; both get the same tuple (deterministic), so
+        the race costs time, never correctness.
+        """
+        hit = self._clusters[k]
+        if hit is not None:
+            return hit
+        nd = self._nodes[k]
+        groups: list[np.ndarray] = []
+        if self.interpolation != "linear":
+            Z, poles = self._Z, self.poles
+            moving = interp.residue_change(Z[k, 0::2], Z[k + 1, 0::2]) > interp.TAU
+            groups = find_clusters(poles[k, 0::2], poles[k + 1, 0::2], moving=moving)
+        e = (k - nd.start, k + 1 - nd.start)
+        groups = [2 * g + par for g in groups for par in (0, 1)]
+        out = tuple(cluster_ends(groups, self.poles[nd], self._Z[nd], e))
+        self._clusters[k] = out
+        return out
+
     # -- basic information -----------------------------------------------------------
     @property
     def n_modes(self) -> int:
         """Number of complex modes (both members of every pair)."""
-        return self.poles.shape[1]
+        return int(self.poles.shape[1])
 
-    def _weights(self, speed_kmh) -> tuple[np.ndarray, np.ndarray]:
+    def _weights(self, speed_kmh: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         v = np.atleast_1d(np.asarray(speed_kmh, float))
         lo, hi = self.speeds[0], self.speeds[-1]
         bad = ~np.isfinite(v) | (v < lo - 1e-9) | (v > hi + 1e-9)
@@ -226,9 +264,9 @@ class TireModel:
         nd = self._nodes[k]
         v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
         w = lagrange_weights(self.speeds[nd], v)
-        lam = w @ self.poles[nd]
+        lam: np.ndarray = w @ self.poles[nd]
         rows = np.arange(w.shape[0])[:, None, None]
-        for cl in self._clusters[k]:
+        for cl in self._clusters_of(k):
             p, _ = cluster_at(cl, w, np.arange(0))
             perm = np.argsort(np.abs(lam[:, cl.members].imag), axis=-1)
             lam[rows, np.take_along_axis(cl.members[None], perm, axis=-1)] = p
@@ -242,7 +280,8 @@ class TireModel:
         interpolated characteristic polynomial.
         """
         k, t = self._weights(speed_kmh)
-        return self._poles_at(int(k[0]), t[:1])[0]
+        p: np.ndarray = self._poles_at(int(k[0]), t[:1])[0]
+        return p
 
     def eigenfrequencies(self, speed_kmh: float) -> np.ndarray:
         """Positive eigenfrequencies ``Im(lambda) / 2 pi`` in Hz at ``speed_kmh``, sorted.
@@ -255,7 +294,7 @@ class TireModel:
         p = self.poles_at(speed_kmh)
         return np.sort(p[p.imag > 0].imag) / (2 * np.pi)
 
-    def _check_n(self, n_modes) -> int:
+    def _check_n(self, n_modes: int | None) -> int:
         if n_modes is None:
             return self.n_modes
         ok = (
@@ -281,24 +320,29 @@ class TireModel:
         return int(i[0])
 
     # -- modal synthesis -------------------------------------------------------------
-    def _total(self, k: int, t, s, cols) -> np.ndarray:
+    def _total(self, k: int, t: np.ndarray, s: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Receptance sum over all modes at lines of interval ``k``: linear part by
         matrix products, every cluster by its rational form (no roots needed)."""
         nd = self._nodes[k]
         v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
         w = lagrange_weights(self.speeds[nd], v)
         T = 1.0 / (s[:, None] - w @ self.poles[nd])  # (n_l, n_m)
-        for cl in self._clusters[k]:
+        for cl in self._clusters_of(k):
             T[:, cl.members.ravel()] = 0.0
         Zn = self._Z[nd]  # (n_nodes, n_m, n_res), a view
-        tot = sum(w[:, i, None] * (T @ Zn[i]) for i in range(Zn.shape[0]))[:, cols]
-        for cl in self._clusters[k]:
+        tot: np.ndarray = sum(w[:, i, None] * (T @ Zn[i]) for i in range(Zn.shape[0]))[:, cols]
+        for cl in self._clusters_of(k):
             tot = tot + cluster_sum(cl, w, s, cols)
         return tot
 
     def _sums(
-        self, freq, speeds, n_list, h_index, residual: bool = False
-    ) -> tuple[np.ndarray, np.ndarray]:
+        self,
+        freq: ArrayLike,
+        speeds: ArrayLike,
+        n_list: Sequence[int],
+        h_index: int | None,
+        residual: bool = False,
+    ) -> tuple[np.ndarray, np.ndarray | None]:
         """Cumulative modal sums: mobility (n_N, n_f, 6, 6) and patch velocity (n_N, n_f, 6).
 
         The modes are interpolated to every line's speed. The ``N`` retained modes
@@ -361,7 +405,7 @@ class TireModel:
         v = out[:, :, 36:] if h_index is not None else None
         return Y, v
 
-    def _plan(self, k: int, near: int, edges):
+    def _plan(self, k: int, near: int, edges: np.ndarray) -> _Plan:
         """Truncation order at operating point ``k + near`` and, per cluster batch, the
         clusters inside one block of ``edges`` and those split by a block edge (with
         their members ranked at that point). Cached: it depends on the counts only."""
@@ -374,7 +418,7 @@ class TireModel:
         rank[order] = np.arange(order.size)
         block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
         plan = []
-        for cl in self._clusters[k]:
+        for cl in self._clusters_of(k):
             b = block[cl.members]
             whole = np.all(b == b[:, :1], axis=1)  # cluster inside one block
             w_sub = interp.subset(cl, whole) if whole.any() else None
@@ -389,7 +433,38 @@ class TireModel:
         self._plans[key] = (order, plan)
         return order, plan
 
-    def _blocks(self, k: int, near: int, t, s, cols, edges, static: bool = False):
+    @overload
+    def _blocks(
+        self,
+        k: int,
+        near: int,
+        t: np.ndarray,
+        s: np.ndarray,
+        cols: np.ndarray,
+        edges: np.ndarray,
+        static: Literal[False] = False,
+    ) -> np.ndarray: ...
+    @overload
+    def _blocks(
+        self,
+        k: int,
+        near: int,
+        t: np.ndarray,
+        s: np.ndarray,
+        cols: np.ndarray,
+        edges: np.ndarray,
+        static: Literal[True],
+    ) -> tuple[np.ndarray, np.ndarray]: ...
+    def _blocks(
+        self,
+        k: int,
+        near: int,
+        t: np.ndarray,
+        s: np.ndarray,
+        cols: np.ndarray,
+        edges: np.ndarray,
+        static: bool = False,
+    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
         """Receptance sums over the blocks of retained modes ``edges`` (n_N, n_l, n_cols),
         modes ranked at operating point ``k + near``; with ``static`` also the sums of
         their quasi-static parts ``R_r / (-lambda_r)`` (same shape)."""
@@ -425,7 +500,13 @@ class TireModel:
             return dyn
         return dyn, np.moveaxis(np.add.reduceat(C0[:, kept], edges[:-1], axis=1), 1, 0)
 
-    def synthesis(self, freq, speeds, harmonic_index: int | None = None, n_modes=None):
+    def synthesis(
+        self,
+        freq: ArrayLike,
+        speeds: ArrayLike,
+        harmonic_index: int | None = None,
+        n_modes: int | None = None,
+    ) -> tuple[np.ndarray, np.ndarray | None]:
         """Hub mobility and free hub velocity line by line, each line at its own speed.
 
         Parameters
@@ -482,7 +563,12 @@ class TireModel:
         )
 
     def hub_mobility(
-        self, freq, speed_kmh: float, n_modes: int | None = None, *, residual: bool = False
+        self,
+        freq: ArrayLike,
+        speed_kmh: float,
+        n_modes: int | None = None,
+        *,
+        residual: bool = False,
     ) -> FRF:
         """Hub mobility ``Y_jj^A`` (6 x 6) at a fixed speed, from the first ``n_modes`` modes.
 
@@ -510,13 +596,13 @@ class TireModel:
 
     def patch_response(
         self,
-        freq,
-        harmonic=None,
+        freq: ArrayLike,
+        harmonic: int | Harmonic | None = None,
         n_modes: int | None = None,
         speed_kmh: float | None = None,
         *,
         residual: bool = False,
-        harmonic_case=None,
+        harmonic_case: int | Harmonic | None = None,
     ) -> FRF:
         """Free hub velocity ``Y_ja^A F_a`` for the patch load of a harmonic case.
 
@@ -545,10 +631,17 @@ class TireModel:
         hi = self._harmonic_index(h)
         v = h.speed_at(f) if speed_kmh is None else np.full(f.size, float(speed_kmh))
         _, vj = self._sums(f, np.atleast_1d(v), [n], hi, residual)
+        assert vj is not None  # a harmonic index was given
         return FRF(f, vj[0][:, :, None], self.hub_dofs, ["patch"], "mobility")
 
     def truncations(
-        self, freq, harmonic=None, n_modes_list=None, *, residual: bool = False, harmonic_case=None
+        self,
+        freq: ArrayLike,
+        harmonic: int | Harmonic | None = None,
+        n_modes_list: Sequence[int] | np.ndarray | None = None,
+        *,
+        residual: bool = False,
+        harmonic_case: int | Harmonic | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Hub mobility and free hub velocity along a harmonic line for many truncations.
 
@@ -582,7 +675,9 @@ class TireModel:
         ]
         if not ns or np.any(np.diff(ns) <= 0):
             raise ModeCountError(f"n_modes_list must be non-empty and increasing, got {ns}")
-        return self._sums(f, h.speed_at(f), ns, self._harmonic_index(h), residual)
+        Y, v = self._sums(f, h.speed_at(f), ns, self._harmonic_index(h), residual)
+        assert v is not None  # a harmonic index was given
+        return Y, v
 
     # -- physical model --------------------------------------------------------------
     def _need_params(self) -> TireParameters:

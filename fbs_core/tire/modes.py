@@ -25,10 +25,12 @@ of the conjugate pairs.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
+from numpy.typing import ArrayLike
 from scipy.optimize import linear_sum_assignment
 
 from ..errors import ModalError
@@ -64,14 +66,14 @@ class ComplexModes:
         a = np.abs(p)
         return np.where(a > 0, -p.real / np.where(a > 0, a, 1.0), 1.0)  # zero pole: 1
 
-    def take(self, idx) -> ComplexModes:
+    def take(self, idx: ArrayLike) -> ComplexModes:
         """The pairs ``idx`` (indices of positive members, 0..n-1), as a new object."""
         idx = np.asarray(idx)
         cols = np.stack([2 * idx, 2 * idx + 1], -1).ravel()
         return ComplexModes(self.poles[cols], self.psi[:, cols], self.chi[:, cols])
 
 
-def complex_modes(M, C, K) -> ComplexModes:
+def complex_modes(M: ArrayLike, C: ArrayLike, K: ArrayLike) -> ComplexModes:
     """All complex modes of ``M x'' + C x' + K x = f`` (dense, real matrices).
 
     Parameters
@@ -128,7 +130,9 @@ def complex_modes(M, C, K) -> ComplexModes:
     return ComplexModes(poles, P, X)
 
 
-def _descriptor_modes(M, C, K, massless) -> ComplexModes:
+def _descriptor_modes(
+    M: np.ndarray, C: np.ndarray, K: np.ndarray, massless: np.ndarray
+) -> ComplexModes:
     """Modes of a system with massless (first-order) DOFs, e.g. tread slip states.
 
     State ``z = [x; v_m]`` (all displacements, velocities of the DOFs with mass):
@@ -203,7 +207,13 @@ def _descriptor_modes(M, C, K, massless) -> ComplexModes:
     return ComplexModes(poles, P, Q)
 
 
-def receptance(s, modes: ComplexModes, out_idx=None, in_idx=None, n_modes=None) -> np.ndarray:
+def receptance(
+    s: ArrayLike,
+    modes: ComplexModes,
+    out_idx: Sequence[int] | np.ndarray | None = None,
+    in_idx: Sequence[int] | np.ndarray | None = None,
+    n_modes: int | None = None,
+) -> np.ndarray:
     """Modal synthesis ``H(s) = sum_r psi_r chi_r^T / (s - lambda_r)`` (``a_r = 1``).
 
     Parameters
@@ -225,7 +235,8 @@ def receptance(s, modes: ComplexModes, out_idx=None, in_idx=None, n_modes=None) 
     psi = modes.psi[:, :nm] if out_idx is None else modes.psi[out_idx, :nm]
     chi = modes.chi[:, :nm] if in_idx is None else modes.chi[in_idx, :nm]
     T = 1.0 / (s[:, None] - modes.poles[None, :nm])  # (n_freq, n_modes)
-    return np.einsum("or,fr,ir->foi", psi, T, chi)  # psi (n_out, r), chi (n_in, r)
+    H: np.ndarray = np.einsum("or,fr,ir->foi", psi, T, chi)  # psi (n_out, r), chi (n_in, r)
+    return H
 
 
 def mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -234,7 +245,8 @@ def mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ``MAC_ij = |a_i^H b_j|^2 / ((a_i^H a_i)(b_j^H b_j))``, shape (n_a, n_b).
     """
     num = np.abs(a.conj().T @ b) ** 2
-    return num / np.outer(np.sum(np.abs(a) ** 2, 0), np.sum(np.abs(b) ** 2, 0))
+    m: np.ndarray = num / np.outer(np.sum(np.abs(a) ** 2, 0), np.sum(np.abs(b) ** 2, 0))
+    return m
 
 
 def track_modes(modes: list[ComplexModes]) -> tuple[list[ComplexModes], np.ndarray]:

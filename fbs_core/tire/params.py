@@ -10,6 +10,7 @@ data (rim-fixed belt frequencies 80 Hz longitudinal, 40 Hz lateral, 50 Hz yaw,
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
+from typing import Any
 
 import numpy as np
 
@@ -158,7 +159,7 @@ class TireParameters:
     # give 400 complex modes, as the thesis' model (orders up to 10 without slip)
     orders: tuple[int, ...] = (16, 6, 14, 14, 12, 11, 10, 9)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "orders", tuple(int(n) for n in self.orders))
         if float(self.slip_zones) != int(self.slip_zones) or not 0 <= self.slip_zones <= 8:
             raise DataFormatError(f"slip_zones must be an integer 0..8, got {self.slip_zones}")
@@ -196,20 +197,20 @@ class TireParameters:
         """Number of first-order slip states (longitudinal and lateral per zone)."""
         return 2 * self.slip_zones
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
         d["orders"] = list(self.orders)
         return d
 
     @classmethod
-    def from_dict(cls, d: dict) -> TireParameters:
+    def from_dict(cls, d: dict[str, Any]) -> TireParameters:
         known = {f.name for f in fields(cls)}
         unknown = set(d) - known
         if unknown:
             raise DataFormatError(
                 f"unknown tire parameter(s) {sorted(unknown)}; known: {sorted(known)}"
             )
-        kw = {
+        kw: dict[str, Any] = {
             k: (
                 tuple(int(x) for x in v)
                 if k == "orders"

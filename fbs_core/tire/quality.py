@@ -17,11 +17,18 @@ needs speeds outside the stored operating points.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import FBSError
+
+if TYPE_CHECKING:
+    from ..harmonics import Harmonic
+    from .model import TireModel
 
 __all__ = [
     "InterpolationQuality",
@@ -57,7 +64,9 @@ class LevelErrors:
     floor_db: float
 
 
-def level_errors(pred, true, within_db: float = 30.0, floor_db: float = 120.0) -> LevelErrors:
+def level_errors(
+    pred: ArrayLike, true: ArrayLike, within_db: float = 30.0, floor_db: float = 120.0
+) -> LevelErrors:
     """Worst level error of ``pred`` against ``true`` per DOF column (dB).
 
     Parameters
@@ -101,7 +110,7 @@ class SpeedRangeWarning(UserWarning):
     """A harmonic band needs vehicle speeds outside the model's operating points."""
 
 
-def speed_coverage(tire, harmonic) -> tuple[float, float]:
+def speed_coverage(tire: TireModel, harmonic: int | Harmonic) -> tuple[float, float]:
     """Part of a harmonic's band that the model's operating points cover, in Hz.
 
     Warns :class:`SpeedRangeWarning` when the band ``v = 3.6 f lambda`` over the
@@ -157,7 +166,7 @@ class InterpolationQuality:
     patch_db: np.ndarray
     worst_db: np.ndarray
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """Plain JSON-able summary: worst dB per harmonic and the method."""
         return {
             "method": "leave one operating point out, predict it from the others "
@@ -169,7 +178,9 @@ class InterpolationQuality:
         }
 
 
-def interpolation_quality(tire, harmonics=(1, 2, 3, 4, 5, 6, 7)) -> InterpolationQuality:
+def interpolation_quality(
+    tire: TireModel, harmonics: Sequence[int] = (1, 2, 3, 4, 5, 6, 7)
+) -> InterpolationQuality:
     """Interpolation quality of a modal tire model from its data alone (leave one out).
 
     Every interior operating point is left out in turn and predicted from its
@@ -198,8 +209,9 @@ def interpolation_quality(tire, harmonics=(1, 2, 3, 4, 5, 6, 7)) -> Interpolatio
     inner = np.arange(1, sp.size - 1)
     mob = np.full((len(hs), inner.size), np.nan)
     pat = np.full((len(hs), inner.size), np.nan)
-    for j, i in enumerate(inner):
-        keep = [q for q in range(max(0, i - 3), min(sp.size, i + 4)) if q != i]
+    for j, i in enumerate(int(x) for x in inner):
+        # the stencil of the interval (i - 1, i + 1) without i: its cubic nodes i - 2 .. i + 2
+        keep = [q for q in range(max(0, i - 2), min(sp.size, i + 3)) if q != i]
         part = TireModel(
             sp[keep],
             tire.poles[keep],
@@ -214,14 +226,15 @@ def interpolation_quality(tire, harmonics=(1, 2, 3, 4, 5, 6, 7)) -> Interpolatio
             if not h.speed_range[0] <= v <= h.speed_range[1]:
                 continue
             f = np.array([v / 3.6 / h.wavelength])
-            Y, Yp = tire.hub_mobility(f, v).data, part.hub_mobility(f, v).data
+            hi = tire._harmonic_index(h)
+            Y, x = tire.synthesis(f, [v], hi)  # stored: exact at the operating point
+            Yp, xp = part.synthesis(f, [v], hi)
+            assert x is not None and xp is not None  # a harmonic index was given
             mob[a, j] = 20 * np.log10(1 + np.linalg.norm(Yp - Y) / np.linalg.norm(Y))
-            x = tire.patch_response(f, h, speed_kmh=v).data
-            xp = part.patch_response(f, h, speed_kmh=v).data
             pat[a, j] = 20 * np.log10(1 + np.linalg.norm(xp - x) / np.linalg.norm(x))
     both = np.fmax(mob, pat)
     worst = np.array([np.nanmax(r) if np.isfinite(r).any() else np.nan for r in both])
     ro = [np.array(a) for a in (sp[inner], mob, pat, worst)]
-    for a in ro:
-        a.setflags(write=False)
+    for arr in ro:
+        arr.setflags(write=False)
     return InterpolationQuality(tuple(h.k for h in hs), *ro)

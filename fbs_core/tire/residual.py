@@ -17,13 +17,19 @@ gyroscopic, non-reciprocal tire both are full complex matrices, not symmetric.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import FBSError
 
 __all__ = ["fit_residual"]
 
 
-def fit_residual(freq, H, H_trunc, band=None) -> tuple[np.ndarray, np.ndarray]:
+def fit_residual(
+    freq: ArrayLike,
+    H: ArrayLike,
+    H_trunc: ArrayLike,
+    band: tuple[float, float] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Fit ``H - H_trunc ~ A + B / omega^2`` per matrix entry (receptances).
 
     Parameters

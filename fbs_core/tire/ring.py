@@ -45,6 +45,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TypeAlias
 
 import numpy as np
 import scipy.linalg as sla
@@ -53,6 +54,12 @@ from numpy.polynomial import legendre
 from ..direct import SecondOrderSystem
 from ..dofs import node_labels
 from .params import DEFAULT_PARAMETERS, FAMILIES, TireParameters
+
+#: Patch data of :func:`_operators`: forward and lateral position and weight of every
+#: patch point, the wheel-axes components (x, y, z) of the belt shapes there, zone areas.
+_Contact: TypeAlias = tuple[
+    np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray
+]
 
 __all__ = [
     "HUB_DOFS",
@@ -116,17 +123,18 @@ def slip_labels(params: TireParameters = DEFAULT_PARAMETERS) -> tuple[str, ...]:
     return tuple(f"slip.z{z}.{d}" for z in range(params.slip_zones) for d in "xy")
 
 
-def _trig(n, kind, theta, d):
+def _trig(n: np.ndarray, kind: np.ndarray, theta: np.ndarray, d: int) -> np.ndarray:
     """d-th theta-derivative of cos(n theta) (kind 0) or sin(n theta) (kind 1).
 
     Returns shape (n_theta, n_basis).
     """
     # cos(x + d pi/2) is the d-th derivative of cos; sin(x) = cos(x - pi/2)
     ph = np.outer(theta, n) - 0.5 * np.pi * kind[None, :] + 0.5 * np.pi * d
-    return np.cos(ph) * (n[None, :] ** d).astype(float)
+    T: np.ndarray = np.cos(ph) * (n[None, :] ** d).astype(float)
+    return T
 
 
-def _width(fam, y, b, d):
+def _width(fam: np.ndarray, y: np.ndarray, b: float, d: int) -> np.ndarray:
     """d-th y-derivative of the width shape of each family, shape (n_y, n_basis)."""
     eta = 2 * y / b
     out = np.zeros((y.size, fam.size))
@@ -144,7 +152,9 @@ def _width(fam, y, b, d):
     return out
 
 
-def _fields(params: TireParameters, basis: _Basis, theta, y):
+def _fields(
+    params: TireParameters, basis: _Basis, theta: np.ndarray, y: np.ndarray
+) -> dict[str, np.ndarray]:
     """Local displacement components and derivatives at the grid ``theta x y``.
 
     Returns a dict of arrays of shape (n_theta * n_y, n_basis), theta-major.
@@ -154,14 +164,15 @@ def _fields(params: TireParameters, basis: _Basis, theta, y):
     T = [_trig(basis.n, basis.kind, theta, d) for d in range(4)]
     g = [_width(fam, y, params.b, d) for d in range(3)]
 
-    def prod(t, w):  # (nth, nb) x (ny, nb) -> (nth*ny, nb)
-        return (t[:, None, :] * w[None, :, :]).reshape(-1, fam.size)
+    def prod(t: np.ndarray, w: np.ndarray) -> np.ndarray:  # (nth, nb) x (ny, nb) -> (nth*ny, nb)
+        p: np.ndarray = (t[:, None, :] * w[None, :, :]).reshape(-1, fam.size)
+        return p
 
     is_ = {name: (fam == i)[None, :].astype(float) for i, name in enumerate(FAMILIES)}
     plate = np.isin(fam, [i for i, name in enumerate(FAMILIES) if name.startswith("w")])
     bending = plate & (fam != FAMILIES.index("w1"))
     yy = np.broadcast_to(y[None, :, None], (theta.size, y.size, 1)).reshape(-1, 1)
-    F = {}
+    F: dict[str, np.ndarray] = {}
     # ip: u = T, w = -T'
     # op: v = T, u = -y T' / R
     # plate families: w = g(y) T
@@ -181,7 +192,7 @@ def _fields(params: TireParameters, basis: _Basis, theta, y):
     return F
 
 
-def _gram(a, wts, b=None):
+def _gram(a: np.ndarray, wts: np.ndarray, b: np.ndarray | None = None) -> np.ndarray:
     """``sum_p wts_p a_p b_p^T`` for field arrays (n_p, n_basis), on non-zero columns only."""
     b = a if b is None else b
     ia = np.flatnonzero(np.any(a != 0, axis=0))
@@ -191,7 +202,7 @@ def _gram(a, wts, b=None):
     return out
 
 
-def _rim_local(theta, y, R):
+def _rim_local(theta: np.ndarray, y: float, R: float) -> list[np.ndarray]:
     """Rim rigid-body displacement at (R, theta, y) in local components.
 
     Returns three arrays (radial, tangential, lateral) of shape (n_theta, 6):
@@ -214,7 +225,9 @@ def _rim_local(theta, y, R):
 
 
 @lru_cache(maxsize=8)
-def _operators(params: TireParameters):
+def _operators(
+    params: TireParameters,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, _Contact]:
     """Speed-independent pieces: M, K0, the Omega-linear A, Omega^2 part, contact data."""
     R, b = params.R, params.b
     basis = _basis(params)
@@ -315,7 +328,7 @@ def _operators(params: TireParameters):
     x_patch = -R * (thp[:, 0] - np.pi / 2)  # forward coordinate in the patch (wheel axes)
     y_patch = np.tile(yc * params.b_c / 2, th_c.size)
     zone_area = np.bincount(zp, weights=wc, minlength=nz)
-    contact = (x_patch, y_patch, wc, dw, zone_area)
+    contact: _Contact = (x_patch, y_patch, wc, dw, zone_area)
     return M, K0, A, Kw2, contact
 
 
@@ -332,7 +345,8 @@ def wheel_rotation(params: TireParameters = DEFAULT_PARAMETERS) -> np.ndarray:
     rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
     c, s = np.cos(-params.toe), np.sin(-params.toe)
     rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    return rz @ rx
+    Q: np.ndarray = rz @ rx
+    return Q
 
 
 def lateral_load_coefficient(params: TireParameters = DEFAULT_PARAMETERS) -> float:
@@ -354,8 +368,9 @@ def _to_vehicle(a: np.ndarray, Q: np.ndarray) -> np.ndarray:
     return out
 
 
-def _sym(a):
-    return 0.5 * (a + a.T)
+def _sym(a: np.ndarray) -> np.ndarray:
+    s: np.ndarray = 0.5 * (a + a.T)
+    return s
 
 
 @lru_cache(maxsize=8)
@@ -391,7 +406,9 @@ def slip_damping(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS) 
     return np.column_stack([params.C_kappa / v * share, params.C_alpha / v * share]).ravel()
 
 
-def system_matrices(speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS):
+def system_matrices(
+    speed_kmh: float, params: TireParameters = DEFAULT_PARAMETERS
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``M, D, G, K`` of the rolling tire at ``speed_kmh`` (dense, real, shape (n, n)).
 
     ``M x'' + (D + G(Omega)) x' + K(Omega) x = f`` with ``G`` skew and odd in

@@ -22,9 +22,11 @@ Every dataset carries ``unit`` and ``description`` attributes. No pickles.
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 
 import h5py
 import numpy as np
@@ -80,7 +82,7 @@ _DATASETS = {
 }
 
 
-def save_tire_model(model: TireModel, path, description: str = "") -> Path:
+def save_tire_model(model: TireModel, path: str | os.PathLike[str], description: str = "") -> Path:
     """Write a :class:`TireModel` to HDF5 (format version 2).
 
     Returns
@@ -121,7 +123,7 @@ def save_tire_model(model: TireModel, path, description: str = "") -> Path:
     return path
 
 
-def load_tire_model(path) -> TireModel:
+def load_tire_model(path: str | os.PathLike[str]) -> TireModel:
     """Read a modal tire model written in format ``tire-fbs/modal-tire``.
 
     Raises
@@ -143,7 +145,7 @@ def load_tire_model(path) -> TireModel:
     return tire_from_content(root, data, params, str(path))
 
 
-def _text(v) -> str:
+def _text(v: Any) -> str:
     if isinstance(v, bytes):
         return v.decode("utf-8", "replace")
     if isinstance(v, np.ndarray) and v.shape == ():
@@ -152,7 +154,10 @@ def _text(v) -> str:
 
 
 def tire_from_content(
-    root: Mapping, data: Mapping, parameters: Mapping | None = None, where: str = "tire model"
+    root: Mapping[str, Any],
+    data: Mapping[str, Any],
+    parameters: Mapping[str, Any] | None = None,
+    where: str = "tire model",
 ) -> TireModel:
     """Build a :class:`TireModel` from already-read content of a ``tire-fbs/modal-tire`` file.
 

@@ -271,8 +271,11 @@ def test_long_band_shows_progress_time_left_and_cancels(browser, dashboard, size
     set_model_value(page, "ctl-case-harmonic", 7)
     _status(page, "frequency lines")
     page.locator(".scatter-status", has_text=" left").first.wait_for(timeout=120_000)
-    text = page.locator(".scatter-status").first.inner_text()
-    assert re.search(r"Computing 150,000 rounds: \d+ % \(\d+ of 633 frequency lines\)", text)
+    # (the status text is inside the pane's shadow root: matched there, not read)
+    page.locator(
+        ".scatter-status",
+        has_text=re.compile(r"Computing 150,000 rounds: \d+ % \(\d+ of 633 frequency lines\)"),
+    ).first.wait_for()
     assert (
         page.locator(".scatter-progress").first.evaluate("e => getComputedStyle(e).visibility")
         == "visible"

@@ -1,0 +1,146 @@
+"""The dashboard's campaign browser: the files of FBS_CAMPAIGN_DIR, their cases with
+filters, and the chosen case's numbers and provenance.
+
+Truth: the campaign file read independently with h5py (the stored blocks and maps), and the
+campaign's own TOML (the case matrix).
+"""
+
+from __future__ import annotations
+
+import json
+
+import h5py
+import numpy as np
+import pytest
+
+from app.export import read_csv, to_csv
+from app.views.campaign import CampaignBrowser, case_rows, list_campaigns
+from fbs_core.campaign import open_campaign, parse_campaign, run_campaign
+
+TOML = """
+[campaign]
+name = "browse"
+seed = 99
+output = "{out}"
+[scatter]
+harmonics = [1]
+noise = [0.05, 0.1]
+targets = ["tire", "both"]
+frequency_dependent = [false]
+rounds = 200
+percentiles = [5.0, 95.0]
+[truncation]
+harmonics = [1]
+n_modes = {{ from = 10, to = 50, step = 10 }}
+thresholds = [0.2]
+f_max = [130.0]
+couplings = ["6dof"]
+[execution]
+task_round_lines = 4000
+"""
+
+
+@pytest.fixture(scope="module")
+def campaign_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("campaigns")
+    camp = parse_campaign(TOML.format(out=(d / "browse.h5").as_posix()), d)
+    assert run_campaign(camp).status == "complete"
+    (d / "notes.h5").write_bytes(b"not an HDF5 file")  # listed only if a campaign
+    with h5py.File(d / "other.h5", "w") as h:
+        h.attrs["content"] = "frf"
+    return d
+
+
+def _labels(attr) -> list[str]:
+    """DOF labels as the store writes them (a JSON list)."""
+    return [str(x) for x in json.loads(attr)] if isinstance(attr, str) else list(attr)
+
+
+def _stored_band(path, name):
+    """Edges and percentiles of a case, joined from its stored blocks with h5py alone."""
+    with h5py.File(path, "r") as h:
+        g = h["cases"][name]["blocks"]
+        keys = sorted(g, key=lambda k: int(k.split("_")[0]))
+        lo = np.concatenate([g[k]["lower"][()] for k in keys])
+        hi = np.concatenate([g[k]["upper"][()] for k in keys])
+        pct = np.concatenate([g[k]["percentiles"][()] for k in keys], axis=1)
+        inputs = h["cases"][name].attrs["inputs"]
+        freq = h["inputs"][inputs]["freq"][()]
+        ref = h["inputs"][inputs]["reference"][()]
+        dofs = _labels(h["inputs"][inputs].attrs["dofs"])
+    return freq, ref, lo, hi, pct, dofs, len(keys)
+
+
+def test_lists_only_campaign_files_of_the_directory(campaign_dir):
+    assert list_campaigns(campaign_dir) == ["browse.h5"]
+    assert list_campaigns(None) == []
+
+
+def test_case_table_holds_every_case_of_the_matrix_with_its_settings(campaign_dir):
+    res = open_campaign(campaign_dir / "browse.h5")
+    rows = case_rows(res)
+    camp = parse_campaign(TOML.format(out="x.h5"), campaign_dir)
+    assert sorted(rows["case"]) == sorted(c.name for c in camp.cases)  # 4 bands + 1 map
+    for c in camp.band_cases:
+        i = rows["case"].index(c.name)
+        assert rows["harmonic"][i] == 1 and rows["noise_pct"][i] == pytest.approx(100 * c.noise)
+        assert rows["target"][i] == c.target and rows["seed"][i] == str(c.seed)
+        assert rows["rounds"][i] == 200 and rows["status"][i] == "complete"
+    (t,) = [i for i, k in enumerate(rows["kind"]) if k == "truncation"]
+    assert rows["truncation"][t] == "N = 10..50 (5)"
+
+
+def test_filters_and_the_chosen_band_are_the_files_numbers(campaign_dir):
+    b = CampaignBrowser(directory=campaign_dir)
+    b.__panel__()
+    assert b.file == "browse.h5"
+    assert len(b.param.case.objects) == 5
+    b.param.update(kind="scatter", noise=10.0, target="tire")
+    (name,) = b.param.case.objects
+    assert b.case == name and list(b._table.value["case"]) == [name]
+    b.dof = "y"
+    path = campaign_dir / "browse.h5"
+    freq, ref, lo, hi, pct, dofs, n_blocks = _stored_band(path, name)
+    assert n_blocks > 1  # joined from several stored blocks
+    j = dofs.index("bushing:y")
+    cols = b.shown.columns
+    np.testing.assert_array_equal(cols["freq_Hz"], freq)
+    np.testing.assert_array_equal(cols["minimum"], lo[:, j])
+    np.testing.assert_array_equal(cols["maximum"], hi[:, j])
+    np.testing.assert_array_equal(cols["p95"], pct[1, :, j])
+    np.testing.assert_array_equal(cols["reference"], np.abs(ref[:, j]))
+    np.testing.assert_allclose(b._band_src.data["hi"], 20 * np.log10(hi[:, j]), rtol=1e-12)
+    # the provenance and the export carry the case's seed and the campaign's
+    with h5py.File(path, "r") as h:
+        seed = str(h["cases"][name].attrs["settings"])
+        digest = str(h["cases"][name].attrs["digest"])
+    meta, back = read_csv(to_csv(cols, b.shown.meta, "campaign"))
+    assert meta["case digest"] == digest and meta["campaign seed"] == "99"
+    assert f'"seed": {meta["case seed"]}' in seed
+    np.testing.assert_allclose(back["maximum"], hi[:, j], rtol=1e-12)
+
+
+def test_the_chosen_truncation_case_shows_the_stored_map_and_suggestion(campaign_dir):
+    b = CampaignBrowser(directory=campaign_dir)
+    b.__panel__()
+    b.kind = "truncation"
+    (name,) = b.param.case.objects
+    with h5py.File(campaign_dir / "browse.h5", "r") as h:
+        g = h["cases"][name]["result"]
+        err, n, centres, sugg = (g[k][()] for k in ("error", "n_modes", "centres", "suggested"))
+        dofs = _labels(g.attrs["dofs"])
+    b.dof = "x"
+    e = b.shown.columns["error_pct"].reshape(n.size, centres.size)
+    np.testing.assert_array_equal(e, 100 * err[:, :, dofs.index("bushing:x")])
+    b.max_over_dofs = True
+    e = b.shown.columns["error_pct"].reshape(n.size, centres.size)
+    np.testing.assert_array_equal(e, 100 * err.max(axis=2))
+    np.testing.assert_array_equal(b._map_src.data["image"][0], 100 * err.max(axis=2))
+    assert b.shown.draw["suggested"] == {"20 % up to 130 Hz": int(sugg[0, 0])}
+    assert f"**{int(sugg[0, 0])}**" in b._suggested.object
+
+
+def test_without_a_directory_the_browser_says_how_to_configure_it(monkeypatch):
+    monkeypatch.delenv("FBS_CAMPAIGN_DIR", raising=False)
+    b = CampaignBrowser()
+    assert b.file is None and "FBS_CAMPAIGN_DIR" in b.message
