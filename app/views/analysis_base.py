@@ -152,4 +152,3 @@ def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
     state.param.watch(from_state, "tab")
     from_state()
     return card
-
