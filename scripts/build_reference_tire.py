@@ -31,7 +31,9 @@ from fbs_core.tire.storage import DATA_FILE, save_tire_model  # noqa: E402
 DESCRIPTION = (
     "Reference rolling tire (205/60 R15 class) built from physics by tire-fbs: rotating belt "
     "on an elastic sidewall foundation (in-plane ring, lateral ring, tilt and width-wise "
-    "families), rigid rim with hub at its centre, contact patch springs; complex modes at "
+    "families), rigid rim with hub at its centre, contact patch springs, linearised about "
+    "the statically loaded tire (patch length and pressure of the static contact under the "
+    "wheel load, hoop-force pre-stress); complex modes at "
     "every 2.5 km/h from 20 to 120 km/h, refined to 1.25 km/h where the interpolation between "
     "two points misses the direct solution by more than 1 %. See docs/tire-model.md."
 )

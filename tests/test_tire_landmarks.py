@@ -26,3 +26,21 @@ def test_landmark_table():
     assert sym.hub_peaks["y"] == ()  # nothing physical to peak on a symmetric tire
     assert ref.hub_peaks["y"] != ()
     assert "thesis" in t.text() and "no slip" in t.text()
+
+
+def test_mechanism_variants_switch_one_thing_each():
+    """Each mechanism variant differs from the reference in the one physics it measures."""
+    from fbs_core.tire import DEFAULT_PARAMETERS
+    from fbs_core.tire.landmarks import MECHANISMS, MechanismTable, mechanism_variants
+    from fbs_core.tire.ring import patch_length
+
+    v = mechanism_variants()
+    ref = v["loaded (reference)"]
+    assert ref == DEFAULT_PARAMETERS and set(v) == {"loaded (reference)"} | set(MECHANISMS)
+    assert v["round belt"].static_deflection == 0
+    assert v["round belt, loaded L_c"].L_c == patch_length(ref) < ref.L_c
+    assert v["lumped patch load"].patch_wave == 0
+    assert v["orders x2"].n_belt > 1.9 * ref.n_belt
+    row = {"table_130": (1,) * 7, "table_160": (2,) * 7, "case5_z_160": 3}
+    text = MechanismTable({"x": row | {"n_modes": 400, "patch_length": 0.1}}).text()
+    assert "thesis" in text and " 270 " in text and "0.100" in text

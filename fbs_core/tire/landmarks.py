@@ -29,6 +29,10 @@ __all__ = [
     "LandmarkTable",
     "landmarks",
     "landmark_table",
+    "MECHANISMS",
+    "mechanism_variants",
+    "MechanismTable",
+    "mechanism_table",
 ]
 
 #: The thesis' landmarks (section 4.1.2, figs. 4.6-4.9, table 5.1, fig. 5.3).
@@ -211,3 +215,106 @@ def landmark_table(
     )
     columns = {name: tuple(v for _, v in m.rows()) for name, m in measured.items()}
     return LandmarkTable(keys, thesis, columns, measured)
+
+
+#: Mechanisms that could drive the thesis' table 5.1 trend (many modes for cases 5-7),
+#: each switched against the reference (loaded) tire. ``None`` values are filled in by
+#: :func:`mechanism_variants` from the reference parameters.
+MECHANISMS: dict[str, dict[str, Any]] = {
+    # the linearisation about the round belt (uniform patch of the parameter L_c)
+    "round belt": {"static_deflection": 0},
+    # the round belt with the loaded tire's patch length: the patch length alone
+    "round belt, loaded L_c": {"static_deflection": 0, "L_c": None},
+    # every point of the patch sees the road at the patch centre: no exp(jkx) modulation
+    "lumped patch load": {"patch_wave": 0},
+    # twice the circumferential orders in every family (a second discretisation)
+    "orders x2": {"orders": None},
+}
+
+
+def mechanism_variants(
+    params: TireParameters = DEFAULT_PARAMETERS,
+) -> dict[str, TireParameters]:
+    """``name -> TireParameters``: the reference and one variant per :data:`MECHANISMS`."""
+    from .ring import patch_length
+
+    out = {"loaded (reference)": params}
+    for name, kw in MECHANISMS.items():
+        kw = dict(kw)
+        if "L_c" in kw:
+            kw["L_c"] = patch_length(params)
+        if "orders" in kw:
+            kw["orders"] = tuple(2 * n if n > 0 else n for n in params.orders)
+        out[name] = dataclasses.replace(params, **kw)
+    return out
+
+
+@dataclass(frozen=True)
+class MechanismTable:
+    """Table 5.1 (suggested modes at 130 and 160 Hz, cases 1-7) per mechanism variant.
+
+    Attributes
+    ----------
+    rows : dict
+        Variant name -> ``{"table_130": tuple, "table_160": tuple, "case5_z_160": int,
+        "n_modes": int, "patch_length": float}``.
+    """
+
+    rows: dict[str, dict[str, Any]]
+
+    def text(self) -> str:
+        """Plain-text table, the thesis first."""
+        th: dict[str, Any] = dict(THESIS)
+        lines = [
+            f"{'variant':<24s} {'modes to 130 Hz, cases 1-7':<30s} "
+            f"{'modes to 160 Hz, cases 1-7':<32s} {'fig 5.3':>7s} {'L_c (m)':>8s} "
+            f"{'modes':>6s}",
+            f"{'thesis':<24s} {' '.join(f'{n:3d}' for n in th['table_5_1_130']):<30s} "
+            f"{' '.join(f'{n:3d}' for n in th['table_5_1_160']):<32s} "
+            f"{th['fig_5_3_case5_z_160']:>7d} {'':>8s} {400:>6d}",
+        ]
+        for name, r in self.rows.items():
+            lines.append(
+                f"{name:<24s} {' '.join(f'{n:3d}' for n in r['table_130']):<30s} "
+                f"{' '.join(f'{n:3d}' for n in r['table_160']):<32s} "
+                f"{r['case5_z_160']:>7d} {r['patch_length']:>8.3f} {r['n_modes']:>6d}"
+            )
+        return "\n".join(lines)
+
+
+def truncation_trend(tire: Any, chassis: Any = None) -> dict[str, Any]:
+    """Suggested modes (20 %, max over the bushing DOFs) up to 130 and 160 Hz for the
+    seven cases, and case 5 bushing z to 160 Hz (fig. 5.3), of ``tire``."""
+    from ..studies import suggest_modes
+
+    s160 = suggest_modes(0.2, 160.0, tire=tire, chassis=chassis)
+    s130 = suggest_modes(0.2, 130.0, maps=s160.maps, tire=tire)
+    z5 = suggest_modes(0.2, 160.0, maps=s160.maps[4:5], dof="bushing:z", tire=tire)
+    return {
+        "table_130": tuple(int(n) for n in s130.n_modes),
+        "table_160": tuple(int(n) for n in s160.n_modes),
+        "case5_z_160": int(z5.n_modes[0]),
+        "n_modes": int(tire.n_modes),
+    }
+
+
+def mechanism_table(
+    params: TireParameters = DEFAULT_PARAMETERS,
+    names: Any = None,
+    chassis: Any = None,
+) -> MechanismTable:
+    """Table 5.1 of the reference tire and of each mechanism variant, rebuilt from physics
+    (``scripts/print_mechanisms.py``; ``names`` picks variants of
+    :func:`mechanism_variants`)."""
+    from .build import build_modal_model
+    from .ring import patch_length
+
+    variants = mechanism_variants(params)
+    if names is not None:
+        variants = {k: v for k, v in variants.items() if k in names}
+    rows = {}
+    for name, p in variants.items():
+        r = truncation_trend(build_modal_model(p), chassis)
+        r["patch_length"] = float(patch_length(p))
+        rows[name] = r
+    return MechanismTable(rows)

@@ -29,6 +29,8 @@ FAMILIES: tuple[str, ...] = ("ip", "op", "w1", "w2", "w3", "w4", "w5", "w6")
 #: limited to |value| <= ANGLE_LIMIT (small-angle alignment of a road wheel).
 SIGNED: tuple[str, ...] = ("camber", "toe", "mu_y0")
 ANGLE_LIMIT = 0.2
+#: On/off switches of physics (0 or 1).
+SWITCHES: tuple[str, ...] = ("static_deflection", "patch_wave")
 
 
 @dataclass(frozen=True)
@@ -101,6 +103,22 @@ class TireParameters:
         Number of zones along the patch whose tread slips as one (each zone adds a
         longitudinal and a lateral first-order slip state); 0: the tread sticks to the
         road (tangential contact springs to the ground).
+    static_deflection : int
+        1: the dynamics are linearised about the statically loaded tire
+        (:mod:`.static`): the contact patch has the length the wheel load ``F_z0``
+        flattens (replacing ``L_c``; the totals ``k_cx, k_cy, k_cz`` are spread over
+        it), the static contact pressure has the distribution of that solution, and
+        the hoop-force change of the static loads adds its geometric stiffness
+        (coupling circumferential orders n and n +/- k). 0: the round belt with the
+        patch length ``L_c`` and a uniform pressure.
+    k_tread : float
+        Compression stiffness of the tread per unit area, N/m^3 (``E / h`` of the tread
+        rubber); only the static contact uses it (the patch length and pressure).
+    patch_wave : int
+        1: the road wave modulates the patch load point by point,
+        ``h(x) = exp(j 2 pi x / lambda)``; 0: every point of the patch sees the wave
+        at the patch centre (``h = 1``, the lumped load of a point contact), to
+        measure what the modulation does.
     mu_y0 : float
         Conicity and ply-steer lateral force per unit load at zero slip and
         camber, ``F_y0 / F_z`` (vehicle y; its sign depends on the tire and its
@@ -147,14 +165,21 @@ class TireParameters:
     # Dynamics, 1992, ch. 10: camber stiffness about 1/10 of the cornering stiffness)
     camber_thrust: float = 1.0
     mu_y0: float = 0.0
-    # Magic Formula 205/60R15 (Pacejka 2006, table A3.1): C_kappa = PKX1 F_z0 with
-    # PKX1 = 21.69; C_alpha = K_ya(F_z0) = 14.95 F_z0 sin(2 atan(1 / 2.13)) = 46 kN/rad.
-    # Relaxation lengths of the tread: 87e3 / 6e5 = 0.145 m, 46e3 / 2e5 = 0.23 m, of the
+    # Magic Formula 205/60R15 (Pacejka 2006, table A3.1, checked against two independent
+    # transcriptions of the table): C_kappa = PKX1 F_z0 with PKX1 = 21.51 (was 21.69
+    # here before, a misquote); C_alpha = K_ya(F_z0) = 14.95 F_z0 sin(2 atan(1 / 2.13))
+    # = 46 kN/rad (PKY1 = -14.95, PKY2 = 2.130, PKY4 = 2).
+    # Relaxation lengths of the tread: 86e3 / 6e5 = 0.143 m, 46e3 / 2e5 = 0.23 m, of the
     # order of the patch length, as in the brush model (Pacejka 2006, sec. 7.2)
-    C_kappa: float = 86.8e3
+    C_kappa: float = 86.04e3
     C_alpha: float = 46.0e3
     v_low: float = 1.0
     slip_zones: int = 2
+    static_deflection: int = 1
+    # tread rubber in compression: E ~ 5 MPa over ~10 mm tread and base rubber (passenger
+    # tread compounds E = 3-8 MPa; Gent & Walter, The Pneumatic Tire, NHTSA 2006, ch. 7)
+    k_tread: float = 5.0e8
+    patch_wave: int = 1
     # the last family keeps orders up to 9 so that 198 DOFs with mass and 4 slip states
     # give 400 complex modes, as the thesis' model (orders up to 10 without slip)
     orders: tuple[int, ...] = (16, 6, 14, 14, 12, 11, 10, 9)
@@ -164,12 +189,17 @@ class TireParameters:
         if float(self.slip_zones) != int(self.slip_zones) or not 0 <= self.slip_zones <= 8:
             raise DataFormatError(f"slip_zones must be an integer 0..8, got {self.slip_zones}")
         object.__setattr__(self, "slip_zones", int(self.slip_zones))
+        for name in SWITCHES:
+            v = getattr(self, name)
+            if v not in (0, 1, True, False):
+                raise DataFormatError(f"{name} must be 0 or 1, got {v!r}")
+            object.__setattr__(self, name, int(v))
         if len(self.orders) != len(FAMILIES):
             raise DataFormatError(
                 f"orders must give one entry per family {FAMILIES}, got {self.orders}"
             )
         for f in fields(self):
-            if f.name in ("orders", "slip_zones"):
+            if f.name in ("orders", "slip_zones", *SWITCHES):
                 continue
             v = getattr(self, f.name)
             if f.name in SIGNED:
@@ -214,7 +244,7 @@ class TireParameters:
             k: (
                 tuple(int(x) for x in v)
                 if k == "orders"
-                else (int(v) if k == "slip_zones" else float(v))
+                else (int(v) if k in ("slip_zones", *SWITCHES) else float(v))
             )
             for k, v in d.items()
         }

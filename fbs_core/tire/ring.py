@@ -54,11 +54,19 @@ from numpy.polynomial import legendre
 from ..direct import SecondOrderSystem
 from ..dofs import node_labels
 from .params import DEFAULT_PARAMETERS, FAMILIES, TireParameters
+from .static import StaticState, solve_static_state
 
 #: Patch data of :func:`_operators`: forward and lateral position and weight of every
-#: patch point, the wheel-axes components (x, y, z) of the belt shapes there, zone areas.
+#: patch point, the wheel-axes components (x, y, z) of the belt shapes there, zone areas,
+#: the static contact pressure at every point and the patch length.
 _Contact: TypeAlias = tuple[
-    np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    tuple[np.ndarray, np.ndarray, np.ndarray],
+    np.ndarray,
+    np.ndarray,
+    float,
 ]
 
 __all__ = [
@@ -73,6 +81,8 @@ __all__ = [
     "lateral_load_coefficient",
     "slip_damping",
     "slip_labels",
+    "static_state",
+    "patch_length",
 ]
 
 #: Hub DOF labels in vehicle coordinates.
@@ -225,10 +235,10 @@ def _rim_local(theta: np.ndarray, y: float, R: float) -> list[np.ndarray]:
 
 
 @lru_cache(maxsize=8)
-def _operators(
+def _free_operators(
     params: TireParameters,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, _Contact]:
-    """Speed-independent pieces: M, K0, the Omega-linear A, Omega^2 part, contact data."""
+) -> tuple[_Basis, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Speed-independent pieces without the road: basis, M, K0, A, Kw2."""
     R, b = params.R, params.b
     basis = _basis(params)
     nb = basis.size
@@ -291,6 +301,53 @@ def _operators(
         ):
             rel = np.hstack([-rim, belt])
             K0 += 0.5 * k * _gram(rel, wth)
+    return basis, M, K0, A, Kw2
+
+
+@lru_cache(maxsize=8)
+def static_state(params: TireParameters = DEFAULT_PARAMETERS) -> StaticState:
+    """The statically loaded tire under ``F_z0`` (:mod:`.static`): patch length,
+    static belt shape and pressure, hoop-force pre-stress and its geometric stiffness."""
+    basis, _, K0, _, _ = _free_operators(params)
+    nb = basis.size
+    return solve_static_state(
+        K0[6 : 6 + nb, 6 : 6 + nb],
+        lambda th, y: _fields(params, basis, th, y),
+        lambda th, y: _rim_local(th, y, params.R),
+        R=params.R,
+        b=params.b,
+        b_c=params.b_c,
+        k_v=params.k_v,
+        k_w=params.k_w,
+        k_t=params.k_tread,
+        F_z0=params.F_z0,
+    )
+
+
+def patch_length(params: TireParameters = DEFAULT_PARAMETERS) -> float:
+    """Length of the contact patch in m: of the static solution under ``F_z0`` with
+    ``static_deflection``, else the parameter ``L_c``."""
+    return static_state(params).L_c if _loaded(params) else params.L_c
+
+
+def _loaded(params: TireParameters) -> bool:
+    """Whether the dynamics are linearised about the loaded tire (needs load and road)."""
+    return bool(params.static_deflection and params.F_z0 > 0 and params.k_cz > 0)
+
+
+@lru_cache(maxsize=8)
+def _operators(
+    params: TireParameters,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, _Contact]:
+    """Speed-independent pieces: M, K0, the Omega-linear A, Omega^2 part, contact data."""
+    R = params.R
+    basis, M0, K00, A0, Kw20 = _free_operators(params)
+    M, K0, A, Kw2 = M0.copy(), K00.copy(), A0.copy(), Kw20.copy()
+    nb = basis.size
+    st = static_state(params) if _loaded(params) else None
+    if st is not None:  # pre-stress of the loaded tire: geometric stiffness of dN(theta)
+        K0[: 6 + nb, : 6 + nb] += st.K_sigma
+    L_c = patch_length(params)
 
     # contact patch: space-fixed springs at the bottom (theta = pi/2), in zones along the
     # patch (composite Gauss rule); with slip, the tread of each zone slips as one
@@ -301,7 +358,7 @@ def _operators(
     xg = (0.5 * (lo + hi) + 0.5 * (hi - lo) * xz).ravel()  # zone 0 at theta < pi/2: front
     wx = (0.5 * (hi - lo) * wz).ravel()
     zone_of = np.repeat(np.arange(nz), xz.size)
-    half = params.L_c / 2 / R
+    half = L_c / 2 / R
     th_c = np.pi / 2 + half * xg
     yc, wyc = legendre.leggauss(16)
     Fc = _fields(params, basis, th_c, yc * params.b_c / 2)
@@ -312,7 +369,7 @@ def _operators(
     dw = (dx, Fc["v"], dz)  # wheel-axes components of the belt displacement in the patch
     Q = wheel_rotation(params)
     dv = [sum(Q[i, j] * dw[j] for j in range(3)) for i in range(3)]  # road (vehicle) axes
-    area = params.L_c * params.b_c
+    area = L_c * params.b_c
     ns = params.n_slip
     Kc = np.zeros((nb + ns, nb + ns))
     zp = np.repeat(zone_of, yc.size)  # zone of every patch point
@@ -328,7 +385,14 @@ def _operators(
     x_patch = -R * (thp[:, 0] - np.pi / 2)  # forward coordinate in the patch (wheel axes)
     y_patch = np.tile(yc * params.b_c / 2, th_c.size)
     zone_area = np.bincount(zp, weights=wc, minlength=nz)
-    contact: _Contact = (x_patch, y_patch, wc, dw, zone_area)
+    # static contact pressure at the patch points (N/m^2): uniform on the round belt, the
+    # static solution's distribution on the loaded tire (scaled to carry exactly F_z0)
+    if st is None:
+        p_static = np.full(wc.size, params.F_z0 / area)
+    else:
+        p_static = st.k_t * st.penetration(thp[:, 0], dw[2], R)
+        p_static *= params.F_z0 / float(wc @ p_static)
+    contact: _Contact = (x_patch, y_patch, wc, dw, zone_area, p_static, L_c)
     return M, K0, A, Kw2, contact
 
 
@@ -469,15 +533,18 @@ def patch_load(wavelength: float, params: TireParameters = DEFAULT_PARAMETERS) -
     Units: N per metre of road amplitude.
     """
     M, *_, contact = _operators(params)
-    x, y, wc, dw, _ = contact
+    x, y, wc, dw, _, p_static, L_c = contact
     Q = wheel_rotation(params)
     k = 2 * np.pi / wavelength
-    h = np.exp(1j * k * (Q[0, 0] * x + Q[0, 1] * y))  # road wave along the vehicle x axis
-    area = params.L_c * params.b_c
+    if params.patch_wave:  # road wave along the vehicle x axis, point by point
+        h = np.exp(1j * k * (Q[0, 0] * x + Q[0, 1] * y))
+    else:  # lumped: the whole patch sees the wave at its centre
+        h = np.ones(x.size, complex)
+    area = L_c * params.b_c
     qz = params.k_cz / area * h
     # static pressure: a cambered wheel presses its lower shoulder harder into the road
     tilt = params.k_cz * (Q[2, 0] * x + Q[2, 1] * y) / params.F_z0 if params.F_z0 > 0 else 0.0
-    p0 = params.F_z0 / area * np.clip(1.0 - tilt, 0.0, None)
+    p0 = p_static * np.clip(1.0 - tilt, 0.0, None)
     qv = (-p0 * 1j * k * h, lateral_load_coefficient(params) * qz, qz)  # vehicle axes
     f = np.zeros(M.shape[0], complex)
     for j in range(3):  # wheel component j of the traction, on the wheel component j of d
