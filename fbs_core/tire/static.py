@@ -49,19 +49,15 @@ import scipy.linalg as sla
 from numpy.polynomial import legendre
 from scipy.optimize import brentq
 
-from ..errors import FBSError
+from ..errors import DataFormatError
 
-__all__ = ["StaticState", "StaticContactError", "solve_static_state"]
+__all__ = ["StaticState", "solve_static_state"]
 
 #: Half-angle of the search grid for the patch (rad) and its number of points.
 PHI_MAX = 0.45
 N_PHI = 241
 #: Points of the fine circumferential grid of the hoop force.
 N_THETA = 1024
-
-
-class StaticContactError(FBSError, ValueError):
-    """The static contact problem has no solution (e.g. the patch does not fit the grid)."""
 
 
 @dataclass(frozen=True)
@@ -135,7 +131,7 @@ def _contact(
             break
         active = new
     else:  # pragma: no cover - the active set of a convex contact converges
-        raise StaticContactError("static contact: the active set did not converge")
+        raise DataFormatError("static contact: the active set did not converge")
     pen = np.where(active, pen, 0.0)
     return x, pen, kt * float(w @ pen)
 
@@ -162,7 +158,7 @@ def solve_static_state(
     See the module docstring for the equations.
     """
     if F_z0 <= 0 or k_t <= 0:
-        raise StaticContactError(
+        raise DataFormatError(
             f"the static state needs a wheel load and a tread: F_z0 = {F_z0}, k_t = {k_t}"
         )
     phi = np.linspace(-PHI_MAX, PHI_MAX, N_PHI)
@@ -189,7 +185,7 @@ def solve_static_state(
     line = pen.reshape(N_PHI, y.size) @ wyq  # pressure integrated over the width
     on = np.flatnonzero(line > 0)
     if on.size == 0 or on[0] == 0 or on[-1] == N_PHI - 1:
-        raise StaticContactError(
+        raise DataFormatError(
             f"static contact patch does not fit the grid |phi| < {PHI_MAX} rad"
         )
     # zero crossings of the line pressure, linear between grid points
