@@ -41,6 +41,7 @@ from app.views import (
 )
 from app.views.analysis_base import analysis_card
 from app.views.campaign import campaign_card
+from app.views.landmarks import landmarks_card
 from app.views.plots import frequency_range, modes_range
 
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
@@ -139,6 +140,7 @@ EXTRA_CARDS.append(  # issue 18: compare, phase and peaks, across speed, contrib
     lambda parts: analysis_card(parts.results, parts.freq)
 )
 EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (when set)
+EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to this tire's
 
 
 def extra_cards(parts: PageParts) -> list:

@@ -185,9 +185,7 @@ def solve_static_state(
     line = pen.reshape(N_PHI, y.size) @ wyq  # pressure integrated over the width
     on = np.flatnonzero(line > 0)
     if on.size == 0 or on[0] == 0 or on[-1] == N_PHI - 1:
-        raise DataFormatError(
-            f"static contact patch does not fit the grid |phi| < {PHI_MAX} rad"
-        )
+        raise DataFormatError(f"static contact patch does not fit the grid |phi| < {PHI_MAX} rad")
     # zero crossings of the line pressure, linear between grid points
     i0, i1 = on[0], on[-1]
     p0 = phi[i0 - 1] + (phi[i0] - phi[i0 - 1]) * (-line[i0 - 1]) / (line[i0] - line[i0 - 1])
