@@ -39,7 +39,7 @@ from app.views import (
     UncoupledView,
     UploadView,
 )
-from app.views.analysis_base import page_card as analysis_card
+from app.views.analysis_base import analysis_card
 from app.views.campaign import campaign_card
 from app.views.landmarks import landmarks_card
 from app.views.plots import frequency_range, modes_range
@@ -136,7 +136,10 @@ class PageParts:
 
 #: Further cards, below the built-in plots, in this order: ``builder(parts) -> panel object``
 #: (None: nothing). A view in its own module under ``app/views/`` adds its builder here.
-EXTRA_CARDS: list[Callable[[PageParts], Any]] = [analysis_card]  # issue 18: Analysis card
+EXTRA_CARDS: list[Callable[[PageParts], Any]] = []
+EXTRA_CARDS.append(  # issue 18: compare, phase and peaks, across speed, contributions
+    lambda parts: analysis_card(parts.results, parts.freq)
+)
 EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (when set)
 EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to this tire's
 

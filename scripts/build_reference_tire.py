@@ -33,9 +33,9 @@ DESCRIPTION = (
     "on an elastic sidewall foundation (in-plane ring, lateral ring, tilt and width-wise "
     "families), rigid rim with hub at its centre, contact patch springs, linearised about "
     "the statically loaded tire (patch length and pressure of the static contact under the "
-    "wheel load, hoop-force pre-stress); complex modes at every 2.5 km/h from 20 to 120 km/h, "
-    "refined to 1.25 km/h where the interpolation between two points misses the direct "
-    "solution by more than 1 %. See docs/tire-model.md."
+    "wheel load, hoop-force pre-stress); complex modes at "
+    "every 2.5 km/h from 20 to 120 km/h, refined to 1.25 km/h where the interpolation between "
+    "two points misses the direct solution by more than 1 %. See docs/tire-model.md."
 )
 
 

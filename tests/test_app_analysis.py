@@ -79,8 +79,7 @@ def test_contributions_view_equals_the_terms_solved_by_hand(store, coupling):
 
 def test_phase_view_bode_real_imag_and_cursors(store):
     r, a = store
-    # harmonic 3: its bushing:z response has resonance peaks to label (harmonic 2's has
-    # none of 3 dB prominence on the statically loaded reference tire)
+    # case 3: the loaded reference tire's case-2 bushing z has no peak to label (issue 14)
     r.state.case.harmonic = 3
     r.state.analysis.tab = "phase"
     view = PhaseView(store=r, analysis=a)

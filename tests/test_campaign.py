@@ -311,7 +311,6 @@ def test_progress_bar_shows_done_total_rate_and_time_left_from_the_work():
     assert 29 <= 3600 * h + 60 * m + s <= 31  # 75 work units left at 2.5 per second
 
 
-
 def test_run_in_process_gives_the_signal_handlers_back(tmp_path):
     """``run`` called in-process (a notebook, a test runner) restores the caller's SIGINT
     and SIGTERM handlers when it returns (else a later SIGTERM of the caller raised the

@@ -14,9 +14,9 @@ import param
 
 from ..analysis_state import ANALYSIS_TABS
 from ..analysis_store import AnalysisResults
-from .live import LiveView, served_document
+from .live import LiveView
 
-__all__ = ["AnalysisView", "analysis_card", "page_card"]
+__all__ = ["AnalysisView", "analysis_card"]
 
 #: Colours of the six interface DOFs' terms (and of pins).
 TERM_COLORS = ("#1971c2", "#2b8a3e", "#e03131", "#f08c00", "#7048e8", "#0c8599")
@@ -47,21 +47,6 @@ class AnalysisView(LiveView):
 
     def _draw_pick(self, pick: dict) -> None:
         """Show the picked speed / frequency (``None``: not picked)."""
-
-    def __panel__(self):
-        # LiveView's, without the built-in views' title blocks (their texts are those of
-        # the report's views): the card's layouts are several figures each
-        if self._layout is None:
-            self._doc = served_document()
-            plots = [
-                pn.pane.Bokeh(f, sizing_mode="stretch_both", min_height=self.min_height)
-                for f in self._build()
-            ]
-            header = self._header()
-            body = plots[0] if len(plots) == 1 else pn.Row(*plots, sizing_mode="stretch_both")
-            self._layout = pn.Column(header, *self._extra(), body, sizing_mode="stretch_both")
-            self._apply()
-        return self._layout
 
 
 def _tab_names() -> dict[str, str]:
@@ -152,8 +137,3 @@ def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
     state.param.watch(from_state, "tab")
     from_state()
     return card
-
-
-def page_card(parts) -> pn.Card:
-    """The card for the page's ``EXTRA_CARDS`` (``app.main.PageParts``: store, shared axes)."""
-    return analysis_card(parts.results, parts.freq)
