@@ -199,9 +199,11 @@ def test_a_result_published_by_another_view_becomes_a_report_section():
     )
     res.pins = (pin,)
     extra = store_sections(res)
-    assert [e.key for e in extra] == ["pins-1"]  # uncoupled not shown: not reported
-    assert extra[0].heading == "Pinned curve" and extra[0].paragraphs == ("Pinned curve",)
-    np.testing.assert_array_equal(extra[0].curves["pinned"], pin.columns["pinned_dB"])
+    # the store's own tire-quality result is one too; uncoupled not shown: not reported
+    assert [e.key for e in extra] == ["tire_quality", "pins-1"]
+    pins = extra[1]
+    assert pins.heading == "Pinned curve" and pins.paragraphs == ("Pinned curve",)
+    np.testing.assert_array_equal(pins.curves["pinned"], pin.columns["pinned_dB"])
     snap = session_snapshot(res.state, extra=extra)
     name, html = build_html(snap)
     assert 'id="pins-1"' in html and "N = 50 + 6 dB" in html
