@@ -294,8 +294,9 @@ def cluster_sum(
         g = np.moveaxis(g.reshape(n_l, n_c, -1), 1, 0)  # (n_c, n_l, n_nodes k)
         tot: np.ndarray = np.moveaxis(g @ cl.m.reshape(n_c, n_nodes * k, -1), 0, 1)
         return tot if cols is None else tot[..., cols]
-    tot = g.reshape(n_l, -1) @ cl.m.reshape(-1, cl.m.shape[-1])
-    return tot if cols is None else tot[:, cols]
+    m = cl.m if cols is None else cl.m[..., cols]  # only the columns wanted
+    out: np.ndarray = g.reshape(n_l, -1) @ m.reshape(-1, m.shape[-1])
+    return out
 
 
 def cluster_at(

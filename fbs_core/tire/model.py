@@ -57,8 +57,8 @@ __all__ = ["TireModel", "OperatingPointError", "ModeCountError", "INTERPOLATIONS
 INTERPOLATIONS = ("cubic", "cluster", "linear")
 
 
-#: Lines per block of the modal sums (bounds the memory of the per-mode terms).
-_CHUNK = 48
+#: Lines per chunk of the modal sums (bounds the memory of the (lines, modes) terms).
+_CHUNK = 512
 
 
 def _renamed(
@@ -141,6 +141,7 @@ class TireModel:
         _nodes: tuple[slice, ...] = field(init=False)
         _order: np.ndarray = field(init=False)
         _plans: dict[tuple[int, int, tuple[int, ...]], _Plan] = field(init=False)
+        _columns: dict[tuple[int, bytes], np.ndarray] = field(init=False)
 
     def __post_init__(self) -> None:
         if self.interpolation not in INTERPOLATIONS:
@@ -216,6 +217,7 @@ class TireModel:
         order.setflags(write=False)
         object.__setattr__(self, "_order", order)
         object.__setattr__(self, "_plans", {})  # cache of truncation plans (see _plan)
+        object.__setattr__(self, "_columns", {})  # residue columns per interval (_node_columns)
 
     def _clusters_of(self, k: int) -> tuple[Cluster, ...]:
         """Clusters of interval ``k`` (:mod:`.interp`), found on first use and kept.
@@ -467,38 +469,73 @@ class TireModel:
     ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
         """Receptance sums over the blocks of retained modes ``edges`` (n_N, n_l, n_cols),
         modes ranked at operating point ``k + near``; with ``static`` also the sums of
-        their quasi-static parts ``R_r / (-lambda_r)`` (same shape)."""
+        their quasi-static parts ``R_r / (-lambda_r)`` (same shape).
+
+        The modes are interpolated to every line's speed (weights ``w_i`` of the
+        interval's nodes), yet the interpolated residues ``sum_i w_i Z_i`` are never
+        formed per line: the modal sum of eq. 2.5 over a block ``b`` is
+        ``sum_i w_i (T_b @ Z_i,b)`` with ``T = 1 / (s - lambda)``, a few matrix products.
+        Clusters of veering modes enter by their rational form (whole in a block) or by
+        their interpolated roots (split by a block edge).
+        """
         order, plan = self._plan(k, near, edges)
         nd = self._nodes[k]
         v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
         w = lagrange_weights(self.speeds[nd], v)
-        Zn = self._Z[nd]
         lam = w @ self.poles[nd]
-        T = 1.0 / (s[:, None] - lam)  # (n_l, n_m)
-        Zl = (w @ Zn.reshape(Zn.shape[0], -1)).reshape(t.size, *Zn.shape[1:])[:, :, cols]
-        C = T[:, :, None] * Zl  # (n_l, n_m, n_cols)
-        if static:  # -R / lambda; a zero pole (free sliding) has no static part: 0
-            inv = np.divide(-1.0, lam, out=np.zeros_like(lam), where=lam != 0)
-            C0 = Zl * inv[:, :, None]
+        n_l, n_b = t.size, len(edges) - 1
+        X = 1.0 / (s[:, None] - lam)  # (n_l, n_m)
+        if static:  # -R / lambda below the dynamic terms; a zero pole has no static part
+            X = np.vstack([X, np.divide(-1.0, lam, out=np.zeros_like(lam), where=lam != 0)])
+        wx = np.vstack([w, w]) if static else w
+        Zc = self._node_columns(k, cols)  # (n_nodes, n_m, n_cols)
+        rank = np.empty_like(order)
+        rank[order] = np.arange(order.size)
+        block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
+        block[rank >= edges[-1]] = -1  # beyond the largest count: left out
+        lone = np.ones(order.size, bool)  # modes outside every cluster
+        for members, _whole, _split, _members in plan:
+            lone[members] = False
+        out = np.zeros((n_b, X.shape[0], cols.size), complex)
+        for b in range(n_b):
+            modes = np.flatnonzero((block == b) & lone)
+            if modes.size:
+                Xb = X[:, modes]
+                for i in range(Zc.shape[0]):
+                    out[b] += wx[:, i, None] * (Xb @ Zc[i, modes])
         zero = np.zeros_like(s)
-        for members, whole, split, split_members in plan:
-            C[:, members] = 0.0
-            if static:
-                C0[:, members] = 0.0
-            if whole is not None:  # the cluster's sum, in the slot of its first member
-                C[:, whole.members[:, 0]] = cluster_sum(whole, w, s, cols, per_cluster=True)
-                if static:
-                    C0[:, whole.members[:, 0]] = cluster_sum(whole, w, zero, cols, per_cluster=True)
+        for _members, whole, split, split_members in plan:
+            if whole is not None:  # a cluster's sum goes to the block of its first member
+                bw = block[whole.members[:, 0]]
+                for b in np.unique(bw[bw >= 0]):
+                    sub = interp.subset(whole, bw == b)
+                    out[b, :n_l] += cluster_sum(sub, w, s, cols)
+                    if static:
+                        out[b, n_l:] += cluster_sum(sub, w, zero, cols)
             if split is not None:  # split by a block edge: every member on its own
                 p, r = cluster_at(split, w, cols)  # roots by frequency, lowest first
-                C[:, split_members] = r / (s[:, None, None, None] - p[..., None])
+                bs = block[split_members]  # (n_c, k)
+                keep = bs >= 0
+                dyn = r / (s[:, None, None, None] - p[..., None])  # (n_l, n_c, k, n_cols)
+                np.add.at(out[:, :n_l], bs[keep], np.moveaxis(dyn[:, keep], 1, 0))
                 if static:
-                    C0[:, split_members] = -r / p[..., None]
-        kept = order[: edges[-1]]  # modes beyond the largest count are left out
-        dyn = np.moveaxis(np.add.reduceat(C[:, kept], edges[:-1], axis=1), 1, 0)
+                    sta = np.moveaxis((-r / p[..., None])[:, keep], 1, 0)
+                    np.add.at(out[:, n_l:], bs[keep], sta)
         if not static:
-            return dyn
-        return dyn, np.moveaxis(np.add.reduceat(C0[:, kept], edges[:-1], axis=1), 1, 0)
+            return out
+        return out[:, :n_l], out[:, n_l:]
+
+    def _node_columns(self, k: int, cols: np.ndarray) -> np.ndarray:
+        """The residues of interval ``k``'s nodes, columns ``cols`` (cached, read-only)."""
+        key = (k, cols.tobytes())
+        hit = self._columns.get(key)
+        if hit is None:
+            if len(self._columns) > 64:
+                self._columns.clear()
+            hit = np.ascontiguousarray(self._Z[self._nodes[k]][:, :, cols])
+            hit.setflags(write=False)
+            self._columns[key] = hit
+        return hit
 
     def synthesis(
         self,
