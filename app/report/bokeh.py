@@ -67,6 +67,16 @@ class TitleBlockModels:
         self.heading = Title(text="", text_font_size="13px", text_font_style="bold", standoff=2)
         fig.add_layout(self.heading, "above")
 
+    def save_tools(self) -> list[SaveTool]:
+        """The figure's save tools, looked up once (``figure.select`` walks the whole model
+        graph: it was the largest cost of a control change)."""
+        tools = getattr(self, "_save_tools", None)
+        if tools is None:
+            tools = self._save_tools = [
+                t for t in self.fig.toolbar.tools if isinstance(t, SaveTool)
+            ]
+        return tools
+
     def update(self, tb: TitleBlock, stem: str | None = None) -> None:
         """Show ``tb`` (lines beyond the models' count are joined into the last one)."""
         lines = list(tb.lines)
@@ -83,7 +93,7 @@ class TitleBlockModels:
             if t.visible != visible:
                 t.visible = visible
         if stem is not None:
-            for tool in self.fig.select(type=SaveTool):
+            for tool in self.save_tools():
                 if tool.filename != stem:
                     tool.filename = stem
 
