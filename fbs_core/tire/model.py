@@ -482,12 +482,7 @@ class TireModel:
         nd = self._nodes[k]
         v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
         w = lagrange_weights(self.speeds[nd], v)
-        lam = w @ self.poles[nd]
         n_l, n_b = t.size, len(edges) - 1
-        X = 1.0 / (s[:, None] - lam)  # (n_l, n_m)
-        if static:  # -R / lambda below the dynamic terms; a zero pole has no static part
-            X = np.vstack([X, np.divide(-1.0, lam, out=np.zeros_like(lam), where=lam != 0)])
-        wx = np.vstack([w, w]) if static else w
         Zc = self._node_columns(k, cols)  # (n_nodes, n_m, n_cols)
         rank = np.empty_like(order)
         rank[order] = np.arange(order.size)
@@ -496,11 +491,17 @@ class TireModel:
         lone = np.ones(order.size, bool)  # modes outside every cluster
         for members, _whole, _split, _members in plan:
             lone[members] = False
+        used = np.flatnonzero((block >= 0) & lone)  # the terms summed one by one
+        lam = w @ self.poles[nd][:, used]
+        X = 1.0 / (s[:, None] - lam)  # (n_l, n_used)
+        if static:  # -R / lambda below the dynamic terms; a zero pole has no static part
+            X = np.vstack([X, np.divide(-1.0, lam, out=np.zeros_like(lam), where=lam != 0)])
+        wx = np.vstack([w, w]) if static else w
         out = np.zeros((n_b, X.shape[0], cols.size), complex)
         for b in range(n_b):
-            modes = np.flatnonzero((block == b) & lone)
-            if modes.size:
-                Xb = X[:, modes]
+            j = np.flatnonzero(block[used] == b)  # columns of X in block b
+            if j.size:
+                Xb, modes = X[:, j], used[j]
                 for i in range(Zc.shape[0]):
                     out[b] += wx[:, i, None] * (Xb @ Zc[i, modes])
         zero = np.zeros_like(s)
@@ -513,7 +514,10 @@ class TireModel:
                     if static:
                         out[b, n_l:] += cluster_sum(sub, w, zero, cols)
             if split is not None:  # split by a block edge: every member on its own
-                p, r = cluster_at(split, w, cols)  # roots by frequency, lowest first
+                # roots by frequency, lowest first; lines at one speed share them
+                wu, inv = np.unique(w, axis=0, return_inverse=True)
+                p, r = cluster_at(split, wu, cols)
+                p, r = p[inv.ravel()], r[inv.ravel()]
                 bs = block[split_members]  # (n_c, k)
                 keep = bs >= 0
                 dyn = r / (s[:, None, None, None] - p[..., None])  # (n_l, n_c, k, n_cols)
