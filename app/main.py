@@ -323,10 +323,15 @@ def create_app(
             extra=store_sections(results),  # what other views publish in the store
         )
 
+    # the modal's own close control (Panel's public close_modal); a button in the page is
+    # reachable by keyboard and by tests, unlike the template's icon or the Escape key
+    help_close = pn.widgets.Button(
+        label="Close help", button_type="primary", css_classes=["help-close"], width=110
+    )
     template = pn.template.BootstrapTemplate(
         title="Tire-chassis FBS: bushing vibration dashboard",
         sidebar=[pn.pane.Markdown(INTRO, styles={"font-size": "0.85em"}), Controls(state=state)],
-        modal=[help_page()],
+        modal=[help_close, help_page()],
         header_background=ACCENT,
         sidebar_width=340,
     )
@@ -340,6 +345,7 @@ def create_app(
         *extra_cards(parts),
         sizing_mode="stretch_width",
     )
+    help_close.on_click(lambda _e: template.close_modal())
     template.main.append(main)
     template.config.raw_css.append(PAGE_CSS)
     if page.view == "present":

@@ -308,7 +308,9 @@ def test_help_page_and_exports_with_date_and_link(browser, dashboard, size, tmp_
     for words in ("Chalmers University of Technology", "How to read each view", "eq. 4.1"):
         help_.get_by_text(words).first.wait_for(state="attached")
     _shot(page, f"help_{size[0]}x{size[1]}.png")
-    page.keyboard.press("Escape")
+    page.locator(".help-close button").click()
+    help_.first.wait_for(state="hidden")
+    page.locator(".modal-backdrop").first.wait_for(state="detached")
     with page.expect_download() as dl:
         page.locator(".download-mobility").first.click()
     meta, cols = read_csv(dl.value.path().read_text())
