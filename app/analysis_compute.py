@@ -83,13 +83,28 @@ def peaks(frf: FRF, harmonic: int) -> tuple:
     return analysis.peak_labels(frf, harmonic=harmonic, max_peaks=8)
 
 
-def peak_modes(freq: float, speed_kmh: float, coupling: str, models=None, n: int = 2) -> tuple:
-    """The ``n`` modes of the assembled tire + chassis nearest a peak (cached per peak).
+#: Grid (Hz, km/h) to which a peak is snapped before the coupled eigenvalue solve, and the
+#: number of modes solved there: a peak that moves a little when N, the DOF or the view
+#: changes (the coupled system itself does not depend on N) finds its modes in the cache.
+PEAK_SNAP_HZ = 0.5
+PEAK_SNAP_KMH = 0.5
+PEAK_CANDIDATES = 6
 
+
+def peak_modes(freq: float, speed_kmh: float, coupling: str, models=None, n: int = 2) -> tuple:
+    """The ``n`` modes of the assembled tire + chassis nearest a peak.
+
+    The system is the one at the peak's speed rounded to :data:`PEAK_SNAP_KMH`, solved
+    (cached) for the :data:`PEAK_CANDIDATES` modes nearest the peak's frequency rounded
+    to :data:`PEAK_SNAP_HZ`; of those, the ``n`` nearest the peak itself are returned.
     Returns ``()`` for models without the physical system (an uploaded modal tire or an
     FRF chassis: the coupled eigenvalues need the assembled system).
     """
-    return _peak_modes(round(float(freq), 2), round(float(speed_kmh), 1), coupling, _key(models), n)
+    f = float(freq)
+    f_snap = max(PEAK_SNAP_HZ, round(f / PEAK_SNAP_HZ) * PEAK_SNAP_HZ)
+    v_snap = round(float(speed_kmh) / PEAK_SNAP_KMH) * PEAK_SNAP_KMH
+    cand = _peak_modes(f_snap, v_snap, coupling, _key(models), max(PEAK_CANDIDATES, n))
+    return tuple(sorted(cand, key=lambda m: abs(m.freq - f))[:n])
 
 
 @shared_cache(maxsize=256)

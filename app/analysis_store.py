@@ -15,6 +15,7 @@ to: the peak labels show at once and gain their modes when these arrive.
 
 from __future__ import annotations
 
+import os
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -257,6 +258,8 @@ class AnalysisResults(param.Parameterized):
         s: Snapshot = r.draw["snapshot"]
 
         def work():
+            if threading.current_thread() is not threading.main_thread():
+                background_priority()
             labels = []
             for p in peaks:
                 if self.phase is not r or self.store.closed:
@@ -299,6 +302,19 @@ class AnalysisResults(param.Parameterized):
 
 
 # -- helpers ----------------------------------------------------------------------------------
+#: Nice value of the threads that label peaks with modes: interactive work wins the cores.
+BACKGROUND_NICE = 10
+
+
+def background_priority() -> None:
+    """Lower the CPU priority of the calling thread (Linux: ``setpriority`` on a thread id
+    applies to that thread only); a no-op where the OS does not allow it."""
+    try:
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), BACKGROUND_NICE)
+    except (AttributeError, OSError):  # not Linux / not permitted
+        pass
+
+
 def nearest_order_line(wavelength, speed_range, speed_kmh: float, freq: float, tol: float):
     """The harmonic case whose line ``f = v / lambda`` passes within ``tol`` (relative) of
     ``(speed_kmh, freq)`` inside its speed range, or None."""

@@ -278,3 +278,21 @@ def test_each_pin_is_published_in_the_store_against_the_current_state(store):
     assert "current_dB" not in res.columns and "different frequency grids" in res.meta["difference"]
     a.unpin("base")
     assert r.pinned == ()
+
+
+def test_peak_modes_are_the_nearest_coupled_modes_and_nearby_peaks_share_a_solve():
+    """A peak's labels: the coupled system's modes nearest the peak (truth: a wider
+    eigenvalue solve of the assembled tire + chassis at the snapped speed, sorted here by
+    distance to the peak); a peak moved a little by a change of N reuses the solve."""
+    from app import analysis_compute as ac
+    from fbs_core.analysis.peaks import coupled_system, system_modes_near
+
+    speed, f = 61.3, 117.37
+    v_snap = round(speed / ac.PEAK_SNAP_KMH) * ac.PEAK_SNAP_KMH
+    got = ac.peak_modes(f, speed, "6dof", n=2)
+    wide = system_modes_near(coupled_system(v_snap, "6dof"), f, 12)
+    want = sorted(wide, key=lambda m: abs(m.freq - f))[:2]
+    assert [m.pole for m in got] == pytest.approx([m.pole for m in want], rel=1e-9)
+    misses = ac._peak_modes.cache_info().misses
+    ac.peak_modes(f + 0.1, speed + 0.2, "6dof", n=2)  # the same snapped point
+    assert ac._peak_modes.cache_info().misses == misses
