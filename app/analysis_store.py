@@ -257,8 +257,8 @@ class AnalysisResults(param.Parameterized):
         peaks = r.draw["peaks"]
         s: Snapshot = r.draw["snapshot"]
 
-        def work():
-            if threading.current_thread() is not threading.main_thread():
+        def work(own_thread: bool = False):
+            if own_thread:
                 background_priority()
             labels = []
             for p in peaks:
@@ -272,7 +272,7 @@ class AnalysisResults(param.Parameterized):
 
         background = bands.served() if self.store.background is None else self.store.background
         if background:
-            threading.Thread(target=work, daemon=True, name="fbs-peak-modes").start()
+            threading.Thread(target=work, args=(True,), daemon=True, name="fbs-peak-modes").start()
         else:
             work()
 
