@@ -24,7 +24,14 @@ import param
 
 from app.bands import served
 from app.report.live import page_url
-from app.report.page import CARD_CSS, PAGE_CSS, PAGE_URL_KEYS, PRESENT_CSS, PageState
+from app.report.page import (
+    CARD_CSS,
+    PAGE_CSS,
+    PAGE_URL_KEYS,
+    VIEW_SWITCH_JS,
+    PageState,
+    present_css,
+)
 from app.report.panel import data_key, help_page, link_notice, report_buttons
 from app.report.session import provenance_of, session_snapshot, store_sections
 from app.state import URL_KEYS, DashboardState
@@ -270,16 +277,18 @@ def page_bar(parts: PageParts, snapshot: Callable, open_help: Callable) -> pn.Ro
         label="Help", button_type="light", css_classes=["help-button"], width=70
     )
     help_button.on_click(lambda _e: open_help())
+    view_switch = pn.widgets.RadioButtonGroup.from_param(
+        page.param.view,
+        name="Page",
+        options={"Normal view": "normal", "Presentation": "present"},
+        css_classes=["ctl-page-view"],
+        width=220,
+    )
+    view_switch.jscallback(value=VIEW_SWITCH_JS)  # the page's type at once (page.py)
     return pn.Row(
         report_buttons(snapshot),
         help_button,
-        pn.widgets.RadioButtonGroup.from_param(
-            page.param.view,
-            name="Page",
-            options={"Normal view": "normal", "Presentation": "present"},
-            css_classes=["ctl-page-view"],
-            width=220,
-        ),
+        view_switch,
         pn.widgets.RadioButtonGroup.from_param(
             page.param.n_axis,
             name="N axis",
@@ -348,8 +357,8 @@ def create_app(
     help_close.on_click(lambda _e: template.close_modal())
     template.main.append(main)
     template.config.raw_css.append(PAGE_CSS)
-    if page.view == "present":
-        template.config.raw_css.append(PRESENT_CSS)
+    # the presentation view's larger type follows the view switch without a reload
+    template.config.raw_css.append(present_css(page.view == "present"))
     template.page = page
     template.state = state  # for tests and benchmarks
     template.results = results

@@ -10,7 +10,16 @@ from __future__ import annotations
 
 import param
 
-__all__ = ["PageState", "PAGE_URL_KEYS", "PAGE_CSS", "PRESENT_CSS", "CARD_CSS"]
+__all__ = [
+    "PageState",
+    "PAGE_URL_KEYS",
+    "PAGE_CSS",
+    "CARD_CSS",
+    "PRESENT_CLASS",
+    "NORMAL_CLASS",
+    "VIEW_SWITCH_JS",
+    "present_css",
+]
 
 
 class PageState(param.Parameterized):
@@ -35,12 +44,34 @@ class PageState(param.Parameterized):
 #: URL query keys of the page state.
 PAGE_URL_KEYS = {"view": "view", "data_card": "card", "n_axis": "naxis", "data": "data"}
 
-#: Larger type of the controls and cards in the presentation view.
-PRESENT_CSS = """
-body { font-size: 17px; }
-.card-title, .card-header { font-size: 1.15em !important; }
-.bk-input, .bk-btn, label { font-size: 16px !important; }
-"""
+#: Larger type of the controls and cards in the presentation view: the page's font size
+#: and Bokeh's font-size variable, which the widgets and cards inside their shadow roots
+#: inherit (a document-level selector such as ``.card-title`` does not reach them).
+PRESENT_RULE = "font-size: 17px; --bokeh-font-size: 16px;"
+#: Classes of ``<body>`` set by the page's view switch in the browser (no reload needed).
+PRESENT_CLASS, NORMAL_CLASS = "fbs-present", "fbs-normal"
+
+
+def present_css(loaded_present: bool) -> str:
+    """CSS of the presentation view's larger type.
+
+    The view switch toggles :data:`PRESENT_CLASS` / :data:`NORMAL_CLASS` on ``<body>``
+    (a JavaScript callback of the switch), so the type follows the switch at once. A page
+    loaded with ``view=present`` has neither class yet: its rules also apply to a body
+    that is not marked normal.
+    """
+    prefixes = [f"body.{PRESENT_CLASS}"]
+    if loaded_present:
+        prefixes.append(f"body:not(.{NORMAL_CLASS})")
+    return "".join(f"{p} {{ {PRESENT_RULE} }}\n" for p in prefixes)
+
+
+#: JavaScript of the view switch (a RadioButtonGroup: ``active`` 1 is the presentation).
+VIEW_SWITCH_JS = (
+    "const on = cb_obj.active === 1;"
+    f"document.body.classList.toggle('{PRESENT_CLASS}', on);"
+    f"document.body.classList.toggle('{NORMAL_CLASS}', !on);"
+)
 
 #: Page-wide CSS (both views): an idle progress bar is not a text field.
 PAGE_CSS = """

@@ -162,13 +162,18 @@ class LiveView(Viewer):
             if self._pending:
                 return
             self._pending = True
+        self._on_document(self._apply)
+
+    def _on_document(self, fn) -> None:
+        """Run ``fn`` (changes of Bokeh models) where it may change the served document:
+        on the session's event loop under its lock, whichever thread asks."""
         doc = self._doc
         if doc is None:
-            self._apply()  # no server: tests, notebooks, exports
+            fn()  # no server: tests, notebooks, exports
         elif served_document() is doc:
-            pn.state.execute(self._apply, schedule=True)
+            pn.state.execute(fn, schedule=True)
         else:  # a thread outside Panel's: Bokeh's thread-safe scheduling
-            doc.add_next_tick_callback(self._apply)
+            doc.add_next_tick_callback(fn)
 
     def _apply(self) -> None:
         with self._guard:
@@ -199,6 +204,11 @@ class LiveView(Viewer):
 
     @param.depends("mode", watch=True)
     def _restyle(self) -> None:
+        # the view switch arrives on a worker thread of the server: Bokeh models change
+        # only on the session's event loop (a RuntimeError of Bokeh otherwise)
+        self._on_document(self._restyle_now)
+
+    def _restyle_now(self) -> None:
         for fig in self._figures:
             style_figure(fig, self.mode, legend_side="below")
         for t in self._titles:
@@ -225,7 +235,7 @@ class LiveView(Viewer):
             per_object = [_plots_in(f) for f in figures]
             self._figures = [p for plots in per_object for p in plots]
             self._titles = [TitleBlockModels(plots[0]) for plots in per_object if plots]
-            self._restyle()
+            self._restyle_now()
             header = self._header()
             plots = [
                 pn.pane.Bokeh(f, sizing_mode="stretch_both", min_height=self.min_height)

@@ -228,6 +228,39 @@ def test_normal_view_first_screen_shows_a_plot(browser, dashboard, size):
     ctx.close()
 
 
+def _type_sizes(page) -> tuple[float, float]:
+    """Computed font sizes (px) of the body and of a card title."""
+    card = page.get_by_text("Coupled response at the bushing").first
+    body = page.evaluate("() => parseFloat(getComputedStyle(document.body).fontSize)")
+    return body, card.evaluate("e => parseFloat(getComputedStyle(e).fontSize)")
+
+
+def test_presentation_switch_changes_the_type_without_a_reload(browser, dashboard):
+    """The page's larger type follows the view switch at once, both ways (issue 17: it
+    needed a reload with ?view=present)."""
+    ctx = _context(browser, (1280, 720))
+    page = ctx.new_page()
+    open_dashboard(page, dashboard.url + "?rounds=1000")
+    body0, card0 = _type_sizes(page)
+    page.evaluate("() => { window.__fbs_not_reloaded = true; }")
+    page.locator(".ctl-page-view button", has_text="Presentation").click()
+    page.wait_for_function("() => parseFloat(getComputedStyle(document.body).fontSize) >= 17")
+    body1, card1 = _type_sizes(page)
+    assert body1 > body0 and card1 > card0, (body0, body1, card0, card1)
+    # the plots' type follows too (restyled on the server)
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0].all_models].filter(m => m.name === 'mobility.figure')"
+        ".every(f => f.left.every(a => parseFloat(a.major_label_text_font_size) >= 16))"
+    )
+    assert page.evaluate("() => window.__fbs_not_reloaded === true")  # same page
+    page.locator(".ctl-page-view button", has_text="Normal view").click()
+    page.wait_for_function(
+        f"() => parseFloat(getComputedStyle(document.body).fontSize) === {body0}"
+    )
+    assert _type_sizes(page) == (body0, card0)
+    ctx.close()
+
+
 def _status(page, words: str, timeout=120_000):
     page.locator(".scatter-status", has_text=words).first.wait_for(timeout=timeout)
 
