@@ -15,8 +15,6 @@ to: the peak labels show at once and gain their modes when these arrive.
 
 from __future__ import annotations
 
-import os
-import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -29,7 +27,7 @@ from fbs_core.errors import FBSError
 from fbs_core.vocabulary import magnitude_db
 
 from . import analysis_compute as ac
-from . import bands, compute
+from . import background, bands, compute
 from .analysis_pins import build_pin, compare_result, pin_result, pin_settings
 from .analysis_state import check_pin_name, decode_pins, encode_pins
 from .store import Result, Results, Snapshot, chassis_label
@@ -257,9 +255,7 @@ class AnalysisResults(param.Parameterized):
         peaks = r.draw["peaks"]
         s: Snapshot = r.draw["snapshot"]
 
-        def work(own_thread: bool = False):
-            if own_thread:
-                background_priority()
+        def work():
             labels = []
             for p in peaks:
                 if self.phase is not r or self.store.closed:
@@ -270,9 +266,9 @@ class AnalysisResults(param.Parameterized):
                 if self.phase is r and not self.store.closed:
                     self.peak_modes = (r, tuple(labels))
 
-        background = bands.served() if self.store.background is None else self.store.background
-        if background:
-            threading.Thread(target=work, args=(True,), daemon=True, name="fbs-peak-modes").start()
+        later = bands.served() if self.store.background is None else self.store.background
+        if later:  # a thread of its own at a lower priority: the plots win the cores
+            background.start(work, "fbs-peak-modes")
         else:
             work()
 
@@ -302,19 +298,6 @@ class AnalysisResults(param.Parameterized):
 
 
 # -- helpers ----------------------------------------------------------------------------------
-#: Nice value of the threads that label peaks with modes: interactive work wins the cores.
-BACKGROUND_NICE = 10
-
-
-def background_priority() -> None:
-    """Lower the CPU priority of the calling thread (Linux: ``setpriority`` on a thread id
-    applies to that thread only); a no-op where the OS does not allow it."""
-    try:
-        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), BACKGROUND_NICE)
-    except (AttributeError, OSError):  # not Linux / not permitted
-        pass
-
-
 def nearest_order_line(wavelength, speed_range, speed_kmh: float, freq: float, tol: float):
     """The harmonic case whose line ``f = v / lambda`` passes within ``tol`` (relative) of
     ``(speed_kmh, freq)`` inside its speed range, or None."""

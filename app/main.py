@@ -22,6 +22,7 @@ from typing import Any
 import panel as pn
 import param
 
+from app import background
 from app.bands import served
 from app.report.live import page_url
 from app.report.page import (
@@ -368,6 +369,8 @@ def create_app(
         doc.on_session_destroyed(lambda _ctx: close_page(template))
     if served():
         pn.state.onload(results.request_band)
+        # once per process, after the first page: the other harmonics' reference studies
+        pn.state.onload(background.warm_reference_studies)
     else:
         results.request_band(wait=True)
     return template
