@@ -235,10 +235,11 @@ def _type_sizes(page) -> tuple[float, float]:
     return body, card.evaluate("e => parseFloat(getComputedStyle(e).fontSize)")
 
 
-def test_presentation_switch_changes_the_type_without_a_reload(browser, dashboard):
+@pytest.mark.parametrize("size", SIZES)
+def test_presentation_switch_changes_the_type_without_a_reload(browser, dashboard, size):
     """The page's larger type follows the view switch at once, both ways (issue 17: it
     needed a reload with ?view=present)."""
-    ctx = _context(browser, (1280, 720))
+    ctx = _context(browser, size)
     page = ctx.new_page()
     open_dashboard(page, dashboard.url + "?rounds=1000")
     body0, card0 = _type_sizes(page)
