@@ -211,7 +211,7 @@ def test_shared_link_that_needs_uploads_says_so(browser, dashboard, size):
     ctx.close()
 
 
-@pytest.mark.parametrize("size", LAYOUT_SIZES[:2])
+@pytest.mark.parametrize("size", LAYOUT_SIZES)
 def test_normal_view_first_screen_shows_a_plot(browser, dashboard, size):
     ctx = _context(browser, size)
     page = ctx.new_page()
