@@ -127,7 +127,7 @@ def resolve_model(kind: str, spec: Any) -> Any:
 def load_model(kind: str, source: str) -> Any:
     """Load a model variant from a file (on the client; the object is then scattered).
 
-    Tire: a modal tire model (:func:`fbs_core.io.load_tire_model`). Chassis: an FRF file
+    Tire: a modal tire model (:func:`fbs_core.io.import_tire_model`). Chassis: an FRF file
     (:func:`fbs_core.io.load_frf`) with inputs ``spindle:*``; it is interpolated onto each
     harmonic's grid (never extrapolated).
     """
@@ -136,7 +136,7 @@ def load_model(kind: str, source: str) -> Any:
     from .. import io
 
     if kind == "tire":
-        return io.load_tire_model(source).model
+        return io.import_tire_model(source).model
     return io.load_frf(source).frf
 
 

@@ -1,0 +1,46 @@
+"""Names renamed for issue 16 (one name per concept): each old name still works for one
+release, warns with a DeprecationWarning naming the new one, and gives what the new name
+gives. The truth of the new names is tested where they live; here the old and new paths
+are compared and checked against an independent source (the model the file was written
+from)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_io_modal import small_tire
+
+import fbs_core
+from fbs_core import io as fio
+from fbs_core import tire as ftire
+from fbs_core.io.modal import write_tire_mat
+from fbs_core.tire import storage
+
+
+def _same_model(a, b):
+    for name in ("speeds", "poles", "psi", "chi", "wavelengths", "participation"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+
+
+def test_tire_load_tire_model_is_read_tire_h5(tmp_path):
+    written = small_tire(seed=3)
+    path = storage.save_tire_model(written, tmp_path / "t.h5")
+    new = ftire.read_tire_h5(path)
+    _same_model(new, written)
+    with pytest.warns(DeprecationWarning, match="read_tire_h5"):
+        old = ftire.load_tire_model(path)
+    _same_model(old, new)
+    with pytest.warns(DeprecationWarning, match="read_tire_h5"):
+        storage.load_tire_model(path)
+
+
+def test_io_load_tire_model_is_import_tire_model():
+    written = small_tire(seed=4)
+    raw = write_tire_mat(written)
+    new = fio.import_tire_model(raw, filename="t.mat")
+    _same_model(new.model, written)
+    with pytest.warns(DeprecationWarning, match="import_tire_model"):
+        old = fio.load_tire_model(raw, filename="t.mat")
+    _same_model(old.model, new.model)
+    assert (old.summary, old.format, old.source) == (new.summary, new.format, new.source)
+    assert "import_tire_model" in fio.__all__ and "read_tire_h5" in fbs_core.tire.__all__
