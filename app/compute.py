@@ -525,9 +525,8 @@ def band_data(result, dof: str, percentile: float = 90) -> dict:
     cols = {
         "freq": np.asarray(result.freq, float),
         "reference": ref,
-        # ScatterBand.lower / .upper are the min / max over the rounds
-        "minimum": np.asarray(result.lower[:, j], float),
-        "maximum": np.asarray(result.upper[:, j], float),
+        "minimum": np.asarray(result.minimum[:, j], float),
+        "maximum": np.asarray(result.maximum[:, j], float),
         "pct_low": np.asarray(result.percentiles[q.index(lo), :, j], float),
         "pct_high": np.asarray(result.percentiles[q.index(hi), :, j], float),
     }

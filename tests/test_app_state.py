@@ -68,7 +68,7 @@ def test_every_accepted_noise_level_and_seed_runs_in_the_library():
 
     n = NoiseState(noise=MAX_NOISE_PCT, seed=MAX_SEED)  # the largest values a user can set
     band = fbs_core.scatter_band(1, noise=n.noise / 100, rounds=5, seed=n.seed)
-    assert band.rounds == 5 and np.all(band.upper >= band.lower)
+    assert band.rounds == 5 and np.all(band.maximum >= band.minimum)
 
 
 def test_one_bad_url_value_keeps_the_valid_ones():

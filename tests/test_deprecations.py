@@ -14,6 +14,7 @@ import fbs_core
 from fbs_core import io as fio
 from fbs_core import tire as ftire
 from fbs_core.io.modal import write_tire_mat
+from fbs_core.studies.scatter import scatter_band_arrays
 from fbs_core.tire import storage
 
 
@@ -44,3 +45,28 @@ def test_io_load_tire_model_is_import_tire_model():
     _same_model(old.model, new.model)
     assert (old.summary, old.format, old.source) == (new.summary, new.format, new.source)
     assert "import_tire_model" in fio.__all__ and "read_tire_h5" in fbs_core.tire.__all__
+
+
+def test_scatter_band_lower_upper_are_minimum_maximum():
+    rng = np.random.default_rng(5)
+    f = np.linspace(10.0, 50.0, 12)
+
+    def c(*shape):
+        return rng.normal(size=shape) + 1j * rng.normal(size=shape)
+
+    YjjA = c(12, 6, 6) + 8 * np.eye(6)  # well away from singular
+    band = scatter_band_arrays(YjjA, c(12, 6), c(12, 6, 6), c(12, 3, 6), freq=f, rounds=60)
+    z = band.rounds_response(np.arange(band.rounds))  # each round regenerated alone
+    every = np.sqrt(z.real * z.real + z.imag * z.imag)  # |v_e| evaluated as the kernel does
+    np.testing.assert_array_equal(band.minimum, every.min(0))
+    np.testing.assert_array_equal(band.maximum, every.max(0))
+    with pytest.warns(DeprecationWarning, match="ScatterBand.minimum"):
+        np.testing.assert_array_equal(band.lower, band.minimum)
+    with pytest.warns(DeprecationWarning, match="ScatterBand.maximum"):
+        np.testing.assert_array_equal(band.upper, band.maximum)
+    conv = band.convergence
+    np.testing.assert_array_equal(conv.maximum[-1], band.maximum)
+    with pytest.warns(DeprecationWarning, match="Convergence.minimum"):
+        np.testing.assert_array_equal(conv.lower, conv.minimum)
+    with pytest.warns(DeprecationWarning, match="Convergence.maximum"):
+        np.testing.assert_array_equal(conv.upper, conv.maximum)

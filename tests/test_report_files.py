@@ -156,7 +156,7 @@ def test_html_holds_the_numbers(parsed, snap):
     band = tabs[next(c for c in tabs if c.startswith("Levels at the reference peak"))]
     j = snap.band.dofs.index("bushing:z")
     i = int(np.argmax(np.abs(snap.band.reference[:, j])))
-    hi = 20 * np.log10(snap.band.upper[i, j])
+    hi = 20 * np.log10(snap.band.maximum[i, j])
     assert ["maximum over the rounds", f"{hi:.2f} dB"] in band
     data = tabs["Data in use"]
     assert ["chassis", "uploaded file 'rear corner <v2>.uff'", "0123abcd4567"] in data

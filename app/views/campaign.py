@@ -160,8 +160,8 @@ def scatter_case_result(result, name: str, dof: str) -> Result:
     cols = {
         "freq_Hz": np.asarray(band.freq),
         "reference": ref,
-        "minimum": np.asarray(band.lower[:, j]),
-        "maximum": np.asarray(band.upper[:, j]),
+        "minimum": np.asarray(band.minimum[:, j]),
+        "maximum": np.asarray(band.maximum[:, j]),
     }
     for k, q in enumerate(band.q):
         cols[f"p{q:g}"] = np.asarray(band.percentiles[k, :, j])

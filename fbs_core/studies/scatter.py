@@ -29,6 +29,7 @@ rounds are processed in chunks of lines whose size is bounded by ``max_chunk_byt
 from __future__ import annotations
 
 import threading
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -80,6 +81,15 @@ def _ro(a: ArrayLike, dtype: DTypeLike | None = None) -> AnyArray:
     return a
 
 
+def _renamed_edge(cls: str, old: str, new: str) -> None:
+    warnings.warn(
+        f"{cls}.{old} is deprecated (it is the {new} over the rounds, not a percentile); "
+        f"use {cls}.{new}",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+
+
 def _db(x: FloatArray) -> FloatArray:
     with np.errstate(divide="ignore", invalid="ignore"):
         return 20 * np.log10(x)
@@ -96,32 +106,45 @@ class Convergence:
     ----------
     rounds : ndarray of int, shape (n_k,)
         Checkpoints, ascending; the last is the total number of rounds.
-    lower, upper : ndarray, shape (n_k, n_f, n_dof)
-        Running minimum and maximum of ``|v_e|``.
+    minimum, maximum : ndarray, shape (n_k, n_f, n_dof)
+        Running minimum and maximum of ``|v_e|`` (the band's lower and upper edges;
+        ``lower`` / ``upper`` are their deprecated names).
     """
 
     rounds: IntArray
-    lower: FloatArray
-    upper: FloatArray
+    minimum: FloatArray
+    maximum: FloatArray
+
+    @property
+    def lower(self) -> FloatArray:
+        """Deprecated name of :attr:`minimum` (one release)."""
+        _renamed_edge("Convergence", "lower", "minimum")
+        return self.minimum
+
+    @property
+    def upper(self) -> FloatArray:
+        """Deprecated name of :attr:`maximum` (one release)."""
+        _renamed_edge("Convergence", "upper", "maximum")
+        return self.maximum
 
     @property
     def upper_change_db(self) -> FloatArray:
         """Largest gap (dB, over lines and DOFs) between the upper edge at each
         checkpoint and the final one, shape ``(n_k,)``; 0 at the last checkpoint."""
-        gap: FloatArray = np.nanmax(_db(self.upper[-1] / self.upper), axis=(1, 2))
+        gap: FloatArray = np.nanmax(_db(self.maximum[-1] / self.maximum), axis=(1, 2))
         return gap
 
     @property
     def lower_change_db(self) -> FloatArray:
         """Largest gap (dB) between the lower edge at each checkpoint and the final one."""
-        gap: FloatArray = np.nanmax(_db(self.lower / self.lower[-1]), axis=(1, 2))
+        gap: FloatArray = np.nanmax(_db(self.minimum / self.minimum[-1]), axis=(1, 2))
         return gap
 
     @property
     def step_change_db(self) -> FloatArray:
         """Largest change (dB) of either edge from one checkpoint to the next, ``(n_k - 1,)``."""
-        up: FloatArray = np.nanmax(_db(self.upper[1:] / self.upper[:-1]), axis=(1, 2))
-        lo: FloatArray = np.nanmax(_db(self.lower[:-1] / self.lower[1:]), axis=(1, 2))
+        up: FloatArray = np.nanmax(_db(self.maximum[1:] / self.maximum[:-1]), axis=(1, 2))
+        lo: FloatArray = np.nanmax(_db(self.minimum[:-1] / self.minimum[1:]), axis=(1, 2))
         return np.maximum(up, lo)
 
     def summary(self) -> str:
@@ -144,8 +167,9 @@ class ScatterBand:
         Response DOF labels.
     reference : ndarray, shape (n_f, n_dof)
         Unpolluted complex response (exactly the kernel's result with all factors 1).
-    lower, upper : ndarray, shape (n_f, n_dof)
-        Minimum and maximum of ``|v_e|`` over the rounds.
+    minimum, maximum : ndarray, shape (n_f, n_dof)
+        Minimum and maximum of ``|v_e|`` over the rounds (the corridor's edges; ``lower`` /
+        ``upper`` are their deprecated names, kept for one release).
     argmin_round, argmax_round : ndarray of int, shape (n_f, n_dof)
         First round attaining them (regenerate it with :meth:`round`).
     q : ndarray, shape (n_q,)
@@ -160,8 +184,8 @@ class ScatterBand:
     freq: FloatArray
     dofs: tuple[str, ...]
     reference: ComplexArray
-    lower: FloatArray
-    upper: FloatArray
+    minimum: FloatArray
+    maximum: FloatArray
     argmin_round: IntArray
     argmax_round: IntArray
     q: FloatArray
@@ -174,6 +198,18 @@ class ScatterBand:
     seed: int
     harmonic: int | None
     _inputs: _Inputs
+
+    @property
+    def lower(self) -> FloatArray:
+        """Deprecated name of :attr:`minimum` (one release)."""
+        _renamed_edge("ScatterBand", "lower", "minimum")
+        return self.minimum
+
+    @property
+    def upper(self) -> FloatArray:
+        """Deprecated name of :attr:`maximum` (one release)."""
+        _renamed_edge("ScatterBand", "upper", "maximum")
+        return self.maximum
 
     def _dof(self, dof: str | int) -> int:
         if isinstance(dof, str):
@@ -458,8 +494,8 @@ def scatter_band_arrays(
         freq=_ro(f),
         dofs=dofs,
         reference=_ro(ref),
-        lower=_ro(lo),
-        upper=_ro(hi),
+        minimum=_ro(lo),
+        maximum=_ro(hi),
         argmin_round=_ro(alo),
         argmax_round=_ro(ahi),
         q=_ro(qs),
