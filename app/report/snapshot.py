@@ -15,11 +15,15 @@ import datetime as _dt
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any, TypeVar
+
+from numpy.typing import ArrayLike
 
 import fbs_core
 from fbs_core.errors import FBSError
 
 __all__ = [
+    "present",
     "ExtraSection",
     "ReportError",
     "DataFile",
@@ -87,6 +91,16 @@ class ReportError(FBSError):
     """A snapshot that cannot be reported: missing or invalid settings, mismatched results."""
 
 
+_T = TypeVar("_T")
+
+
+def present(value: _T | None, what: str) -> _T:
+    """``value``, which a report part needs: a :class:`ReportError` naming ``what`` if None."""
+    if value is None:
+        raise ReportError(f"the snapshot holds no {what}")
+    return value
+
+
 @dataclass(frozen=True)
 class DataFile:
     """One model of the snapshot: the shipped reference (``name=None``) or an uploaded file.
@@ -104,7 +118,7 @@ class DataFile:
     name: str | None = None
     digest: str | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.role not in ("tire", "chassis"):
             raise ReportError(f"unknown data role {self.role!r}; allowed: tire, chassis")
         if self.name is not None and not str(self.name).strip():
@@ -137,7 +151,7 @@ class Provenance:
     chassis: DataFile = field(default_factory=lambda: DataFile("chassis"))
     notes: tuple[str, ...] = ()
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.tire.role != "tire" or self.chassis.role != "chassis":
             raise ReportError("Provenance takes DataFile('tire', ...) and DataFile('chassis', ...)")
         object.__setattr__(self, "notes", tuple(str(n) for n in self.notes))
@@ -158,7 +172,7 @@ class Provenance:
         return "; ".join(d.describe() for d in (self.tire, self.chassis))
 
 
-def _check_setting(name: str, value):
+def _check_setting(name: str, value: Any) -> Any:
     typ, meaning = SETTING_KEYS[name]
     if typ is bool:
         if not isinstance(value, bool):
@@ -192,7 +206,7 @@ def _check_setting(name: str, value):
     return value
 
 
-def normalise_settings(settings: Mapping) -> Mapping:
+def normalise_settings(settings: Mapping[str, Any]) -> Mapping[str, Any]:
     """Checked, typed, read-only copy of ``settings`` (keys of :data:`SETTING_KEYS`).
 
     Raises
@@ -242,11 +256,11 @@ class ExtraSection:
     heading: str
     paragraphs: tuple[str, ...] = ()
     rows: tuple[tuple[str, str], ...] = ()
-    freq: object = None
-    curves: Mapping = field(default_factory=dict)
+    freq: ArrayLike | None = None
+    curves: Mapping[str, Any] = field(default_factory=dict)
     y_label: str = "Level (dB)"
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         import numpy as np
 
         if not str(self.key).strip() or not str(self.heading).strip():
@@ -263,7 +277,7 @@ class ExtraSection:
                     )
 
     @classmethod
-    def of_result(cls, key: str, result) -> ExtraSection:
+    def of_result(cls, key: str, result: Any) -> ExtraSection:
         """The section of a published result (``columns``, ``meta``, ``caption``)."""
         import re
 
@@ -326,7 +340,7 @@ class Snapshot:
         Sections contributed by other views (after the built-in ones).
     """
 
-    settings: Mapping
+    settings: Mapping[str, Any]
     provenance: Provenance = field(default_factory=Provenance)
     url: str = ""
     created: _dt.datetime = field(default_factory=lambda: _dt.datetime.now(_dt.UTC))
@@ -337,9 +351,9 @@ class Snapshot:
     band: fbs_core.ScatterBand | None = None
     eigen: fbs_core.ModeFrequencies | None = None
     n_modes_total: int | None = None
-    extra: tuple = ()
+    extra: tuple[ExtraSection, ...] = ()
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         s = normalise_settings(self.settings)
         object.__setattr__(self, "settings", s)
         if not isinstance(self.provenance, Provenance):
@@ -380,7 +394,7 @@ class Snapshot:
         if self.n_modes_total is None and self.truncation is not None:
             object.__setattr__(self, "n_modes_total", self.truncation.n_modes_total)
 
-    def _check_results(self, s):
+    def _check_results(self, s: Mapping[str, Any]) -> None:
         dof = f"bushing:{s['dof']}"
         for name in ("reference", "truncated"):
             frf = getattr(self, name)
