@@ -218,6 +218,16 @@ def test_snapshot_refuses_results_that_do_not_match(results):
         )
 
 
+def test_a_plot_of_a_missing_result_is_a_report_error(results):
+    from app.report import figures
+
+    s = Snapshot(settings=SETTINGS, url=URL, truncation=results["truncation"])  # no band
+    with pytest.raises(ReportError, match="holds no scatter band"):
+        figures.draw_band(s)
+    with pytest.raises(ReportError, match="holds no eigenfrequencies"):
+        figures.draw_eigen(s)
+
+
 def test_plot_file_png_carries_the_title_block(snap):
     from PIL import Image
 
