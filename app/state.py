@@ -28,7 +28,7 @@ __all__ = [
 ]
 
 #: Where the Monte-Carlo noise is applied (thesis eqs. 5.2-5.4).
-NOISE_TARGETS = ("both", "tire", "vehicle")
+NOISE_TARGETS = ("both", "tire", "chassis")  # fbs_core.studies.scatter.TARGETS
 #: Retained-mode counts offered (thesis 5.1: 10 to 400 in steps of 10).
 MODE_COUNTS = tuple(range(10, 401, 10))
 #: Largest noise level in percent (fbs_core.scatter_band needs p < 1, two decimals here).

@@ -32,7 +32,7 @@ def test_every_control_of_the_issue_exists_with_its_range():
     assert n.param.noise.softbounds == (0.0, 10.0)
     n.noise = 0.25
     n.noise = 25.0
-    assert set(n.param.target.objects) == {"tire", "vehicle", "both"}
+    assert set(n.param.target.objects) == {"tire", "chassis", "both"}
     n.frequency_dependent = True
     n.rounds = 100
     assert t.threshold == 20.0 and t.f_max == 160.0

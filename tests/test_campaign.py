@@ -225,7 +225,7 @@ def test_truncation_cases_5dof_and_a_chassis_variant_from_a_file(tmp_path):
     on_grid = chassis_frf.interpolate(f)
     (bc,) = camp.band_cases
     direct = fbs_core.scatter_band(
-        1, 0.2, "vehicle", 200, seed=bc.seed, chassis=on_grid, coupling="5dof"
+        1, 0.2, "chassis", 200, seed=bc.seed, chassis=on_grid, coupling="5dof"
     )
     _same_band(res.band(bc.name), direct)
     for tc in camp.truncation_cases:

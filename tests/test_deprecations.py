@@ -70,3 +70,63 @@ def test_scatter_band_lower_upper_are_minimum_maximum():
         np.testing.assert_array_equal(conv.lower, conv.minimum)
     with pytest.warns(DeprecationWarning, match="Convergence.maximum"):
         np.testing.assert_array_equal(conv.upper, conv.maximum)
+
+
+def test_noise_target_vehicle_is_the_chassis():
+    rng = np.random.default_rng(6)
+    f = np.linspace(10.0, 50.0, 8)
+
+    def c(*shape):
+        return rng.normal(size=shape) + 1j * rng.normal(size=shape)
+
+    arrays = (c(8, 6, 6) + 8 * np.eye(6), c(8, 6), c(8, 6, 6), c(8, 3, 6))
+    new = scatter_band_arrays(*arrays, target="chassis", freq=f, rounds=40, seed=2)
+    tire = scatter_band_arrays(*arrays, target="tire", freq=f, rounds=40, seed=2)
+    # noise in the chassis only: the tire's factors are all 1, the chassis' are not
+    fc_, ft_ = new.factors(3, 2), tire.factors(3, 2)
+    assert np.all(fc_["Yjj_A"] == 1.0) and not np.all(fc_["Yjj_E"] == 1.0)
+    assert np.all(ft_["Yjj_E"] == 1.0)
+    with pytest.warns(DeprecationWarning, match="'vehicle' is deprecated; use 'chassis'"):
+        old = scatter_band_arrays(*arrays, target="vehicle", freq=f, rounds=40, seed=2)
+    assert old.target == "chassis"
+    np.testing.assert_array_equal(old.maximum, new.maximum)
+    np.testing.assert_array_equal(old.round(7), new.round(7))
+
+
+def test_campaign_target_spellings_keep_case_names_and_seeds(tmp_path):
+    from fbs_core.campaign import parse_campaign
+
+    def case(target):
+        text = (
+            f'[campaign]\nname = "t"\nseed = 7\noutput = "{(tmp_path / "o.h5").as_posix()}"\n'
+            f'[scatter]\nharmonics = [1]\nnoise = [0.1]\ntargets = ["{target}"]\nrounds = 50\n'
+        )
+        (c,) = parse_campaign(text, tmp_path).band_cases
+        return c
+
+    chassis, vehicle = case("chassis"), case("vehicle")
+    assert chassis.target == vehicle.target == "chassis"
+    assert (chassis.name, chassis.seed, chassis.digest()) == (
+        vehicle.name,
+        vehicle.seed,
+        vehicle.digest(),
+    )
+    # the first release's spelling in the name keeps the seed of every existing campaign
+    assert "_vehicle_" in chassis.name
+
+
+def test_percent_and_fraction_are_inverse_and_match_the_core_docs():
+    from fbs_core.vocabulary import fraction, percent
+
+    # the core's fractions: a 10 % noise draws factors in [0.9, 1.1] (checked on a band)
+    rng = np.random.default_rng(8)
+    f = np.linspace(10.0, 50.0, 4)
+    z = rng.normal(size=(4, 6, 6)) + 8 * np.eye(6)
+    band = scatter_band_arrays(
+        z + 0j, z[:, :, 0] + 0j, z + 0j, z[:, :3] + 0j, noise=fraction(10.0), freq=f, rounds=30
+    )
+    s = np.concatenate([band.factors(r, 0)["Yjj_E"].ravel() for r in range(band.rounds)])
+    assert 0.9 <= s.min() < 0.91 and 1.09 < s.max() <= 1.1
+    assert percent(band.noise) == 10.0
+    x = np.array([0.07, 0.2, 1.0])
+    np.testing.assert_array_equal(fraction(percent(x)), x)

@@ -62,7 +62,7 @@ def test_zero_noise_reproduces_the_reference_exactly(arrays):
 
 
 @pytest.mark.parametrize("fd", [False, True], ids=["freq-independent", "freq-dependent"])
-@pytest.mark.parametrize("target", ["tire", "vehicle", "both"])
+@pytest.mark.parametrize("target", ["tire", "chassis", "both"])
 def test_every_round_inside_band_and_band_is_the_extremes(arrays, fd, target):
     b = _band(arrays, target=target, frequency_dependent=fd, percentiles=(5, 50, 95))
     all_rounds = _mag(b.rounds_response(np.arange(b.rounds)))  # (R, NF, NE)
@@ -99,10 +99,10 @@ def test_regenerated_round_equals_the_batch(arrays):
     )
 
 
-def test_tire_noise_leaves_vehicle_untouched_and_vice_versa(arrays):
+def test_tire_noise_leaves_chassis_untouched_and_vice_versa(arrays):
     both = _band(arrays, target="both", seed=3, frequency_dependent=True)
     tire = _band(arrays, target="tire", seed=3, frequency_dependent=True)
-    veh = _band(arrays, target="vehicle", seed=3, frequency_dependent=True)
+    veh = _band(arrays, target="chassis", seed=3, frequency_dependent=True)
     for r, line in [(0, 0), (17, 5), (199, 39)]:
         fb, ft, fv = both.factors(r, line), tire.factors(r, line), veh.factors(r, line)
         for k in ("Yjj_E", "Yej_E"):
@@ -203,7 +203,7 @@ def test_singular_interface_raises(arrays):
     [
         (dict(noise=-0.1), fc.FBSError, "noise"),
         (dict(noise=1.0), fc.FBSError, "noise"),
-        (dict(target="chassis"), fc.FBSError, "allowed: tire, vehicle, both"),
+        (dict(target="car"), fc.FBSError, "allowed: tire, chassis, both"),
         (dict(rounds=0), fc.FBSError, "rounds"),
         (dict(rounds=2.5), fc.FBSError, "rounds"),
         (dict(percentiles=(5, 120)), fc.FBSError, "percentiles"),

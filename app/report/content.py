@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 import fbs_core
 from fbs_core.harmonics import Harmonic
+from fbs_core.vocabulary import fraction, percent
 
 from . import figures
 from .method import EQUATIONS, METHOD_PARAGRAPHS, THESIS, Equation
@@ -203,9 +204,9 @@ def _coupled_section(snap: Snapshot) -> Section:
 def _truncation_section(snap: Snapshot) -> Section:
     m, s = present(snap.truncation, "truncation map"), snap.settings
     dof = snap.map_dof
-    err = 100 * (m.max_error if dof is None else m.dof_error(dof))
+    err = percent(m.max_error if dof is None else m.dof_error(dof))
     thr, fmax = s["threshold"], s["f_max"]
-    n_sugg = int(m.suggest(thr / 100, fmax, dof))
+    n_sugg = int(m.suggest(fraction(thr), fmax, dof))
     sel = m.centres <= fmax + 1e-9
     rows = []
     for i, n in enumerate(m.n_modes):
@@ -258,7 +259,7 @@ def _suggested_section(snap: Snapshot) -> Section:
         )
     what = sm.dof or "maximum over the 6 bushing DOFs"
     para = (
-        f"Smallest N from which the eq. 5.1 error stays below {sm.threshold * 100:g} % at all "
+        f"Smallest N from which the eq. 5.1 error stays below {percent(sm.threshold):g} % at all "
         f"centres up to {sm.f_max:g} Hz ({what}), and the highest eigenfrequency among those "
         f"modes at {sm.speed:g} km/h (thesis table 5.1).",
     )

@@ -27,6 +27,7 @@ from matplotlib.patches import Patch
 from numpy.typing import ArrayLike
 
 from fbs_core.units import frf_unit, output_kind
+from fbs_core.vocabulary import percent
 
 from .colormap import LINE_STYLES, ErrorColorScale, threshold_contour
 from .snapshot import Snapshot, present
@@ -154,7 +155,7 @@ def draw_truncation(snap: Snapshot, n_suggested: int | None = None) -> Draw:
     """Error map (eq. 5.1) with the threshold scale, contour, chosen and suggested N."""
     m, s = present(snap.truncation, "truncation map"), snap.settings
     dof = snap.map_dof
-    err = 100 * np.asarray(m.max_error if dof is None else m.dof_error(dof), float)
+    err = percent(np.asarray(m.max_error if dof is None else m.dof_error(dof), float))
     thr, fmax = float(s["threshold"]), float(s["f_max"])
     scale = ErrorColorScale(thr)
 

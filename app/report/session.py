@@ -16,6 +16,7 @@ import numpy as np
 
 import fbs_core
 from fbs_core import studies
+from fbs_core.vocabulary import fraction, percent
 
 from .. import compute
 from .snapshot import DataFile, ExtraSection, Provenance, Snapshot
@@ -97,7 +98,7 @@ def band_matches(band: Any, settings: Mapping[str, Any], models: Any = None) -> 
     s = settings
     return bool(
         band.harmonic == s["harmonic"]
-        and abs(band.noise * 100 - s["noise"]) <= 1e-9 * max(1.0, s["noise"])
+        and abs(percent(band.noise) - s["noise"]) <= 1e-9 * max(1.0, s["noise"])
         and band.target == s["target"]
         and band.frequency_dependent == s["frequency_dependent"]
         and band.rounds == s["rounds"]
@@ -184,7 +185,7 @@ def session_snapshot(
     tr = compute.coupled_response(k, s["n_modes"], coupling, models)
     map_dof = None if st.map_dof is None else f"bushing:{st.map_dof}"
     sugg = studies.suggest_modes(
-        s["threshold"] / 100.0,
+        fraction(s["threshold"]),
         s["f_max"],
         maps=[compute.error_map(h, coupling, models) for h in range(1, 8)],
         dof=map_dof,

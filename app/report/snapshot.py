@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike
 
 import fbs_core
 from fbs_core.errors import FBSError
+from fbs_core.vocabulary import percent
 
 __all__ = [
     "present",
@@ -41,7 +42,7 @@ __all__ = [
 #: accepted in the settings (the dashboard's choices).
 DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 COUPLINGS = ("6dof", "5dof")
-NOISE_TARGETS = ("both", "tire", "vehicle")
+NOISE_TARGETS = ("both", "tire", "chassis")
 MAP_MODES = ("selected DOF", "max over 6 DOFs")
 N_AXES = ("linear", "log")
 
@@ -420,7 +421,7 @@ class Snapshot:
                     f"{(100 - w) / 2:g} and {(100 + w) / 2:g} % of a {w} % central band"
                 )
             b = self.band
-            given = (b.noise * 100, b.target, b.frequency_dependent, b.rounds, b.seed)
+            given = (percent(b.noise), b.target, b.frequency_dependent, b.rounds, b.seed)
             said = (s["noise"], s["target"], s["frequency_dependent"], s["rounds"], s["seed"])
             if not (abs(given[0] - said[0]) <= 1e-9 * max(1.0, said[0]) and given[1:] == said[1:]):
                 raise ReportError(
@@ -436,12 +437,12 @@ class Snapshot:
         if self.suggested is not None:
             sm = self.suggested
             if not (
-                abs(sm.threshold * 100 - s["threshold"]) <= 1e-9 * s["threshold"]
+                abs(percent(sm.threshold) - s["threshold"]) <= 1e-9 * s["threshold"]
                 and sm.f_max == s["f_max"]
                 and sm.dof == self.map_dof
             ):
                 raise ReportError(
-                    f"the suggested modes were read at threshold {sm.threshold * 100:g} %, "
+                    f"the suggested modes were read at threshold {percent(sm.threshold):g} %, "
                     f"f_max {sm.f_max:g} Hz, DOF {sm.dof}; the settings say "
                     f"{s['threshold']:g} %, {s['f_max']:g} Hz, DOF {self.map_dof}"
                 )

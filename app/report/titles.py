@@ -46,8 +46,8 @@ VIEWS: dict[str, str] = {
     "speed-map": "Bushing level over speed and frequency for the harmonic",
 }
 
-_NOISE_EQ = {"tire": "5.2", "vehicle": "5.3", "both": "5.4"}
-_NOISE_WHERE = {"tire": "the tire", "vehicle": "the vehicle", "both": "tire and vehicle"}
+_NOISE_EQ = {"tire": "5.2", "chassis": "5.3", "both": "5.4"}
+_NOISE_WHERE = {"tire": "the tire", "chassis": "the chassis", "both": "tire and chassis"}
 
 
 @dataclass(frozen=True)

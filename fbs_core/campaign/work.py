@@ -374,7 +374,7 @@ def assemble_band(
         percentiles=_sc._ro(pct),
         convergence=_sc.Convergence(_sc._ro(np.asarray(ck)), _sc._ro(clo), _sc._ro(chi)),
         noise=float(noise),
-        target=str(target),
+        target=_sc.target_name(str(target), warn=False),  # "vehicle" in older files
         rounds=int(rounds),
         frequency_dependent=bool(frequency_dependent),
         seed=seed,

@@ -4,7 +4,8 @@ Every element of the subsystem FRFs is scaled by a factor uniform in
 ``[1 - p, 1 + p]`` and the bushing response of eq. 4.1 is recomputed, ``R`` times:
 
 - tire only (eq. 5.2):     ``Y_ej^E [S o Y_jj^A + Y_jj^E]^-1 S o (Y_ja^A F_a)``
-- vehicle only (eq. 5.3):  ``S o Y_ej^E [Y_jj^A + S o Y_jj^E]^-1 Y_ja^A F_a``
+- chassis only (eq. 5.3):  ``S o Y_ej^E [Y_jj^A + S o Y_jj^E]^-1 Y_ja^A F_a``
+  (the thesis' "vehicle": the chassis substructure)
 - both (eq. 5.4):          ``S o Y_ej^E [S o Y_jj^A + S o Y_jj^E]^-1 S o (Y_ja^A F_a)``
 
 The thesis writes one symbol ``S`` but describes it as "a scaling matrix ... with
@@ -48,10 +49,19 @@ from ._rng import as_seed, seed_key
 #: ``8 R n_e`` bytes, stays below 50 MB for six responses).
 MAX_ROUNDS = 1_000_000
 
-__all__ = ["TARGETS", "ScatterBand", "Convergence", "scatter_band", "scatter_band_arrays"]
+__all__ = [
+    "TARGETS",
+    "ScatterBand",
+    "Convergence",
+    "scatter_band",
+    "scatter_band_arrays",
+    "target_name",
+]
 
-#: Where the noise goes.
-TARGETS = ("tire", "vehicle", "both")
+#: Where the noise goes: the tire, the chassis (the thesis' "vehicle") or both.
+TARGETS = ("tire", "chassis", "both")
+#: Deprecated spellings of a target (one release).
+_OLD_TARGETS = {"vehicle": "chassis"}
 
 _EMPTY_MAG = np.empty((0, 0, 0))
 # one compiled parallel run at a time (some numba threading layers abort on concurrent
@@ -177,8 +187,10 @@ class ScatterBand:
     percentiles : ndarray, shape (n_q, n_f, n_dof)
         Percentiles of ``|v_e|`` over the rounds (numpy's "linear" definition).
     convergence : Convergence
-    noise, target, rounds, frequency_dependent, seed, harmonic
-        The settings.
+    noise : float
+        The noise level ``p`` as a fraction (0.1 = factors in [0.9, 1.1]).
+    target, rounds, frequency_dependent, seed, harmonic
+        The other settings.
     """
 
     freq: FloatArray
@@ -276,10 +288,32 @@ def split_factors(s: FloatArray, nj: int, ne: int) -> dict[str, FloatArray]:
     }
 
 
-def _flags(target: str) -> tuple[bool, bool]:
+def target_name(target: str, *, warn: bool = True) -> str:
+    """The name in :data:`TARGETS` of a noise target; ``"vehicle"`` is the deprecated name of
+    ``"chassis"`` (a ``DeprecationWarning`` when ``warn``; bands stored with it still load).
+
+    Raises
+    ------
+    FBSError
+        For an unknown target, naming the allowed ones.
+    """
+    if target in _OLD_TARGETS:
+        if warn:
+            warnings.warn(
+                f"noise target {target!r} is deprecated; use {_OLD_TARGETS[target]!r}",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+        return _OLD_TARGETS[target]
     if target not in TARGETS:
         raise FBSError(f"unknown noise target {target!r}; allowed: {', '.join(TARGETS)}")
-    return target in ("tire", "both"), target in ("vehicle", "both")
+    return target
+
+
+def _flags(target: str) -> tuple[bool, bool]:
+    """Which subsystems get noise: ``(tire, chassis)``."""
+    t = target_name(target, warn=False)
+    return t in ("tire", "both"), t in ("chassis", "both")
 
 
 def _split(z: ComplexArray) -> tuple[FloatArray, FloatArray]:
@@ -371,7 +405,7 @@ def scatter_band_arrays(
         Chassis transfer mobility ``Y_ej^E``.
     noise : float
         ``p``: factors uniform in ``[1 - p, 1 + p]`` (0.1 = +-10 %), ``0 <= p < 1``.
-    target : {"tire", "vehicle", "both"}
+    target : {"tire", "chassis", "both"}
         Eq. 5.2, 5.3 or 5.4.
     rounds : int
         Number of rounds ``R``.
@@ -415,6 +449,7 @@ def scatter_band_arrays(
     ne = arrays[6].shape[1]
     if not (0.0 <= noise < 1.0):
         raise FBSError(f"noise must be in [0, 1) (0.1 = +-10 %), got {noise!r}")
+    target = target_name(target)
     tire, vehicle = _flags(target)
     if isinstance(rounds, bool) or not isinstance(rounds, int | np.integer) or rounds < 1:
         raise FBSError(f"rounds must be a positive integer, got {rounds!r}")
@@ -560,6 +595,7 @@ def scatter_band(
     >>> r = band.peak_round(42.0, "bushing:z")                     # doctest: +SKIP
     >>> curve = band.round(r)                                      # doctest: +SKIP
     """
+    target = target_name(target)
     h = _models.resolve_harmonic(harmonic)
     tire = _models.resolve_tire(tire)
     dirs = _models.coupled_directions(coupling)
