@@ -223,7 +223,7 @@ def band_block(
         ``(n_k, n_l, n_e)``, ``checkpoints``, ``l0``, ``l1`` and the provenance of the run
         (``worker``, ``host``, ``pid``, ``seconds``).
     """
-    from ..studies import _kernels
+    from ..studies import _noise_kernels
     from ..studies import scatter as _sc
     from ..studies._rng import seed_key
 
@@ -258,7 +258,7 @@ def band_block(
         b = min(l1, a + chunk)
         m = mag[: b - a]
         with _sc._LOCK:
-            _kernels.noisy_block_run(
+            _noise_kernels.noisy_block_run(
                 *inputs.arrays,
                 a,
                 b,
@@ -271,7 +271,7 @@ def band_block(
                 m,
                 _sc._EMPTY_CPLX,
             )
-            _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, a - l0)
+            _noise_kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, a - l0)
     return {
         "l0": int(l0),
         "l1": int(l1),

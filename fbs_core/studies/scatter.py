@@ -42,7 +42,7 @@ from .._typing import AnyArray, ComplexArray, FloatArray, IntArray
 from ..errors import DataFormatError, FBSError, SingularInterfaceError, StudyCancelled
 from ..frf import check_grid
 from ..harmonics import Harmonic
-from . import _kernels, _models
+from . import _models, _noise_kernels
 from ._rng import as_seed, seed_key
 
 #: Largest number of Monte-Carlo rounds of one band (one line's working memory,
@@ -271,14 +271,14 @@ class ScatterBand:
         nj, ne = arrays[2].shape[1], arrays[6].shape[1]
         tire, vehicle = _flags(self.target)
         stream_line = line if self.frequency_dependent else 0
-        s = _kernels.noise_factors(
+        s = _noise_kernels.noise_factors(
             key, np.array([r], np.int64), np.array([stream_line]), self.noise, nj, ne, tire, vehicle
         )[0]
         return split_factors(s, nj, ne)
 
 
 def split_factors(s: FloatArray, nj: int, ne: int) -> dict[str, FloatArray]:
-    """Split one stream of factors into the four scaling arrays (layout of :mod:`._kernels`)."""
+    """The four scaling arrays of one stream of factors (layout of :mod:`._noise_kernels`)."""
     o1, o2, o3 = nj * nj, nj * nj + nj, 2 * nj * nj + nj
     return {
         "Yjj_A": s[..., :o1].reshape(s.shape[:-1] + (nj, nj)),
@@ -333,7 +333,7 @@ def _run_complex(
     nf, ne = arrays[0].shape[0], arrays[6].shape[1]
     out = np.empty((rids.size, nf, ne), np.complex128)
     with _LOCK:
-        _kernels.noisy_block_run(
+        _noise_kernels.noisy_block_run(
             *arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep, _EMPTY_MAG, out
         )
     return out
@@ -367,7 +367,7 @@ def _check_inputs(
     for name, x in (("YjjA", YjjA), ("vj", vj), ("YjjE", YjjE), ("YejE", YejE)):
         if not np.all(np.isfinite(x)):
             raise DataFormatError(f"{name} contains non-finite values")
-    order = _ro(_kernels.pivot_order(YjjA, YjjE))
+    order = _ro(_noise_kernels.pivot_order(YjjA, YjjE))
     return (*_split(YjjA), *_split(vj), *_split(YjjE), *_split(YejE), order)
 
 
@@ -501,7 +501,7 @@ def scatter_band_arrays(
         l1 = min(nf, l0 + chunk)
         m = mag[: l1 - l0]
         with _LOCK:
-            _kernels.noisy_block_run(
+            _noise_kernels.noisy_block_run(
                 *arrays,
                 l0,
                 l1,
@@ -514,7 +514,7 @@ def scatter_band_arrays(
                 m,
                 _EMPTY_CPLX,
             )
-            _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
+            _noise_kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
         if progress is not None:
             progress(l1, nf)
     del mag
