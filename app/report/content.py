@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 import fbs_core
 from fbs_core.harmonics import Harmonic
 from fbs_core.vocabulary import fraction, percent
+from fbs_core.vocabulary import magnitude_db as level_db  # the dashboard's dB conversion
 
 from . import figures
 from .method import EQUATIONS, METHOD_PARAGRAPHS, THESIS, Equation
@@ -89,12 +90,6 @@ class Report:
     method: tuple[str, ...]
     equations: tuple[Equation, ...]
     thesis: str
-
-
-def level_db(x: ArrayLike) -> np.ndarray:
-    """``20 log10 |x|`` with magnitudes floored at 1e-30 (the dashboard's dB conversion)."""
-    db: np.ndarray = 20.0 * np.log10(np.maximum(np.abs(np.asarray(x)), 1e-30))
-    return db
 
 
 def _fixed(x: SupportsFloat, digits: int) -> str:

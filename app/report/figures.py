@@ -27,6 +27,7 @@ from matplotlib.patches import Patch
 from numpy.typing import ArrayLike
 
 from fbs_core.units import frf_unit, output_kind
+from fbs_core.vocabulary import magnitude_db as _db
 from fbs_core.vocabulary import percent
 
 from .colormap import LINE_STYLES, ErrorColorScale, threshold_contour
@@ -72,11 +73,6 @@ def level_unit(dof: str) -> str:
     """Unit of a bushing velocity level per road amplitude (``bushing:rz`` -> rad/s)."""
     d = dof.split(":")[-1]
     return f"dB re 1 {frf_unit(output_kind(f'bushing:{d}'), 'road', 'mobility')}"
-
-
-def _db(x: ArrayLike) -> np.ndarray:
-    db: np.ndarray = 20.0 * np.log10(np.maximum(np.abs(np.asarray(x)), 1e-30))
-    return db
 
 
 def _axes(fig: Figure, rect: Rect, legend_rows: int = 1, right: float = 0.0) -> Axes:
