@@ -84,6 +84,19 @@ def test_one_bad_url_value_keeps_the_valid_ones():
     assert s.truncation.threshold == 12.0 and s.truncation.map_mode == "selected DOF"
 
 
+def test_a_link_made_before_the_rename_opens_the_chassis_target():
+    from panel.io.location import Location
+
+    from app.main import sync_url
+
+    s = DashboardState()
+    sync_url(s, Location(search="?target=vehicle&seed=5"))
+    assert (s.noise.target, s.noise.seed) == ("chassis", 5)
+    with pytest.raises(ValueError):
+        s.noise.target = "wheel"
+    assert s.noise.target == "chassis"
+
+
 def test_single_round_stays_inside_the_batch():
     n = NoiseState(rounds=1000, single_round=999)
     n.rounds = 100
