@@ -27,7 +27,15 @@ import numpy as np
 import fbs_core
 from fbs_core import studies
 from fbs_core.units import frf_unit, output_kind
-from fbs_core.vocabulary import DB_FLOOR, DIRECTIONS, EIGEN_SPEEDS, magnitude_db, readonly
+from fbs_core.vocabulary import (
+    DB_FLOOR,
+    DIRECTIONS,
+    EIGEN_SPEEDS,
+    fraction,
+    magnitude_db,
+    percent,
+    readonly,
+)
 
 __all__ = [
     "DB_FLOOR",
@@ -255,7 +263,7 @@ def error_map_data(
     return {
         "centre_freq": np.asarray(m.centres, float),
         "n_modes": np.asarray(m.n_modes, int),
-        "error_pct": 100.0 * np.asarray(err, float),
+        "error_pct": percent(np.asarray(err, float)),
     }
 
 
@@ -300,7 +308,7 @@ def suggested_table_ready(
 def _suggested_table(threshold_pct, f_max, coupling, dof, models, residual=False) -> dict:
     maps = [error_map(k, coupling, models, residual) for k in range(1, 8)]
     s = studies.suggest_modes(
-        threshold=threshold_pct / 100.0,
+        threshold=fraction(threshold_pct),
         f_max=f_max,
         maps=maps,
         dof=None if dof is None else f"bushing:{dof}",
@@ -487,7 +495,7 @@ def band(*args, cancel=None, progress=None, **kwargs):
     harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models = key
     res = studies.scatter_band(
         harmonic,
-        noise=noise_pct / 100.0,
+        noise=fraction(noise_pct),
         target=target,
         rounds=rounds,
         frequency_dependent=fdep,
@@ -525,9 +533,8 @@ def band_data(result, dof: str, percentile: float = 90) -> dict:
     cols = {
         "freq": np.asarray(result.freq, float),
         "reference": ref,
-        # ScatterBand.lower / .upper are the min / max over the rounds
-        "minimum": np.asarray(result.lower[:, j], float),
-        "maximum": np.asarray(result.upper[:, j], float),
+        "minimum": np.asarray(result.minimum[:, j], float),
+        "maximum": np.asarray(result.maximum[:, j], float),
         "pct_low": np.asarray(result.percentiles[q.index(lo), :, j], float),
         "pct_high": np.asarray(result.percentiles[q.index(hi), :, j], float),
     }

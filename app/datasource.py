@@ -323,11 +323,11 @@ class DataSource(param.Parameterized):
             return self._load_tire(data, filename)
 
     def _load_tire(self, data: bytes, filename: str | None) -> bool:
-        from fbs_core.io import load_tire_model
+        from fbs_core.io import import_tire_model
 
         name = filename or "upload"
         try:
-            res = load_tire_model(bytes(data), filename=name)
+            res = import_tire_model(bytes(data), filename=name)
             notes = check_tire(res.model)
             check_pair(res.model, self.models.chassis)
         except FBSError as e:

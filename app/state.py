@@ -28,7 +28,9 @@ __all__ = [
 ]
 
 #: Where the Monte-Carlo noise is applied (thesis eqs. 5.2-5.4).
-NOISE_TARGETS = ("both", "tire", "vehicle")
+NOISE_TARGETS = ("both", "tire", "chassis")  # fbs_core.studies.scatter.TARGETS
+#: Old names of targets (links made before the rename still open on the same state).
+RENAMED_TARGETS = {"vehicle": "chassis"}
 #: Retained-mode counts offered (thesis 5.1: 10 to 400 in steps of 10).
 MODE_COUNTS = tuple(range(10, 401, 10))
 #: Largest noise level in percent (fbs_core.scatter_band needs p < 1, two decimals here).
@@ -37,6 +39,13 @@ MAX_NOISE_PCT = 99.99
 MAX_SEED = 2**32 - 1
 #: What the truncation error map shows.
 MAP_MODES = ("selected DOF", "max over 6 DOFs")
+
+
+class _TargetSelector(param.Selector):
+    """The noise target; an old name (:data:`RENAMED_TARGETS`) is set as its new one."""
+
+    def __set__(self, obj: object, val: object) -> None:
+        super().__set__(obj, RENAMED_TARGETS.get(val, val) if isinstance(val, str) else val)
 
 
 class CaseState(param.Parameterized):
@@ -92,7 +101,7 @@ class NoiseState(param.Parameterized):
         doc="Noise level p in percent: scaling factors uniform in [1-p, 1+p] "
         "(below 100 %: a factor must stay positive, as fbs_core.scatter_band requires).",
     )
-    target = param.Selector(
+    target = _TargetSelector(
         default="both", objects=list(NOISE_TARGETS), doc="Subsystem(s) that get noise."
     )
     frequency_dependent = param.Boolean(

@@ -29,7 +29,7 @@ def timed(fn, repeat=3):
 
 
 def main():
-    t, _ = timed(lambda: storage.load_tire_model(storage.DATA_FILE))
+    t, _ = timed(lambda: storage.read_tire_h5(storage.DATA_FILE))
     print(f"load data/reference_tire.h5:                     {t * 1e3:8.1f} ms")
     tire = reference_tire()
     ns = list(range(10, 401, 10))

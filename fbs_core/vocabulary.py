@@ -6,6 +6,8 @@ spelling them again.
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
@@ -17,7 +19,9 @@ __all__ = [
     "DIRECTIONS",
     "EIGEN_SPEEDS",
     "HARMONIC_CASES",
+    "fraction",
     "magnitude_db",
+    "percent",
     "readonly",
 ]
 
@@ -33,6 +37,34 @@ HARMONIC_CASES: tuple[int, ...] = tuple(range(1, 8))
 
 #: Magnitudes are floored at this value before the dB conversion (no ``-inf`` at zeros).
 DB_FLOOR = 1e-30
+
+_Ratio = TypeVar("_Ratio", float, np.ndarray)
+
+
+def percent(fraction: _Ratio) -> _Ratio:
+    """A ratio of the core in percent, as the dashboard shows it (0.2 -> 20.0).
+
+    The core takes and returns ratios as fractions: the noise level ``p`` (0.1 = +-10 %),
+    the eq. 5.1 error and its threshold (0.2 = 20 %). The dashboard shows percent; this and
+    :func:`fraction` are its only conversions.
+
+    Examples
+    --------
+    >>> percent(0.2)
+    20.0
+    """
+    return fraction * 100.0
+
+
+def fraction(percent: _Ratio) -> _Ratio:
+    """A percentage of the dashboard as the core's fraction (20.0 -> 0.2); see :func:`percent`.
+
+    Examples
+    --------
+    >>> fraction(10.0)
+    0.1
+    """
+    return percent / 100.0
 
 
 def readonly(a: ArrayLike, dtype: DTypeLike | None = None) -> np.ndarray:

@@ -129,10 +129,10 @@ def test_offloaded_band_runs_on_the_workers_equals_the_in_process_band_and_shows
         percentiles=compute.Q_LEVELS,
     )
     b = res.band.result
-    for k in ("lower", "upper", "percentiles", "reference"):
+    for k in ("minimum", "maximum", "percentiles", "reference"):
         np.testing.assert_allclose(getattr(b, k), getattr(direct, k), rtol=1e-12, atol=0)
     np.testing.assert_array_equal(b.argmax_round, direct.argmax_round)
-    np.testing.assert_allclose(b.convergence.upper, direct.convergence.upper, rtol=1e-12)
+    np.testing.assert_allclose(b.convergence.maximum, direct.convergence.maximum, rtol=1e-12)
     r = int(direct.argmax_round[50, 2])  # a round regenerates as the in-process one does
     np.testing.assert_allclose(b.round(r), direct.round(r), rtol=1e-12, atol=0)
     assert res.band_curves.meta["rounds"] == rounds  # drawn and exported like any band

@@ -32,7 +32,7 @@ def test_every_control_of_the_issue_exists_with_its_range():
     assert n.param.noise.softbounds == (0.0, 10.0)
     n.noise = 0.25
     n.noise = 25.0
-    assert set(n.param.target.objects) == {"tire", "vehicle", "both"}
+    assert set(n.param.target.objects) == {"tire", "chassis", "both"}
     n.frequency_dependent = True
     n.rounds = 100
     assert t.threshold == 20.0 and t.f_max == 160.0
@@ -68,7 +68,7 @@ def test_every_accepted_noise_level_and_seed_runs_in_the_library():
 
     n = NoiseState(noise=MAX_NOISE_PCT, seed=MAX_SEED)  # the largest values a user can set
     band = fbs_core.scatter_band(1, noise=n.noise / 100, rounds=5, seed=n.seed)
-    assert band.rounds == 5 and np.all(band.upper >= band.lower)
+    assert band.rounds == 5 and np.all(band.maximum >= band.minimum)
 
 
 def test_one_bad_url_value_keeps_the_valid_ones():
@@ -82,6 +82,19 @@ def test_one_bad_url_value_keeps_the_valid_ones():
     assert (s.case.harmonic, s.case.n_modes, s.case.dof) == (1, 150, "x")
     assert (s.noise.noise, s.noise.seed) == (10.0, 5)
     assert s.truncation.threshold == 12.0 and s.truncation.map_mode == "selected DOF"
+
+
+def test_a_link_made_before_the_rename_opens_the_chassis_target():
+    from panel.io.location import Location
+
+    from app.main import sync_url
+
+    s = DashboardState()
+    sync_url(s, Location(search="?target=vehicle&seed=5"))
+    assert (s.noise.target, s.noise.seed) == ("chassis", 5)
+    with pytest.raises(ValueError):
+        s.noise.target = "wheel"
+    assert s.noise.target == "chassis"
 
 
 def test_single_round_stays_inside_the_batch():

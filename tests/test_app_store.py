@@ -67,7 +67,7 @@ def test_an_export_during_a_band_describes_the_band_it_holds(monkeypatch):
         7, noise=0.1, rounds=200, n_modes=50, percentiles=compute.Q_LEVELS, seed=0
     )
     j = want.dofs.index("bushing:z")
-    np.testing.assert_allclose(cols["maximum_dB"], 20 * np.log10(want.upper[:, j]), rtol=1e-12)
+    np.testing.assert_allclose(cols["maximum_dB"], 20 * np.log10(want.maximum[:, j]), rtol=1e-12)
 
 
 class Recorder(bands.Turnstile):

@@ -172,7 +172,7 @@ def test_exports_hold_the_plotted_data_and_the_core_truth(page):
         percentiles=compute.Q_LEVELS,
     )
     j = band.dofs.index(f"bushing:{c.dof}")
-    np.testing.assert_allclose(cols["maximum_dB"], _db(band.upper[:, j]), rtol=1e-12)
+    np.testing.assert_allclose(cols["maximum_dB"], _db(band.maximum[:, j]), rtol=1e-12)
     np.testing.assert_array_equal(cols["maximum_dB"], src["scatter.minmax"].data["upper"])
     np.testing.assert_allclose(
         cols[f"round_{n.single_round}_dB"], _db(band.round(n.single_round)[:, j]), rtol=1e-12

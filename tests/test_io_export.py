@@ -50,8 +50,8 @@ def scatter() -> ScatterBand:
         freq=F,
         dofs=DOFS,
         reference=ref,
-        lower=lo,
-        upper=hi,
+        minimum=lo,
+        maximum=hi,
         argmin_round=arg,
         argmax_round=arg,
         q=np.array([5.0, 95.0]),
@@ -78,7 +78,7 @@ def test_study_result_is_flattened_with_named_axes():
     assert md["fbs_core_version"] == fbs_core.__version__ and md["kind"] == "TruncationMap"
     band = as_result_data(scatter())
     assert band.arrays["percentiles"][0] == ("q", "freq", "dofs")
-    assert band.arrays["convergence/lower"][0] == ("convergence/rounds", "freq", "dofs")
+    assert band.arrays["convergence/minimum"][0] == ("convergence/rounds", "freq", "dofs")
     assert band.metadata["seed"] == 42 and band.metadata["noise"] == 0.1
 
 

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from fbs_core import FRF
 from fbs_core.errors import FBSError
-from fbs_core.io import load_frf, load_tire_model, save_frf
+from fbs_core.io import import_tire_model, load_frf, save_frf
 from fbs_core.io.modal import write_tire_mat
 
 TIMEOUT = 3.0
@@ -77,7 +77,7 @@ def run(kind: str, raw: bytes) -> None:
     name = seeds()[kind][1]
     try:
         if kind.startswith("tire"):
-            load_tire_model(raw, filename=name, timeout=TIMEOUT)
+            import_tire_model(raw, filename=name, timeout=TIMEOUT)
         else:
             load_frf(raw, filename=name, timeout=TIMEOUT)
     except FBSError as e:

@@ -9,7 +9,7 @@ import pytest
 import scipy.io
 
 from fbs_core.errors import DataFormatError
-from fbs_core.io import load_tire_model
+from fbs_core.io import import_tire_model
 from fbs_core.io.modal import write_tire_mat
 from fbs_core.tire.model import TireModel
 
@@ -41,7 +41,7 @@ def mat5(**v) -> bytes:
 @pytest.mark.parametrize("version", ["5", "7.3"])
 def test_tire_model_round_trip_gives_the_same_mobility(version):
     tire = small_tire()
-    r = load_tire_model(write_tire_mat(tire, version=version), filename="tire.mat")
+    r = import_tire_model(write_tire_mat(tire, version=version), filename="tire.mat")
     model, summary = r
     f = np.linspace(5.0, 150.0, 60)
     for v in (20.0, 70.0):
@@ -69,23 +69,23 @@ def _vars(tire=None, **changes):
 def test_tire_model_layout_errors():
     t = small_tire()
     with pytest.raises(DataFormatError, match="lacks the variable 'chi'"):
-        load_tire_model(mat5(**_vars(chi=None)), filename="t.mat")
+        import_tire_model(mat5(**_vars(chi=None)), filename="t.mat")
     with pytest.raises(DataFormatError, match="'psi' has size 2x10x5"):
-        load_tire_model(mat5(**_vars(psi=t.psi[:, :, :5])), filename="t.mat")
+        import_tire_model(mat5(**_vars(psi=t.psi[:, :, :5])), filename="t.mat")
     with pytest.raises(DataFormatError, match="n_speeds = 3"):
-        load_tire_model(mat5(**_vars(speeds=np.array([20.0, 60.0, 120.0]))), filename="t.mat")
+        import_tire_model(mat5(**_vars(speeds=np.array([20.0, 60.0, 120.0]))), filename="t.mat")
     bad = np.array(t.poles)
     bad[0, 0] = np.inf
     with pytest.raises(DataFormatError, match="non-finite"):
-        load_tire_model(mat5(**_vars(poles=bad)), filename="t.mat")
+        import_tire_model(mat5(**_vars(poles=bad)), filename="t.mat")
     bad = np.array(t.poles)
     bad[0, 1] = bad[0, 0]
     with pytest.raises(DataFormatError, match="conjugate pairs"):
-        load_tire_model(mat5(**_vars(poles=bad)), filename="t.mat")
+        import_tire_model(mat5(**_vars(poles=bad)), filename="t.mat")
     with pytest.raises(DataFormatError, match="'hub_dofs' must be 6"):
-        load_tire_model(mat5(**_vars(), hub_dofs=np.array(["hub:x"])), filename="t.mat")
+        import_tire_model(mat5(**_vars(), hub_dofs=np.array(["hub:x"])), filename="t.mat")
     with pytest.raises(DataFormatError, match="tire models are read from MATLAB"):
-        load_tire_model(b"freq,Re(a:x / a:x)\n1,2,3\n", filename="t.csv")
+        import_tire_model(b"freq,Re(a:x / a:x)\n1,2,3\n", filename="t.csv")
 
 
 def test_project_format_is_read_through_the_owners_reader(tmp_path):
@@ -93,7 +93,7 @@ def test_project_format_is_read_through_the_owners_reader(tmp_path):
 
     tire = small_tire()
     p = storage.save_tire_model(tire, tmp_path / "t.h5")
-    model, summary = load_tire_model(p.read_bytes(), filename="upload.h5")
+    model, summary = import_tire_model(p.read_bytes(), filename="upload.h5")
     f = np.linspace(5.0, 150.0, 40)
     assert model.hub_mobility(f, 50.0).allclose(tire.hub_mobility(f, 50.0), rtol=1e-12)
     assert "tire-fbs tire model" in summary
@@ -103,7 +103,7 @@ def test_shipped_reference_tire_reads_unchanged():
     from fbs_core.tire import storage
 
     before = storage.DATA_FILE.read_bytes()
-    model = load_tire_model(storage.DATA_FILE).model
+    model = import_tire_model(storage.DATA_FILE).model
     np.testing.assert_array_equal(model.poles, storage.reference_tire().poles)
     assert storage.DATA_FILE.read_bytes() == before
 
@@ -115,14 +115,14 @@ def test_project_format_refusals():
     from fbs_core.tire import storage
 
     with pytest.raises(DataFormatError, match="is not a 'tire-fbs/modal-tire' file"):
-        load_tire_model(save_frf(_frf_for_refusal(), format="hdf5"), filename="t.h5")
+        import_tire_model(save_frf(_frf_for_refusal(), format="hdf5"), filename="t.h5")
     b = io.BytesIO()
     with h5py.File(b, "w") as h:
         h.attrs["format"] = storage.FORMAT
         h.attrs["format_version"] = 99
         h["speeds"] = np.array([20.0, np.nan])
     with pytest.raises(DataFormatError, match="non-finite"):
-        load_tire_model(b.getvalue(), filename="t.h5")
+        import_tire_model(b.getvalue(), filename="t.h5")
 
 
 def _frf_for_refusal():
@@ -176,7 +176,7 @@ def _deep_json(depth=100_000):
 def test_crafted_tire_files_end_in_domain_errors(tmp_path, edit, match):
     raw = _crafted(tmp_path, edit)
     with pytest.raises(DataFormatError, match=match):
-        load_tire_model(raw, filename="crafted.h5")
+        import_tire_model(raw, filename="crafted.h5")
 
 
 def test_the_uploaded_tire_file_is_never_opened_in_this_process(tmp_path, monkeypatch):
@@ -190,5 +190,5 @@ def test_the_uploaded_tire_file_is_never_opened_in_this_process(tmp_path, monkey
         raise AssertionError("h5py.File opened in the server process")
 
     monkeypatch.setattr(h5py, "File", refuse)
-    model = load_tire_model(raw, filename="upload.h5").model
+    model = import_tire_model(raw, filename="upload.h5").model
     np.testing.assert_array_equal(model.poles, small_tire().poles)

@@ -44,6 +44,22 @@ def test_round_trip_bytes(fmt, quantity):
     assert "spindle:z" in r.summary and "0.5 to 80 Hz" in r.summary
 
 
+@pytest.mark.parametrize(
+    "fmt, mat_version, label",
+    [
+        ("uff", "5", "UFF 58"),
+        ("csv", "5", "CSV"),
+        ("hdf5", "5", "HDF5"),
+        ("mat", "5", "MATLAB v5"),
+        ("mat", "7.3", "MATLAB v7.3"),
+    ],
+)
+def test_the_import_names_the_format_it_read(fmt, mat_version, label):
+    raw = save_frf(two_dof(FREQ[:8]), format=fmt, mat_version=mat_version)
+    r = load_frf(raw, filename=f"up.{ENDING[fmt]}")
+    assert r.format == label and r.summary.startswith(f"up.{ENDING[fmt]} ({label}): ")
+
+
 def test_round_trip_mat73_and_binary_uff(tmp_path):
     Y = two_dof(FREQ)
     p = save_frf(Y, tmp_path / "y73.mat", mat_version="7.3", metadata={"N": 40})

@@ -156,7 +156,7 @@ def test_html_holds_the_numbers(parsed, snap):
     band = tabs[next(c for c in tabs if c.startswith("Levels at the reference peak"))]
     j = snap.band.dofs.index("bushing:z")
     i = int(np.argmax(np.abs(snap.band.reference[:, j])))
-    hi = 20 * np.log10(snap.band.upper[i, j])
+    hi = 20 * np.log10(snap.band.maximum[i, j])
     assert ["maximum over the rounds", f"{hi:.2f} dB"] in band
     data = tabs["Data in use"]
     assert ["chassis", "uploaded file 'rear corner <v2>.uff'", "0123abcd4567"] in data
@@ -216,6 +216,16 @@ def test_snapshot_refuses_results_that_do_not_match(results):
         Snapshot(
             settings=dict(harmonic=1, n_modes=20, dof="z", coupling="6dof"), band=results["band"]
         )
+
+
+def test_a_plot_of_a_missing_result_is_a_report_error(results):
+    from app.report import figures
+
+    s = Snapshot(settings=SETTINGS, url=URL, truncation=results["truncation"])  # no band
+    with pytest.raises(ReportError, match="holds no scatter band"):
+        figures.draw_band(s)
+    with pytest.raises(ReportError, match="holds no eigenfrequencies"):
+        figures.draw_eigen(s)
 
 
 def test_plot_file_png_carries_the_title_block(snap):

@@ -94,7 +94,7 @@ def test_title_block_lines():
     assert tb.what.startswith("Noise scatter band")
     assert harmonic_description(4) in tb.lines
     assert "DOF bushing:z | N = 60 of 400 tire modes | 6-DOF hub coupling (braked wheel)" in text
-    assert "Noise p = 10 % in tire and vehicle (eq. 5.4)" in text
+    assert "Noise p = 10 % in tire and chassis (eq. 5.4)" in text
     assert "R = 10,000 rounds, seed 0, 90 % central band, round #0" in text
     assert "uploaded tire 'my tire.h5', digest d1g3st" in text
     assert "uploaded chassis 'car.uff', digest ab12" in text

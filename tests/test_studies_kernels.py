@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import fbs_core as fc
-from fbs_core.studies import _kernels, _rng
+from fbs_core.studies import _noise_kernels, _rng
 
 MASK = (1 << 64) - 1
 G = 0x9E3779B97F4A7C15
@@ -42,11 +42,11 @@ def _numba_solve(A, b):
     zero = np.zeros((m, n, n))
     args = [np.ascontiguousarray(x) for z in (A, b) for x in (z.real, z.imag)]
     args[4:4] = [zero, zero]
-    args += [np.ascontiguousarray(eye), zero, _kernels.pivot_order(A, 0 * A)]
+    args += [np.ascontiguousarray(eye), zero, _noise_kernels.pivot_order(A, 0 * A)]
     for x in args:
         x.setflags(write=False)  # the signature the library compiles
     out = np.empty((1, m, n), complex)
-    _kernels.noisy_block_run(
+    _noise_kernels.noisy_block_run(
         *args,
         0,
         m,
@@ -108,11 +108,11 @@ def test_numpy_factors_equal_kernel_factors():
     rids = np.array([0, 7, 33], np.int64)
     out = np.empty((3, m, n), complex)
     key = _rng.seed_key(9)
-    _kernels.noisy_block_run(
+    _noise_kernels.noisy_block_run(
         *args, 0, m, key, rids, 0.1, True, False, True, np.empty((0, 0, 0)), out
     )
     lines = np.tile(np.arange(m), 3)
-    s = _kernels.noise_factors(key, np.repeat(rids, m), lines, 0.1, n, n, True, False)
+    s = _noise_kernels.noise_factors(key, np.repeat(rids, m), lines, 0.1, n, n, True, False)
     S = fc.studies.scatter.split_factors(s.reshape(3, m, -1), n, n)
     # y = S_A^-1-free: with A = I scaled by S_A (diagonal only matters), x = s_a / diag(S_A)
     d = np.einsum("rfii->rfi", S["Yjj_A"])
@@ -131,14 +131,14 @@ def test_lane_kernel_equals_numpy_on_random_systems():
     for fd in (False, True):
         out = np.empty((rids.size, nf, ne), complex)
         args = [x for z in (A, a, E, B) for x in (z.real.copy(), z.imag.copy())]
-        args.append(_kernels.pivot_order(A, E))
+        args.append(_noise_kernels.pivot_order(A, E))
         for x in args:
             x.setflags(write=False)
-        _kernels.noisy_block_run(
+        _noise_kernels.noisy_block_run(
             *args, 0, nf, key, rids, 0.1, True, True, fd, np.empty((0, 0, 0)), out
         )
         lines = np.tile(np.arange(nf) if fd else np.zeros(nf, np.int64), rids.size)
-        s = _kernels.noise_factors(key, np.repeat(rids, nf), lines, 0.1, nj, ne, True, True)
+        s = _noise_kernels.noise_factors(key, np.repeat(rids, nf), lines, 0.1, nj, ne, True, True)
         S = fc.studies.scatter.split_factors(s.reshape(rids.size, nf, -1), nj, ne)
         x = np.linalg.solve(S["Yjj_A"] * A + S["Yjj_E"] * E, (S["vj_A"] * a)[..., None])
         y = np.einsum("rfek,rfk->rfe", S["Yej_E"] * B, x[..., 0])
@@ -151,7 +151,7 @@ def test_pivot_order_is_lapack_partial_pivoting():
     rng = np.random.default_rng(4)
     A, E = _rand_c(rng, 30, 6, 6), _rand_c(rng, 30, 6, 6)
     A[:10] *= np.logspace(-5, 5, 6)[:, None]  # rows of very different size
-    order = _kernels.pivot_order(A, E)
+    order = _noise_kernels.pivot_order(A, E)
     for line in range(30):
         P = sla.lu(A[line] + E[line])[0]
         np.testing.assert_array_equal(order[line], np.argmax(P, axis=0))
@@ -179,7 +179,7 @@ def test_row_order_changes_no_result():
     for y in args:
         y.setflags(write=False)
     out = np.empty((1, m, n), complex)
-    _kernels.noisy_block_run(
+    _noise_kernels.noisy_block_run(
         *args,
         0,
         m,
@@ -196,10 +196,12 @@ def test_row_order_changes_no_result():
 
 
 def test_rng_matches_python_reference():
-    n_el = _kernels.n_elements(6, 6)
+    n_el = _noise_kernels.n_elements(6, 6)
     for seed, r, line in [(0, 0, 0), (1, 9999, 0), (12345, 17, 1999), (2**63 + 5, 3, 7)]:
         key = _rng.seed_key(seed)
-        s = _kernels.noise_factors(key, np.array([r]), np.array([line]), 0.1, 6, 6, True, True)
+        s = _noise_kernels.noise_factors(
+            key, np.array([r]), np.array([line]), 0.1, 6, 6, True, True
+        )
         np.testing.assert_array_equal(s[0], _factors_python(seed, r, line, 0.1, n_el))
 
 
@@ -207,7 +209,7 @@ def test_rng_is_uniform_on_the_interval_and_independent():
     p = 0.1
     n = 4000
     key = _rng.seed_key(0)
-    s = _kernels.noise_factors(key, np.arange(n), np.zeros(n, np.int64), p, 6, 6, True, True)
+    s = _noise_kernels.noise_factors(key, np.arange(n), np.zeros(n, np.int64), p, 6, 6, True, True)
     assert s.min() >= 1 - p and s.max() < 1 + p
     u = (s.ravel() - (1 - p)) / (2 * p)
     # mean 1/2, variance 1/12 of U(0, 1); histogram flat (chi-square, 20 bins)
@@ -225,8 +227,8 @@ def test_rng_is_uniform_on_the_interval_and_independent():
 def test_rng_streams_differ_by_seed_round_and_line():
     key0, key1 = _rng.seed_key(0), _rng.seed_key(1)
     r = np.array([0, 0, 1]), np.array([0, 1, 0])
-    s0 = _kernels.noise_factors(key0, *r, 0.1, 6, 6, True, True)
-    s1 = _kernels.noise_factors(key1, *r, 0.1, 6, 6, True, True)
+    s0 = _noise_kernels.noise_factors(key0, *r, 0.1, 6, 6, True, True)
+    s1 = _noise_kernels.noise_factors(key1, *r, 0.1, 6, 6, True, True)
     assert not np.any(s0[0] == s0[1]) and not np.any(s0[0] == s0[2])
     assert not np.any(s0 == s1)
 
@@ -246,7 +248,7 @@ def _stats(mag, qs):
     out = [np.empty((nl, ne)) for _ in range(2)] + [np.empty((nl, ne), np.int64) for _ in range(2)]
     pct = np.empty((len(qs), nl, ne))
     conv = [np.empty((1, nl, ne)) for _ in range(2)]
-    _kernels.band_stats(mag, np.asarray(qs, float), ck, *out, pct, *conv, 0)
+    _noise_kernels.band_stats(mag, np.asarray(qs, float), ck, *out, pct, *conv, 0)
     return out, pct
 
 
@@ -272,10 +274,10 @@ def test_band_percentiles_when_the_sample_misleads():
     R = 5000
     rng = np.random.default_rng(0)
     col = rng.uniform(1.0, 2.0, R)
-    m = _kernels._SAMPLE
+    m = _noise_kernels._SAMPLE
     col[(np.arange(m) * R) // m] = 1e-3 * (1 + np.arange(m))  # sample: all tiny
     col[1] = 1e9  # an outlier: the histogram's bins are too coarse, it declines too
-    assert not _kernels._order_stats_histogram(
+    assert not _noise_kernels._order_stats_histogram(
         col, col.min(), col.max(), np.array([R // 2]), np.empty(1)
     )
     mag = np.ascontiguousarray(np.broadcast_to(col, (1, 1, R)))
@@ -299,7 +301,7 @@ def test_histogram_order_statistics_are_exact(shape):
     ranks = np.array([0, 1, 499, 500, 4999, 5000, 9498, 9499, 9998, 9999], np.int64)
     out = np.full(ranks.size, np.nan)
     before = col.copy()
-    ok = _kernels._order_stats_histogram(col, col.min(), col.max(), ranks, out)
+    ok = _noise_kernels._order_stats_histogram(col, col.min(), col.max(), ranks, out)
     np.testing.assert_array_equal(col, before)  # the column is left as it was
     assert ok == (shape != "outliers")
     if ok:

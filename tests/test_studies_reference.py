@@ -60,8 +60,8 @@ def test_mode_frequencies_rise_with_mode_count():
 def test_scatter_band_on_reference_models():
     b0 = fc.scatter_band(4, noise=0.0, rounds=8, frequency_dependent=True)
     mag = np.sqrt(b0.reference.real**2 + b0.reference.imag**2)
-    np.testing.assert_array_equal(b0.upper, mag)
-    np.testing.assert_array_equal(b0.lower, mag)
+    np.testing.assert_array_equal(b0.maximum, mag)
+    np.testing.assert_array_equal(b0.minimum, mag)
     # the reference is eq. 4.1 through the labelled coupling API (second method)
     h = fc.harmonic(4)
     f = h.frequencies()
@@ -79,13 +79,13 @@ def test_scatter_band_on_reference_models():
     )
     np.testing.assert_allclose(b0.reference, r.data[..., 0], rtol=1e-9)
     b = fc.scatter_band(4, noise=0.1, rounds=500, frequency_dependent=True, seed=1)
-    assert np.all(b.lower <= mag) and np.all(mag <= b.upper)
+    assert np.all(b.minimum <= mag) and np.all(mag <= b.maximum)
     assert b.percentiles.shape == (2, f.size, 6)
-    assert np.all(b.lower <= b.percentiles[0]) and np.all(b.percentiles[1] <= b.upper)
+    assert np.all(b.minimum <= b.percentiles[0]) and np.all(b.percentiles[1] <= b.maximum)
     r = b.peak_round(42.0, "bushing:z")
     line = int(np.argmin(np.abs(f - 42.0)))
     z = b.round(r)[line, 2]
-    assert np.sqrt(z.real**2 + z.imag**2) == b.upper[line, 2]
+    assert np.sqrt(z.real**2 + z.imag**2) == b.maximum[line, 2]
 
 
 def test_five_dof_coupling_changes_the_prediction():

@@ -51,8 +51,8 @@ def _band(arrays, **kw):
 def test_zero_noise_reproduces_the_reference_exactly(arrays):
     b = _band(arrays, noise=0.0, frequency_dependent=True)
     ref = _mag(b.reference)
-    np.testing.assert_array_equal(b.lower, ref)
-    np.testing.assert_array_equal(b.upper, ref)
+    np.testing.assert_array_equal(b.minimum, ref)
+    np.testing.assert_array_equal(b.maximum, ref)
     np.testing.assert_array_equal(b.percentiles, np.broadcast_to(ref, b.percentiles.shape))
     # the reference is eq. 4.1 (second method: numpy batched solve)
     YjjA, vj, YjjE, YejE = arrays
@@ -62,21 +62,21 @@ def test_zero_noise_reproduces_the_reference_exactly(arrays):
 
 
 @pytest.mark.parametrize("fd", [False, True], ids=["freq-independent", "freq-dependent"])
-@pytest.mark.parametrize("target", ["tire", "vehicle", "both"])
+@pytest.mark.parametrize("target", ["tire", "chassis", "both"])
 def test_every_round_inside_band_and_band_is_the_extremes(arrays, fd, target):
     b = _band(arrays, target=target, frequency_dependent=fd, percentiles=(5, 50, 95))
     all_rounds = _mag(b.rounds_response(np.arange(b.rounds)))  # (R, NF, NE)
-    assert np.all(all_rounds >= b.lower) and np.all(all_rounds <= b.upper)
-    np.testing.assert_array_equal(b.lower, all_rounds.min(0))
-    np.testing.assert_array_equal(b.upper, all_rounds.max(0))
+    assert np.all(all_rounds >= b.minimum) and np.all(all_rounds <= b.maximum)
+    np.testing.assert_array_equal(b.minimum, all_rounds.min(0))
+    np.testing.assert_array_equal(b.maximum, all_rounds.max(0))
     np.testing.assert_allclose(
         b.percentiles, np.percentile(all_rounds, (5, 50, 95), axis=0), rtol=1e-13
     )
     # the recorded rounds attain the extremes
     li, di = np.meshgrid(np.arange(NF), np.arange(NE), indexing="ij")
-    np.testing.assert_array_equal(all_rounds[b.argmax_round, li, di], b.upper)
-    np.testing.assert_array_equal(all_rounds[b.argmin_round, li, di], b.lower)
-    assert np.all(b.lower < b.upper)
+    np.testing.assert_array_equal(all_rounds[b.argmax_round, li, di], b.maximum)
+    np.testing.assert_array_equal(all_rounds[b.argmin_round, li, di], b.minimum)
+    assert np.all(b.minimum < b.maximum)
 
 
 def test_regenerated_round_equals_the_batch(arrays):
@@ -85,7 +85,7 @@ def test_regenerated_round_equals_the_batch(arrays):
     line = int(np.argmin(np.abs(FREQ - 35.0)))
     one = b.round(r)
     assert one.shape == (NF, NE)
-    assert _mag(one)[line, 2] == b.upper[line, 2]  # bit for bit the batch's maximum
+    assert _mag(one)[line, 2] == b.maximum[line, 2]  # bit for bit the batch's maximum
     batch = b.rounds_response(np.arange(b.rounds))
     np.testing.assert_array_equal(one, batch[r])
     np.testing.assert_array_equal(b.round(299), batch[299])
@@ -99,10 +99,10 @@ def test_regenerated_round_equals_the_batch(arrays):
     )
 
 
-def test_tire_noise_leaves_vehicle_untouched_and_vice_versa(arrays):
+def test_tire_noise_leaves_chassis_untouched_and_vice_versa(arrays):
     both = _band(arrays, target="both", seed=3, frequency_dependent=True)
     tire = _band(arrays, target="tire", seed=3, frequency_dependent=True)
-    veh = _band(arrays, target="vehicle", seed=3, frequency_dependent=True)
+    veh = _band(arrays, target="chassis", seed=3, frequency_dependent=True)
     for r, line in [(0, 0), (17, 5), (199, 39)]:
         fb, ft, fv = both.factors(r, line), tire.factors(r, line), veh.factors(r, line)
         for k in ("Yjj_E", "Yej_E"):
@@ -140,12 +140,12 @@ def test_same_seed_same_band_other_seed_other_band(arrays):
     a = _band(arrays, seed=11, frequency_dependent=True)
     b = _band(arrays, seed=11, frequency_dependent=True)
     c = _band(arrays, seed=12, frequency_dependent=True)
-    for name in ("lower", "upper", "percentiles", "argmax_round"):
+    for name in ("minimum", "maximum", "percentiles", "argmax_round"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
-    assert not np.array_equal(a.upper, c.upper)
+    assert not np.array_equal(a.maximum, c.maximum)
     g = _band(arrays, seed=np.random.default_rng(4))
     h = _band(arrays, seed=np.random.default_rng(4))
-    np.testing.assert_array_equal(g.upper, h.upper)
+    np.testing.assert_array_equal(g.maximum, h.maximum)
     assert g.seed == h.seed
 
 
@@ -155,9 +155,9 @@ def test_chunking_gives_identical_results_and_bounds_memory(arrays):
     small = _band(arrays, rounds=4000, frequency_dependent=True, max_chunk_bytes=8 * 6 * 4000 * 3)
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
-    for name in ("lower", "upper", "percentiles", "argmin_round"):
+    for name in ("minimum", "maximum", "percentiles", "argmin_round"):
         np.testing.assert_array_equal(getattr(whole, name), getattr(small, name))
-    np.testing.assert_array_equal(whole.convergence.upper, small.convergence.upper)
+    np.testing.assert_array_equal(whole.convergence.maximum, small.convergence.maximum)
     all_rounds_bytes = 4000 * NF * NE * 8
     assert peak < all_rounds_bytes / 4  # chunks of 3 lines, never all rounds at once
 
@@ -166,14 +166,14 @@ def test_convergence_report(arrays):
     b = _band(arrays, rounds=1000, frequency_dependent=True)
     conv = b.convergence
     np.testing.assert_array_equal(conv.rounds, [10, 20, 50, 100, 200, 500, 1000])
-    assert np.all(np.diff(conv.upper, axis=0) >= 0) and np.all(np.diff(conv.lower, axis=0) <= 0)
-    np.testing.assert_array_equal(conv.upper[-1], b.upper)
-    np.testing.assert_array_equal(conv.lower[-1], b.lower)
+    assert np.all(np.diff(conv.maximum, axis=0) >= 0) and np.all(np.diff(conv.minimum, axis=0) <= 0)
+    np.testing.assert_array_equal(conv.maximum[-1], b.maximum)
+    np.testing.assert_array_equal(conv.minimum[-1], b.minimum)
     up, lo = conv.upper_change_db, conv.lower_change_db
     assert up[-1] == 0 and lo[-1] == 0 and np.all(np.diff(up) <= 0) and np.all(up >= 0)
     # running extremes over the first 100 rounds, by the second method
     first = _mag(b.rounds_response(np.arange(100)))
-    np.testing.assert_array_equal(conv.upper[3], first.max(0))
+    np.testing.assert_array_equal(conv.maximum[3], first.max(0))
     assert conv.step_change_db.shape == (6,)
     assert "rounds" in conv.summary()
     custom = _band(arrays, rounds=50, checkpoints=[5, 25])
@@ -185,7 +185,7 @@ def test_results_are_frozen_and_carry_axes(arrays):
     np.testing.assert_array_equal(b.freq, FREQ)
     assert b.dofs == tuple(f"bushing:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))
     with pytest.raises(ValueError):
-        b.upper[0, 0] = 1.0
+        b.maximum[0, 0] = 1.0
     with pytest.raises(AttributeError):
         b.noise = 0.2
 
@@ -203,7 +203,7 @@ def test_singular_interface_raises(arrays):
     [
         (dict(noise=-0.1), fc.FBSError, "noise"),
         (dict(noise=1.0), fc.FBSError, "noise"),
-        (dict(target="chassis"), fc.FBSError, "allowed: tire, vehicle, both"),
+        (dict(target="car"), fc.FBSError, "allowed: tire, chassis, both"),
         (dict(rounds=0), fc.FBSError, "rounds"),
         (dict(rounds=2.5), fc.FBSError, "rounds"),
         (dict(percentiles=(5, 120)), fc.FBSError, "percentiles"),
@@ -252,5 +252,5 @@ def test_concurrent_bands_from_threads_agree(arrays):
         bands = list(
             ex.map(lambda s: _band(arrays, seed=s % 2, frequency_dependent=True), range(4))
         )
-    np.testing.assert_array_equal(bands[0].upper, bands[2].upper)
-    np.testing.assert_array_equal(bands[1].upper, bands[3].upper)
+    np.testing.assert_array_equal(bands[0].maximum, bands[2].maximum)
+    np.testing.assert_array_equal(bands[1].maximum, bands[3].maximum)

@@ -20,7 +20,7 @@ from fbs_core.tire import (
     OperatingPointError,
     TireModel,
     build_modal_model,
-    load_tire_model,
+    read_tire_h5,
     reference_tire,
     save_tire_model,
 )
@@ -236,11 +236,11 @@ def test_shipped_file_is_reproducible(tmp_path):
     """Regenerate two operating points from the stored parameters and compare them with
     data/reference_tire.h5 (poles, and the all-modes synthesis, which does not depend on
     how the modes are ordered or scaled)."""
-    shipped = load_tire_model(DATA_FILE)
+    shipped = read_tire_h5(DATA_FILE)
     assert DATA_FILE.stat().st_size < 7e6
     speeds = (65.0, 67.5)
     new = build_modal_model(shipped.params, speeds=speeds)
-    again = load_tire_model(save_tire_model(new, tmp_path / "tire.h5"))
+    again = read_tire_h5(save_tire_model(new, tmp_path / "tire.h5"))
     f = np.linspace(10.0, 400.0, 25)
     for i, v in enumerate(speeds):
         j = list(shipped.speeds).index(v)
@@ -262,21 +262,21 @@ def test_file_format_attributes_and_errors(tmp_path, tire):
         assert f["speeds"].attrs["unit"] == "km/h"
         assert [s.decode() for s in f["hub_dofs"][()]] == list(HUB_DOFS)
     with pytest.raises(DataFormatError, match="no modal tire file"):
-        load_tire_model(tmp_path / "missing.h5")
+        read_tire_h5(tmp_path / "missing.h5")
     bad = tmp_path / "bad.h5"
     with h5py.File(bad, "w") as f:
         f.attrs["format"] = "something-else"
     with pytest.raises(DataFormatError, match="is not a"):
-        load_tire_model(bad)
+        read_tire_h5(bad)
     path = save_tire_model(tire, tmp_path / "v.h5")
     with h5py.File(path, "a") as f:
         f.attrs["format_version"] = 99
     with pytest.raises(DataFormatError, match="format_version 99"):
-        load_tire_model(path)
+        read_tire_h5(path)
     text = tmp_path / "text.h5"
     text.write_text("not hdf5")
     with pytest.raises(DataFormatError, match="cannot read"):
-        load_tire_model(text)
+        read_tire_h5(text)
 
 
 def test_harmonic_case_keyword_is_deprecated(tire):

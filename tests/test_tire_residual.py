@@ -115,12 +115,12 @@ def test_truncated_delivery_with_residual_is_stored_and_compensates(tmp_path):
     model than the plain truncated one, and version-1 files still load."""
     import h5py
 
-    from fbs_core.tire import load_tire_model, save_tire_model
+    from fbs_core.tire import read_tire_h5, save_tire_model
 
     tire = reference_tire()
     small = tire.truncated(120)
     assert small.n_modes == 120 and small.residual.shape == (tire.speeds.size, 36 + 6 * 7)
-    back = load_tire_model(save_tire_model(small, tmp_path / "t.h5"))
+    back = read_tire_h5(save_tire_model(small, tmp_path / "t.h5"))
     np.testing.assert_array_equal(back.residual, small.residual)
     f = np.linspace(10.0, 120.0, 23)
     v = 61.3
@@ -143,7 +143,7 @@ def test_truncated_delivery_with_residual_is_stored_and_compensates(tmp_path):
     old = save_tire_model(bare, tmp_path / "v1.h5")
     with h5py.File(old, "a") as fh5:
         fh5.attrs["format_version"] = 1
-    m1 = load_tire_model(old)
+    m1 = read_tire_h5(old)
     assert m1.residual is None and m1.n_modes == 400
     with pytest.raises(ValueError, match="residual has shape"):
         TireModel(

@@ -12,8 +12,11 @@ Helpers the live views call on their figures (built once, then only properties a
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from bokeh.models import ColumnDataSource, Legend, LegendItem, SaveTool, Title
+from numpy.typing import ArrayLike
 
 from .colormap import LINE_STYLES, ErrorColorScale, contour_columns, threshold_contour
 from .titles import TitleBlock
@@ -49,7 +52,7 @@ class TitleBlockModels:
     tool's file name), so a change costs a few property patches.
     """
 
-    def __init__(self, fig, lines: int = TITLE_LINES):
+    def __init__(self, fig: Any, lines: int = TITLE_LINES) -> None:
         self.fig = fig
         # Bokeh stacks the "above" panels from the plot outwards: add the last line first
         self.titles = [
@@ -104,7 +107,7 @@ class TitleBlockModels:
             t.text_font_size = s["detail"]
 
 
-def style_figure(fig, mode: str = "normal", legend_side: str = "right") -> None:
+def style_figure(fig: Any, mode: str = "normal", legend_side: str = "right") -> None:
     """Type sizes of ``mode`` (``"normal"`` or ``"present"``) and legends outside the data.
 
     Raises
@@ -143,7 +146,7 @@ class ErrorMapLayers:
         Initial threshold in percent.
     """
 
-    def __init__(self, fig, threshold: float):
+    def __init__(self, fig: Any, threshold: float) -> None:
         self.scale = ErrorColorScale(float(threshold))
         self.mapper = self.scale.bokeh_mapper(name="truncation.mapper")
         self.contour = ColumnDataSource({"xs": [], "ys": []}, name="truncation.contour")
@@ -156,7 +159,9 @@ class ErrorMapLayers:
         )
         self.fig = fig
 
-    def update(self, centres, n_modes, error_pct, threshold: float) -> None:
+    def update(
+        self, centres: ArrayLike, n_modes: ArrayLike, error_pct: ArrayLike, threshold: float
+    ) -> None:
         """New threshold and map: the mapper's cap and the contour polylines."""
         thr = float(threshold)
         if thr != self.scale.threshold:

@@ -13,11 +13,17 @@ line of ``error == threshold`` (:func:`threshold_contour`), and lines drawn over
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import contourpy
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .snapshot import ReportError
+
+if TYPE_CHECKING:
+    from bokeh.models import LinearColorMapper
+    from matplotlib.colors import BoundaryNorm, Colormap
 
 __all__ = [
     "BELOW_PALETTE",
@@ -98,7 +104,7 @@ class ErrorColorScale:
     palette: tuple[str, ...] = BELOW_PALETTE
     above: str = ABOVE_COLOR
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         t = self.threshold
         if isinstance(t, bool) or not isinstance(t, int | float) or not np.isfinite(t) or t <= 0:
             raise ReportError(f"threshold must be a positive number of percent, got {t!r}")
@@ -114,13 +120,13 @@ class ErrorColorScale:
         """The largest value still below the threshold (the top of the sequential scale)."""
         return float(np.nextafter(self.threshold, -np.inf))
 
-    def at_or_above(self, error) -> np.ndarray:
+    def at_or_above(self, error: ArrayLike) -> np.ndarray:
         """Boolean mask of ``error >= threshold`` (NaN: False)."""
         e = np.asarray(error, float)
         with np.errstate(invalid="ignore"):
             return e >= self.threshold
 
-    def colors(self, error) -> np.ndarray:
+    def colors(self, error: ArrayLike) -> np.ndarray:
         """The colour of each error value (``#rrggbb`` strings, same shape as ``error``).
 
         ``[0, threshold)`` is cut into ``len(palette)`` equal steps; negative values take the
@@ -135,7 +141,7 @@ class ErrorColorScale:
         out = np.where(self.at_or_above(e), self.above, out)
         return np.where(np.isnan(e), "#ffffff", out).astype(str)
 
-    def bokeh_mapper(self, name: str | None = None):
+    def bokeh_mapper(self, name: str | None = None) -> LinearColorMapper:
         """A Bokeh ``LinearColorMapper`` with the same mapping (``high_color`` = above).
 
         Bokeh maps values above ``high`` to ``high_color``; ``high`` is :attr:`cap`, so a
@@ -153,7 +159,7 @@ class ErrorColorScale:
             name=name,
         )
 
-    def matplotlib(self):
+    def matplotlib(self) -> tuple[Colormap, BoundaryNorm]:
         """``(cmap, norm)`` for matplotlib: the same steps, :attr:`above` as the over colour."""
         from matplotlib.colors import BoundaryNorm, ListedColormap
 
@@ -164,7 +170,9 @@ class ErrorColorScale:
         return cmap, BoundaryNorm(bounds, cmap.N)
 
 
-def threshold_contour(x, y, error, threshold: float) -> list[np.ndarray]:
+def threshold_contour(
+    x: ArrayLike, y: ArrayLike, error: ArrayLike, threshold: float
+) -> list[np.ndarray]:
     """Polylines of ``error == threshold`` over a grid (the map's threshold boundary).
 
     Linear interpolation on the grid cells (marching squares, :mod:`contourpy`); exact where
@@ -215,7 +223,9 @@ def contour_columns(lines: list[np.ndarray]) -> dict[str, list[list[float]]]:
     }
 
 
-def log_rows(n_modes, error, n_rows: int = 256) -> tuple[float, float, np.ndarray]:
+def log_rows(
+    n_modes: ArrayLike, error: ArrayLike, n_rows: int = 256
+) -> tuple[float, float, np.ndarray]:
     """The map's rows resampled for a logarithmic N axis (an image is stretched linearly
     between its edges on screen, so its rows must be uniform in log N).
 

@@ -8,16 +8,20 @@ the PDF hold the same text.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
 from dataclasses import dataclass
+from typing import SupportsFloat
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import fbs_core
+from fbs_core.harmonics import Harmonic
+from fbs_core.vocabulary import fraction, percent
+from fbs_core.vocabulary import magnitude_db as level_db  # the dashboard's dB conversion
 
 from . import figures
 from .method import EQUATIONS, METHOD_PARAGRAPHS, THESIS, Equation
-from .snapshot import SETTING_KEYS, ReportError, Snapshot
+from .snapshot import SETTING_KEYS, ExtraSection, ReportError, Snapshot, present
 from .titles import (
     TitleBlock,
     coupling_description,
@@ -56,7 +60,7 @@ class FigureBlock:
 
     key: str
     title: TitleBlock
-    draw: Callable
+    draw: figures.Draw
     aspect: float = 0.55
     stem: str = ""
 
@@ -88,30 +92,25 @@ class Report:
     thesis: str
 
 
-def level_db(x) -> np.ndarray:
-    """``20 log10 |x|`` with magnitudes floored at 1e-30 (the dashboard's dB conversion)."""
-    return 20.0 * np.log10(np.maximum(np.abs(np.asarray(x)), 1e-30))
-
-
-def _fixed(x: float, digits: int) -> str:
+def _fixed(x: SupportsFloat, digits: int) -> str:
     """``x`` with ``digits`` decimals, never ``-0.00``."""
     v = round(float(x), digits)
     return f"{v + 0.0:.{digits}f}"
 
 
-def _db(x: float) -> str:
+def _db(x: SupportsFloat) -> str:
     return f"{_fixed(x, 2)} dB"
 
 
-def _hz(x: float) -> str:
+def _hz(x: SupportsFloat) -> str:
     return f"{_fixed(x, 1)} Hz"
 
 
-def _pct(x: float) -> str:
+def _pct(x: SupportsFloat) -> str:
     return f"{_fixed(x, 1)} %"
 
 
-def _setting_text(name, value) -> str:
+def _setting_text(name: str, value: object) -> str:
     if isinstance(value, bool):
         return "yes" if value else "no"
     if name == "rounds":
@@ -145,7 +144,7 @@ def _provenance_table(snap: Snapshot) -> Table:
     return Table("Data in use", ("model", "source", "digest"), tuple(rows))
 
 
-def _peak_row(label: str, freq, v, h) -> tuple[str, ...]:
+def _peak_row(label: str, freq: np.ndarray, v: ArrayLike, h: Harmonic) -> tuple[str, ...]:
     lv = level_db(v)
     i = int(np.argmax(lv))
     return (label, _db(lv[i]), _hz(freq[i]), f"{h.speed_at(freq[i]):.1f} km/h")
@@ -198,11 +197,11 @@ def _coupled_section(snap: Snapshot) -> Section:
 
 
 def _truncation_section(snap: Snapshot) -> Section:
-    m, s = snap.truncation, snap.settings
+    m, s = present(snap.truncation, "truncation map"), snap.settings
     dof = snap.map_dof
-    err = 100 * (m.max_error if dof is None else m.dof_error(dof))
+    err = percent(m.max_error if dof is None else m.dof_error(dof))
     thr, fmax = s["threshold"], s["f_max"]
-    n_sugg = int(m.suggest(thr / 100, fmax, dof))
+    n_sugg = int(m.suggest(fraction(thr), fmax, dof))
     sel = m.centres <= fmax + 1e-9
     rows = []
     for i, n in enumerate(m.n_modes):
@@ -240,7 +239,7 @@ def _truncation_section(snap: Snapshot) -> Section:
 
 
 def _suggested_section(snap: Snapshot) -> Section:
-    sm = snap.suggested
+    sm = present(snap.suggested, "suggested modes")
     rows = []
     for k, n, ef, (lo, hi) in zip(
         sm.harmonics, sm.n_modes, sm.eigenfrequency, sm.freq_range, strict=True
@@ -255,7 +254,7 @@ def _suggested_section(snap: Snapshot) -> Section:
         )
     what = sm.dof or "maximum over the 6 bushing DOFs"
     para = (
-        f"Smallest N from which the eq. 5.1 error stays below {sm.threshold * 100:g} % at all "
+        f"Smallest N from which the eq. 5.1 error stays below {percent(sm.threshold):g} % at all "
         f"centres up to {sm.f_max:g} Hz ({what}), and the highest eigenfrequency among those "
         f"modes at {sm.speed:g} km/h (thesis table 5.1).",
     )
@@ -269,7 +268,7 @@ def _suggested_section(snap: Snapshot) -> Section:
 
 
 def _band_section(snap: Snapshot) -> Section:
-    b, s = snap.band, snap.settings
+    b, s = present(snap.band, "scatter band"), snap.settings
     dof = snap.response_dof
     j = b.dofs.index(dof)
     w = s["percentile"]
@@ -278,14 +277,14 @@ def _band_section(snap: Snapshot) -> Section:
     ref = level_db(b.reference[:, j])
     i = int(np.argmax(ref))
     rnd = level_db(b.round(s["single_round"])[:, j])
-    width = level_db(b.upper[:, j]) - level_db(b.lower[:, j])
+    width = level_db(b.maximum[:, j]) - level_db(b.minimum[:, j])
     k = int(np.argmax(width))
     conv = np.asarray(b.convergence.step_change_db, float)
     f_i = _hz(b.freq[i])
     rows = (
         ("unpolluted reference", _db(ref[i])),
-        ("minimum over the rounds", _db(level_db(b.lower[i, j]))),
-        ("maximum over the rounds", _db(level_db(b.upper[i, j]))),
+        ("minimum over the rounds", _db(level_db(b.minimum[i, j]))),
+        ("maximum over the rounds", _db(level_db(b.maximum[i, j]))),
         (f"{lo:g} % percentile", _db(level_db(b.percentiles[q.index(lo), i, j]))),
         (f"{hi:g} % percentile", _db(level_db(b.percentiles[q.index(hi), i, j]))),
         (f"round #{s['single_round']}", _db(rnd[i])),
@@ -322,7 +321,7 @@ def _band_section(snap: Snapshot) -> Section:
 
 
 def _eigen_section(snap: Snapshot) -> Section:
-    e, n = snap.eigen, snap.settings["n_modes"]
+    e, n = present(snap.eigen, "eigenfrequencies"), snap.settings["n_modes"]
     hit = np.flatnonzero(e.n_modes == n)
     rows = []
     if hit.size:
@@ -345,11 +344,11 @@ def _eigen_section(snap: Snapshot) -> Section:
     return Section("eigenfrequency", "Eigenfrequency vs number of modes", para, fig, (table,))
 
 
-def _extra_section(snap: Snapshot, ex) -> Section:
+def _extra_section(snap: Snapshot, ex: ExtraSection) -> Section:
     """A section contributed by another view (:class:`~app.report.snapshot.ExtraSection`)."""
     table = Table(f"{ex.heading}: settings and description", ("item", "value"), ex.rows)
     fig = None
-    if ex.curves:
+    if ex.curves and ex.freq is not None:  # curves always come with their frequencies
         base = title_block(snap, "report")
         tb = TitleBlock(ex.heading, base.lines)
         fig = FigureBlock(

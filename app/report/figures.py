@@ -14,19 +14,33 @@ from __future__ import annotations
 
 import io
 import threading
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import matplotlib
 import numpy as np
 from matplotlib import patheffects
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from numpy.typing import ArrayLike
 
 from fbs_core.units import frf_unit, output_kind
+from fbs_core.vocabulary import magnitude_db as _db
+from fbs_core.vocabulary import percent
 
 from .colormap import LINE_STYLES, ErrorColorScale, threshold_contour
-from .snapshot import Snapshot
+from .snapshot import Snapshot, present
 from .titles import TitleBlock
+
+if TYPE_CHECKING:
+    from .content import FigureBlock
+
+#: A plot's region of a figure: ``(left, bottom, width, height)`` in figure fraction.
+Rect: TypeAlias = tuple[float, float, float, float]
+#: What every ``draw_*`` returns: ``draw(fig, rect)`` adds the plot's axes inside ``rect``.
+Draw: TypeAlias = Callable[[Figure, Rect], None]
 
 __all__ = [
     "COLORS",
@@ -52,7 +66,7 @@ _SPEED_COLORS = ("#74c0fc", "#1c7ed6", "#0b3d91")
 _RENDER_LOCK = threading.Lock()
 #: Font sizes (pt) of tick labels, axis labels and legends.
 TICK_PT, LABEL_PT, LEGEND_PT = 9.0, 10.0, 9.0
-_DASH = {"solid": "-", "dashed": (0, (6, 3)), "dotted": (0, (1.5, 2.5))}
+_DASH: dict[str, Any] = {"solid": "-", "dashed": (0, (6, 3)), "dotted": (0, (1.5, 2.5))}
 
 
 def level_unit(dof: str) -> str:
@@ -61,11 +75,7 @@ def level_unit(dof: str) -> str:
     return f"dB re 1 {frf_unit(output_kind(f'bushing:{d}'), 'road', 'mobility')}"
 
 
-def _db(x) -> np.ndarray:
-    return 20.0 * np.log10(np.maximum(np.abs(np.asarray(x)), 1e-30))
-
-
-def _axes(fig: Figure, rect, legend_rows: int = 1, right: float = 0.0):
+def _axes(fig: Figure, rect: Rect, legend_rows: int = 1, right: float = 0.0) -> Axes:
     """Axes inside ``rect`` leaving room for tick labels and a legend below."""
     left, bottom, width, height = rect
     h_in = fig.get_figheight() * height
@@ -86,14 +96,15 @@ def _axes(fig: Figure, rect, legend_rows: int = 1, right: float = 0.0):
     return ax
 
 
-def _legend_below(ax, handles, rect, ncol: int = 3):
+def _legend_below(ax: Axes, handles: list[Any], rect: Rect, ncol: int = 3) -> None:
     """The legend under the axes, at the bottom of the plot's region (outside the data)."""
     left, bottom, width, _ = rect
-    ax.figure.legend(
+    fig: Any = ax.figure  # no overload of the stubs of Figure.legend matches this call
+    fig.legend(
         handles=handles,
         loc="lower center",
-        bbox_to_anchor=(left + width / 2, bottom + 0.02 / ax.figure.get_figheight()),
-        bbox_transform=ax.figure.transFigure,
+        bbox_to_anchor=(left + width / 2, bottom + 0.02 / fig.get_figheight()),
+        bbox_transform=fig.transFigure,
         ncol=ncol,
         fontsize=LEGEND_PT,
         frameon=False,
@@ -101,18 +112,18 @@ def _legend_below(ax, handles, rect, ncol: int = 3):
     )
 
 
-def _labels(ax, x: str, y: str):
+def _labels(ax: Axes, x: str, y: str) -> None:
     ax.set_xlabel(x, fontsize=LABEL_PT)
     ax.set_ylabel(y, fontsize=LABEL_PT)
 
 
-def draw_coupled(snap: Snapshot):
+def draw_coupled(snap: Snapshot) -> Draw:
     """Coupled response v_e* (eq. 4.1) in dB: all modes and N modes."""
     dof, n = snap.response_dof, snap.settings["n_modes"]
 
-    def draw(fig, rect):
+    def draw(fig: Figure, rect: Rect) -> None:
         ax = _axes(fig, rect)
-        handles = []
+        handles: list[Any] = []
         for frf, label, color, style in (
             (snap.reference, "all tire modes", COLORS["reference"], "-"),
             (snap.truncated, f"N = {n} modes", COLORS["truncated"], "--"),
@@ -130,21 +141,21 @@ def draw_coupled(snap: Snapshot):
     return draw
 
 
-def _halo_line(ax, draw, style_key: str, **kw):
+def _halo_line(ax: Axes, draw: Callable[..., Any], style_key: str, **kw: Any) -> Any:
     color, dash, width, halo = LINE_STYLES[style_key]
     effects = [patheffects.Stroke(linewidth=width + 2.5, foreground=halo), patheffects.Normal()]
     return draw(color=color, linestyle=_DASH[dash], linewidth=width, path_effects=effects, **kw)
 
 
-def draw_truncation(snap: Snapshot, n_suggested: int | None = None):
+def draw_truncation(snap: Snapshot, n_suggested: int | None = None) -> Draw:
     """Error map (eq. 5.1) with the threshold scale, contour, chosen and suggested N."""
-    m, s = snap.truncation, snap.settings
+    m, s = present(snap.truncation, "truncation map"), snap.settings
     dof = snap.map_dof
-    err = 100 * np.asarray(m.max_error if dof is None else m.dof_error(dof), float)
+    err = percent(np.asarray(m.max_error if dof is None else m.dof_error(dof), float))
     thr, fmax = float(s["threshold"]), float(s["f_max"])
     scale = ErrorColorScale(thr)
 
-    def draw(fig, rect):
+    def draw(fig: Figure, rect: Rect) -> None:
         ax = _axes(fig, rect, legend_rows=2, right=0.9)
         ax.grid(False)
         cmap, norm = scale.matplotlib()
@@ -167,7 +178,7 @@ def draw_truncation(snap: Snapshot, n_suggested: int | None = None):
                 linewidth=0.0,
             )
             hatched.set_rasterized(True)
-        handles = [Patch(facecolor=scale.above, edgecolor="white", hatch="///")]
+        handles: list[Any] = [Patch(facecolor=scale.above, edgecolor="white", hatch="///")]
         handles[0].set_label(f"error >= {thr:g} %")
         for line in threshold_contour(x, y, err, thr):
             xy = (line[:, 0], line[:, 1])
@@ -187,7 +198,7 @@ def draw_truncation(snap: Snapshot, n_suggested: int | None = None):
         _labels(ax, "Centre frequency (Hz)", "Retained modes N")
         cb = fig.colorbar(mesh, ax=ax, pad=0.02, fraction=0.05, extend="max")
         cb.set_label(f"Error (%), red: >= {thr:g} %", fontsize=LABEL_PT)
-        cb.set_ticks(np.linspace(0.0, thr, 5))
+        cb.set_ticks(np.linspace(0.0, thr, 5).tolist())
         cb.ax.tick_params(labelsize=TICK_PT)
         _legend_below(ax, handles, rect, ncol=3)
 
@@ -203,21 +214,21 @@ def _legend_line(key: str, label: str) -> Line2D:
     )  # fmt: skip
 
 
-def draw_band(snap: Snapshot):
+def draw_band(snap: Snapshot) -> Draw:
     """Scatter band: min-max corridor, central percentile band, reference, one round."""
-    b, s = snap.band, snap.settings
+    b, s = present(snap.band, "scatter band"), snap.settings
     dof = snap.response_dof
     j = b.dofs.index(dof)
     w = s["percentile"]
     q = [float(v) for v in b.q]
     lo, hi = (100 - w) / 2, (100 + w) / 2
 
-    def draw(fig, rect):
+    def draw(fig: Figure, rect: Rect) -> None:
         ax = _axes(fig, rect, legend_rows=2)
         f = np.asarray(b.freq, float)
         h = [
             ax.fill_between(
-                f, _db(b.lower[:, j]), _db(b.upper[:, j]), color=COLORS["band"], lw=0,
+                f, _db(b.minimum[:, j]), _db(b.maximum[:, j]), color=COLORS["band"], lw=0,
                 label=f"min-max over R = {s['rounds']:,} rounds",
             ),
             ax.fill_between(
@@ -235,13 +246,13 @@ def draw_band(snap: Snapshot):
     return draw
 
 
-def draw_eigen(snap: Snapshot):
+def draw_eigen(snap: Snapshot) -> Draw:
     """Highest retained eigenfrequency versus N at the operating speeds (fig. 5.8)."""
-    e, n = snap.eigen, snap.settings["n_modes"]
+    e, n = present(snap.eigen, "eigenfrequencies"), snap.settings["n_modes"]
 
-    def draw(fig, rect):
+    def draw(fig: Figure, rect: Rect) -> None:
         ax = _axes(fig, rect)
-        handles = []
+        handles: list[Any] = []
         for v, row, c in zip(e.speeds, e.frequency, _SPEED_COLORS, strict=False):
             (ln,) = ax.plot(e.n_modes, row, color=c, lw=1.6, label=f"{v:g} km/h")
             handles.append(ln)
@@ -255,12 +266,12 @@ def draw_eigen(snap: Snapshot):
 _CURVE_COLORS = ("#1f2937", "#d9480f", "#1c7ed6", "#2f9e44", "#ae3ec9", "#f59f00")
 
 
-def draw_curves(freq, curves, y_label: str):
+def draw_curves(freq: ArrayLike, curves: Mapping[str, ArrayLike], y_label: str) -> Draw:
     """Curves in dB versus frequency (a section contributed by another view)."""
 
-    def draw(fig, rect):
+    def draw(fig: Figure, rect: Rect) -> None:
         ax = _axes(fig, rect, legend_rows=1 + (len(curves) - 1) // 3)
-        handles = []
+        handles: list[Any] = []
         for i, (label, y) in enumerate(curves.items()):
             style = "-" if i < len(_CURVE_COLORS) else "--"
             (ln,) = ax.plot(
@@ -284,7 +295,7 @@ def draw_title_block(fig: Figure, tb: TitleBlock, top: float, left: float = 0.03
     return y - 0.06 / h_in
 
 
-def standalone(block, width_in: float = 9.0, title: bool = True) -> Figure:
+def standalone(block: FigureBlock, width_in: float = 9.0, title: bool = True) -> Figure:
     """One plot as its own figure, with its title block above it when ``title``."""
     lines = 1 + len(block.title.lines) if title else 0
     tb_in = (11.0 * 1.45 + 8.5 * 1.45 * (lines - 1)) / 72 + 0.15 if title else 0.0

@@ -17,6 +17,7 @@ from . import figures
 from .content import Report, Table, report_content
 from .method import UNITS, Equation
 from .snapshot import Snapshot
+from .titles import TitleBlock
 
 __all__ = ["build_html", "render_html", "CSS"]
 
@@ -46,7 +47,7 @@ figure svg { max-width: 100%; height: auto; }
 _NUM = re.compile(r"^[-+]?[\d,.]+( (dB|Hz|%|km/h))?$")
 
 
-def _e(text) -> str:
+def _e(text: object) -> str:
     return html.escape(str(text), quote=True)
 
 
@@ -78,7 +79,7 @@ def _table(t: Table) -> str:
     )
 
 
-def _title_block(tb) -> str:
+def _title_block(tb: TitleBlock) -> str:
     lines = "\n".join(_e(line) for line in tb.lines)
     return f'<div class="title-block"><div class="what">{_e(tb.what)}</div>{lines}</div>'
 

@@ -8,6 +8,8 @@ object with the state's attribute names), the page URL and the N-axis scale.
 from __future__ import annotations
 
 import datetime as dt
+from collections.abc import Mapping
+from typing import Any
 
 import fbs_core
 
@@ -33,7 +35,7 @@ VIEW_OF_KEY = {
 }
 
 
-def _n_total(models) -> int | None:
+def _n_total(models: Any) -> int | None:
     tire = None if models is None else getattr(models, "tire", None)
     try:
         return int((tire or fbs_core.reference_tire()).n_modes)
@@ -41,7 +43,9 @@ def _n_total(models) -> int | None:
         return None
 
 
-def title_snapshot(s, url: str = "", n_axis: str = "linear", created=None) -> Snapshot:
+def title_snapshot(
+    s: Any, url: str = "", n_axis: str = "linear", created: dt.datetime | None = None
+) -> Snapshot:
     """A results-free report snapshot of a state snapshot ``s`` (for titles and names)."""
     settings = {k: getattr(s, k) for k in SETTING_KEYS if hasattr(s, k)}
     settings["n_axis"] = n_axis
@@ -55,7 +59,7 @@ def title_snapshot(s, url: str = "", n_axis: str = "linear", created=None) -> Sn
     )
 
 
-def view_title(key: str, s, url: str = "", n_axis: str = "linear") -> tuple[TitleBlock, str]:
+def view_title(key: str, s: Any, url: str = "", n_axis: str = "linear") -> tuple[TitleBlock, str]:
     """``(title block, file stem)`` of the live view ``key`` for the state snapshot ``s``."""
     snap = title_snapshot(s, url, n_axis)
     view = VIEW_OF_KEY[key]
@@ -77,7 +81,7 @@ def _url_defaults() -> dict[str, object]:
     return out
 
 
-def _is_default(value, default) -> bool:
+def _is_default(value: Any, default: object) -> bool:
     if isinstance(default, bool) or isinstance(value, bool):
         return str(value).lower() == str(default).lower()
     if isinstance(default, (int, float)):
@@ -88,7 +92,7 @@ def _is_default(value, default) -> bool:
     return str(value) == str(default)
 
 
-def short_query(query: dict) -> dict:
+def short_query(query: Mapping[str, Any]) -> dict[str, Any]:
     """``query`` without the pairs that hold the default value (the page applies those
     anyway): a link that reproduces the same state, short enough for a title block."""
     defaults = _url_defaults()

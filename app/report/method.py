@@ -72,7 +72,7 @@ EQUATIONS: tuple[Equation, ...] = (
     ),
     Equation(
         "5.3",
-        "Noise in the vehicle",
+        "Noise in the chassis",
         r"$\mathbf{v}_e^* = \mathbf{S}\circ\mathbf{Y}_{ej}^E\,[\mathbf{Y}_{jj}^A"
         r" + \mathbf{S}\circ\mathbf{Y}_{jj}^E]^{-1}\,\mathbf{Y}_{ja}^A\mathbf{F}_a$",
         "v_e* = S o Y_ej^E [Y_jj^A + S o Y_jj^E]^-1 Y_ja^A F_a",
@@ -80,7 +80,7 @@ EQUATIONS: tuple[Equation, ...] = (
     ),
     Equation(
         "5.4",
-        "Noise in tire and vehicle",
+        "Noise in tire and chassis",
         r"$\mathbf{v}_e^* = \mathbf{S}\circ\mathbf{Y}_{ej}^E\,[\mathbf{S}\circ\mathbf{Y}_{jj}^A"
         r" + \mathbf{S}\circ\mathbf{Y}_{jj}^E]^{-1}\,\mathbf{S}\circ(\mathbf{Y}_{ja}^A"
         r"\mathbf{F}_a)$",

@@ -25,15 +25,15 @@ __all__ = [
 class PageState(param.Parameterized):
     """How the page is laid out (not what it computes)."""
 
-    view = param.Selector(
+    view: param.Selector[str] = param.Selector(
         default="normal",
         objects=["normal", "present"],
         doc="normal, or present: the presentation view for a projector.",
     )
-    data_card = param.Selector(
+    data_card: param.Selector[str] = param.Selector(
         default="open", objects=["open", "closed"], doc="The 'Your data' card open or collapsed."
     )
-    n_axis = param.Selector(
+    n_axis: param.Selector[str] = param.Selector(
         default="linear", objects=["linear", "log"], doc="Scale of the error map's N axis."
     )
     data = param.String(

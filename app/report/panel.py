@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import panel as pn
 
@@ -26,7 +27,7 @@ __all__ = [
 HELP_TEXT = (Path(__file__).with_name("help.md")).read_text(encoding="utf-8")
 
 
-def help_page(**kw) -> pn.pane.Markdown:
+def help_page(**kw: Any) -> pn.pane.Markdown:
     """The help page as a Markdown pane."""
     kw.setdefault("sizing_mode", "stretch_width")
     kw.setdefault("css_classes", ["help-page"])
@@ -37,8 +38,8 @@ def report_buttons(snapshot: Callable[[], Snapshot]) -> pn.Row:
     """Two downloads, the report as a self-contained HTML file and as PDF, each built from
     ``snapshot()`` when clicked (the file name says what it shows)."""
 
-    def make(kind: str):
-        def callback():
+    def make(kind: str) -> pn.widgets.FileDownload:
+        def callback() -> io.StringIO | io.BytesIO:
             btn.loading = True
             try:
                 name, content = (build_html if kind == "html" else build_pdf)(snapshot())

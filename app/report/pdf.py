@@ -9,15 +9,17 @@ from __future__ import annotations
 
 import io
 import textwrap
+from typing import Any
 
 import matplotlib
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from . import figures
-from .content import Report, Table, report_content
-from .method import UNITS
+from .content import FigureBlock, Report, Table, report_content
+from .method import UNITS, Equation
 from .snapshot import Snapshot
+from .titles import TitleBlock
 
 __all__ = ["build_pdf", "render_pdf"]
 
@@ -39,7 +41,7 @@ class _Pages:
     def width(self) -> float:
         return PAGE[0] - 2 * MARGIN
 
-    def _new(self):
+    def _new(self) -> Figure:
         self.flush()
         self.fig = Figure(figsize=PAGE)
         self.page += 1
@@ -48,38 +50,41 @@ class _Pages:
             MARGIN / PAGE[0], 0.35 / PAGE[1], f"{self.footer} | page {self.page}", fontsize=7,
             color="#868e96",
         )  # fmt: skip
+        return self.fig
 
-    def page_break(self):
+    def page_break(self) -> None:
         self._new()
 
-    def flush(self):
+    def flush(self) -> None:
         if self.fig is not None:
             self.pdf.savefig(self.fig, dpi=150)
             self.fig = None
 
-    def need(self, h: float):
+    def need(self, h: float) -> Figure:
+        """The current page, a new one when ``h`` inches do not fit on it."""
         if self.fig is None or self.y + h > PAGE[1] - MARGIN:
-            self._new()
+            return self._new()
+        return self.fig
 
-    def text(self, s: str, size: float = 9.0, **kw):
+    def text(self, s: str, size: float = 9.0, **kw: Any) -> None:
         h = size * _LINE
-        self.need(h)
+        fig = self.need(h)
         self.y += h
-        self.fig.text(MARGIN / PAGE[0], 1 - self.y / PAGE[1], s, fontsize=size, **kw)
+        fig.text(MARGIN / PAGE[0], 1 - self.y / PAGE[1], s, fontsize=size, **kw)
 
-    def para(self, s: str, size: float = 9.0, **kw):
+    def para(self, s: str, size: float = 9.0, **kw: Any) -> None:
         width = int(self.width * 72 / (size * 0.55))
         for line in textwrap.wrap(s, width) or [""]:
             self.text(line, size, **kw)
         self.y += size * 0.4 / 72
 
-    def heading(self, s: str, size: float = 13.0):
+    def heading(self, s: str, size: float = 13.0) -> None:
         self.need(size * _LINE * 4)  # keep a heading with what follows
         self.y += 0.12
         self.text(s, size, weight="bold")
         self.y += 0.04
 
-    def table(self, t: Table, size: float = 8.0):
+    def table(self, t: Table, size: float = 8.0) -> None:
         cols = len(t.header)
         widths = [max(len(r[i]) for r in (t.header, *t.rows)) for i in range(cols)]
         fmt = "  ".join(f"{{:<{w}}}" for w in widths)
@@ -90,24 +95,24 @@ class _Pages:
             self.text(fmt.format(*r), size, family="DejaVu Sans Mono")
         self.y += 0.12
 
-    def title_block(self, tb):
+    def title_block(self, tb: TitleBlock) -> None:
         self.text(tb.what, 10.0, weight="bold")
         for line in tb.lines:
             for part in textwrap.wrap(line, 118) or [""]:
                 self.text(part, 8.0, color="#343a40")
         self.y += 0.05
 
-    def figure(self, block):
+    def figure(self, block: FigureBlock) -> None:
         w = self.width
         h = w * block.aspect
         self.need(h + 1.2)
         self.title_block(block.title)
-        self.need(h)
+        fig = self.need(h)
         rect = (MARGIN / PAGE[0], 1 - (self.y + h) / PAGE[1], w / PAGE[0], h / PAGE[1])
-        block.draw(self.fig, rect)
+        block.draw(fig, rect)
         self.y += h + 0.1
 
-    def equation(self, eq):
+    def equation(self, eq: Equation) -> None:
         self.need(0.9)
         self.text(f"Eq. {eq.number}: {eq.name}", 9.0, weight="bold")
         self.y += 0.05

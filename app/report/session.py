@@ -9,11 +9,14 @@ when it was computed for the current settings.
 from __future__ import annotations
 
 import datetime as dt
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
 import fbs_core
 from fbs_core import studies
+from fbs_core.vocabulary import fraction, percent
 
 from .. import compute
 from .snapshot import DataFile, ExtraSection, Provenance, Snapshot
@@ -30,30 +33,39 @@ __all__ = [
 _DIRS = ("x", "y", "z", "rx", "ry", "rz")
 
 
-def settings_of(state, n_axis: str = "linear") -> dict:
-    """The settings of a ``DashboardState`` as the plain dict of a report snapshot."""
-    c, n, t = state.case, state.noise, state.truncation
+def settings_of(state: Any, n_axis: str = "linear") -> dict[str, Any]:
+    """The settings of a ``DashboardState`` as the plain dict of a report snapshot.
+
+    Read through :meth:`app.store.Snapshot.of` (the one place that reads a state's values).
+    """
+    from ..store import Snapshot as StateSnapshot
+
+    return _settings(StateSnapshot.of(state), n_axis)
+
+
+def _settings(st: Any, n_axis: str) -> dict[str, Any]:
+    """The report's settings of an :class:`app.store.Snapshot` of the state."""
     return dict(
-        harmonic=int(c.harmonic),
-        n_modes=int(c.n_modes),
-        dof=str(c.dof),
-        coupling=str(c.coupling),
-        threshold=float(t.threshold),
-        f_max=float(t.f_max),
-        map_mode=str(t.map_mode),
+        harmonic=st.harmonic,
+        n_modes=st.n_modes,
+        dof=str(st.dof),
+        coupling=str(st.coupling),
+        threshold=st.threshold,
+        f_max=st.f_max,
+        map_mode=str(st.map_mode),
         n_axis=n_axis,
-        noise=float(n.noise),
-        target=str(n.target),
-        frequency_dependent=bool(n.frequency_dependent),
-        rounds=int(n.rounds),
-        seed=int(n.seed),
-        single_round=int(n.single_round),
-        percentile=int(n.percentile),
+        noise=st.noise,
+        target=str(st.target),
+        frequency_dependent=st.frequency_dependent,
+        rounds=st.rounds,
+        seed=st.seed,
+        single_round=st.single_round,
+        percentile=st.percentile,
     )
 
 
 def _digests(key: str) -> dict[str, str]:
-    out = {}
+    out: dict[str, str] = {}
     for part in str(key).split(";"):
         if "=" in part:
             k, v = part.split("=", 1)
@@ -61,7 +73,7 @@ def _digests(key: str) -> dict[str, str]:
     return out
 
 
-def provenance_of(models, notes=()) -> Provenance:
+def provenance_of(models: Any, notes: Iterable[str] = ()) -> Provenance:
     """Reference models or uploaded file names with their digests (an ``app`` ``Models``)."""
     if models is None or models.is_reference:
         return Provenance(notes=tuple(notes))
@@ -79,14 +91,14 @@ def provenance_of(models, notes=()) -> Provenance:
     return Provenance(tire=tire, chassis=chassis, notes=tuple(notes))
 
 
-def band_matches(band, settings: dict, models=None) -> bool:
+def band_matches(band: Any, settings: Mapping[str, Any], models: Any = None) -> bool:
     """True when ``band`` (a ScatterBand) was computed for these settings."""
     if band is None:
         return False
     s = settings
     return bool(
         band.harmonic == s["harmonic"]
-        and abs(band.noise * 100 - s["noise"]) <= 1e-9 * max(1.0, s["noise"])
+        and abs(percent(band.noise) - s["noise"]) <= 1e-9 * max(1.0, s["noise"])
         and band.target == s["target"]
         and band.frequency_dependent == s["frequency_dependent"]
         and band.rounds == s["rounds"]
@@ -99,7 +111,7 @@ def band_matches(band, settings: dict, models=None) -> bool:
 BUILTIN_RESULTS = ("response", "error_map", "suggested", "eigen", "band_curves")
 
 
-def store_sections(store) -> tuple[ExtraSection, ...]:
+def store_sections(store: Any) -> tuple[ExtraSection, ...]:
     """The sections other views contribute: each published :class:`app.store.Result`
     parameter of ``store`` beyond :data:`BUILTIN_RESULTS` (and the uncoupled subsystems only
     while the page shows them), in the store's parameter order.
@@ -110,7 +122,7 @@ def store_sections(store) -> tuple[ExtraSection, ...]:
     """
     from ..store import Result
 
-    out = []
+    out: list[ExtraSection] = []
     for name in store.param:
         if name in BUILTIN_RESULTS:
             continue
@@ -125,7 +137,7 @@ def store_sections(store) -> tuple[ExtraSection, ...]:
     return tuple(out)
 
 
-def _frf(freq, data) -> fbs_core.FRF:
+def _frf(freq: Any, data: Any) -> fbs_core.FRF:
     return fbs_core.FRF(
         np.asarray(freq, float),
         np.asarray(data)[:, :, None],
@@ -135,15 +147,15 @@ def _frf(freq, data) -> fbs_core.FRF:
 
 
 def session_snapshot(
-    state,
+    state: Any,
     *,
     url: str = "",
-    band=None,
+    band: Any = None,
     band_n_modes: int | None = None,
     n_axis: str = "linear",
-    notes=(),
+    notes: Iterable[str] = (),
     created: dt.datetime | None = None,
-    extra=(),
+    extra: Sequence[ExtraSection] = (),
 ) -> Snapshot:
     """The report snapshot of a session's current state.
 
@@ -162,15 +174,18 @@ def session_snapshot(
     extra : sequence of ExtraSection
         Sections of other views (:func:`store_sections` of the page's store).
     """
-    s = settings_of(state, n_axis)
-    models = state.case.models
+    from ..store import Snapshot as StateSnapshot
+
+    st = StateSnapshot.of(state)
+    s = _settings(st, n_axis)
+    models = st.models
     k, coupling = s["harmonic"], s["coupling"]
     m = compute.error_map(k, coupling, models)
     ref = compute.coupled_response(k, None, coupling, models)
     tr = compute.coupled_response(k, s["n_modes"], coupling, models)
-    map_dof = f"bushing:{s['dof']}" if s["map_mode"] == "selected DOF" else None
+    map_dof = None if st.map_dof is None else f"bushing:{st.map_dof}"
     sugg = studies.suggest_modes(
-        s["threshold"] / 100.0,
+        fraction(s["threshold"]),
         s["f_max"],
         maps=[compute.error_map(h, coupling, models) for h in range(1, 8)],
         dof=map_dof,

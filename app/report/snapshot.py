@@ -15,11 +15,16 @@ import datetime as _dt
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any, TypeVar
+
+from numpy.typing import ArrayLike
 
 import fbs_core
 from fbs_core.errors import FBSError
+from fbs_core.vocabulary import percent
 
 __all__ = [
+    "present",
     "ExtraSection",
     "ReportError",
     "DataFile",
@@ -37,7 +42,7 @@ __all__ = [
 #: accepted in the settings (the dashboard's choices).
 DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 COUPLINGS = ("6dof", "5dof")
-NOISE_TARGETS = ("both", "tire", "vehicle")
+NOISE_TARGETS = ("both", "tire", "chassis")
 MAP_MODES = ("selected DOF", "max over 6 DOFs")
 N_AXES = ("linear", "log")
 
@@ -87,6 +92,16 @@ class ReportError(FBSError):
     """A snapshot that cannot be reported: missing or invalid settings, mismatched results."""
 
 
+_T = TypeVar("_T")
+
+
+def present(value: _T | None, what: str) -> _T:
+    """``value``, which a report part needs: a :class:`ReportError` naming ``what`` if None."""
+    if value is None:
+        raise ReportError(f"the snapshot holds no {what}")
+    return value
+
+
 @dataclass(frozen=True)
 class DataFile:
     """One model of the snapshot: the shipped reference (``name=None``) or an uploaded file.
@@ -104,7 +119,7 @@ class DataFile:
     name: str | None = None
     digest: str | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.role not in ("tire", "chassis"):
             raise ReportError(f"unknown data role {self.role!r}; allowed: tire, chassis")
         if self.name is not None and not str(self.name).strip():
@@ -137,7 +152,7 @@ class Provenance:
     chassis: DataFile = field(default_factory=lambda: DataFile("chassis"))
     notes: tuple[str, ...] = ()
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.tire.role != "tire" or self.chassis.role != "chassis":
             raise ReportError("Provenance takes DataFile('tire', ...) and DataFile('chassis', ...)")
         object.__setattr__(self, "notes", tuple(str(n) for n in self.notes))
@@ -158,7 +173,7 @@ class Provenance:
         return "; ".join(d.describe() for d in (self.tire, self.chassis))
 
 
-def _check_setting(name: str, value):
+def _check_setting(name: str, value: Any) -> Any:
     typ, meaning = SETTING_KEYS[name]
     if typ is bool:
         if not isinstance(value, bool):
@@ -192,7 +207,7 @@ def _check_setting(name: str, value):
     return value
 
 
-def normalise_settings(settings: Mapping) -> Mapping:
+def normalise_settings(settings: Mapping[str, Any]) -> Mapping[str, Any]:
     """Checked, typed, read-only copy of ``settings`` (keys of :data:`SETTING_KEYS`).
 
     Raises
@@ -242,11 +257,11 @@ class ExtraSection:
     heading: str
     paragraphs: tuple[str, ...] = ()
     rows: tuple[tuple[str, str], ...] = ()
-    freq: object = None
-    curves: Mapping = field(default_factory=dict)
+    freq: ArrayLike | None = None
+    curves: Mapping[str, Any] = field(default_factory=dict)
     y_label: str = "Level (dB)"
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         import numpy as np
 
         if not str(self.key).strip() or not str(self.heading).strip():
@@ -263,7 +278,7 @@ class ExtraSection:
                     )
 
     @classmethod
-    def of_result(cls, key: str, result) -> ExtraSection:
+    def of_result(cls, key: str, result: Any) -> ExtraSection:
         """The section of a published result (``columns``, ``meta``, ``caption``)."""
         import re
 
@@ -326,7 +341,7 @@ class Snapshot:
         Sections contributed by other views (after the built-in ones).
     """
 
-    settings: Mapping
+    settings: Mapping[str, Any]
     provenance: Provenance = field(default_factory=Provenance)
     url: str = ""
     created: _dt.datetime = field(default_factory=lambda: _dt.datetime.now(_dt.UTC))
@@ -337,9 +352,9 @@ class Snapshot:
     band: fbs_core.ScatterBand | None = None
     eigen: fbs_core.ModeFrequencies | None = None
     n_modes_total: int | None = None
-    extra: tuple = ()
+    extra: tuple[ExtraSection, ...] = ()
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         s = normalise_settings(self.settings)
         object.__setattr__(self, "settings", s)
         if not isinstance(self.provenance, Provenance):
@@ -380,7 +395,7 @@ class Snapshot:
         if self.n_modes_total is None and self.truncation is not None:
             object.__setattr__(self, "n_modes_total", self.truncation.n_modes_total)
 
-    def _check_results(self, s):
+    def _check_results(self, s: Mapping[str, Any]) -> None:
         dof = f"bushing:{s['dof']}"
         for name in ("reference", "truncated"):
             frf = getattr(self, name)
@@ -406,7 +421,7 @@ class Snapshot:
                     f"{(100 - w) / 2:g} and {(100 + w) / 2:g} % of a {w} % central band"
                 )
             b = self.band
-            given = (b.noise * 100, b.target, b.frequency_dependent, b.rounds, b.seed)
+            given = (percent(b.noise), b.target, b.frequency_dependent, b.rounds, b.seed)
             said = (s["noise"], s["target"], s["frequency_dependent"], s["rounds"], s["seed"])
             if not (abs(given[0] - said[0]) <= 1e-9 * max(1.0, said[0]) and given[1:] == said[1:]):
                 raise ReportError(
@@ -422,12 +437,12 @@ class Snapshot:
         if self.suggested is not None:
             sm = self.suggested
             if not (
-                abs(sm.threshold * 100 - s["threshold"]) <= 1e-9 * s["threshold"]
+                abs(percent(sm.threshold) - s["threshold"]) <= 1e-9 * s["threshold"]
                 and sm.f_max == s["f_max"]
                 and sm.dof == self.map_dof
             ):
                 raise ReportError(
-                    f"the suggested modes were read at threshold {sm.threshold * 100:g} %, "
+                    f"the suggested modes were read at threshold {percent(sm.threshold):g} %, "
                     f"f_max {sm.f_max:g} Hz, DOF {sm.dof}; the settings say "
                     f"{s['threshold']:g} %, {s['f_max']:g} Hz, DOF {self.map_dof}"
                 )

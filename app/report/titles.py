@@ -10,7 +10,9 @@ URL that reproduces it. The file name says the same in short.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import fbs_core
 
@@ -44,8 +46,8 @@ VIEWS: dict[str, str] = {
     "speed-map": "Bushing level over speed and frequency for the harmonic",
 }
 
-_NOISE_EQ = {"tire": "5.2", "vehicle": "5.3", "both": "5.4"}
-_NOISE_WHERE = {"tire": "the tire", "vehicle": "the vehicle", "both": "tire and vehicle"}
+_NOISE_EQ = {"tire": "5.2", "chassis": "5.3", "both": "5.4"}
+_NOISE_WHERE = {"tire": "the tire", "chassis": "the chassis", "both": "tire and chassis"}
 
 
 @dataclass(frozen=True)
@@ -69,7 +71,7 @@ class TitleBlock:
         return "\n".join((self.what, *self.lines))
 
 
-def harmonic_description(k) -> str:
+def harmonic_description(k: int) -> str:
     """``"Harmonic 4: road wavelength 0.2395 m, 30-120 km/h, band 34.8-139.2 Hz"``.
 
     From :func:`fbs_core.harmonic` (thesis fig. 4.4, table 5.1).
@@ -106,7 +108,7 @@ def modes_description(n_modes: int, n_total: int | None = None) -> str:
     return f"N = {n}{of} tire modes"
 
 
-def noise_description(settings) -> str:
+def noise_description(settings: Mapping[str, Any]) -> str:
     """The noise settings in one line (thesis eqs. 5.2-5.4)."""
     s = settings
     target = s["target"]
@@ -184,7 +186,7 @@ def title_block(snap: Snapshot, view: str) -> TitleBlock:
     if view not in VIEWS:
         raise ReportError(f"unknown view {view!r}; allowed: {', '.join(VIEWS)}")
     parts = {p: _part(snap, view, p) for p in _PARTS[view]}
-    lines = [parts.pop(p) for p in ("harmonic", "all-harmonics") if p in parts]
+    lines = [line for p in ("harmonic", "all-harmonics") if p in parts and (line := parts.pop(p))]
     noise = parts.pop("noise", None)
     case = [v for v in parts.values() if v]
     if case:

@@ -14,7 +14,9 @@ import param
 
 from ..analysis_state import ANALYSIS_TABS
 from ..analysis_store import AnalysisResults
+from .common import FREQ_LABEL
 from .live import LiveView
+from .plots import frequency_range, new_figure
 
 __all__ = ["AnalysisView", "analysis_card"]
 
@@ -47,6 +49,20 @@ class AnalysisView(LiveView):
 
     def _draw_pick(self, pick: dict) -> None:
         """Show the picked speed / frequency (``None``: not picked)."""
+
+    def _frequency_figure(self, name: str, y_label: str, min_height: int, **kw):
+        """A figure over frequency on the views' shared (linked-zoom) frequency range,
+        created with the first such figure (review D1/D7: the views' common set-up)."""
+        if self.x_range is None:
+            self.x_range = frequency_range()
+        return new_figure(
+            x_label=FREQ_LABEL,
+            y_label=y_label,
+            x_range=self.x_range,
+            name=name,
+            min_height=min_height,
+            **kw,
+        )
 
 
 def _tab_names() -> dict[str, str]:

@@ -17,8 +17,8 @@ from fbs_core.analysis import MAX_PINS
 
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .analysis_speed import _pick_spans
-from .common import COLORS, FREQ_LABEL, level_label
-from .plots import add_image, fit_range, frequency_range, new_figure
+from .common import COLORS, level_label
+from .plots import add_image, fit_range
 
 __all__ = ["CompareView"]
 
@@ -88,36 +88,12 @@ class CompareView(AnalysisView):
             pn.state.execute(update, schedule=True)
 
     def _build(self):
-        if self.x_range is None:
-            self.x_range = frequency_range()
-        self._lv = lv = new_figure(
-            x_label=FREQ_LABEL,
-            y_label=level_label("z"),
-            x_range=self.x_range,
-            name="compare.levels",
-            min_height=250,
-        )
-        self._df = df = new_figure(
-            x_label=FREQ_LABEL,
-            y_label="Current minus pin (dB)",
-            x_range=self.x_range,
-            name="compare.diff",
-            min_height=200,
-        )
-        self._bd = bd = new_figure(
-            x_label=FREQ_LABEL,
-            y_label=level_label("z", "Band level"),
-            x_range=self.x_range,
-            name="compare.band",
-            min_height=250,
-        )
-        self._mp = mp = new_figure(
-            x_label=FREQ_LABEL,
-            y_label="Retained modes N",
-            x_range=self.x_range,
-            name="compare.map_figure",
-            min_height=200,
-            title="Error map: current minus pin",
+        spectrum = self._frequency_figure
+        self._lv = lv = spectrum("compare.levels", level_label("z"), 250)
+        self._df = df = spectrum("compare.diff", "Current minus pin (dB)", 200)
+        self._bd = bd = spectrum("compare.band", level_label("z", "Band level"), 250)
+        self._mp = mp = spectrum(
+            "compare.map_figure", "Retained modes N", 200, title="Error map: current minus pin"
         )
         self._curves, self._diffs, self._bands = [], [], []
         for i, color in enumerate(CURVE_COLORS):

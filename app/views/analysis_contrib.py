@@ -13,8 +13,8 @@ import panel as pn
 from bokeh.models import ColumnDataSource, HoverTool, Span
 
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
-from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
-from .plots import add_line, fit_range, frequency_range, new_figure
+from .common import COLORS, level_label, level_tooltips
+from .plots import add_line, fit_range
 
 __all__ = ["ContributionsView"]
 
@@ -39,14 +39,8 @@ class ContributionsView(AnalysisView):
         ]
 
     def _build(self):
-        if self.x_range is None:
-            self.x_range = frequency_range()
-        self._lines_fig = fig = new_figure(
-            x_label=FREQ_LABEL,
-            y_label=level_label("z"),
-            x_range=self.x_range,
-            name="contributions.figure",
-            min_height=400,
+        self._lines_fig = fig = self._frequency_figure(
+            "contributions.figure", level_label("z"), 400
         )
         self._terms = {}
         for d, color in zip(DOFS, TERM_COLORS, strict=True):
@@ -73,12 +67,8 @@ class ContributionsView(AnalysisView):
             {"freq": np.zeros(0), **{f"c{k}": np.zeros(0) for k in range(len(DOFS) + 1)}},
             name="contributions.stacked",
         )
-        self._stack_fig = sf = new_figure(
-            x_label=FREQ_LABEL,
-            y_label="Share of the total (%)",
-            x_range=self.x_range,
-            name="contributions.stacked_figure",
-            min_height=400,
+        self._stack_fig = sf = self._frequency_figure(
+            "contributions.stacked_figure", "Share of the total (%)", 400
         )
         for k, (d, color) in enumerate(zip(DOFS, TERM_COLORS, strict=True)):
             sf.varea(

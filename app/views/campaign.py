@@ -31,7 +31,7 @@ from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure
 
 from fbs_core.campaign import CampaignError, CampaignResult, open_campaign
-from fbs_core.vocabulary import DIRECTIONS, magnitude_db
+from fbs_core.vocabulary import DIRECTIONS, magnitude_db, percent
 
 from ..store import Result
 from .common import COLORS, FREQ_LABEL, MODES_LABEL, level_label
@@ -112,7 +112,7 @@ def case_rows(result) -> dict[str, list]:
         cols["case"].append(c.name)
         cols["kind"].append(c.kind)
         cols["harmonic"].append(int(s.get("harmonic", 0)))
-        cols["noise_pct"].append(round(100 * float(s["noise"]), 6) if band else None)
+        cols["noise_pct"].append(round(percent(float(s["noise"])), 6) if band else None)
         cols["target"].append(str(s["target"]) if band else "")
         cols["freq_dependent"].append(bool(s["frequency_dependent"]) if band else None)
         cols["truncation"].append("" if band else _truncation_label(s))
@@ -160,8 +160,8 @@ def scatter_case_result(result, name: str, dof: str) -> Result:
     cols = {
         "freq_Hz": np.asarray(band.freq),
         "reference": ref,
-        "minimum": np.asarray(band.lower[:, j]),
-        "maximum": np.asarray(band.upper[:, j]),
+        "minimum": np.asarray(band.minimum[:, j]),
+        "maximum": np.asarray(band.maximum[:, j]),
     }
     for k, q in enumerate(band.q):
         cols[f"p{q:g}"] = np.asarray(band.percentiles[k, :, j])
@@ -178,7 +178,7 @@ def scatter_case_result(result, name: str, dof: str) -> Result:
         meta=meta,
         filename=f"{Path(result.path).stem}_{name}_{dof}.csv",
         caption=(
-            f"**{name}** &middot; bushing:{dof} &middot; noise {100 * s['noise']:g} % in "
+            f"**{name}** &middot; bushing:{dof} &middot; noise {percent(s['noise']):g} % in "
             f"{s['target']} &middot; {s['rounds']:,} rounds &middot; seed {s['seed']}"
         ),
         draw={"kind": "scatter", "dof": dof, "q": tuple(float(q) for q in band.q)},
@@ -202,7 +202,7 @@ def truncation_case_result(result, name: str, dof: str | None) -> Result:
     if t.suggested is not None:
         for i, th in enumerate(t.thresholds):
             for k, fm in enumerate(t.f_max):
-                sugg[f"{100 * th:g} % up to {fm:g} Hz"] = int(t.suggested[i, k])
+                sugg[f"{percent(th):g} % up to {fm:g} Hz"] = int(t.suggested[i, k])
     meta = {
         "view": "campaign truncation error map (thesis eq. 5.1)",
         "response DOF": what,
@@ -214,14 +214,14 @@ def truncation_case_result(result, name: str, dof: str | None) -> Result:
         columns={
             "n_modes": nn.ravel(),
             "centre_freq_Hz": ff.ravel(),
-            "error_pct": 100 * err.ravel(),
+            "error_pct": percent(err.ravel()),
         },
         meta=meta,
         filename=f"{Path(result.path).stem}_{name}_{dof or 'maxdof'}.csv",
         caption=f"**{name}** &middot; {what}",
         draw={
             "kind": "truncation",
-            "error_pct": 100 * err,
+            "error_pct": percent(err),
             "n_modes": np.asarray(t.n_modes),
             "centres": np.asarray(t.centres),
             "suggested": sugg,

@@ -54,8 +54,12 @@ __all__ = [
     "TARGET_NAMES",
 ]
 
-#: Noise targets as written in a campaign file -> the target of :func:`fbs_core.scatter_band`.
-TARGET_NAMES = {"tire": "tire", "chassis": "vehicle", "vehicle": "vehicle", "both": "both"}
+#: Noise targets as written in a campaign file -> the target of :func:`fbs_core.scatter_band`
+#: ("vehicle", the thesis' word, is the chassis).
+TARGET_NAMES = {"tire": "tire", "chassis": "chassis", "vehicle": "chassis", "both": "both"}
+#: A case's name (and so its seed, :func:`case_seed`) spells the chassis target as the first
+#: release did, so a campaign file gives the same cases and numbers as before.
+_NAME_TOKENS = {"chassis": "vehicle"}
 COUPLINGS = ("6dof", "5dof")
 SEED_MODES = ("per-case", "common")
 OUTPUTS = {
@@ -89,7 +93,7 @@ class BandCase:
         """Readable, unique id (the group name in the result file)."""
         nm = "all" if self.n_modes is None else str(self.n_modes)
         return (
-            f"band_h{self.harmonic}_p{self.noise:g}_{self.target}_"
+            f"band_h{self.harmonic}_p{self.noise:g}_{_NAME_TOKENS.get(self.target, self.target)}_"
             f"{'fdep' if self.frequency_dependent else 'fixed'}_R{self.rounds}_N{nm}_"
             f"{self.coupling}_{self.tire}_{self.chassis}"
         )
@@ -104,7 +108,9 @@ class BandCase:
         return {"kind": self.kind, **asdict(self)}
 
     def digest(self) -> str:
-        return _digest(self.settings())
+        s = self.settings()
+        s["target"] = _NAME_TOKENS.get(self.target, self.target)  # as the first release did
+        return _digest(s)
 
 
 @dataclass(frozen=True)

@@ -127,7 +127,7 @@ def resolve_model(kind: str, spec: Any) -> Any:
 def load_model(kind: str, source: str) -> Any:
     """Load a model variant from a file (on the client; the object is then scattered).
 
-    Tire: a modal tire model (:func:`fbs_core.io.load_tire_model`). Chassis: an FRF file
+    Tire: a modal tire model (:func:`fbs_core.io.import_tire_model`). Chassis: an FRF file
     (:func:`fbs_core.io.load_frf`) with inputs ``spindle:*``; it is interpolated onto each
     harmonic's grid (never extrapolated).
     """
@@ -136,7 +136,7 @@ def load_model(kind: str, source: str) -> Any:
     from .. import io
 
     if kind == "tire":
-        return io.load_tire_model(source).model
+        return io.import_tire_model(source).model
     return io.load_frf(source).frf
 
 
@@ -223,7 +223,7 @@ def band_block(
         ``(n_k, n_l, n_e)``, ``checkpoints``, ``l0``, ``l1`` and the provenance of the run
         (``worker``, ``host``, ``pid``, ``seconds``).
     """
-    from ..studies import _kernels
+    from ..studies import _noise_kernels
     from ..studies import scatter as _sc
     from ..studies._rng import seed_key
 
@@ -258,7 +258,7 @@ def band_block(
         b = min(l1, a + chunk)
         m = mag[: b - a]
         with _sc._LOCK:
-            _kernels.noisy_block_run(
+            _noise_kernels.noisy_block_run(
                 *inputs.arrays,
                 a,
                 b,
@@ -271,7 +271,7 @@ def band_block(
                 m,
                 _sc._EMPTY_CPLX,
             )
-            _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, a - l0)
+            _noise_kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, a - l0)
     return {
         "l0": int(l0),
         "l1": int(l1),
@@ -366,15 +366,15 @@ def assemble_band(
         freq=_sc._ro(np.asarray(freq)),
         dofs=tuple(dofs),
         reference=_sc._ro(np.asarray(reference)),
-        lower=_sc._ro(lo),
-        upper=_sc._ro(hi),
+        minimum=_sc._ro(lo),
+        maximum=_sc._ro(hi),
         argmin_round=_sc._ro(cat("argmin_round", 0)),
         argmax_round=_sc._ro(cat("argmax_round", 0)),
         q=_sc._ro(qs),
         percentiles=_sc._ro(pct),
         convergence=_sc.Convergence(_sc._ro(np.asarray(ck)), _sc._ro(clo), _sc._ro(chi)),
         noise=float(noise),
-        target=str(target),
+        target=_sc.target_name(str(target), warn=False),  # "vehicle" in older files
         rounds=int(rounds),
         frequency_dependent=bool(frequency_dependent),
         seed=seed,

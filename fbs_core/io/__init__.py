@@ -5,7 +5,9 @@ Entry points (all accept a path, or the bytes of an upload plus its file name):
 * :func:`load_frf` - FRFs from UFF dataset 58, MATLAB .mat (v5, v7.3), CSV, HDF5;
   returns an :class:`ImportResult` (the FRF, a short summary, notes, metadata).
 * :func:`save_frf` - an FRF to any of these formats (returns bytes without a path).
-* :func:`load_tire_model` - a modal tire model from the project's format or MATLAB.
+* :func:`import_tire_model` - a modal tire model from the project's format or MATLAB
+  (``load_tire_model`` is its deprecated name; the package's own trusted file is read by
+  :func:`fbs_core.tire.read_tire_h5`).
 * :func:`export_result` - coupled and study results to CSV, UFF 58 or HDF5 with
   metadata (harmonic, N, noise, seed, fbs_core version) for traceability.
 
@@ -19,6 +21,7 @@ anything but private temporary files. File formats: ``docs/file-formats.md``.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +33,7 @@ from ._sandbox import DEFAULT_TIMEOUT
 from .checks import (
     DEFAULT_MAX_BYTES,
     FORMATS,
+    Source,
     check_quantity_arg,
     common_grid,
     describe,
@@ -59,6 +63,7 @@ __all__ = [
     "common_grid",
     "describe",
     "export_result",
+    "import_tire_model",
     "interface_check",
     "load_frf",
     "load_result",
@@ -118,6 +123,30 @@ def _finish(
     if notes:
         text += "\nnotes: " + "; ".join(notes)
     return ImportResult(frf, text, tuple(notes), dict(meta), name, fmt)
+
+
+#: How an import names each format in its summary (MATLAB by its container version).
+_LABELS = {
+    "uff": "UFF 58",
+    "csv": "CSV",
+    "hdf5": "HDF5",
+    "mat5": "MATLAB v5",
+    "mat73": "MATLAB v7.3",
+}
+
+
+def _open(
+    source: SourceLike, filename: str | None, format: str | None, max_bytes: int
+) -> tuple[Source, str, str, str]:
+    """The source read once and its format: ``(source, format, kind, label)``.
+
+    What every importer does before its parser runs in the sandbox: the size limit, the
+    format from the ending or ``format``, the magic bytes checked against it, and the
+    format's name for the summary.
+    """
+    src = read_source(source, filename, max_bytes)
+    fmt, kind = detect_format(src, format)
+    return src, fmt, kind, _LABELS[kind if fmt == "mat" else fmt]
 
 
 def load_frf(
@@ -190,8 +219,7 @@ def load_frf(
     ('spindle:z',)
     """
     check_quantity_arg(quantity)
-    src = read_source(source, filename, max_bytes)
-    fmt, kind = detect_format(src, format)
+    src, fmt, kind, label = _open(source, filename, format, max_bytes)
     if freq is not None and fmt != "uff":
         raise DataFormatError("freq= applies to UFF files only; use FRF.interpolate after loading")
     if name is not None and fmt != "hdf5":
@@ -214,12 +242,6 @@ def load_frf(
         frf, notes, meta = read_hdf5(
             src, nodes=nodes, quantity=quantity, name=name, timeout=timeout
         )
-    label = {
-        "mat": "MATLAB v5" if kind == "mat5" else "MATLAB v7.3",
-        "uff": "UFF 58",
-        "csv": "CSV",
-        "hdf5": "HDF5",
-    }[fmt]
     return _finish(frf, notes, meta, src.name, label, require_outputs, require_inputs)
 
 
@@ -445,7 +467,7 @@ def load_result(
     return read_hdf5_result(src, timeout=timeout)
 
 
-def load_tire_model(
+def import_tire_model(
     source: SourceLike,
     *,
     filename: str | None = None,
@@ -474,13 +496,11 @@ def load_tire_model(
     DataFormatError
         For damaged files, missing variables, wrong shapes, non-finite values.
     """
-    src = read_source(source, filename, max_bytes)
-    fmt, kind = detect_format(src, format)
+    src, fmt, kind, label = _open(source, filename, format, max_bytes)
     if fmt == "mat":
         from .modal import read_tire_mat
 
         model = read_tire_mat(src, kind, timeout=timeout)
-        label = "MATLAB v5" if kind == "mat5" else "MATLAB v7.3"
     elif fmt == "hdf5":
         from .modal import read_tire_native
 
@@ -498,6 +518,26 @@ def load_tire_model(
         src.name,
         label,
         model,
+    )
+
+
+def load_tire_model(
+    source: SourceLike,
+    *,
+    filename: str | None = None,
+    format: str | None = None,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+    timeout: float = DEFAULT_TIMEOUT,
+) -> ImportResult:
+    """Deprecated name of :func:`import_tire_model` (a ``DeprecationWarning``; removed in the
+    next release)."""
+    warnings.warn(
+        "fbs_core.io.load_tire_model is deprecated; use fbs_core.io.import_tire_model",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return import_tire_model(
+        source, filename=filename, format=format, max_bytes=max_bytes, timeout=timeout
     )
 
 

@@ -515,7 +515,7 @@ def check_tire(tire: Any) -> list[str]:
     Parameters
     ----------
     tire : TireModel
-        A modal tire model (e.g. from :func:`fbs_core.io.load_tire_model`).
+        A modal tire model (e.g. from :func:`fbs_core.io.import_tire_model`).
 
     Returns
     -------

@@ -4,7 +4,8 @@ Every element of the subsystem FRFs is scaled by a factor uniform in
 ``[1 - p, 1 + p]`` and the bushing response of eq. 4.1 is recomputed, ``R`` times:
 
 - tire only (eq. 5.2):     ``Y_ej^E [S o Y_jj^A + Y_jj^E]^-1 S o (Y_ja^A F_a)``
-- vehicle only (eq. 5.3):  ``S o Y_ej^E [Y_jj^A + S o Y_jj^E]^-1 Y_ja^A F_a``
+- chassis only (eq. 5.3):  ``S o Y_ej^E [Y_jj^A + S o Y_jj^E]^-1 Y_ja^A F_a``
+  (the thesis' "vehicle": the chassis substructure)
 - both (eq. 5.4):          ``S o Y_ej^E [S o Y_jj^A + S o Y_jj^E]^-1 S o (Y_ja^A F_a)``
 
 The thesis writes one symbol ``S`` but describes it as "a scaling matrix ... with
@@ -29,6 +30,7 @@ rounds are processed in chunks of lines whose size is bounded by ``max_chunk_byt
 from __future__ import annotations
 
 import threading
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -40,17 +42,26 @@ from .._typing import AnyArray, ComplexArray, FloatArray, IntArray
 from ..errors import DataFormatError, FBSError, SingularInterfaceError, StudyCancelled
 from ..frf import check_grid
 from ..harmonics import Harmonic
-from . import _kernels, _models
+from . import _models, _noise_kernels
 from ._rng import as_seed, seed_key
 
 #: Largest number of Monte-Carlo rounds of one band (one line's working memory,
 #: ``8 R n_e`` bytes, stays below 50 MB for six responses).
 MAX_ROUNDS = 1_000_000
 
-__all__ = ["TARGETS", "ScatterBand", "Convergence", "scatter_band", "scatter_band_arrays"]
+__all__ = [
+    "TARGETS",
+    "ScatterBand",
+    "Convergence",
+    "scatter_band",
+    "scatter_band_arrays",
+    "target_name",
+]
 
-#: Where the noise goes.
-TARGETS = ("tire", "vehicle", "both")
+#: Where the noise goes: the tire, the chassis (the thesis' "vehicle") or both.
+TARGETS = ("tire", "chassis", "both")
+#: Deprecated spellings of a target (one release).
+_OLD_TARGETS = {"vehicle": "chassis"}
 
 _EMPTY_MAG = np.empty((0, 0, 0))
 # one compiled parallel run at a time (some numba threading layers abort on concurrent
@@ -80,6 +91,15 @@ def _ro(a: ArrayLike, dtype: DTypeLike | None = None) -> AnyArray:
     return a
 
 
+def _renamed_edge(cls: str, old: str, new: str) -> None:
+    warnings.warn(
+        f"{cls}.{old} is deprecated (it is the {new} over the rounds, not a percentile); "
+        f"use {cls}.{new}",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+
+
 def _db(x: FloatArray) -> FloatArray:
     with np.errstate(divide="ignore", invalid="ignore"):
         return 20 * np.log10(x)
@@ -96,32 +116,45 @@ class Convergence:
     ----------
     rounds : ndarray of int, shape (n_k,)
         Checkpoints, ascending; the last is the total number of rounds.
-    lower, upper : ndarray, shape (n_k, n_f, n_dof)
-        Running minimum and maximum of ``|v_e|``.
+    minimum, maximum : ndarray, shape (n_k, n_f, n_dof)
+        Running minimum and maximum of ``|v_e|`` (the band's lower and upper edges;
+        ``lower`` / ``upper`` are their deprecated names).
     """
 
     rounds: IntArray
-    lower: FloatArray
-    upper: FloatArray
+    minimum: FloatArray
+    maximum: FloatArray
+
+    @property
+    def lower(self) -> FloatArray:
+        """Deprecated name of :attr:`minimum` (one release)."""
+        _renamed_edge("Convergence", "lower", "minimum")
+        return self.minimum
+
+    @property
+    def upper(self) -> FloatArray:
+        """Deprecated name of :attr:`maximum` (one release)."""
+        _renamed_edge("Convergence", "upper", "maximum")
+        return self.maximum
 
     @property
     def upper_change_db(self) -> FloatArray:
         """Largest gap (dB, over lines and DOFs) between the upper edge at each
         checkpoint and the final one, shape ``(n_k,)``; 0 at the last checkpoint."""
-        gap: FloatArray = np.nanmax(_db(self.upper[-1] / self.upper), axis=(1, 2))
+        gap: FloatArray = np.nanmax(_db(self.maximum[-1] / self.maximum), axis=(1, 2))
         return gap
 
     @property
     def lower_change_db(self) -> FloatArray:
         """Largest gap (dB) between the lower edge at each checkpoint and the final one."""
-        gap: FloatArray = np.nanmax(_db(self.lower / self.lower[-1]), axis=(1, 2))
+        gap: FloatArray = np.nanmax(_db(self.minimum / self.minimum[-1]), axis=(1, 2))
         return gap
 
     @property
     def step_change_db(self) -> FloatArray:
         """Largest change (dB) of either edge from one checkpoint to the next, ``(n_k - 1,)``."""
-        up: FloatArray = np.nanmax(_db(self.upper[1:] / self.upper[:-1]), axis=(1, 2))
-        lo: FloatArray = np.nanmax(_db(self.lower[:-1] / self.lower[1:]), axis=(1, 2))
+        up: FloatArray = np.nanmax(_db(self.maximum[1:] / self.maximum[:-1]), axis=(1, 2))
+        lo: FloatArray = np.nanmax(_db(self.minimum[:-1] / self.minimum[1:]), axis=(1, 2))
         return np.maximum(up, lo)
 
     def summary(self) -> str:
@@ -144,8 +177,9 @@ class ScatterBand:
         Response DOF labels.
     reference : ndarray, shape (n_f, n_dof)
         Unpolluted complex response (exactly the kernel's result with all factors 1).
-    lower, upper : ndarray, shape (n_f, n_dof)
-        Minimum and maximum of ``|v_e|`` over the rounds.
+    minimum, maximum : ndarray, shape (n_f, n_dof)
+        Minimum and maximum of ``|v_e|`` over the rounds (the corridor's edges; ``lower`` /
+        ``upper`` are their deprecated names, kept for one release).
     argmin_round, argmax_round : ndarray of int, shape (n_f, n_dof)
         First round attaining them (regenerate it with :meth:`round`).
     q : ndarray, shape (n_q,)
@@ -153,15 +187,17 @@ class ScatterBand:
     percentiles : ndarray, shape (n_q, n_f, n_dof)
         Percentiles of ``|v_e|`` over the rounds (numpy's "linear" definition).
     convergence : Convergence
-    noise, target, rounds, frequency_dependent, seed, harmonic
-        The settings.
+    noise : float
+        The noise level ``p`` as a fraction (0.1 = factors in [0.9, 1.1]).
+    target, rounds, frequency_dependent, seed, harmonic
+        The other settings.
     """
 
     freq: FloatArray
     dofs: tuple[str, ...]
     reference: ComplexArray
-    lower: FloatArray
-    upper: FloatArray
+    minimum: FloatArray
+    maximum: FloatArray
     argmin_round: IntArray
     argmax_round: IntArray
     q: FloatArray
@@ -174,6 +210,18 @@ class ScatterBand:
     seed: int
     harmonic: int | None
     _inputs: _Inputs
+
+    @property
+    def lower(self) -> FloatArray:
+        """Deprecated name of :attr:`minimum` (one release)."""
+        _renamed_edge("ScatterBand", "lower", "minimum")
+        return self.minimum
+
+    @property
+    def upper(self) -> FloatArray:
+        """Deprecated name of :attr:`maximum` (one release)."""
+        _renamed_edge("ScatterBand", "upper", "maximum")
+        return self.maximum
 
     def _dof(self, dof: str | int) -> int:
         if isinstance(dof, str):
@@ -223,14 +271,14 @@ class ScatterBand:
         nj, ne = arrays[2].shape[1], arrays[6].shape[1]
         tire, vehicle = _flags(self.target)
         stream_line = line if self.frequency_dependent else 0
-        s = _kernels.noise_factors(
+        s = _noise_kernels.noise_factors(
             key, np.array([r], np.int64), np.array([stream_line]), self.noise, nj, ne, tire, vehicle
         )[0]
         return split_factors(s, nj, ne)
 
 
 def split_factors(s: FloatArray, nj: int, ne: int) -> dict[str, FloatArray]:
-    """Split one stream of factors into the four scaling arrays (layout of :mod:`._kernels`)."""
+    """The four scaling arrays of one stream of factors (layout of :mod:`._noise_kernels`)."""
     o1, o2, o3 = nj * nj, nj * nj + nj, 2 * nj * nj + nj
     return {
         "Yjj_A": s[..., :o1].reshape(s.shape[:-1] + (nj, nj)),
@@ -240,10 +288,32 @@ def split_factors(s: FloatArray, nj: int, ne: int) -> dict[str, FloatArray]:
     }
 
 
-def _flags(target: str) -> tuple[bool, bool]:
+def target_name(target: str, *, warn: bool = True) -> str:
+    """The name in :data:`TARGETS` of a noise target; ``"vehicle"`` is the deprecated name of
+    ``"chassis"`` (a ``DeprecationWarning`` when ``warn``; bands stored with it still load).
+
+    Raises
+    ------
+    FBSError
+        For an unknown target, naming the allowed ones.
+    """
+    if target in _OLD_TARGETS:
+        if warn:
+            warnings.warn(
+                f"noise target {target!r} is deprecated; use {_OLD_TARGETS[target]!r}",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+        return _OLD_TARGETS[target]
     if target not in TARGETS:
         raise FBSError(f"unknown noise target {target!r}; allowed: {', '.join(TARGETS)}")
-    return target in ("tire", "both"), target in ("vehicle", "both")
+    return target
+
+
+def _flags(target: str) -> tuple[bool, bool]:
+    """Which subsystems get noise: ``(tire, chassis)``."""
+    t = target_name(target, warn=False)
+    return t in ("tire", "both"), t in ("chassis", "both")
 
 
 def _split(z: ComplexArray) -> tuple[FloatArray, FloatArray]:
@@ -263,7 +333,7 @@ def _run_complex(
     nf, ne = arrays[0].shape[0], arrays[6].shape[1]
     out = np.empty((rids.size, nf, ne), np.complex128)
     with _LOCK:
-        _kernels.noisy_block_run(
+        _noise_kernels.noisy_block_run(
             *arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep, _EMPTY_MAG, out
         )
     return out
@@ -297,7 +367,7 @@ def _check_inputs(
     for name, x in (("YjjA", YjjA), ("vj", vj), ("YjjE", YjjE), ("YejE", YejE)):
         if not np.all(np.isfinite(x)):
             raise DataFormatError(f"{name} contains non-finite values")
-    order = _ro(_kernels.pivot_order(YjjA, YjjE))
+    order = _ro(_noise_kernels.pivot_order(YjjA, YjjE))
     return (*_split(YjjA), *_split(vj), *_split(YjjE), *_split(YejE), order)
 
 
@@ -335,7 +405,7 @@ def scatter_band_arrays(
         Chassis transfer mobility ``Y_ej^E``.
     noise : float
         ``p``: factors uniform in ``[1 - p, 1 + p]`` (0.1 = +-10 %), ``0 <= p < 1``.
-    target : {"tire", "vehicle", "both"}
+    target : {"tire", "chassis", "both"}
         Eq. 5.2, 5.3 or 5.4.
     rounds : int
         Number of rounds ``R``.
@@ -379,6 +449,7 @@ def scatter_band_arrays(
     ne = arrays[6].shape[1]
     if not (0.0 <= noise < 1.0):
         raise FBSError(f"noise must be in [0, 1) (0.1 = +-10 %), got {noise!r}")
+    target = target_name(target)
     tire, vehicle = _flags(target)
     if isinstance(rounds, bool) or not isinstance(rounds, int | np.integer) or rounds < 1:
         raise FBSError(f"rounds must be a positive integer, got {rounds!r}")
@@ -430,7 +501,7 @@ def scatter_band_arrays(
         l1 = min(nf, l0 + chunk)
         m = mag[: l1 - l0]
         with _LOCK:
-            _kernels.noisy_block_run(
+            _noise_kernels.noisy_block_run(
                 *arrays,
                 l0,
                 l1,
@@ -443,7 +514,7 @@ def scatter_band_arrays(
                 m,
                 _EMPTY_CPLX,
             )
-            _kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
+            _noise_kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
         if progress is not None:
             progress(l1, nf)
     del mag
@@ -458,8 +529,8 @@ def scatter_band_arrays(
         freq=_ro(f),
         dofs=dofs,
         reference=_ro(ref),
-        lower=_ro(lo),
-        upper=_ro(hi),
+        minimum=_ro(lo),
+        maximum=_ro(hi),
         argmin_round=_ro(alo),
         argmax_round=_ro(ahi),
         q=_ro(qs),
@@ -524,6 +595,7 @@ def scatter_band(
     >>> r = band.peak_round(42.0, "bushing:z")                     # doctest: +SKIP
     >>> curve = band.round(r)                                      # doctest: +SKIP
     """
+    target = target_name(target)
     h = _models.resolve_harmonic(harmonic)
     tire = _models.resolve_tire(tire)
     dirs = _models.coupled_directions(coupling)

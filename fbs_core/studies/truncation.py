@@ -125,7 +125,8 @@ class TruncationMap:
         return self.response[hit[0]] if hit.size else None
 
     def suggest(self, threshold: float = 0.2, f_max: float = 160.0, dof: str | None = None) -> int:
-        """Smallest retained-mode count from which the error stays below ``threshold``.
+        """Smallest retained-mode count from which the error stays below ``threshold``
+        (a fraction, 0.2 = 20 %) at every centre up to ``f_max`` Hz.
 
         See :func:`suggest_n_modes`; ``dof=None`` uses the maximum over DOFs.
         """
@@ -155,7 +156,10 @@ def suggest_n_modes(
     error : ndarray, shape (n_N, n_c)
     centres : ndarray, shape (n_c,)
     n_modes : ndarray of int, shape (n_N,), ascending
-    threshold, f_max : float
+    threshold : float
+        Largest acceptable error as a fraction (0.2 = 20 %).
+    f_max : float
+        Highest centre frequency judged, Hz.
     n_total : int, optional
         Modes of the reference; returned when no count in ``n_modes`` qualifies
         (default: ``max(n_modes)``).
@@ -440,7 +444,12 @@ class SuggestedModes:
         Highest eigenfrequency among those modes at ``speed`` (NaN where n_modes is 0).
     freq_range : ndarray, shape (n_h, 2)
         Excitation band of each harmonic in Hz.
-    threshold, f_max, speed : float
+    threshold : float
+        Largest acceptable eq. 5.1 error as a fraction (0.2 = 20 %).
+    f_max : float
+        Upper frequency of the predictions, Hz.
+    speed : float
+        Speed of the eigenfrequencies, km/h.
     dof : str or None
         Response DOF judged (None: maximum over DOFs).
     maps : tuple of TruncationMap

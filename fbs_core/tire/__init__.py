@@ -9,7 +9,7 @@ from .model import ModeCountError, OperatingPointError, TireModel
 from .modes import ComplexModes, ModalError, complex_modes, track_modes
 from .params import DEFAULT_PARAMETERS, FAMILIES, TireParameters
 from .ring import HUB_DOFS, build_tire_system, patch_load, ring_closed_form, system_matrices
-from .storage import DATA_FILE, load_tire_model, reference_tire, save_tire_model
+from .storage import DATA_FILE, load_tire_model, read_tire_h5, reference_tire, save_tire_model
 
 __all__ = [
     "DATA_FILE",
@@ -29,6 +29,7 @@ __all__ = [
     "landmark_table",
     "load_tire_model",
     "patch_load",
+    "read_tire_h5",
     "reference_tire",
     "ring_closed_form",
     "save_tire_model",

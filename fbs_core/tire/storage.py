@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
@@ -42,6 +43,7 @@ __all__ = [
     "READABLE_VERSIONS",
     "DATA_FILE",
     "save_tire_model",
+    "read_tire_h5",
     "load_tire_model",
     "tire_from_content",
     "reference_tire",
@@ -123,8 +125,12 @@ def save_tire_model(model: TireModel, path: str | os.PathLike[str], description:
     return path
 
 
-def load_tire_model(path: str | os.PathLike[str]) -> TireModel:
-    """Read a modal tire model written in format ``tire-fbs/modal-tire``.
+def read_tire_h5(path: str | os.PathLike[str]) -> TireModel:
+    """Read a modal tire model written in format ``tire-fbs/modal-tire`` (this package's file).
+
+    The file is opened in this process: for the shipped reference model and files written by
+    :func:`save_tire_model`. Files from users or suppliers (MATLAB or this format) go
+    through :func:`fbs_core.io.import_tire_model`, which parses them in a sandbox process.
 
     Raises
     ------
@@ -145,6 +151,18 @@ def load_tire_model(path: str | os.PathLike[str]) -> TireModel:
     return tire_from_content(root, data, params, str(path))
 
 
+def load_tire_model(path: str | os.PathLike[str]) -> TireModel:
+    """Deprecated name of :func:`read_tire_h5` (a ``DeprecationWarning``; removed in the
+    next release). Not to be confused with :func:`fbs_core.io.import_tire_model`."""
+    warnings.warn(
+        "fbs_core.tire.load_tire_model is deprecated; use fbs_core.tire.read_tire_h5 "
+        "(this package's HDF5 file) or fbs_core.io.import_tire_model (user files)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return read_tire_h5(path)
+
+
 def _text(v: Any) -> str:
     if isinstance(v, bytes):
         return v.decode("utf-8", "replace")
@@ -161,8 +179,8 @@ def tire_from_content(
 ) -> TireModel:
     """Build a :class:`TireModel` from already-read content of a ``tire-fbs/modal-tire`` file.
 
-    No file is opened here: the importer (:func:`fbs_core.io.load_tire_model`) passes
-    what the sandbox parsed, :func:`load_tire_model` what h5py read.
+    No file is opened here: the importer (:func:`fbs_core.io.import_tire_model`) passes
+    what the sandbox parsed, :func:`read_tire_h5` what h5py read.
 
     Parameters
     ----------
@@ -260,4 +278,4 @@ def reference_tire() -> TireModel:
     >>> tire.n_modes
     400
     """
-    return load_tire_model(DATA_FILE)
+    return read_tire_h5(DATA_FILE)
