@@ -28,7 +28,7 @@ import numpy as np
 from fbs_core import FRF
 from fbs_core.analysis import PinnedState, db_difference, pin_state, truncation_map_difference
 from fbs_core.errors import FBSError
-from fbs_core.vocabulary import magnitude_db
+from fbs_core.vocabulary import magnitude_db, percent
 
 from . import compute
 from .analysis_state import PinSettings
@@ -209,7 +209,7 @@ def compare_result(s: Snapshot, pins: tuple[Pin, ...], compare_to: str) -> Resul
             dmap = {
                 "n_modes": np.asarray(md.n_modes, int),
                 "centres": np.asarray(md.centres, float),
-                "diff_pct": 100.0 * np.asarray(err, float),
+                "diff_pct": percent(np.asarray(err, float)),
                 "pin": target.name,
                 "what": f"bushing:{what}" if what else "max over 6 DOFs",
             }

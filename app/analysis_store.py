@@ -24,7 +24,7 @@ import param
 
 from fbs_core.analysis import add_pin, delta_cursor, phase_deg, pin_state, remove_pin
 from fbs_core.errors import FBSError
-from fbs_core.vocabulary import magnitude_db
+from fbs_core.vocabulary import magnitude_db, percent
 
 from . import analysis_compute as ac
 from . import background, bands, compute
@@ -377,7 +377,8 @@ def peak_text(p: dict, modes=()) -> str:
     if p.get("speed") is not None:
         text += f" @ {p['speed']:.0f} km/h"
     if modes:
-        text += "\nmodes " + ", ".join(f"{m.freq:.1f} Hz ({100 * m.damping:.1f} %)" for m in modes)
+        shown = (f"{m.freq:.1f} Hz ({percent(m.damping):.1f} %)" for m in modes)
+        text += "\nmodes " + ", ".join(shown)
     return text
 
 

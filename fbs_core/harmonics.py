@@ -12,6 +12,7 @@ The wavelengths are fitted to the band edges of table 5.1 (12.9-51.5 Hz for case
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -161,3 +162,31 @@ def harmonic(k: int | Harmonic) -> Harmonic:
             f"unknown harmonic {k!r}; allowed: 1, 2, 3, 4, 5, 6, 7 (thesis table 5.1)"
         )
     return HARMONICS[int(k) - 1]
+
+
+def renamed_argument(
+    harmonic: int | Harmonic | None,
+    harmonic_case: int | Harmonic | None,
+    function: str,
+    stacklevel: int = 3,
+) -> int | Harmonic:
+    """The harmonic given as ``harmonic`` or under its deprecated name ``harmonic_case``
+    (kept for one release, with a :class:`DeprecationWarning`).
+
+    Raises
+    ------
+    TypeError
+        For neither or both.
+    """
+    if harmonic_case is None:
+        if harmonic is None:
+            raise TypeError(f"{function}() missing the argument 'harmonic'")
+        return harmonic
+    warnings.warn(
+        f"{function}(harmonic_case=...) is deprecated; use harmonic=...",
+        DeprecationWarning,
+        stacklevel=stacklevel,
+    )
+    if harmonic is not None:
+        raise TypeError(f"{function}(): give 'harmonic' only (harmonic_case is its old name)")
+    return harmonic_case

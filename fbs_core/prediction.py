@@ -37,7 +37,7 @@ from .direct import SecondOrderSystem
 from .dofs import DIRECTIONS, node_labels
 from .errors import CouplingOptionError
 from .frf import FRF, check_grid
-from .harmonics import Harmonic
+from .harmonics import Harmonic, renamed_argument
 from .harmonics import harmonic as _harmonic
 from .vocabulary import COUPLINGS as _COUPLING_NAMES
 
@@ -339,7 +339,7 @@ def bushing_response(
     >>> v.outputs[2], v.inputs                       # doctest: +SKIP
     ('bushing:z', ('patch',))
     """
-    h = _harmonic(_renamed(harmonic, harmonic_case))
+    h = _harmonic(renamed_argument(harmonic, harmonic_case, "bushing_response"))
     coupled_dofs(coupling)
     f = h.frequencies() if freq is None else check_grid(freq)
     if speed_kmh is not None:
@@ -363,21 +363,3 @@ def bushing_response(
 
 
 _HARMONIC_SET = {_harmonic(k) for k in range(1, 8)}
-
-
-def _renamed(
-    harmonic: int | Harmonic | None, harmonic_case: int | Harmonic | None
-) -> int | Harmonic:
-    """The harmonic given under its name or its deprecated one (``harmonic_case``)."""
-    if harmonic_case is None:
-        if harmonic is None:
-            raise TypeError("bushing_response() missing the argument 'harmonic'")
-        return harmonic
-    warnings.warn(
-        "bushing_response(harmonic_case=...) is deprecated; use harmonic=...",
-        DeprecationWarning,
-        stacklevel=3,
-    )
-    if harmonic is not None:
-        raise TypeError("give 'harmonic' only (harmonic_case is its deprecated name)")
-    return harmonic_case

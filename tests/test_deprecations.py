@@ -130,3 +130,29 @@ def test_percent_and_fraction_are_inverse_and_match_the_core_docs():
     assert percent(band.noise) == 10.0
     x = np.array([0.07, 0.2, 1.0])
     np.testing.assert_array_equal(fraction(percent(x)), x)
+
+
+@pytest.mark.parametrize(
+    "function, kwargs",
+    [
+        (fbs_core.analysis.speed_map, {"n_modes": 40, "speeds": [40.0, 60.0]}),
+        (fbs_core.analysis.bushing_contributions, {"n_modes": 40}),
+        (fbs_core.bushing_response, {"n_modes": 40}),
+    ],
+)
+def test_harmonic_case_keyword_is_harmonic(function, kwargs):
+    """``harmonic_case=`` (old) warns and gives what ``harmonic=`` gives; neither or both
+    is a TypeError naming the function."""
+    new = function(harmonic=1, **kwargs)
+    with pytest.warns(DeprecationWarning, match="harmonic_case=.*use harmonic="):
+        old = function(harmonic_case=1, **kwargs)
+    for name in ("response", "terms", "data"):
+        if hasattr(new, name):
+            np.testing.assert_array_equal(getattr(old, name), getattr(new, name))
+            break
+    else:
+        raise AssertionError(f"no data attribute on {type(new).__name__}")
+    with pytest.raises(TypeError, match=function.__name__):
+        function(**kwargs)
+    with pytest.raises(TypeError, match="give 'harmonic' only"), pytest.warns(DeprecationWarning):
+        function(1, harmonic_case=1, **kwargs)

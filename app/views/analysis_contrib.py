@@ -12,6 +12,8 @@ import numpy as np
 import panel as pn
 from bokeh.models import ColumnDataSource, HoverTool, Span
 
+from fbs_core.vocabulary import percent
+
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .common import COLORS, level_label, level_tooltips
 from .plots import add_line, fit_range
@@ -123,7 +125,7 @@ class ContributionsView(AnalysisView):
         cum = np.zeros(f.size)
         stack = {"freq": f, "c0": cum.copy()}
         for k, dof in enumerate(DOFS):
-            share = 100 * c[f"hub_{dof}_share"] if dof in interface else np.zeros(f.size)
+            share = percent(c[f"hub_{dof}_share"]) if dof in interface else np.zeros(f.size)
             stack[f"s{k}"] = share
             cum = cum + share
             stack[f"c{k + 1}"] = cum.copy()

@@ -29,7 +29,8 @@ from ..coupling import _check_same, _interface_pairs
 from ..dofs import index_of
 from ..errors import DOFError
 from ..frf import FRF, check_grid
-from ..harmonics import harmonic
+from ..harmonics import harmonic as _harmonic
+from ..harmonics import renamed_argument
 from ..prediction import coupled_dofs
 
 __all__ = [
@@ -266,7 +267,7 @@ def interface_contributions(
 
 
 def bushing_contributions(
-    harmonic_case: Any,
+    harmonic: Any = None,
     n_modes: int | None = None,
     freq: npt.ArrayLike | None = None,
     coupling: str = "6dof",
@@ -274,6 +275,7 @@ def bushing_contributions(
     speed_kmh: float | None = None,
     tire: Any = None,
     chassis: ChassisModel | None = None,
+    harmonic_case: Any = None,
 ) -> Contributions:
     """Contributions of the hub forces to the bushing response of a harmonic case.
 
@@ -283,7 +285,7 @@ def bushing_contributions(
 
     Parameters
     ----------
-    harmonic_case : int or Harmonic
+    harmonic : int or Harmonic
         Excitation case 1..7.
     n_modes : int, optional
         Retained complex tire modes; ``None`` keeps all.
@@ -309,7 +311,7 @@ def bushing_contributions(
     >>> c.at("bushing:z").inputs                          # doctest: +SKIP
     ('hub:x', 'hub:y', 'hub:z', 'hub:rx', 'hub:ry', 'hub:rz')
     """
-    h = harmonic(harmonic_case)
+    h = _harmonic(renamed_argument(harmonic, harmonic_case, "bushing_contributions"))
     dofs = coupled_dofs(coupling)
     f = h.frequencies() if freq is None else check_grid(np.asarray(freq))
     if tire is None:

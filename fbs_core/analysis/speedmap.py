@@ -34,7 +34,8 @@ from ..chassis import BUSHING, SPINDLE, reference_chassis
 from ..dofs import index_of
 from ..errors import DataFormatError, FBSError
 from ..frf import check_grid
-from ..harmonics import Harmonic, harmonic
+from ..harmonics import Harmonic, renamed_argument
+from ..harmonics import harmonic as _harmonic
 from ..prediction import coupled_dofs
 from ..tire.model import ModeCountError, OperatingPointError
 
@@ -205,7 +206,7 @@ def _cached(k: int, n_modes: int | None, sbytes: bytes, fbytes: bytes, coupling:
     return _compute(
         reference_tire(),
         reference_chassis(),
-        harmonic(k),
+        _harmonic(k),
         n_modes,
         np.frombuffer(sbytes, float),
         np.frombuffer(fbytes, float),
@@ -242,7 +243,7 @@ def _compute(
 
 
 def speed_map(
-    harmonic_case: Any,
+    harmonic: Any = None,
     n_modes: int | None = None,
     *,
     speeds: npt.ArrayLike | None = None,
@@ -250,12 +251,13 @@ def speed_map(
     coupling: str = "6dof",
     tire: Any = None,
     chassis: Any = None,
+    harmonic_case: Any = None,
 ) -> SpeedMap:
     """Bushing response of a harmonic case over speed and frequency (eq. 4.1 at each speed).
 
     Parameters
     ----------
-    harmonic_case : int or Harmonic
+    harmonic : int or Harmonic
         Excitation case 1..7 (its wavelength sets the patch load).
     n_modes : int, optional
         Even number of retained complex tire modes; ``None`` keeps all.
@@ -289,7 +291,7 @@ def speed_map(
     >>> m.level_db("bushing:z").shape == (m.speeds.size, m.freq.size)  # doctest: +SKIP
     True
     """
-    h = harmonic(harmonic_case)
+    h = _harmonic(renamed_argument(harmonic, harmonic_case, "speed_map"))
     coupled_dofs(coupling)
     ref = tire is None and chassis is None
     if tire is None:
