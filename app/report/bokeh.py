@@ -69,16 +69,9 @@ class TitleBlockModels:
             fig.add_layout(t, "above")
         self.heading = Title(text="", text_font_size="13px", text_font_style="bold", standoff=2)
         fig.add_layout(self.heading, "above")
-
-    def save_tools(self) -> list[SaveTool]:
-        """The figure's save tools, looked up once (``figure.select`` walks the whole model
-        graph: it was the largest cost of a control change)."""
-        tools = getattr(self, "_save_tools", None)
-        if tools is None:
-            tools = self._save_tools = [
-                t for t in self.fig.toolbar.tools if isinstance(t, SaveTool)
-            ]
-        return tools
+        # the figure's save tools, found once (figure.select walks the whole model graph:
+        # it was the largest cost of a control change)
+        self.save_tools = [t for t in fig.toolbar.tools if isinstance(t, SaveTool)]
 
     def update(self, tb: TitleBlock, stem: str | None = None) -> None:
         """Show ``tb`` (lines beyond the models' count are joined into the last one)."""
@@ -96,7 +89,7 @@ class TitleBlockModels:
             if t.visible != visible:
                 t.visible = visible
         if stem is not None:
-            for tool in self.save_tools():
+            for tool in self.save_tools:
                 if tool.filename != stem:
                     tool.filename = stem
 
