@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 import tracemalloc
 
 import numpy as np
@@ -150,7 +151,7 @@ def test_same_seed_same_band_other_seed_other_band(arrays):
 
 
 def test_chunking_gives_identical_results_and_bounds_memory(arrays):
-    whole = _band(arrays, rounds=4000, frequency_dependent=True)
+    whole = _band(arrays, rounds=4000, frequency_dependent=True, max_chunk_seconds=None)
     tracemalloc.start()
     small = _band(arrays, rounds=4000, frequency_dependent=True, max_chunk_bytes=8 * 6 * 4000 * 3)
     peak = tracemalloc.get_traced_memory()[1]
@@ -254,3 +255,85 @@ def test_concurrent_bands_from_threads_agree(arrays):
         )
     np.testing.assert_array_equal(bands[0].maximum, bands[2].maximum)
     np.testing.assert_array_equal(bands[1].maximum, bands[3].maximum)
+
+
+def _chunks(arrays, **kw):
+    """The band and the number of lines of each of its chunks (from the progress calls)."""
+    done = []
+    band = _band(arrays, progress=lambda d, n: done.append(d), **kw)
+    return band, np.diff(done).tolist()
+
+
+def test_chunks_are_bounded_in_time_and_change_no_number(arrays):
+    """A chunk lasts at most ``max_chunk_seconds`` (sized by the measured time per line): with
+    a bound shorter than any line, every chunk after the first is one line; without a
+    bound one chunk holds every line memory allows. The numbers are the same."""
+    kw = {"rounds": 3000, "frequency_dependent": True, "seed": 4}
+    whole, sizes = _chunks(arrays, max_chunk_seconds=None, **kw)
+    assert sizes == [NF]
+    short, sizes = _chunks(arrays, max_chunk_seconds=1e-9, **kw)
+    assert len(sizes) >= NF - sizes[0] + 1 and set(sizes[1:]) == {1}
+    for name in ("minimum", "maximum", "percentiles", "argmin_round", "argmax_round"):
+        np.testing.assert_array_equal(getattr(whole, name), getattr(short, name))
+    np.testing.assert_array_equal(whole.convergence.minimum, short.convergence.minimum)
+    # the default bound (0.1 s): a 200,000-round band whose memory bound would allow all
+    # its lines in one chunk (about 1.4 s of work on 2 cores) runs in several
+    _, sizes = _chunks(arrays, rounds=200_000, max_chunk_bytes=8 * NE * 200_000 * NF)
+    assert len(sizes) > 1
+
+
+def test_single_rounds_need_no_kernel_lock(arrays):
+    """A page regenerates single rounds while another thread's band holds the parallel
+    kernel: they run on the calling thread without its lock."""
+    from fbs_core.studies import scatter
+
+    band = _band(arrays, rounds=500, frequency_dependent=True, seed=9)
+    want, want_7 = band.rounds_response([3, 499]), band.round(7)
+    got = {}
+
+    def regenerate():
+        got["rounds"] = band.rounds_response([3, 499])
+        got["round"] = band.round(7)
+
+    with scatter._LOCK:  # another band's chunk is running
+        t = threading.Thread(target=regenerate, daemon=True)
+        t.start()
+        t.join(120)  # liveness, not speed: with the lock needed it never ends
+        alive = t.is_alive()
+    t.join()
+    assert not alive, "regenerating a round waited for another band's kernel"
+    np.testing.assert_array_equal(got["rounds"], want)
+    np.testing.assert_array_equal(got["round"], want_7)
+
+
+class _CountingTire:
+    """The reference tire, counting its modal syntheses."""
+
+    def __init__(self):
+        self._tire = fc.reference_tire()
+        self.n_modes = self._tire.n_modes
+        self.calls = 0
+
+    def truncations(self, *args, **kw):
+        self.calls += 1
+        return self._tire.truncations(*args, **kw)
+
+
+def test_a_new_seed_reuses_the_subsystem_arrays():
+    """Bands that differ in their noise settings only (a dashboard user changing the seed,
+    one request after the other) synthesise the tire once; N or the harmonic again."""
+    tire = _CountingTire()
+    kw = {"rounds": 64, "n_modes": 20, "tire": tire}
+    a = fc.scatter_band(2, seed=1, **kw)
+    b = fc.scatter_band(2, seed=2, noise=0.2, frequency_dependent=True, **kw)
+    assert tire.calls == 1
+    fc.scatter_band(2, seed=1, **{**kw, "n_modes": 30})
+    fc.scatter_band(3, seed=1, **kw)
+    assert tire.calls == 3
+    # the same numbers as with the tire synthesised afresh
+    fresh = fc.scatter_band(2, seed=2, noise=0.2, frequency_dependent=True, **{
+        **kw, "tire": _CountingTire()
+    })  # fmt: skip
+    np.testing.assert_array_equal(b.maximum, fresh.maximum)
+    np.testing.assert_array_equal(b.reference, fresh.reference)
+    assert not np.array_equal(a.maximum, b.maximum)

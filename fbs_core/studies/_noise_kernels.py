@@ -247,6 +247,85 @@ def _workspace(
     return s, base, W, X, Y, piv, pm
 
 
+@njit(**_JIT)
+def _block(
+    b: int,
+    Ar: FloatArray,
+    Ai: FloatArray,
+    ar: FloatArray,
+    ai: FloatArray,
+    Er: FloatArray,
+    Ei: FloatArray,
+    Br: FloatArray,
+    Bi: FloatArray,
+    order: IntArray,
+    l0: int,
+    l1: int,
+    key: np.uint64,
+    rids: IntArray,
+    p: float,
+    tire: bool,
+    vehicle: bool,
+    freq_dep: bool,
+    mag: FloatArray,
+    cplx: ComplexArray,
+) -> None:
+    """Block ``b`` of ``LANES`` rounds of :func:`noisy_block_run` (all its lines)."""
+    nj = Ar.shape[1]
+    ne = Br.shape[1]
+    n_el = 2 * nj * nj + nj + ne * nj
+    k_tire = (nj * nj + nj) // 2
+    k_all = (n_el + 1) // 2
+    nr = rids.size
+    want_mag = mag.size > 0
+    r0 = b * LANES
+    nv = min(LANES, nr - r0)
+    lane_ids = np.empty(LANES, np.int64)
+    for v in range(LANES):
+        lane_ids[v] = rids[r0 + min(v, nv - 1)]  # pad with the last round (not written)
+    s, base, W, X, Y, piv, pm = _workspace(nj, ne, n_el)
+    for line in range(l0, l1):
+        if freq_dep or line == l0:
+            stream_line = line if freq_dep else 0
+            if tire:
+                _lane_factors(key, lane_ids, nv, stream_line, p, 0, k_tire, s, base)
+            if vehicle:
+                _lane_factors(key, lane_ids, nv, stream_line, p, k_tire, k_all, s, base)
+        _lane_solve(
+            Ar[line],
+            Ai[line],
+            ar[line],
+            ai[line],
+            Er[line],
+            Ei[line],
+            Br[line],
+            Bi[line],
+            order[line],
+            s,
+            nv,
+            W[0],
+            W[1],
+            X[0],
+            X[1],
+            X[2],
+            X[3],
+            piv,
+            pm,
+            Y[0],
+            Y[1],
+        )
+        if want_mag:
+            for e in range(ne):
+                for v in range(nv):
+                    mag[line - l0, e, r0 + v] = np.sqrt(
+                        Y[0, e, v] * Y[0, e, v] + Y[1, e, v] * Y[1, e, v]
+                    )
+        else:
+            for e in range(ne):
+                for v in range(nv):
+                    cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
+
+
 @njit(parallel=True, **_JIT)
 def noisy_block_run(
     Ar: FloatArray,
@@ -276,63 +355,52 @@ def noisy_block_run(
     else the complex response into ``cplx (n_rounds, n_f, n_e)`` (regeneration mode).
     Lines are global indices, so a chunk of lines gives the same numbers as the whole.
     ``tire``/``vehicle`` select which factors are random (the others are 1);
-    frequency-independent noise uses stream line 0 for every line.
+    frequency-independent noise uses stream line 0 for every line. The blocks of
+    ``LANES`` rounds run in parallel (numba's threading layer).
     """
-    nj = Ar.shape[1]
-    ne = Br.shape[1]
-    n_el = 2 * nj * nj + nj + ne * nj
-    k_tire = (nj * nj + nj) // 2
-    k_all = (n_el + 1) // 2
-    nr = rids.size
-    n_blocks = (nr + LANES - 1) // LANES
-    want_mag = mag.size > 0
+    n_blocks = (rids.size + LANES - 1) // LANES
     for b in prange(n_blocks):
-        r0 = b * LANES
-        nv = min(LANES, nr - r0)
-        lane_ids = np.empty(LANES, np.int64)
-        for v in range(LANES):
-            lane_ids[v] = rids[r0 + min(v, nv - 1)]  # pad with the last round (not written)
-        s, base, W, X, Y, piv, pm = _workspace(nj, ne, n_el)
-        for line in range(l0, l1):
-            if freq_dep or line == l0:
-                stream_line = line if freq_dep else 0
-                if tire:
-                    _lane_factors(key, lane_ids, nv, stream_line, p, 0, k_tire, s, base)
-                if vehicle:
-                    _lane_factors(key, lane_ids, nv, stream_line, p, k_tire, k_all, s, base)
-            _lane_solve(
-                Ar[line],
-                Ai[line],
-                ar[line],
-                ai[line],
-                Er[line],
-                Ei[line],
-                Br[line],
-                Bi[line],
-                order[line],
-                s,
-                nv,
-                W[0],
-                W[1],
-                X[0],
-                X[1],
-                X[2],
-                X[3],
-                piv,
-                pm,
-                Y[0],
-                Y[1],
-            )
-            if want_mag:
-                for e in range(ne):
-                    for v in range(nv):
-                        mag[line - l0, e, r0 + v] = np.sqrt(
-                            Y[0, e, v] * Y[0, e, v] + Y[1, e, v] * Y[1, e, v]
-                        )
-            else:
-                for e in range(ne):
-                    for v in range(nv):
-                        cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
+        _block(
+            b, Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p, tire, vehicle,
+            freq_dep, mag, cplx,
+        )  # fmt: skip
+
+
+@njit(**_JIT)
+def noisy_block_run_serial(
+    Ar: FloatArray,
+    Ai: FloatArray,
+    ar: FloatArray,
+    ai: FloatArray,
+    Er: FloatArray,
+    Ei: FloatArray,
+    Br: FloatArray,
+    Bi: FloatArray,
+    order: IntArray,
+    l0: int,
+    l1: int,
+    key: np.uint64,
+    rids: IntArray,
+    p: float,
+    tire: bool,
+    vehicle: bool,
+    freq_dep: bool,
+    mag: FloatArray,
+    cplx: ComplexArray,
+) -> None:
+    """:func:`noisy_block_run` on the calling thread alone, bit for bit the same numbers.
+
+    It never enters numba's threading layer, so any thread may run it at any time (no
+    lock): the single rounds a page regenerates (one block of ``LANES`` rounds, which the
+    parallel version would run on one thread anyway) never wait for another session's
+    band.
+    """
+    n_blocks = (rids.size + LANES - 1) // LANES
+    for b in range(n_blocks):
+        _block(
+            b, Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p, tire, vehicle,
+            freq_dep, mag, cplx,
+        )  # fmt: skip
 
 
 def pivot_order(A: ComplexArray, E: ComplexArray) -> IntArray:

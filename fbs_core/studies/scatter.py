@@ -30,7 +30,9 @@ rounds are processed in chunks of lines whose size is bounded by ``max_chunk_byt
 from __future__ import annotations
 
 import threading
+import time
 import warnings
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -65,8 +67,17 @@ _OLD_TARGETS = {"vehicle": "chassis"}
 
 _EMPTY_MAG = np.empty((0, 0, 0))
 # one compiled parallel run at a time (some numba threading layers abort on concurrent
-# launches from several Python threads, e.g. a dashboard serving two sessions)
+# launches from several Python threads, e.g. a dashboard serving two sessions); the
+# serial kernel (single rounds, the reference) runs without it
 _LOCK = threading.Lock()
+#: Default bound of one chunk's duration (s): the band asks ``cancel`` (and takes its
+#: turn) between chunks, so this is how long a cancel or another study waits at most.
+CHUNK_SECONDS = 0.1
+#: Measured seconds per round and line of the parallel kernel, by ``(n_j, n_e,
+#: frequency_dependent)``: sizes the first chunk of the next band (see ``max_chunk_seconds``)
+_RATE: dict[tuple[int, int, bool], float] = {}
+#: Rounds x lines of a first chunk when no rate is known yet (a few ms of work)
+_PROBE = 50_000
 _EMPTY_CPLX = np.empty((0, 0, 0), np.complex128)
 
 #: The kernel inputs of a band (real and imaginary parts of the four matrices and the
@@ -332,11 +343,24 @@ def _run_complex(
 ) -> ComplexArray:
     nf, ne = arrays[0].shape[0], arrays[6].shape[1]
     out = np.empty((rids.size, nf, ne), np.complex128)
-    with _LOCK:
-        _noise_kernels.noisy_block_run(
-            *arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep, _EMPTY_MAG, out
-        )
+    args = (*arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep, _EMPTY_MAG, out)
+    if rids.size <= _noise_kernels.LANES:  # one block: one thread either way, no lock needed
+        _noise_kernels.noisy_block_run_serial(*args)
+    else:
+        with _LOCK:
+            _noise_kernels.noisy_block_run(*args)
     return out
+
+
+def _chunk_lines(seconds: float | None, rate: float | None, rounds: int, max_lines: int) -> int:
+    """Lines of the next chunk: within ``seconds`` at ``rate`` (s per round and line), a
+    probe of about :data:`_PROBE` round-lines when the rate is not known, at least one line
+    and at most ``max_lines`` (the memory bound)."""
+    if seconds is None:
+        return max_lines
+    if rate is None:
+        return int(max(1, min(max_lines, _PROBE // rounds)))
+    return int(max(1, min(max_lines, seconds / (rate * rounds))))
 
 
 def default_checkpoints(rounds: int) -> IntArray:
@@ -388,6 +412,7 @@ def scatter_band_arrays(
     percentiles: ArrayLike = (5.0, 95.0),
     checkpoints: ArrayLike | None = None,
     max_chunk_bytes: float = 64e6,
+    max_chunk_seconds: float | None = CHUNK_SECONDS,
     cancel: Callable[[], bool] | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> ScatterBand:
@@ -421,6 +446,12 @@ def scatter_band_arrays(
         Round counts at which the band edges are recorded (default 10, 20, 50, ...).
     max_chunk_bytes : float
         Working-memory bound of one chunk of lines (``8 R n_e`` bytes per line).
+    max_chunk_seconds : float or None
+        Duration bound of one chunk of lines (default :data:`CHUNK_SECONDS`, 0.1 s): each
+        chunk gets as many lines as the measured time per line of the previous chunk (or
+        of the last band of the same shape) allows within it, at least one line. Chunks
+        never change the result; short ones let ``cancel`` act (and other studies take
+        their turn) within about this time. None: chunks bounded by memory only.
     cancel : callable, optional
         Called without arguments before each chunk of lines; when it returns True the
         study stops with :class:`~fbs_core.errors.StudyCancelled` (a dashboard whose
@@ -490,17 +521,24 @@ def scatter_band_arrays(
     clo = np.empty((ck.size, nf, ne))
     chi = np.empty((ck.size, nf, ne))
     per_line = 8 * ne * rounds
-    chunk = int(max(1, min(nf, max_chunk_bytes // per_line)))
-    mag = np.empty((chunk, ne, rounds))
+    max_lines = int(max(1, min(nf, max_chunk_bytes // per_line)))
+    mag = np.empty((max_lines, ne, rounds))
     rids = np.arange(rounds, dtype=np.int64)
+    shape = (nj, ne, bool(frequency_dependent))
+    rate = _RATE.get(shape) if max_chunk_seconds is not None else None
+    chunk = _chunk_lines(max_chunk_seconds, rate, rounds, max_lines)
     if progress is not None:
         progress(0, nf)
-    for l0 in range(0, nf, chunk):
+    l0 = 0
+    while l0 < nf:
         if cancel is not None and cancel():
             raise StudyCancelled(f"scatter band cancelled after {l0} of {nf} lines")
         l1 = min(nf, l0 + chunk)
+        if nf - l1 < chunk // 4:  # no short tail chunk (one turn more for a few lines)
+            l1 = min(nf, l0 + max_lines)
         m = mag[: l1 - l0]
         with _LOCK:
+            t0 = time.perf_counter()
             _noise_kernels.noisy_block_run(
                 *arrays,
                 l0,
@@ -515,8 +553,13 @@ def scatter_band_arrays(
                 _EMPTY_CPLX,
             )
             _noise_kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
+            spent = time.perf_counter() - t0
+        if max_chunk_seconds is not None:
+            rate = _RATE[shape] = max(spent, 1e-9) / ((l1 - l0) * rounds)
+            chunk = _chunk_lines(max_chunk_seconds, rate, rounds, max_lines)
         if progress is not None:
             progress(l1, nf)
+        l0 = l1
     del mag
     for name, x in (("reference", np.abs(ref)), ("upper edge", hi), ("lower edge", lo)):
         if not np.all(np.isfinite(x)):
@@ -546,6 +589,38 @@ def scatter_band_arrays(
     )
 
 
+#: Subsystem arrays of the last few bands, so that a band differing only in its noise
+#: settings (seed, level, target, rounds) does not synthesise the tire again: key ->
+#: ``(tire, chassis, arrays)``; the models are held to check identity (no id reuse).
+_INPUTS: OrderedDict[tuple, tuple[Any, Any, tuple]] = OrderedDict()
+_INPUTS_SIZE = 8
+_INPUTS_LOCK = threading.Lock()
+
+
+def _subsystem_arrays(
+    tire: Any, chassis: Any, f: FloatArray, h: Harmonic, n: int, dirs: tuple[str, ...]
+) -> tuple[ComplexArray, ComplexArray, ComplexArray, ComplexArray, tuple[str, ...]]:
+    """``(Y_jj^A, v_j, Y_jj^E, Y_ej^E, response labels)`` of one band, read-only, cached.
+
+    Models are immutable; they are matched by identity (``chassis`` None: the reference).
+    """
+    key = (id(tire), id(chassis), h.k, f.tobytes(), n, dirs)
+    with _INPUTS_LOCK:
+        hit = _INPUTS.get(key)
+        if hit is not None and hit[0] is tire and hit[1] is chassis:
+            _INPUTS.move_to_end(key)
+            return hit[2]
+    YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
+    YjjA, vj = _models.tire_arrays(tire, f, h, [n], dirs)
+    out = (_ro(YjjA[0]), _ro(vj[0]), _ro(YjjE), _ro(YejE), resp)
+    with _INPUTS_LOCK:
+        _INPUTS[key] = (tire, chassis, out)
+        _INPUTS.move_to_end(key)
+        while len(_INPUTS) > _INPUTS_SIZE:
+            _INPUTS.popitem(last=False)
+    return out
+
+
 def scatter_band(
     harmonic: int | Harmonic,
     noise: float = 0.1,
@@ -563,6 +638,7 @@ def scatter_band(
     percentiles: ArrayLike = (5.0, 95.0),
     checkpoints: ArrayLike | None = None,
     max_chunk_bytes: float = 64e6,
+    max_chunk_seconds: float | None = CHUNK_SECONDS,
     cancel: Callable[[], bool] | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> ScatterBand:
@@ -581,7 +657,7 @@ def scatter_band(
     tire, chassis : optional
         Models (default the reference ones); ``chassis`` may be an FRF on ``freq``.
     coupling : {"6dof", "5dof"} or sequence of directions
-    percentiles, checkpoints, max_chunk_bytes, cancel, progress
+    percentiles, checkpoints, max_chunk_bytes, max_chunk_seconds, cancel, progress
         See :func:`scatter_band_arrays`.
 
     Returns
@@ -604,11 +680,10 @@ def scatter_band(
     n = n_total if n_modes is None else int(n_modes)
     if not 1 <= n <= n_total:
         raise FBSError(f"n_modes must be in 1..{n_total} (the tire's modes), got {n_modes!r}")
-    YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
-    YjjA, vj = _models.tire_arrays(tire, f, h, [n], dirs)
+    YjjA, vj, YjjE, YejE, resp = _subsystem_arrays(tire, chassis, f, h, n, dirs)
     return scatter_band_arrays(
-        YjjA[0],
-        vj[0],
+        YjjA,
+        vj,
         YjjE,
         YejE,
         noise,
@@ -622,6 +697,7 @@ def scatter_band(
         percentiles=percentiles,
         checkpoints=checkpoints,
         max_chunk_bytes=max_chunk_bytes,
+        max_chunk_seconds=max_chunk_seconds,
         cancel=cancel,
         progress=progress,
     )
