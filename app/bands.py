@@ -1,25 +1,34 @@
 """Scatter bands of all sessions: cancelled when superseded, computed in turns.
 
 A band is the one computation of the dashboard that takes seconds (up to minutes for
-200,000 rounds). Three rules keep one session from starving the others:
+200,000 rounds). Four rules keep one session from starving the others:
 
 - **one live band per session**: a new request of a session cancels its running band
   (:class:`Job`); the kernel stops at its next chunk of lines
   (``fbs_core.scatter_band(cancel=...)``), so a dragged slider leaves no queue behind;
-- **turns**: the kernel asks before every chunk of lines (a few hundred milliseconds of
-  work or less); all running bands queue for the next chunk in arrival order
+- **turns**: the kernel asks before every chunk of lines (about 0.1 s of work); all running bands queue for the next chunk in arrival order
   (:class:`Turnstile`), so two sessions' bands advance chunk by chunk, alternately, and a
   short band waits for at most one chunk of a long one per turn;
 - **no pool to fill**: each live band has its own thread (a session has at most one live
   band, a cancelled one ends at its next turn), so no session can occupy the workers
-  others need.
+  others need;
+- **interactive work first**: a band's thread lowers its own CPU priority (its nice value
+  by :data:`BAND_NICE`, or ``FBS_BAND_NICE``; Linux, per thread; numba's worker threads,
+  which the band's thread starts, inherit it), so the threads that answer control changes
+  (Panel's workers, the event loop that sends the plots) get the cores whenever they need
+  them, and a band takes what is left.
 
 The numba kernels run one chunk at a time process-wide anyway (``fbs_core`` holds a lock
-around them), so the turns cost no parallelism.
+around the parallel kernel), so the turns cost no parallelism. A chunk lasts about 0.1 s
+(``fbs_core.scatter_band(max_chunk_seconds=...)``: the lines of a chunk are sized by the
+measured time per line), whatever the round count, so a turn is never long; the single
+rounds a page draws and the band's reference run on the calling thread without that lock.
 """
 
 from __future__ import annotations
 
+import os
+import sys
 import threading
 import time
 from collections import deque
@@ -31,7 +40,50 @@ from fbs_core.errors import FBSError, StudyCancelled
 
 from . import compute, offload
 
-__all__ = ["Job", "Turnstile", "TURNSTILE", "run", "served", "start"]
+__all__ = [
+    "BAND_NICE",
+    "Job",
+    "Turnstile",
+    "TURNSTILE",
+    "band_nice",
+    "lower_priority",
+    "run",
+    "served",
+    "start",
+]
+
+#: How much a band's thread raises its nice value (lowers its CPU priority), unless
+#: ``FBS_BAND_NICE`` says otherwise (0: bands run at the server's priority).
+BAND_NICE = 10
+BAND_NICE_ENV = "FBS_BAND_NICE"
+
+
+def band_nice() -> int:
+    """:data:`BAND_NICE` or ``$FBS_BAND_NICE`` (an integer 0-19; anything else: the default)."""
+    raw = os.environ.get(BAND_NICE_ENV, "").strip()
+    if raw.isdigit() and int(raw) <= 19:
+        return int(raw)
+    return BAND_NICE
+
+
+def lower_priority(by: int | None = None) -> int | None:
+    """Raise the calling thread's nice value by ``by`` (default :func:`band_nice`, at most
+    to 19); its new value.
+
+    Linux only (``setpriority`` with the thread's id acts on that thread alone, and threads
+    it starts later inherit it); elsewhere, or when refused, nothing changes and None is
+    returned. Relative, so a server started with ``nice`` keeps the difference.
+    """
+    by = band_nice() if by is None else by
+    if not sys.platform.startswith("linux"):  # elsewhere the id would name a process
+        return None
+    tid = threading.get_native_id()
+    try:
+        now = os.getpriority(os.PRIO_PROCESS, tid)
+        os.setpriority(os.PRIO_PROCESS, tid, min(19, now + by))
+        return os.getpriority(os.PRIO_PROCESS, tid)
+    except OSError:  # refused (e.g. a sandbox without the right to renice)
+        return None
 
 
 def served() -> bool:
@@ -164,12 +216,14 @@ def start(
     """:func:`run` on a thread of its own (daemon: it never holds up a shutdown).
 
     The thread works for the calling thread's session: Panel's current document is set in
-    it, so what ``done`` publishes is drawn through that session's event loop.
+    it, so what ``done`` publishes is drawn through that session's event loop. It runs at a
+    lower CPU priority (:func:`lower_priority`).
     """
     doc = pn.state.curdoc
 
     def work():
         pn.state.curdoc = doc
+        lower_priority()
         run(job, done, context, turnstile)
 
     t = threading.Thread(target=work, name="scatter-band", daemon=True)

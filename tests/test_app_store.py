@@ -8,6 +8,7 @@ in which the kernel's chunks actually ran (recorded by the turnstile).
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 
@@ -170,3 +171,60 @@ def test_a_page_closed_during_a_band_draws_nothing_more(turns):
     res.state.case.harmonic = 2  # a late event of the closed page
     assert res.band_curves is before and res.response.meta["harmonic"] == 6
     assert app is not None
+
+
+def _nice() -> int:
+    return os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+
+
+def test_a_band_runs_at_a_lower_cpu_priority_than_the_controls(monkeypatch):
+    """The band's thread (and so the numba threads it starts) yields the cores to the
+    threads that answer control changes: its nice value is BAND_NICE above theirs."""
+    monkeypatch.delenv(bands.BAND_NICE_ENV, raising=False)
+    seen = []
+    real = compute.band
+
+    def band(*args, **kw):
+        seen.append((threading.current_thread().name, _nice()))
+        return real(*args, **kw)
+
+    monkeypatch.setattr(compute, "band", band)
+    res = _results(seed=41)
+    mine = _nice()
+    res.request_band()  # background: on the band's own thread
+    _wait(lambda: res.band is not None and not res.band_status.busy, "the band")
+    assert seen == [("scatter-band", min(19, mine + bands.BAND_NICE))]
+    assert _nice() == mine  # the caller's thread (a Panel worker when served) is untouched
+    monkeypatch.setenv(bands.BAND_NICE_ENV, "0")  # the deployment's switch
+    res.state.noise.seed = 42
+    _wait(lambda: res.band.settings.seed == 42 and not res.band_status.busy, "the band")
+    assert seen[-1] == ("scatter-band", mine)
+
+
+def test_a_dof_change_does_not_wait_for_another_sessions_band():
+    """Another session's band holds the parallel kernel (a chunk is running): this session's
+    DOF change redraws its band (a regenerated single round) all the same."""
+    from fbs_core.studies import scatter
+
+    res = _results(seed=51)
+    res.request_band()
+    _wait(lambda: res.band is not None and not res.band_status.busy, "the band")
+    done = threading.Event()
+
+    def change():
+        res.state.case.dof = "x"
+        done.set()
+
+    with scatter._LOCK:  # a chunk of another session's band is running
+        threading.Thread(target=change, daemon=True).start()
+        finished = done.wait(120)  # liveness, not speed: with the lock needed it never ends
+    assert finished, "the DOF change waited for another session's band"
+    assert res.band_curves.meta["response DOF"] == "bushing:x"
+    want = fbs_core.scatter_band(
+        1, noise=0.1, rounds=200, n_modes=50, percentiles=compute.Q_LEVELS, seed=51
+    )
+    j = want.dofs.index("bushing:x")
+    k = [c for c in res.band_curves.columns if c.startswith("round_")][0]
+    np.testing.assert_allclose(
+        res.band_curves.columns[k], 20 * np.log10(np.abs(want.round(0)[:, j])), rtol=1e-12
+    )
