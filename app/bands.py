@@ -6,7 +6,9 @@ A band is the one computation of the dashboard that takes seconds (up to minutes
 - **one live band per session**: a new request of a session cancels its running band
   (:class:`Job`); the kernel stops at its next chunk of lines
   (``fbs_core.scatter_band(cancel=...)``), so a dragged slider leaves no queue behind;
-- **turns**: the kernel asks before every chunk of lines (about 0.1 s of work); all running bands queue for the next chunk in arrival order
+- **turns**: the kernel asks before every chunk of lines (about 0.1 s of work), and a
+  band's setup (the subsystem arrays: a tire synthesis for a new N or harmonic) runs in
+  the turn of its first chunk; all running bands queue for the next chunk in arrival order
   (:class:`Turnstile`), so two sessions' bands advance chunk by chunk, alternately, and a
   short band waits for at most one chunk of a long one per turn;
 - **no pool to fill**: each live band has its own thread (a session has at most one live
@@ -169,6 +171,12 @@ class Turnstile:
             self._cond.notify_all()
 
     @property
+    def holder(self) -> Job | None:
+        """The job whose turn it is (None between turns)."""
+        with self._cond:
+            return self._holder
+
+    @property
     def waiting(self) -> int:
         with self._cond:
             return len(self._queue)
@@ -195,9 +203,20 @@ def run(job: Job, done: Done, context=None, turnstile: Turnstile | None = None) 
         if res is None and offload.wanted(job.key):  # heavy: on the Dask cluster
             res = offload.band(job.key, lambda: job.cancelled, job.report)
         if res is None:
-            res = compute.band(
-                *job.key, cancel=lambda: not turns.next_turn(job), progress=job.report
-            )
+            # the band's setup (the tire synthesis of a new N or harmonic) is work like a
+            # chunk: done in a turn of its own, so it does not share the cores with another
+            # session's chunk; its first chunk follows in the same turn
+            if not turns.next_turn(job):
+                return
+            first = [True]
+
+            def cancel() -> bool:
+                if first:
+                    first.clear()
+                    return job.cancelled
+                return not turns.next_turn(job)
+
+            res = compute.band(*job.key, cancel=cancel, progress=job.report)
     except StudyCancelled:
         return
     except Exception as exc:  # the page shows the message instead of a silent spinner

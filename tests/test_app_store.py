@@ -228,3 +228,37 @@ def test_a_dof_change_does_not_wait_for_another_sessions_band():
     np.testing.assert_allclose(
         res.band_curves.columns[k], 20 * np.log10(np.abs(want.round(0)[:, j])), rtol=1e-12
     )
+
+
+def test_a_bands_setup_runs_in_its_turn(turns, monkeypatch):
+    """The subsystem arrays of a new band (a tire synthesis) are computed in the band's turn,
+    not beside another session's chunk."""
+    from collections import OrderedDict
+
+    from fbs_core.studies import _models, scatter
+
+    monkeypatch.setattr(scatter, "_INPUTS", OrderedDict())  # nothing cached: a synthesis
+    holders = []
+    real = _models.tire_arrays
+
+    def tire_arrays(*args, **kw):
+        holders.append(turns.holder)
+        return real(*args, **kw)
+
+    chunks = []
+    kernel = scatter._kernels.noisy_block_run
+
+    def chunk(*args):
+        chunks.append(turns.holder)
+        return kernel(*args)
+
+    monkeypatch.setattr(_models, "tire_arrays", tire_arrays)
+    monkeypatch.setattr(scatter._kernels, "noisy_block_run", chunk)
+    res = _results(seed=61, rounds=5_000)
+    res.request_band()
+    _wait(lambda: res.band is not None and not res.band_status.busy, "the band")
+    assert len(holders) == 1 and holders[0] is not None and holders[0].owner is res
+    # every chunk ran in a turn of its own band, the first in the setup's turn: one turn
+    # per chunk, the setup's included
+    assert chunks and all(h is not None and h.owner is res for h in chunks)
+    assert turns.turns.count(res.snapshot().band_key()) == len(chunks)
