@@ -592,14 +592,15 @@ def scatter_band_arrays(
 #: Subsystem arrays of the last few bands, so that a band differing only in its noise
 #: settings (seed, level, target, rounds) does not synthesise the tire again: key ->
 #: ``(tire, chassis, arrays)``; the models are held to check identity (no id reuse).
-_INPUTS: OrderedDict[tuple, tuple[Any, Any, tuple]] = OrderedDict()
+_Subsystems = tuple[ComplexArray, ComplexArray, ComplexArray, ComplexArray, tuple[str, ...]]
+_INPUTS: OrderedDict[tuple[Any, ...], tuple[Any, Any, _Subsystems]] = OrderedDict()
 _INPUTS_SIZE = 8
 _INPUTS_LOCK = threading.Lock()
 
 
 def _subsystem_arrays(
     tire: Any, chassis: Any, f: FloatArray, h: Harmonic, n: int, dirs: tuple[str, ...]
-) -> tuple[ComplexArray, ComplexArray, ComplexArray, ComplexArray, tuple[str, ...]]:
+) -> _Subsystems:
     """``(Y_jj^A, v_j, Y_jj^E, Y_ej^E, response labels)`` of one band, read-only, cached.
 
     Models are immutable; they are matched by identity (``chassis`` None: the reference).
