@@ -701,22 +701,49 @@ def _model(sess: BokehSession, title: str):
     raise LookupError(f"no control titled {title!r} in the page")
 
 
-async def _timed_change(sess: BokehSession, changes: dict, timeout_s: float, quiet_s: float = 0.3):
+def _n_slider(sess: BokehSession):
+    """The "Retained tire modes N" slider (a discrete slider: its value is the index)."""
+    for m in sess.doc.models:
+        if type(m).__name__ == "Slider" and m.start == 0 and m.end == 39:
+            return m
+    raise LookupError("no N slider in the page")
+
+
+def _dof_buttons(sess: BokehSession):
+    """The "Response DOF at the bushing" buttons (``active`` is the index of the DOF)."""
+    for m in sess.doc.models:
+        if type(m).__name__ == "RadioButtonGroup" and list(m.labels) == DOF_LABELS:
+            return m
+    raise LookupError("no response DOF buttons in the page")
+
+
+DOF_LABELS = ["x", "y", "z", "rx", "ry", "rz"]
+
+
+async def _timed_change(
+    sess: BokehSession, changes: dict, timeout_s: float, quiet_s: float = 0.3, raw=()
+):
     """Send control changes in one patch, as BokehJS does; (first, settled) in ms.
 
-    ``first``: the first plot-data update; ``settled``: the last one before the plots stay
-    quiet for ``quiet_s`` with no computation in progress (the scatter band's progress bar
-    off). Both are ``timeout_s`` if nothing came in time.
+    ``changes`` maps control titles to values; ``raw`` adds ``(model, attribute, value)``
+    changes (controls without a title). ``first``: the first plot-data update;
+    ``settled``: the last one before the plots stay quiet for ``quiet_s`` with no
+    computation in progress (the scatter band's progress bar off). Both are ``timeout_s``
+    if nothing came in time.
     """
     from bokeh.document.events import ModelChangedEvent
 
-    events = []
+    targets = []
     for title, value in changes.items():
         m = _model(sess, title)
         for attr in ("value", "value_throttled"):
             if attr in m.properties():
-                m.set_from_json(attr, value, setter=sess)
-                events.append(ModelChangedEvent(sess.doc, m, attr, value))
+                targets.append((m, attr, value))
+    targets += list(raw)
+    events = []
+    for m, attr, value in targets:
+        m.set_from_json(attr, value, setter=sess)
+        events.append(ModelChangedEvent(sess.doc, m, attr, value))
     n0 = len(sess._change_times)
     t0 = time.perf_counter()
     await sess._send(events)
@@ -731,23 +758,40 @@ async def _timed_change(sess: BokehSession, changes: dict, timeout_s: float, qui
     return (timeout_s * 1000 if first is None else first * 1000), timeout_s * 1000
 
 
+#: The victim's changes in turn: N, the harmonic with a new seed (a band to compute, not
+#: a cache hit), the response DOF.
+KINDS = ("N", "harmonic", "DOF")
+
+
 async def _timed_changes(sess: BokehSession, n: int, timeout_s: float, seed0: int):
-    """Victim: harmonic changes, each with a new seed (a band to compute, not a cache hit)."""
-    first, settled = [], []
+    """Victim: ``n`` changes of N, harmonic (+ seed) and DOF in turn; (kinds, first, settled)."""
+    kinds, first, settled = [], [], []
     current = _value(sess, "Harmonic") or 1
+    n_slider, dof = _n_slider(sess), _dof_buttons(sess)
     for k in range(n):
-        current = current % 7 + 1
-        f, s = await _timed_change(sess, {"Seed": seed0 + k, "Harmonic": current}, timeout_s)
+        kind = KINDS[k % 3]
+        if kind == "N":  # 50 -> 100 -> 150 -> 50 (indexes 4, 9, 14)
+            idx = {4: 9, 9: 14}.get(int(n_slider.value), 4)
+            raw = [(n_slider, a, idx) for a in ("value", "value_throttled")]
+            f, s = await _timed_change(sess, {}, timeout_s, raw=raw)
+        elif kind == "harmonic":
+            current = current % 7 + 1
+            f, s = await _timed_change(sess, {"Seed": seed0 + k, "Harmonic": current}, timeout_s)
+        else:  # z -> x -> y -> z
+            idx = {2: 0, 0: 1}.get(int(dof.active), 2)
+            f, s = await _timed_change(sess, {}, timeout_s, raw=[(dof, "active", idx)])
+        kinds.append(kind)
         first.append(f)
         settled.append(s)
-    return first, settled
+    return kinds, first, settled
 
 
 def attack_flood(rep: Report, base: str, app: str, cookie: str, args) -> None:
     rep.section(
-        f"6. one session floods the compute ({args.flood_rounds:,}-round bands, a new one every "
-        f"{args.flood_every:.0f} s), another ({args.victim_rounds:,}-round bands) changes the "
-        f"harmonic and the seed {args.flood_changes} times"
+        f"6. one session floods the compute ({args.flood_rounds:,}-round bands, "
+        f"{args.flood_query}, a new one every {args.flood_every:.0f} s), another "
+        f"({args.victim_rounds:,}-round bands) changes N, the harmonic (and the seed) and the "
+        f"DOF in turn, {args.flood_changes} times"
     )
 
     async def main():
@@ -755,10 +799,9 @@ def attack_flood(rep: Report, base: str, app: str, cookie: str, args) -> None:
         await victim.settle(120, 1.0)
         for h in range(2, 9):  # every harmonic once: its truncation map is cached
             await _timed_change(victim, {"Harmonic": (h - 1) % 7 + 1}, 120)
-        base_first, base_settled = await _timed_changes(
-            victim, args.flood_changes, args.flood_timeout, 10_000
-        )
-        hostile = await _open(base, f"{app}?rounds={args.flood_rounds}", cookie)
+        base_changes = await _timed_changes(victim, args.flood_changes, args.flood_timeout, 10_000)
+        query = f"rounds={args.flood_rounds}" + (f"&{args.flood_query}" if args.flood_query else "")
+        hostile = await _open(base, f"{app}?{query}", cookie)
         stop = asyncio.Event()
         sent = 0
 
@@ -773,26 +816,30 @@ def attack_flood(rep: Report, base: str, app: str, cookie: str, args) -> None:
                     pass
 
         task = asyncio.ensure_future(flood())
-        await asyncio.sleep(args.flood_every * 6)  # six bands queued before the victim moves
+        await asyncio.sleep(args.flood_every * 6)  # six bands requested before the victim moves
         t0 = time.perf_counter()
-        flood_first, flood_settled = await _timed_changes(
-            victim, args.flood_changes, args.flood_timeout, 20_000
-        )
+        flood_changes = await _timed_changes(victim, args.flood_changes, args.flood_timeout, 20_000)
         secs = time.perf_counter() - t0
         stop.set()
         await task
         errors = victim.errors + hostile.errors
         await hostile.close()
         await victim.close()
-        return base_first, base_settled, flood_first, flood_settled, sent, secs, errors
+        return base_changes, flood_changes, sent, secs, errors
 
-    b1, b2, f1, f2, sent, secs, errors = run(main())
+    (kinds, b1, b2), (_, f1, f2), sent, secs, errors = run(main())
 
     def stats(v):
         return f"p50 {_pct(v, 50):.0f} / p95 {_pct(v, 95):.0f} / max {max(v):.0f} ms"
 
+    def by_kind(v):
+        return "; ".join(
+            f"{kind} " + " ".join(f"{x:.0f}" for x, k in zip(v, kinds, strict=True) if k == kind)
+            for kind in KINDS
+        )
+
     rep.line(
-        "victim alone: harmonic change -> first plot update; -> settled plots",
+        "victim alone: change -> first plot update; -> settled plots",
         f"{stats(b1)}; {stats(b2)}",
         None,
     )
@@ -801,11 +848,13 @@ def attack_flood(rep: Report, base: str, app: str, cookie: str, args) -> None:
         stats(f1),
         _pct(f1, 95) < 1000,
     )
+    rep.line("  first update by kind of change (ms)", by_kind(f1), None)
     rep.line(
         "victim under the flood: settled plots (its own scatter band included)",
         stats(f2),
         _pct(f2, 95) < 1000,
     )
+    rep.line("  settled by kind of change (ms)", by_kind(f2), None)
     if errors:
         rep.line("session errors during the flood", str(errors[:3]), False)
 
@@ -888,6 +937,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--big", action="store_true", help="the issue's file sizes (slow)")
     ap.add_argument("--flood-rounds", type=int, default=200_000)
     ap.add_argument("--flood-every", type=float, default=1.0, help="s between hostile bands")
+    ap.add_argument(
+        "--flood-query",
+        default="h=7&fdep=true",
+        help="URL settings of the hostile session besides rounds (default: harmonic 7, "
+        "frequency-dependent noise)",
+    )
     ap.add_argument("--flood-changes", type=int, default=10)
     ap.add_argument("--victim-rounds", type=int, default=1_000, help="rounds of the victim's band")
     ap.add_argument("--flood-timeout", type=float, default=30.0, help="s per victim change")

@@ -265,6 +265,10 @@ class BokehSession:
             raise RuntimeError(f"expected ACK from the server, got {ack and ack.msgtype}")
         await self._protocol.create("PULL-DOC-REQ").send(self._sock)
         reply = await asyncio.wait_for(self._pop(), timeout_s)
+        while reply is not None and reply.msgtype == "PATCH-DOC":
+            # a change of the session made before the reply (e.g. the progress of a band
+            # started with the page): the document in the reply already holds it
+            reply = await asyncio.wait_for(self._pop(), timeout_s)
         if reply is None or reply.msgtype != "PULL-DOC-REPLY":
             raise RuntimeError(
                 f"expected PULL-DOC-REPLY, got {reply and reply.msgtype}: {reply and reply.content}"
