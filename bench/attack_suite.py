@@ -13,9 +13,11 @@ websocket protocol (``bench/load_clients.py``'s protocol client: no browser need
 5. hostile files through the upload widgets: wide / tall / gzip-compressed CSV, truncated
    and garbage UFF, MAT and HDF5 decompression bombs, pickles under other names, markup in
    file names; time to the answer, the answer, and the server's memory;
-6. one session flooding the compute (200,000-round bands, a new one every second) while
-   another session's control changes are timed: p50/p95 of the time to its first plot
-   update and to its settled plots, side by side with the same changes without the flood;
+6. one session flooding the compute (200,000-round bands at harmonic 7 with
+   frequency-dependent noise, a new one every second) while another session's control
+   changes (N, harmonic with a new seed, response DOF, in turn) are timed: p50/p95 of the
+   time to its first plot update and to its settled plots, side by side with the same
+   changes without the flood;
 7. a login flood: 200 wrong logins at once from one client;
 8. SIGTERM after all this: how long the server takes to end (only with ``--serve``).
 
