@@ -246,14 +246,14 @@ def test_a_bands_setup_runs_in_its_turn(turns, monkeypatch):
         return real(*args, **kw)
 
     chunks = []
-    kernel = scatter._kernels.noisy_block_run
+    kernel = scatter._noise_kernels.noisy_block_run
 
     def chunk(*args):
         chunks.append(turns.holder)
         return kernel(*args)
 
     monkeypatch.setattr(_models, "tire_arrays", tire_arrays)
-    monkeypatch.setattr(scatter._kernels, "noisy_block_run", chunk)
+    monkeypatch.setattr(scatter._noise_kernels, "noisy_block_run", chunk)
     res = _results(seed=61, rounds=5_000)
     res.request_band()
     _wait(lambda: res.band is not None and not res.band_status.busy, "the band")
