@@ -290,31 +290,3 @@ def test_harmonic_case_keyword_is_deprecated(tire):
     np.testing.assert_array_equal(Y, tire.truncations(f, 2, [20])[0])
     with pytest.raises(FBSError, match="not both"), pytest.warns(DeprecationWarning):
         tire.patch_response(f, 2, harmonic_case=2)
-
-
-def test_single_counts_after_a_multi_count_request_are_its_rows(tire, monkeypatch):
-    """A single-count request after a multi-count one on the same lines (the scatter band
-    after the error map) is served from it: same numbers as a separate synthesis, for the
-    plain and the residual sums apart, and the caller's arrays are its own."""
-    h = harmonic(3)
-    f = h.frequencies(4.0)
-    tire.truncations(f, h, [20, 60, 100])
-    tire.truncations(f, h, [20, 60, 100], residual=True)
-    sums = TireModel._sums
-    calls = []
-    monkeypatch.setattr(
-        TireModel, "_sums", lambda self, *a, **k: calls.append(a) or sums(self, *a, **k)
-    )
-    Y, v = tire.truncations(f, h, [60])
-    Yr, vr = tire.truncations(f, h, [60], residual=True)
-    assert calls == []  # no new sums
-    monkeypatch.undo()
-    sep = tire.patch_response(f, h, n_modes=60).data[:, :, 0]
-    np.testing.assert_allclose(v[0], sep, rtol=1e-10, atol=1e-12 * np.abs(sep).max())
-    # the residual sums differ from the plain ones (a mix-up of the two would pass above)
-    assert np.abs(vr[0] - v[0]).max() > 1e-6 * np.abs(v[0]).max()
-    Yd, vd = tire._sums(f, h.speed_at(f), [60], tire._harmonic_index(h), True)
-    np.testing.assert_allclose(vr[0], vd[0], rtol=1e-10, atol=1e-12 * np.abs(vd).max())
-    Y[...] = 0.0  # the caller's copy: a later request is unchanged
-    np.testing.assert_allclose(tire.truncations(f, h, [60])[1][0], v[0])
-    assert np.abs(tire.truncations(f, h, [60])[0]).max() > 0

@@ -21,7 +21,6 @@ the gyroscopic tire) through their characteristic polynomial and moments
 
 from __future__ import annotations
 
-import threading
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -57,9 +56,6 @@ __all__ = ["TireModel", "OperatingPointError", "ModeCountError", "INTERPOLATIONS
 #: Interpolation schemes between operating points.
 INTERPOLATIONS = ("cubic", "cluster", "linear")
 
-
-#: Guards every tire's cache of recent truncations (threads of a server share the models).
-_RECENT_LOCK = threading.Lock()
 
 #: Lines per chunk of the modal sums (bounds the memory of the (lines, modes) terms).
 _CHUNK = 512
@@ -146,7 +142,6 @@ class TireModel:
         _order: np.ndarray = field(init=False)
         _plans: dict[tuple[int, int, tuple[int, ...]], _Plan] = field(init=False)
         _columns: dict[tuple[int, bytes], np.ndarray] = field(init=False)
-        _recent: dict[tuple[bytes, int, bool], Any] = field(init=False)
 
     def __post_init__(self) -> None:
         if self.interpolation not in INTERPOLATIONS:
@@ -223,7 +218,6 @@ class TireModel:
         object.__setattr__(self, "_order", order)
         object.__setattr__(self, "_plans", {})  # cache of truncation plans (see _plan)
         object.__setattr__(self, "_columns", {})  # residue columns per interval (_node_columns)
-        object.__setattr__(self, "_recent", {})  # recent multi-count truncations (truncations)
 
     def _clusters_of(self, k: int) -> tuple[Cluster, ...]:
         """Clusters of interval ``k`` (:mod:`.interp`), found on first use and kept.
@@ -722,38 +716,9 @@ class TireModel:
         ]
         if not ns or np.any(np.diff(ns) <= 0):
             raise ModeCountError(f"n_modes_list must be non-empty and increasing, got {ns}")
-        hi = self._harmonic_index(h)
-        key = (f.tobytes(), hi, bool(residual))
-        with _RECENT_LOCK:
-            hit = self._recent.get(key)
-        if hit is not None and set(ns) <= set(hit[0]):
-            # counts of a recent, larger request (the error map holds every N of the
-            # selector): its rows, copied, instead of the same sums again
-            rows = [hit[0].index(n) for n in ns]
-            return hit[1][rows], hit[2][rows]
-        Y, v = self._sums(f, h.speed_at(f), ns, hi, residual)
+        Y, v = self._sums(f, h.speed_at(f), ns, self._harmonic_index(h), residual)
         assert v is not None  # a harmonic index was given
-        if len(ns) > 1:
-            self._remember(key, tuple(ns), Y, v)
         return Y, v
-
-    #: Bytes of recent multi-count truncations kept for later single-count requests.
-    RECENT_BYTES = 96 * 2**20
-
-    def _remember(self, key: tuple[bytes, int, bool], ns: tuple[int, ...], Y: Any, v: Any) -> None:
-        """Keep a copy of a multi-count truncation (read-only), newest last, within
-        :attr:`RECENT_BYTES`."""
-        Yc, vc = np.array(Y), np.array(v)
-        Yc.setflags(write=False)
-        vc.setflags(write=False)
-        with _RECENT_LOCK:
-            recent = self._recent
-            recent.pop(key, None)
-            recent[key] = (ns, Yc, vc)
-            while len(recent) > 1 and (
-                sum(e[1].nbytes + e[2].nbytes for e in recent.values()) > self.RECENT_BYTES
-            ):
-                recent.pop(next(iter(recent)))
 
     # -- physical model --------------------------------------------------------------
     def _need_params(self) -> TireParameters:
