@@ -40,6 +40,7 @@ def start(work: Callable[[], object], name: str) -> threading.Thread:
     """Run ``work()`` on a daemon thread at :data:`BACKGROUND_NICE` (errors are logged)."""
 
     def run() -> None:
+        compute.mark_background()  # sessions never wait for this thread's results
         lower_priority()
         try:
             work()

@@ -65,6 +65,20 @@ PERCENTILE_BANDS = (50, 80, 90, 95, 99)
 Q_LEVELS = tuple(sorted({q for w in PERCENTILE_BANDS for q in ((100 - w) / 2, (100 + w) / 2)}))
 
 
+_thread_kind = threading.local()
+
+
+def mark_background() -> None:
+    """Mark the calling thread as background work (app/background.py): a session's thread
+    that needs a result such a thread is computing computes it itself (see shared_cache)."""
+    _thread_kind.background = True
+
+
+def in_background() -> bool:
+    """True on a thread marked by :func:`mark_background`."""
+    return bool(getattr(_thread_kind, "background", False))
+
+
 def shared_cache(maxsize: int):
     """``functools.lru_cache`` that computes a missing entry once for all threads.
 
@@ -81,12 +95,18 @@ def shared_cache(maxsize: int):
 
         @wraps(fn)
         def wrapper(*args):
+            me = in_background()
             with guard:
-                done = running.get(args)
-                mine = done is None
+                entry = running.get(args)
+                mine = entry is None
                 if mine:
-                    done = running[args] = threading.Event()
+                    entry = running[args] = (threading.Event(), me)
+            done, by_background = entry
             if not mine:
+                if by_background and not me:
+                    # never wait for a low-priority thread (app/background.py): on a busy
+                    # machine it runs at a fraction of a core; compute it here instead
+                    return cached(*args)
                 done.wait()
                 return cached(*args)  # a hit (recomputed only if the first call failed)
             try:

@@ -366,7 +366,9 @@ def create_app(
     template.views = views
     doc = pn.state.curdoc
     if doc is not None:  # a served session, or a document built without one
-        doc.on_session_destroyed(lambda _ctx: close_page(template))
+        # bound now: Bokeh may clear the session's module namespace before its
+        # session-destroyed callbacks run ("name 'close_page' is not defined", seen under load)
+        doc.on_session_destroyed(lambda _ctx, close=close_page: close(template))
     if served():
         pn.state.onload(results.request_band)
         # once per process, after the first page: the other harmonics' reference studies

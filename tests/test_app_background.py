@@ -42,3 +42,26 @@ def test_the_reference_studies_are_warmed_once(monkeypatch):
     t.join(60)
     assert background.warm_reference_studies() is None  # once per process
     assert asked == [(h, "6dof") for h in range(1, 8)]
+
+
+def test_a_session_never_waits_for_a_background_thread_computing_the_same_result():
+    """Priority inversion: the warm-up (nice 10) computing a map a page asks for would make
+    the page wait at a fraction of a core on a busy machine. The page's thread computes it
+    itself; two sessions' threads still share one computation."""
+    started, release = threading.Event(), threading.Event()
+    calls = []
+
+    @compute.shared_cache(maxsize=4)
+    def slow(x):
+        calls.append(threading.current_thread().name)
+        if threading.current_thread().name == "test-bg":
+            started.set()
+            assert release.wait(120)
+        return x * 2
+
+    bg = background.start(lambda: slow(21), "test-bg")
+    assert started.wait(60)
+    assert slow(21) == 42  # returns while the background thread is still held
+    assert calls == ["test-bg", threading.current_thread().name]
+    release.set()
+    bg.join(60)

@@ -299,6 +299,9 @@ def bushing_contributions(
         Default the reference tire.
     chassis : ChassisModel, optional
         Default the reference chassis.
+    harmonic_case : int or Harmonic, optional
+        Deprecated name of ``harmonic`` (a ``DeprecationWarning``; removed in the next
+        release).
 
     Returns
     -------

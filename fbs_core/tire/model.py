@@ -142,6 +142,7 @@ class TireModel:
         _order: np.ndarray = field(init=False)
         _plans: dict[tuple[int, int, tuple[int, ...]], _Plan] = field(init=False)
         _columns: dict[tuple[int, bytes], np.ndarray] = field(init=False)
+        _layouts: dict[tuple[int, int, tuple[int, ...]], Any] = field(init=False)
 
     def __post_init__(self) -> None:
         if self.interpolation not in INTERPOLATIONS:
@@ -218,6 +219,7 @@ class TireModel:
         object.__setattr__(self, "_order", order)
         object.__setattr__(self, "_plans", {})  # cache of truncation plans (see _plan)
         object.__setattr__(self, "_columns", {})  # residue columns per interval (_node_columns)
+        object.__setattr__(self, "_layouts", {})  # modes per block of a plan (_layout)
 
     def _clusters_of(self, k: int) -> tuple[Cluster, ...]:
         """Clusters of interval ``k`` (:mod:`.interp`), found on first use and kept.
@@ -484,35 +486,23 @@ class TireModel:
         w = lagrange_weights(self.speeds[nd], v)
         n_l, n_b = t.size, len(edges) - 1
         Zc = self._node_columns(k, cols)  # (n_nodes, n_m, n_cols)
-        rank = np.empty_like(order)
-        rank[order] = np.arange(order.size)
-        block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
-        block[rank >= edges[-1]] = -1  # beyond the largest count: left out
-        lone = np.ones(order.size, bool)  # modes outside every cluster
-        for members, _whole, _split, _members in plan:
-            lone[members] = False
-        used = np.flatnonzero((block >= 0) & lone)  # the terms summed one by one
+        block, used, per_block, wholes = self._layout(k, near, edges, order, plan)
         lam = w @ self.poles[nd][:, used]
         X = 1.0 / (s[:, None] - lam)  # (n_l, n_used)
         if static:  # -R / lambda below the dynamic terms; a zero pole has no static part
             X = np.vstack([X, np.divide(-1.0, lam, out=np.zeros_like(lam), where=lam != 0)])
         wx = np.vstack([w, w]) if static else w
         out = np.zeros((n_b, X.shape[0], cols.size), complex)
-        for b in range(n_b):
-            j = np.flatnonzero(block[used] == b)  # columns of X in block b
-            if j.size:
-                Xb, modes = X[:, j], used[j]
-                for i in range(Zc.shape[0]):
-                    out[b] += wx[:, i, None] * (Xb @ Zc[i, modes])
+        for b, j in per_block:  # j: columns of X in block b
+            Xb, modes = X[:, j], used[j]
+            for i in range(Zc.shape[0]):
+                out[b] += wx[:, i, None] * (Xb @ Zc[i, modes])
         zero = np.zeros_like(s)
-        for _members, whole, split, split_members in plan:
-            if whole is not None:  # a cluster's sum goes to the block of its first member
-                bw = block[whole.members[:, 0]]
-                for b in np.unique(bw[bw >= 0]):
-                    sub = interp.subset(whole, bw == b)
-                    out[b, :n_l] += cluster_sum(sub, w, s, cols)
-                    if static:
-                        out[b, n_l:] += cluster_sum(sub, w, zero, cols)
+        for b, sub in wholes:  # a whole cluster's sum goes to the block of its first member
+            out[b, :n_l] += cluster_sum(sub, w, s, cols)
+            if static:
+                out[b, n_l:] += cluster_sum(sub, w, zero, cols)
+        for _members, _whole, split, split_members in plan:
             if split is not None:  # split by a block edge: every member on its own
                 # roots by frequency, lowest first; lines at one speed share them
                 wu, inv = np.unique(w, axis=0, return_inverse=True)
@@ -528,6 +518,37 @@ class TireModel:
         if not static:
             return out
         return out[:, :n_l], out[:, n_l:]
+
+    def _layout(
+        self, k: int, near: int, edges: np.ndarray, order: np.ndarray, plan: list[Any]
+    ) -> tuple[np.ndarray, np.ndarray, list[tuple[int, np.ndarray]], list[tuple[int, Any]]]:
+        """Where every mode of interval ``k`` goes for the blocks ``edges`` (cached with the
+        plan: it depends on the counts only): the block of every mode (-1: left out), the
+        modes summed term by term (outside every cluster), their columns per block, and
+        the whole clusters of each block."""
+        key = (k, near, tuple(int(e) for e in edges))
+        hit = self._layouts.get(key)
+        if hit is not None:
+            return hit
+        rank = np.empty_like(order)
+        rank[order] = np.arange(order.size)
+        block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
+        block[rank >= edges[-1]] = -1  # beyond the largest count: left out
+        lone = np.ones(order.size, bool)  # modes outside every cluster
+        for members, _whole, _split, _members in plan:
+            lone[members] = False
+        used = np.flatnonzero((block >= 0) & lone)  # the terms summed one by one
+        per_block = [(b, np.flatnonzero(block[used] == b)) for b in range(len(edges) - 1)]
+        wholes = []
+        for _members, whole, _split, _sm in plan:
+            if whole is not None:
+                bw = block[whole.members[:, 0]]
+                wholes += [(int(b), interp.subset(whole, bw == b)) for b in np.unique(bw[bw >= 0])]
+        out = (block, used, [(b, j) for b, j in per_block if j.size], wholes)
+        if len(self._layouts) > 4 * len(self._clusters):
+            self._layouts.clear()
+        self._layouts[key] = out
+        return out
 
     def _node_columns(self, k: int, cols: np.ndarray) -> np.ndarray:
         """The residues of interval ``k``'s nodes, columns ``cols`` (cached, read-only)."""
