@@ -40,7 +40,7 @@ import param
 from fbs_core.units import frf_unit, input_kind, output_kind
 from fbs_core.vocabulary import EIGEN_SPEEDS
 
-from . import bands, compute
+from . import background, bands, compute
 from .state import DashboardState
 
 __all__ = ["Result", "Results", "Snapshot", "BandStatus", "progress_status"]
@@ -294,8 +294,8 @@ class Results(param.Parameterized):
         it is computed on a thread of its own (served pages: its seven residual maps must
         not delay the first page); the table is published again when it is ready."""
         args = (s.threshold, s.f_max, s.coupling, s.map_dof, s.models, True)
-        background = bands.served() if self.background is None else self.background
-        if s.residual or not background or compute.suggested_table_ready(*args):
+        later = bands.served() if self.background is None else self.background
+        if s.residual or not later or compute.suggested_table_ready(*args):
             return compute.suggested_table(*args)
         with self._lock:
             if args in self._pending:
@@ -310,8 +310,8 @@ class Results(param.Parameterized):
                     self._pending.discard(args)
             self._suggested()  # publish again (with the column if the state still wants it)
 
-        def start():
-            threading.Thread(target=work, name="residual-table", daemon=True).start()
+        def start():  # at a lower priority: the page's own updates win the cores
+            background.start(work, "residual-table")
 
         if bands.served():  # after the page is sent (its first build stays as fast)
             import panel as pn
