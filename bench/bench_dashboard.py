@@ -218,13 +218,13 @@ def analysis_bench(servers, measure, modes, n, rounds):
             page.wait_for_function(JS_READY, arg=name, timeout=300_000)
             wait_band_idle(page)
         # the difference to a pin of another harmonic is empty (another grid): on a change
-        # of harmonic the compare tab's current curve is what changes
+        # of harmonic (and after it, of DOF) the compare tab's current curve is what changes
         hname = "compare.curve0" if tab == "compare" else name
         res = {
             f"{tab}: modes N ({name})": measure("value", "ctl-case-n_modes", modes, name),
             f"{tab}: harmonic ({hname})": measure("value", "ctl-case-harmonic", harmonics, hname),
         }
-        res[f"{tab}: response DOF ({name})"] = measure("active", "ctl-case-dof", dofs, name)
+        res[f"{tab}: response DOF ({hname})"] = measure("active", "ctl-case-dof", dofs, hname)
         for k, v in res.items():
             for tree, ms in v.items():
                 print(f"[{tree.name}] {k:46s} {stats(ms)}")
