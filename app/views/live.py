@@ -32,10 +32,8 @@ from __future__ import annotations
 import datetime as dt
 import html
 import io
-import logging
 import re
 import threading
-import weakref
 
 import panel as pn
 import param
@@ -57,13 +55,7 @@ def _plots_in(obj) -> list:
     return list(obj.select({"type": Plot})) if hasattr(obj, "select") else []
 
 
-log = logging.getLogger(__name__)
-
 __all__ = ["LiveView", "download_button", "export_meta", "inline_html", "served_document"]
-
-#: Views waiting to be drawn, per served document, and the lock that guards them.
-_waiting: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-_waiting_lock = threading.Lock()
 
 
 def served_document():
@@ -165,45 +157,25 @@ class LiveView(Viewer):
     def redraw(self) -> None:
         """Draw the newest published result, on the session's event loop when served.
 
-        The redraws a control change causes in several views of one page are drawn
-        together: one callback on the event loop draws every view waiting then, under
-        one hold of the document (``pn.io.hold``), so the browser gets their changes as
-        one combined patch and lays the page out once, instead of one message per
-        property (each a serialization pass over the document on the server and a
-        layout pass in the browser: most of a change's time with the Analysis card
-        open)."""
+        A view's draw runs under a hold of the document (``pn.io.hold``): the browser gets
+        its changes as one combined patch and lays the page out once, instead of one
+        message per property (each a serialization pass over the document on the
+        server). Views are not held together: the first one published is drawn first
+        (drawing several views in one hold delayed the coupled response by the others)."""
         if self._layout is None:
             return
         with self._guard:
             if self._pending:
                 return
             self._pending = True
+        self._on_document(self._apply_held)
+
+    def _apply_held(self) -> None:
         if self._doc is None:
-            self._apply()  # no server: tests, notebooks, exports
+            self._apply()
             return
-        self._draw_with_others()
-
-    def _draw_with_others(self) -> None:
-        """Queue this view's draw for its document; schedule the draw if none is."""
-        doc = self._doc
-        with _waiting_lock:
-            queued = _waiting.get(doc)
-            if queued is not None:
-                queued.append(self._apply)
-                return
-            _waiting[doc] = [self._apply]
-
-        def draw_waiting() -> None:
-            with _waiting_lock:
-                draws = _waiting.pop(doc, [])
-            with pn.io.hold(doc):
-                for draw in draws:
-                    try:
-                        draw()
-                    except Exception:  # one view's failure must not keep the others stale
-                        log.exception("drawing a view failed")
-
-        self._on_document(draw_waiting)
+        with pn.io.hold(self._doc):
+            self._apply()
 
     def _on_document(self, fn) -> None:
         """Run ``fn`` (changes of Bokeh models) where it may change the served document:
