@@ -97,10 +97,9 @@ def shared_cache(maxsize: int):
         def wrapper(*args):
             me = in_background()
             with guard:
-                entry = running.get(args)
-                mine = entry is None
-                if mine:
-                    entry = running[args] = (threading.Event(), me)
+                found = running.get(args)
+                mine = found is None
+                entry = running[args] = (threading.Event(), me) if found is None else found
             done, by_background = entry
             if not mine:
                 if by_background and not me:

@@ -47,6 +47,10 @@ if TYPE_CHECKING:
 #: A truncation plan of :meth:`TireModel._plan`: the truncation order and, per cluster
 #: batch, its members, the clusters whole inside a block and those split by a block edge
 #: (with their members ranked).
+#: Where the modes of an interval go for some blocks (see TireModel._layout).
+_Layout: TypeAlias = tuple[
+    np.ndarray, np.ndarray, list[tuple[int, np.ndarray]], list[tuple[int, Any]]
+]
 _Plan: TypeAlias = (
     "tuple[np.ndarray, list[tuple[np.ndarray, Cluster | None, Cluster | None, np.ndarray | None]]]"
 )
@@ -142,7 +146,7 @@ class TireModel:
         _order: np.ndarray = field(init=False)
         _plans: dict[tuple[int, int, tuple[int, ...]], _Plan] = field(init=False)
         _columns: dict[tuple[int, bytes], np.ndarray] = field(init=False)
-        _layouts: dict[tuple[int, int, tuple[int, ...]], Any] = field(init=False)
+        _layouts: dict[tuple[int, int, tuple[int, ...]], _Layout] = field(init=False)
 
     def __post_init__(self) -> None:
         if self.interpolation not in INTERPOLATIONS:
@@ -521,7 +525,7 @@ class TireModel:
 
     def _layout(
         self, k: int, near: int, edges: np.ndarray, order: np.ndarray, plan: list[Any]
-    ) -> tuple[np.ndarray, np.ndarray, list[tuple[int, np.ndarray]], list[tuple[int, Any]]]:
+    ) -> _Layout:
         """Where every mode of interval ``k`` goes for the blocks ``edges`` (cached with the
         plan: it depends on the counts only): the block of every mode (-1: left out), the
         modes summed term by term (outside every cluster), their columns per block, and
