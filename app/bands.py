@@ -1,7 +1,8 @@
 """Scatter bands of all sessions: cancelled when superseded, computed in turns.
 
 A band is the one computation of the dashboard that takes seconds (up to minutes for
-200,000 rounds). Four rules keep one session from starving the others:
+200,000 rounds). A band that several sessions ask for at once is computed once for all of
+them (:class:`SharedRun`). Four rules keep one session from starving the others:
 
 - **one live band per session**: a new request of a session cancels its running band
   (:class:`Job`); the kernel stops at its next chunk of lines
@@ -45,6 +46,7 @@ from . import compute, offload
 __all__ = [
     "BAND_NICE",
     "Job",
+    "SharedRun",
     "Turnstile",
     "TURNSTILE",
     "band_nice",
@@ -188,44 +190,125 @@ TURNSTILE = Turnstile()
 Done = Callable[[Job, object, object, float, object], None]
 
 
-def run(job: Job, done: Done, context=None, turnstile: Turnstile | None = None) -> None:
-    """Compute ``job``'s band here and call ``done(job, context, band, seconds, error)``.
+class SharedRun:
+    """One band computation shared by every session that asks for the same band.
 
-    ``band`` is None when the job was cancelled (then ``done`` is not called) or failed
-    (``error`` holds the core's message).
+    Sessions of a review meeting often ask for the same band at once (the same link, the
+    same harmonic): the first request computes it, later ones join and get its result.
+    The run stops at its next chunk only when every joined job has been cancelled. It
+    stands for its jobs in the :class:`Turnstile` (``key``, ``owner``, ``cancelled``).
     """
-    t0 = time.perf_counter()
-    if job.cancelled:
-        return
-    turns = TURNSTILE if turnstile is None else turnstile
+
+    def __init__(self, first: Job) -> None:
+        self.key = first.key
+        self.owner = first.owner
+        self._jobs = [first]
+        self._lock = threading.Lock()
+        self.finished = threading.Event()
+        self.result: object = None
+        self.error: BaseException | None = None
+
+    def add(self, job: Job) -> None:
+        with self._lock:
+            self._jobs.append(job)
+
+    @property
+    def jobs(self) -> list[Job]:
+        with self._lock:
+            return list(self._jobs)
+
+    @property
+    def cancelled(self) -> bool:
+        """True once every job of the run has been cancelled."""
+        return all(j.cancelled for j in self.jobs)
+
+    def report(self, done: int, total: int) -> None:
+        """The kernel's progress: passed on to every job still wanting the band."""
+        for j in self.jobs:
+            j.report(done, total)
+
+
+_RUNS: dict[tuple, SharedRun] = {}
+_RUNS_LOCK = threading.Lock()
+
+
+def _join(job: Job) -> tuple[SharedRun, bool]:
+    """The running computation of ``job``'s band, joined (or a new one): (run, computes)."""
+    with _RUNS_LOCK:
+        shared = _RUNS.get(job.key)
+        if shared is None:
+            shared = _RUNS[job.key] = SharedRun(job)
+            return shared, True
+        shared.add(job)
+        return shared, False
+
+
+def _compute(shared: SharedRun, turns: Turnstile) -> None:
+    """Compute ``shared``'s band in this thread, chunk by chunk in turns."""
     try:
-        res = compute.cached_band(job.key)
-        if res is None and offload.wanted(job.key):  # heavy: on the Dask cluster
-            res = offload.band(job.key, lambda: job.cancelled, job.report)
+        res = None
+        if offload.wanted(shared.key):  # heavy: on the Dask cluster
+            res = offload.band(shared.key, lambda: shared.cancelled, shared.report)
         if res is None:
             # the band's setup (the tire synthesis of a new N or harmonic) is work like a
             # chunk: done in a turn of its own, so it does not share the cores with another
             # session's chunk; its first chunk follows in the same turn
-            if not turns.next_turn(job):
-                return
+            if not turns.next_turn(shared):
+                raise StudyCancelled("every session cancelled the band")
             first = [True]
 
             def cancel() -> bool:
                 if first:
                     first.clear()
-                    return job.cancelled
-                return not turns.next_turn(job)
+                    return shared.cancelled
+                return not turns.next_turn(shared)
 
-            res = compute.band(*job.key, cancel=cancel, progress=job.report)
+            res = compute.band(*shared.key, cancel=cancel, progress=shared.report)
+        shared.result = res
     except StudyCancelled:
-        return
-    except Exception as exc:  # the page shows the message instead of a silent spinner
-        done(job, context, None, time.perf_counter() - t0, exc)
-        if not isinstance(exc, FBSError):
-            raise
-        return
+        pass
+    except Exception as exc:  # handed to every job's ``done``
+        shared.error = exc
     finally:
-        turns.leave(job)
+        turns.leave(shared)
+        with _RUNS_LOCK:
+            if _RUNS.get(shared.key) is shared:
+                del _RUNS[shared.key]
+        shared.finished.set()
+
+
+def run(job: Job, done: Done, context=None, turnstile: Turnstile | None = None) -> None:
+    """Compute ``job``'s band here and call ``done(job, context, band, seconds, error)``.
+
+    A band another session is computing already is not computed twice: the job joins that
+    run (:class:`SharedRun`) and waits for its result. ``band`` is None when the job was
+    cancelled (then ``done`` is not called) or failed (``error`` holds the core's message).
+    """
+    t0 = time.perf_counter()
+    if job.cancelled:
+        return
+    turns = TURNSTILE if turnstile is None else turnstile
+    res = compute.cached_band(job.key)
+    while res is None:
+        shared, computes = _join(job)
+        if computes:
+            _compute(shared, turns)
+        else:
+            while not shared.finished.wait(0.05):
+                if job.cancelled:
+                    return
+        if job.cancelled:
+            return
+        error = shared.error
+        if error is not None:
+            # the page shows the message instead of a silent spinner
+            done(job, context, None, time.perf_counter() - t0, error)
+            if computes and not isinstance(error, FBSError):
+                raise error
+            return
+        # None: the run stopped because everyone else cancelled it just before this job
+        # joined; compute afresh
+        res = shared.result
     done(job, context, res, time.perf_counter() - t0, None)
 
 

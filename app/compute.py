@@ -504,8 +504,8 @@ def band(*args, cancel=None, progress=None, **kwargs):
 
     ``cancel`` is handed to :func:`fbs_core.scatter_band` (asked between chunks of lines;
     :class:`fbs_core.StudyCancelled` when it returns True), and ``progress`` (called with
-    the lines done and the total after each chunk). Two sessions that ask for the
-    same missing band at once each compute it (a cancel of one never fails the other).
+    the lines done and the total after each chunk). Sessions asking for the same missing
+    band at once share one computation (:class:`app.bands.SharedRun`).
     """
     key = band_key(*args, **kwargs)
     res = cached_band(key)

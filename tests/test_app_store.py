@@ -262,3 +262,56 @@ def test_a_bands_setup_runs_in_its_turn(turns, monkeypatch):
     # per chunk, the setup's included
     assert chunks and all(h is not None and h.owner is res for h in chunks)
     assert turns.turns.count(res.snapshot().band_key()) == len(chunks)
+
+
+def test_sessions_asking_for_the_same_band_share_one_computation(turns, monkeypatch):
+    """Three sessions ask for the same missing band at once (a meeting opening one link):
+    the core computes it once, all three show it, and a session that leaves (cancels)
+    does not stop it for the others. Truth: ``fbs_core.scatter_band`` called directly."""
+    calls = []
+    real = compute.band
+    gate = threading.Event()
+
+    def band(*args, **kw):
+        calls.append(args)
+        gate.wait(WAIT_S)  # all three sessions ask before the computation goes on
+        return real(*args, **kw)
+
+    monkeypatch.setattr(compute, "band", band)
+    sessions = [_results(seed=71, rounds=3_000) for _ in range(3)]
+    for res in sessions:
+        res.request_band()
+    # all three asked: three computations (each its own) or one run with three jobs
+    _wait(lambda: len(calls) == 3 or len(_run_jobs()) == 3, "all three sessions to ask")
+    sessions[0].cancel_band()  # one leaves the meeting before the band is done
+    gate.set()
+    for res in sessions[1:]:
+        _wait(lambda r=res: r.band is not None and not r.band_status.busy, "the shared band")
+    assert len(calls) == 1  # computed once
+    assert sessions[1].band.result is sessions[2].band.result
+    assert sessions[0].band is None  # the cancelled session shows nothing of it
+    want = fbs_core.scatter_band(
+        1, noise=0.1, rounds=3_000, n_modes=50, percentiles=compute.Q_LEVELS, seed=71
+    )
+    np.testing.assert_array_equal(sessions[1].band.result.maximum, want.maximum)
+    _wait(lambda: _live_band_threads() == 0 and not bands._RUNS, "the band threads to end")
+
+
+def _run_jobs() -> list:
+    return [j for run in list(getattr(bands, "_RUNS", {}).values()) for j in run.jobs]
+
+
+def test_a_shared_band_stops_once_every_session_cancelled_it(turns):
+    sessions = [_results(seed=81, rounds=150_000) for _ in range(2)]
+    for res in sessions:
+        res.state.case.harmonic = 7
+        res.request_band()
+    key = (7, 50, "6dof", 10.0, "both", False, 150_000, 81, None)
+    _wait(lambda: turns.turns.count(key) >= 2, "the long band to run")
+    sessions[0].cancel_band()
+    n = turns.turns.count(key)
+    _wait(lambda: turns.turns.count(key) >= n + 2, "the band to go on for the other session")
+    sessions[1].cancel_band()
+    _wait(lambda: _live_band_threads() == 0 and not bands._RUNS, "the band to stop")
+    assert turns.turns.count(key) < 40  # stopped after a few chunks of its ~100
+    assert all(res.band is None for res in sessions)
