@@ -163,6 +163,22 @@ def test_chunking_gives_identical_results_and_bounds_memory(arrays):
     assert peak < all_rounds_bytes / 4  # chunks of 3 lines, never all rounds at once
 
 
+def test_regenerated_rounds_are_kept_read_only_and_stay_the_batchs(arrays):
+    """A page redraws the same round for every DOF and percentile change: the band keeps
+    the last few regenerated rounds. Kept or regenerated, a round is the batch's."""
+    b = _band(arrays, rounds=40, frequency_dependent=True)
+    batch = b.rounds_response(np.arange(b.rounds))
+    first = b.round(3)
+    assert b.round(3) is first  # kept
+    with pytest.raises(ValueError):
+        first[0, 0] = 0  # read-only: a caller cannot change what the next one gets
+    for r in range(10, 10 + b.ROUND_CACHE):  # evicts round 3
+        np.testing.assert_array_equal(b.round(r), batch[r])
+    again = b.round(3)
+    assert again is not first
+    np.testing.assert_array_equal(again, batch[3])
+
+
 def test_convergence_report(arrays):
     b = _band(arrays, rounds=1000, frequency_dependent=True)
     conv = b.convergence
@@ -176,6 +192,14 @@ def test_convergence_report(arrays):
     first = _mag(b.rounds_response(np.arange(100)))
     np.testing.assert_array_equal(conv.maximum[3], first.max(0))
     assert conv.step_change_db.shape == (6,)
+    assert conv.step_change_db is conv.step_change_db  # once per band, read-only
+    assert not conv.step_change_db.flags.writeable
+    # the largest change of either edge between neighbouring checkpoints (second method)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        up = 20 * np.log10(conv.maximum[1:] / conv.maximum[:-1])
+        lo = 20 * np.log10(conv.minimum[:-1] / conv.minimum[1:])
+    want = np.maximum(np.nanmax(up, axis=(1, 2)), np.nanmax(lo, axis=(1, 2)))
+    np.testing.assert_array_equal(conv.step_change_db, want)
     assert "rounds" in conv.summary()
     custom = _band(arrays, rounds=50, checkpoints=[5, 25])
     np.testing.assert_array_equal(custom.convergence.rounds, [5, 25, 50])

@@ -35,6 +35,7 @@ import warnings
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -161,12 +162,14 @@ class Convergence:
         gap: FloatArray = np.nanmax(_db(self.minimum / self.minimum[-1]), axis=(1, 2))
         return gap
 
-    @property
+    @cached_property
     def step_change_db(self) -> FloatArray:
-        """Largest change (dB) of either edge from one checkpoint to the next, ``(n_k - 1,)``."""
+        """Largest change (dB) of either edge from one checkpoint to the next, ``(n_k - 1,)``.
+
+        Computed once per band (read-only): every page showing the band asks for it."""
         up: FloatArray = np.nanmax(_db(self.maximum[1:] / self.maximum[:-1]), axis=(1, 2))
         lo: FloatArray = np.nanmax(_db(self.minimum[:-1] / self.minimum[1:]), axis=(1, 2))
-        return np.maximum(up, lo)
+        return _ro(np.maximum(up, lo))
 
     def summary(self) -> str:
         """One line per checkpoint: rounds and the remaining change of both edges in dB."""
@@ -243,18 +246,38 @@ class ScatterBand:
             return self.dofs.index(dof)
         return int(dof)
 
+    #: Regenerated rounds kept per band (:meth:`round`): the pages showing a band draw the
+    #: same few rounds again for every DOF and percentile change.
+    ROUND_CACHE = 4
+
     def round(self, r: int) -> ComplexArray:
         """The complex response of round ``r``, shape ``(n_f, n_dof)``, regenerated alone.
 
-        Identical (bit for bit) to the round inside the batch.
+        Identical (bit for bit) to the round inside the batch. Read-only: the last
+        :attr:`ROUND_CACHE` rounds asked for are kept with the band.
 
         Raises
         ------
         FBSError
             For ``r`` outside ``0 .. rounds - 1``.
         """
-        v: ComplexArray = self.rounds_response([r])[0]
+        r = int(r)
+        cache, lock = self._round_cache
+        with lock:
+            v = cache.get(r)
+            if v is not None:
+                cache.move_to_end(r)
+                return v
+        v = _ro(self.rounds_response([r])[0])
+        with lock:
+            cache[r] = v
+            while len(cache) > self.ROUND_CACHE:
+                cache.popitem(last=False)
         return v
+
+    @cached_property
+    def _round_cache(self) -> tuple[OrderedDict[int, ComplexArray], threading.Lock]:
+        return OrderedDict(), threading.Lock()
 
     def rounds_response(self, rounds: ArrayLike) -> ComplexArray:
         """Complex responses of several rounds, shape ``(n, n_f, n_dof)``."""
