@@ -278,5 +278,25 @@ def test_caption_follows_the_state(page):
     view = MobilityView(store=app.results)
     view.__panel__()
     state.case.n_modes = 70
-    text = html.unescape(view._caption.object)
+    text = html.unescape(view._caption.text)
     assert f"<b>Harmonic {state.case.harmonic}</b>" in text and "N = 70" in text
+
+
+def test_a_caption_change_sends_one_small_patch():
+    """A changed caption is one change of one string property (no new models, nothing
+    else re-sent); an unchanged one sends nothing."""
+    import panel as pn
+    from bokeh.document import Document
+
+    from app.views.live import LiveText
+
+    doc = Document()
+    caption = LiveText("<p>a</p>")
+    doc.add_root(pn.panel(caption).get_root(doc))  # the page holds it
+    n_models = len(doc.models)
+    events = []
+    doc.on_change(events.append)
+    caption.text = "<p>b</p>"
+    caption.text = "<p>b</p>"
+    assert [(e.model, e.attr, e.new) for e in events] == [(caption.model, "text", "<p>b</p>")]
+    assert len(doc.models) == n_models

@@ -55,7 +55,14 @@ def _plots_in(obj) -> list:
     return list(obj.select({"type": Plot})) if hasattr(obj, "select") else []
 
 
-__all__ = ["LiveView", "download_button", "export_meta", "inline_html", "served_document"]
+__all__ = [
+    "LiveText",
+    "LiveView",
+    "download_button",
+    "export_meta",
+    "inline_html",
+    "served_document",
+]
 
 
 def served_document():
@@ -109,6 +116,42 @@ def download_button(key: str, result) -> pn.widgets.FileDownload:
     return btn
 
 
+class LiveText:
+    """A caption or status line that changes with the results: a Bokeh ``Div`` set in place.
+
+    Setting a Panel HTML pane's text re-sends every property of its model (its stylesheets
+    are new models each time, so the served document recomputes its whole model graph and
+    serializes them); a ``Div``'s ``text`` is one string property, one small patch. Like
+    every change of a Bokeh model, :attr:`text` is set where the document may change (a
+    view's draw on the session's event loop, or no server at all).
+    """
+
+    def __init__(self, text: str = "", *, css_classes=(), styles=None, height=None) -> None:
+        from bokeh.models import Div
+
+        self.model = Div(
+            text=text,
+            css_classes=list(css_classes),
+            styles=dict(styles or {}),
+            sizing_mode="stretch_width",
+            height=height,
+            margin=(0, 10),
+        )
+        self._pane = pn.pane.Bokeh(self.model, sizing_mode="stretch_width", height=height)
+
+    @property
+    def text(self) -> str:
+        return str(self.model.text)
+
+    @text.setter
+    def text(self, value: str) -> None:
+        if self.model.text != value:  # an unchanged text sends nothing
+            self.model.text = value
+
+    def __panel__(self) -> pn.pane.Bokeh:
+        return self._pane
+
+
 class LiveView(Viewer):
     """Base of the plot views: build once, redraw the published result in place."""
 
@@ -130,7 +173,7 @@ class LiveView(Viewer):
         super().__init__(**params)
         self._layout = None
         self._doc = None
-        self._caption: pn.pane.HTML | None = None
+        self._caption: LiveText | None = None
         self._pending = False
         self._guard = threading.Lock()
         self._figures: list = []
@@ -157,25 +200,19 @@ class LiveView(Viewer):
     def redraw(self) -> None:
         """Draw the newest published result, on the session's event loop when served.
 
-        A view's draw runs under a hold of the document (``pn.io.hold``): the browser gets
-        its changes as one combined patch and lays the page out once, instead of one
-        message per property (each a serialization pass over the document on the
-        server). Views are not held together: the first one published is drawn first
-        (drawing several views in one hold delayed the coupled response by the others)."""
+        Each property set is its own patch (Bokeh's normal path). A view's draw is not held
+        with ``pn.io.hold``: on the event loop Panel's hold writes the held events through
+        its own queue of socket writes, and when two of a session's held patches meet a
+        busy socket, the later one can stay in that queue until the session's next change
+        (20 concurrent sessions, ``bench/load_test.py --client bokeh``: one change in 100
+        never reached its session)."""
         if self._layout is None:
             return
         with self._guard:
             if self._pending:
                 return
             self._pending = True
-        self._on_document(self._apply_held)
-
-    def _apply_held(self) -> None:
-        if self._doc is None:
-            self._apply()
-            return
-        with pn.io.hold(self._doc):
-            self._apply()
+        self._on_document(self._apply)
 
     def _on_document(self, fn) -> None:
         """Run ``fn`` (changes of Bokeh models) where it may change the served document:
@@ -197,9 +234,7 @@ class LiveView(Viewer):
         if r is None:
             return
         if self._caption is not None and r.caption:
-            text = f"<p>{inline_html(r.caption)}</p>"
-            if self._caption.object != text:
-                self._caption.object = text
+            self._caption.text = f"<p>{inline_html(r.caption)}</p>"
         self._draw(r)
         self._draw_title()
 
@@ -228,6 +263,7 @@ class LiveView(Viewer):
             t.style(self.mode)
 
     def _header(self) -> pn.Row:
+        first: pn.pane.HTML | LiveText
         if self.note:
             first = pn.pane.HTML(
                 f"<p>{inline_html(self.note)}</p>",
@@ -236,7 +272,7 @@ class LiveView(Viewer):
                 sizing_mode="stretch_width",
             )
         else:
-            first = self._caption = pn.pane.HTML("", margin=(0, 10), sizing_mode="stretch_width")
+            first = self._caption = LiveText()
         return pn.Row(*self._controls(), first, download_button(self.key, self.result))
 
     def __panel__(self):

@@ -15,7 +15,7 @@ from bokeh.core.properties import value
 from bokeh.events import Tap
 
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
-from .live import LiveView, download_button, inline_html
+from .live import LiveText, LiveView, download_button, inline_html
 from .plots import add_band, add_line, fit_range, frequency_range, new_figure
 
 #: Styles of the progress bar: hidden when idle (its box kept: no new layout of the page).
@@ -73,13 +73,10 @@ class ScatterBandView(LiveView):
 
     def _extra(self):
         # its own line, two lines high: the text's length changes, its box does not
-        self._status = pn.pane.HTML(
-            "",
+        self._status = LiveText(
             height=40,
-            margin=(0, 10),
             css_classes=["scatter-status"],
             styles={"font-size": "0.85em", "line-height": "1.3"},
-            sizing_mode="stretch_width",
         )
         return [self._status]
 
@@ -154,9 +151,7 @@ class ScatterBandView(LiveView):
         if self.store.closed:
             return
         st = self.store.band_status
-        text = f"<p>{inline_html(st.text)}</p>" if st.text else ""
-        if self._status.object != text:
-            self._status.object = text
+        self._status.text = f"<p>{inline_html(st.text)}</p>" if st.text else ""
         value = (st.percent if st.total else -1) if st.busy else 0
         if self._progress.active != st.busy or self._progress.value != value:
             self._progress.param.update(

@@ -233,7 +233,9 @@ class SuggestedModesView(Viewer):
         frame = self.frame(r)
         if not frame.equals(self._table.value):  # a re-sent table costs the browser a redraw
             self._table.value = frame
-        self._caption.object = f"<p>{inline_html(r.caption)}</p>"
+        text = f"<p>{inline_html(r.caption)}</p>"
+        if self._caption.object != text:  # an unchanged caption sends nothing
+            self._caption.object = text
 
     def __panel__(self):
         if self._layout is None:
