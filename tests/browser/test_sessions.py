@@ -36,14 +36,21 @@ def _all_plotted(sess: BokehSession) -> bool:
     return True
 
 
+def _computing(sess: BokehSession) -> bool:
+    """The page says a result is still being computed: on a fresh server the suggested-N
+    table's column with residuals arrives seconds after the page (its caption says so)."""
+    return any("being computed" in str(getattr(m, "text", "")) for m in sess.doc.models)
+
+
 async def _opened(url: str) -> BokehSession:
     sess = BokehSession()
     await sess.open(url, TIMEOUT_S)
     for _ in range(int(TIMEOUT_S / 0.1)):
-        if _all_plotted(sess):
+        if _all_plotted(sess) and not _computing(sess):
             break
         await asyncio.sleep(0.1)
     assert _all_plotted(sess), f"not every view got its data: {sess.errors}"
+    assert not _computing(sess), "the page still says a result is being computed"
     assert await sess.settle(TIMEOUT_S, 1.0) is not None, "plot data never settled"
     return sess
 
