@@ -22,7 +22,7 @@ from typing import Any
 import panel as pn
 import param
 
-from app import background
+from app import background, closed_pages
 from app.bands import served
 from app.report.live import page_url
 from app.report.page import (
@@ -370,6 +370,7 @@ def create_app(
         # session-destroyed callbacks run ("name 'close_page' is not defined", seen under load)
         doc.on_session_destroyed(lambda _ctx, close=close_page: close(template))
     if served():
+        closed_pages.quiet_closed_page_writes()  # once per process: the server's loop
         pn.state.onload(results.request_band)
         # once per process, after the first page: the other harmonics' reference studies
         pn.state.onload(background.warm_reference_studies)
@@ -390,8 +391,13 @@ def close_page(page: pn.template.BootstrapTemplate) -> None:
     its data alive for the life of the process (finding 2 of issue 20).
     """
     page.results.close()
-    for obj in page.select():
-        obj.param.watchers = {}
+    # the template's areas, not ``page.select()``: in a served page the template renders
+    # Panel's BrowserInfo too, which has no ``select`` (the callback failed there, and the
+    # watchers stayed)
+    for area in (page.header, page.sidebar, page.main, page.modal):
+        for item in area.objects:
+            for obj in item.select():
+                obj.param.watchers = {}
 
 
 if pn.state.served:

@@ -116,7 +116,12 @@ class DashboardServer:
 
     def errors(self) -> list[str]:
         """Server log lines that report an exception."""
-        return [ln for ln in self.log if "Traceback" in ln or "ERROR" in ln]
+        # a failed session callback is logged by Panel as a warning, not an error
+        return [
+            ln
+            for ln in self.log
+            if "Traceback" in ln or "ERROR" in ln or "failed with following error" in ln
+        ]
 
     def stop(self):
         if self.proc.poll() is None:
