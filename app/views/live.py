@@ -41,6 +41,7 @@ from panel.viewable import Viewer
 
 from .. import compute
 from ..export import to_csv
+from ..panel_private import html_model, html_text
 from ..report.bokeh import TitleBlockModels, style_figure
 from ..report.live import page_url, view_title
 from ..store import Result, Results
@@ -61,6 +62,7 @@ __all__ = [
     "download_button",
     "export_meta",
     "inline_html",
+    "on_document",
     "served_document",
 ]
 
@@ -116,21 +118,33 @@ def download_button(key: str, result) -> pn.widgets.FileDownload:
     return btn
 
 
-class LiveText:
-    """A caption or status line that changes with the results: a Bokeh ``Div`` set in place.
+def on_document(doc, fn) -> None:
+    """Run ``fn`` (changes of Bokeh models) where it may change the served document
+    ``doc``: on the session's event loop under its lock, whichever thread asks (``doc``
+    None: no server, at once)."""
+    if doc is None:
+        fn()  # no server: tests, notebooks, exports
+    elif served_document() is doc:
+        pn.state.execute(fn, schedule=True)
+    else:  # a thread outside Panel's: Bokeh's thread-safe scheduling
+        doc.add_next_tick_callback(fn)
 
-    Setting a Panel HTML pane's text re-sends every property of its model (its stylesheets
-    are new models each time, so the served document recomputes its whole model graph and
-    serializes them); a ``Div``'s ``text`` is one string property, one small patch. Like
-    every change of a Bokeh model, :attr:`text` is set where the document may change (a
-    view's draw on the session's event loop, or no server at all).
+
+class LiveText:
+    """A caption or status line that changes with the results, set in place.
+
+    Its model is Panel's own HTML model held in a Bokeh pane, and only its ``text``
+    changes: one string property, one small patch (why not ``pn.pane.HTML`` or Bokeh's
+    ``Div``, with the measurements: :mod:`app.panel_private`). Like every change of a
+    Bokeh model, :attr:`text` is set where the document may change (a view's draw on the
+    session's event loop, or no server at all). Text from users' files inside the HTML
+    stays escaped (:func:`inline_html`).
     """
 
     def __init__(self, text: str = "", *, css_classes=(), styles=None, height=None) -> None:
-        from bokeh.models import Div
-
-        self.model = Div(
-            text=text,
+        self._text = text
+        self.model = html_model(
+            text,
             css_classes=list(css_classes),
             styles=dict(styles or {}),
             sizing_mode="stretch_width",
@@ -141,12 +155,14 @@ class LiveText:
 
     @property
     def text(self) -> str:
-        return str(self.model.text)
+        """The HTML shown."""
+        return self._text
 
     @text.setter
     def text(self, value: str) -> None:
-        if self.model.text != value:  # an unchanged text sends nothing
-            self.model.text = value
+        if value != self._text:  # an unchanged text sends nothing
+            self._text = value
+            self.model.text = html_text(value)
 
     def __panel__(self) -> pn.pane.Bokeh:
         return self._pane
@@ -215,15 +231,8 @@ class LiveView(Viewer):
         self._on_document(self._apply)
 
     def _on_document(self, fn) -> None:
-        """Run ``fn`` (changes of Bokeh models) where it may change the served document:
-        on the session's event loop under its lock, whichever thread asks."""
-        doc = self._doc
-        if doc is None:
-            fn()  # no server: tests, notebooks, exports
-        elif served_document() is doc:
-            pn.state.execute(fn, schedule=True)
-        else:  # a thread outside Panel's: Bokeh's thread-safe scheduling
-            doc.add_next_tick_callback(fn)
+        """Run ``fn`` (changes of Bokeh models) where it may change the served document."""
+        on_document(self._doc, fn)
 
     def _apply(self) -> None:
         with self._guard:

@@ -13,7 +13,7 @@ from ..report.bokeh import ErrorMapLayers
 from ..report.colormap import LINE_STYLES, log_rows
 from ..store import Results
 from .common import COLORS, MODES_LABEL
-from .live import LiveView, download_button, inline_html
+from .live import LiveText, LiveView, download_button, inline_html, on_document, served_document
 from .plots import (
     add_image,
     add_line,
@@ -201,6 +201,7 @@ class SuggestedModesView(Viewer):
     def __init__(self, **params):
         super().__init__(**params)
         self._layout = None
+        self._doc = None
 
     @staticmethod
     def frame(r):
@@ -227,18 +228,20 @@ class SuggestedModesView(Viewer):
     def _changed(self):
         if self._layout is None or self.store.closed:
             return
+        on_document(self._doc, self._apply)
+
+    def _apply(self) -> None:
+        if self.store.closed:
+            return
         r = self.store.suggested
-        # Panel widgets and panes are safe to update from any thread (Panel schedules the
-        # model change on the session's loop)
         frame = self.frame(r)
         if not frame.equals(self._table.value):  # a re-sent table costs the browser a redraw
             self._table.value = frame
-        text = f"<p>{inline_html(r.caption)}</p>"
-        if self._caption.object != text:  # an unchanged caption sends nothing
-            self._caption.object = text
+        self._caption.text = f"<p>{inline_html(r.caption)}</p>"
 
     def __panel__(self):
         if self._layout is None:
+            self._doc = served_document()
             r = self.store.suggested
             self._table = pn.widgets.Tabulator(
                 self.frame(r),
@@ -250,11 +253,8 @@ class SuggestedModesView(Viewer):
                 layout="fit_data_stretch",
                 theme="bootstrap5",
             )
-            self._caption = pn.pane.HTML(
-                f"<p>{inline_html(r.caption)}</p>",
-                margin=(0, 10),
-                styles={"color": "#495057"},
-                sizing_mode="stretch_width",
+            self._caption = LiveText(
+                f"<p>{inline_html(r.caption)}</p>", styles={"color": "#495057"}
             )
             dl = download_button("suggested", lambda: self.store.suggested)
             self._layout = pn.Column(
