@@ -19,7 +19,10 @@ them (:class:`SharedRun`). Four rules keep one session from starving the others:
   by :data:`BAND_NICE`, or ``FBS_BAND_NICE``; Linux, per thread; numba's worker threads,
   which the band's thread starts, inherit it), so the threads that answer control changes
   (Panel's workers, the event loop that sends the plots) get the cores whenever they need
-  them, and a band takes what is left.
+  them, and a band takes what is left. Not before the kernels are compiled
+  (:data:`KERNELS_WARM`): the first band of a process compiles them (tens of seconds of
+  CPU without numba's cache), and at a low priority on a machine that other processes keep
+  busy that took minutes, with every page waiting for its first band.
 
 The numba kernels run one chunk at a time process-wide anyway (``fbs_core`` holds a lock
 around the parallel kernel), so the turns cost no parallelism. A chunk lasts about 0.1 s
@@ -46,6 +49,7 @@ from . import compute, offload
 __all__ = [
     "BAND_NICE",
     "Job",
+    "KERNELS_WARM",
     "SharedRun",
     "Turnstile",
     "TURNSTILE",
@@ -228,6 +232,10 @@ class SharedRun:
             j.report(done, total)
 
 
+#: Set once a band of this process has finished a chunk: the kernels are compiled, and
+#: band threads may lower their priority from then on.
+KERNELS_WARM = threading.Event()
+
 _RUNS: dict[tuple, SharedRun] = {}
 _RUNS_LOCK = threading.Lock()
 
@@ -263,7 +271,11 @@ def _compute(shared: SharedRun, turns: Turnstile) -> None:
                     return shared.cancelled
                 return not turns.next_turn(shared)
 
-            res = compute.band(*shared.key, cancel=cancel, progress=shared.report)
+            def progress(done: int, total: int) -> None:
+                KERNELS_WARM.set()  # a chunk ran here: the kernels are compiled
+                shared.report(done, total)
+
+            res = compute.band(*shared.key, cancel=cancel, progress=progress)
         shared.result = res
     except StudyCancelled:
         pass
@@ -319,13 +331,15 @@ def start(
 
     The thread works for the calling thread's session: Panel's current document is set in
     it, so what ``done`` publishes is drawn through that session's event loop. It runs at a
-    lower CPU priority (:func:`lower_priority`).
+    lower CPU priority (:func:`lower_priority`) once the kernels are compiled
+    (:data:`KERNELS_WARM`).
     """
     doc = pn.state.curdoc
 
     def work():
         pn.state.curdoc = doc
-        lower_priority()
+        if KERNELS_WARM.is_set():
+            lower_priority()
         run(job, done, context, turnstile)
 
     t = threading.Thread(target=work, name="scatter-band", daemon=True)
