@@ -84,23 +84,45 @@ class AnalysisResults(param.Parameterized):
     compare = param.ClassSelector(class_=Result, allow_None=True)
     message = param.String(default="", doc="The last pin action's problem ('' if none).")
 
+    #: Results published ahead of the main views when their tab is shown, and re-published
+    #: only for a new snapshot (they depend on nothing else).
+    SHOWN_FIRST = {"contributions": "contributions", "phase": "phase", "speed": "speed_map"}
+
     def __init__(self, **params):
+        self._made: dict[str, AnalysisSnapshot] = {}  # the state of each result published
         super().__init__(**params)
+        self.store.first_publishers.append(self._publish_shown)
+
+    def _publish_shown(self) -> None:
+        """Publish the shown tab's result now, ahead of the main views' results (the store
+        calls this first on a change of the case); its own watcher later finds it current."""
+        name = self.SHOWN_FIRST.get(self.state.analysis.tab)
+        if name == "contributions":
+            self._contributions()
+        elif name == "phase":
+            self._phase()
+        elif name == "speed_map":
+            self._speed_map()
 
     @property
     def state(self):
         return self.store.state
 
-    def _publish(self, name: str, tab: str | None, make: Callable[[AnalysisSnapshot], Any]):
+    def _publish(self, name: str, tab: str | None, make: Callable[[AnalysisSnapshot], Any]) -> bool:
         """Publish ``make(snapshot)`` as ``name`` under the session's lock, but only while
-        ``tab`` is shown (None: always)."""
+        ``tab`` is shown (None: always); whether it was published."""
         with self.store.lock:
             if self.store.closed:
-                return
+                return False
             s = AnalysisSnapshot.of(self.state)
             if tab is not None and s.tab != tab:
-                return
+                return False
+            if name in self.SHOWN_FIRST.values():
+                if self._made.get(name) == s and getattr(self, name) is not None:
+                    return False  # published for this very state already (ahead of the others)
             setattr(self, name, make(s))
+            self._made[name] = s
+            return True
 
     # -- results -----------------------------------------------------------------------------
     @param.depends(
@@ -143,7 +165,8 @@ class AnalysisResults(param.Parameterized):
         on_init=True,
     )
     def _phase(self):
-        self._publish("phase", "phase", phase_result)
+        if not self._publish("phase", "phase", phase_result):
+            return
         r = self.phase
         if r is not None and r.draw.get("modes_wanted") and not self.store.closed:
             self._find_modes(r)
@@ -428,6 +451,7 @@ def phase_result(s: AnalysisSnapshot) -> Result:
         "view": f"phase view ({s.phase_mode}): {what}",
         "harmonic": b.harmonic,
         "N (retained tire modes)": b.n_modes,
+        "response DOF": f"bushing:{b.dof}",
         "coupling": b.coupling,
         "phase": "degrees, unwrapped along frequency",
         "unit": unit,

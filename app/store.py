@@ -225,6 +225,10 @@ class Results(param.Parameterized):
         self._pending: set = set()  # residual tables being computed (see _residual_table)
         params["state"] = state if state is not None else DashboardState()
         params.setdefault("band_status", BandStatus())
+        #: Publishers that run first on a change of the case, before this store's own (the
+        #: Analysis card registers the one of the view it shows: what the user looks at is
+        #: computed and drawn first; ``app.analysis_store``).
+        self.first_publishers: list[Callable[[], None]] = []
         super().__init__(**params)
 
     # -- publishing ------------------------------------------------------------------------
@@ -246,6 +250,20 @@ class Results(param.Parameterized):
         return Snapshot.of(self.state)
 
     # -- the results, each next to what it depends on -----------------------------------------
+    # (param calls a class's watchers in the order of their definition: this one first)
+    @param.depends(
+        "state.case.harmonic",
+        "state.case.n_modes",
+        "state.case.dof",
+        "state.case.coupling",
+        "state.case.spindle_input",
+        "state.case.models",
+        watch=True,
+    )
+    def _first(self):
+        for publish in list(self.first_publishers):
+            publish()
+
     @param.depends(
         "state.case.harmonic",
         "state.case.n_modes",
