@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import threading
 
 from tornado.websocket import WebSocketClosedError
 
@@ -50,7 +51,12 @@ def test_a_task_failing_on_a_closed_page_leaves_no_traceback(caplog):
 
         gc.collect()
 
-    with caplog.at_level(logging.DEBUG):
+    def run() -> None:  # a loop of its own (the test process may be inside one already)
         asyncio.run(scenario())
+
+    with caplog.at_level(logging.DEBUG):
+        t = threading.Thread(target=run)
+        t.start()
+        t.join()
     assert "a page closed" in caplog.text
     assert "Traceback" not in caplog.text and "never retrieved" not in caplog.text
