@@ -97,12 +97,8 @@ class AnalysisResults(param.Parameterized):
         """Publish the shown tab's result now, ahead of the main views' results (the store
         calls this first on a change of the case); its own watcher later finds it current."""
         name = self.SHOWN_FIRST.get(self.state.analysis.tab)
-        if name == "contributions":
-            self._contributions()
-        elif name == "phase":
-            self._phase()
-        elif name == "speed_map":
-            self._speed_map()
+        if name is not None:
+            getattr(self, f"_{name}")()  # the result's own publisher
 
     @property
     def state(self):
