@@ -168,3 +168,36 @@ def test_bad_input():
         interface_contributions(Y, Y, Y, other)
     with pytest.raises(DOFError, match="selects no"):
         interface_contributions(Y, Y, Y, Y, couple=[])
+
+
+@pytest.mark.parametrize("coupling", ["6dof", "5dof"])
+def test_contributions_read_from_the_truncation_map_are_the_direct_ones(coupling):
+    """The map keeps the interface forces of its solve: its contributions for a count it
+    holds (and for all modes) are those of a separate tire synthesis and coupling."""
+    from fbs_core.analysis import map_contributions
+    from fbs_core.studies import truncation_map
+
+    m = truncation_map(2, n_modes=[20, 40, 60], coupling=coupling)
+    for n in (40, None):
+        c = map_contributions(m, n)
+        d = bushing_contributions(2, n_modes=n, coupling=coupling)
+        assert c.interface == d.interface and c.outputs == d.outputs
+        scale = np.abs(d.terms).max()
+        np.testing.assert_allclose(c.terms, d.terms, rtol=0, atol=1e-9 * scale)
+        np.testing.assert_allclose(
+            c.forces, d.forces, rtol=1e-9, atol=1e-9 * np.abs(d.forces).max()
+        )
+        # and their sum is the map's own response for that count
+        np.testing.assert_allclose(
+            c.total.data[:, :, 0], m.response_for(n), rtol=0, atol=1e-12 * scale
+        )
+
+
+def test_map_contributions_refuse_a_count_the_map_does_not_hold():
+    from fbs_core.analysis import map_contributions
+    from fbs_core.errors import FBSError
+    from fbs_core.studies import truncation_map
+
+    m = truncation_map(1, n_modes=[20, 40])
+    with pytest.raises(FBSError, match=r"no interface forces for N = 30 \(counts 20, 40"):
+        map_contributions(m, 30)

@@ -9,6 +9,7 @@ from .contributions import (
     bushing_contributions,
     contribution_kernel,
     interface_contributions,
+    map_contributions,
 )
 
 __all__ = [
@@ -16,6 +17,7 @@ __all__ = [
     "bushing_contributions",
     "contribution_kernel",
     "interface_contributions",
+    "map_contributions",
 ]
 from .peaks import (  # noqa: E402
     Mode,

@@ -27,7 +27,7 @@ from .. import kernels
 from ..chassis import BUSHING, SPINDLE, ChassisModel, reference_chassis
 from ..coupling import _check_same, _interface_pairs
 from ..dofs import index_of
-from ..errors import DOFError
+from ..errors import DOFError, FBSError
 from ..frf import FRF, check_grid
 from ..harmonics import harmonic as _harmonic
 from ..harmonics import renamed_argument
@@ -38,6 +38,7 @@ __all__ = [
     "contribution_kernel",
     "interface_contributions",
     "bushing_contributions",
+    "map_contributions",
 ]
 
 
@@ -338,3 +339,47 @@ def bushing_contributions(
         interface=[(f"hub:{d.split(':')[1]}", f"spindle:{d.split(':')[1]}") for d in SPINDLE],
         couple=dofs,
     )
+
+
+def map_contributions(
+    truncation_map: Any, n_modes: int | None, load: str = "patch"
+) -> Contributions:
+    """The contributions of one retained-mode count, read from a truncation map.
+
+    :func:`fbs_core.studies.truncation_map` keeps the interface forces ``g`` of every
+    retained count (the solve that gives its responses, eqs. 2.37 and 4.1) and the
+    chassis transfer mobility ``Y_ej^E``; the terms are ``Y_ej^E[:, :, k] g_k``, so the
+    contributions of a count in the map cost a product, no tire synthesis and no
+    solve. They are those of :func:`bushing_contributions` for the same harmonic,
+    count, coupling and models (non-residual map: the same eq. 4.1).
+
+    Parameters
+    ----------
+    truncation_map : TruncationMap
+        Made with its interface forces (``truncation_map``, ``truncation_map_arrays``).
+    n_modes : int or None
+        A count of the map; ``None`` (or the tire's total) is the all-modes reference.
+    load : str
+        Name of the load input of the result.
+
+    Returns
+    -------
+    Contributions
+        Outputs the map's response DOFs, interface its coupled source DOFs.
+
+    Raises
+    ------
+    FBSError
+        When the map holds no forces for that count (compute it with
+        :func:`bushing_contributions`).
+    """
+    m = truncation_map
+    g = m.forces_for(n_modes)
+    if g is None or m.transfer is None:
+        held = ", ".join(str(int(n)) for n in m.n_modes)
+        raise FBSError(
+            f"the truncation map holds no interface forces for N = {n_modes} (counts {held}"
+            f"{'' if m.forces is not None else '; made without the forces'})"
+        )
+    terms = m.transfer * g[:, None, :]
+    return Contributions(m.freq, tuple(m.dofs), tuple(m.interface), load, terms, g, "mobility")

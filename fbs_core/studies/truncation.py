@@ -72,6 +72,19 @@ class TruncationMap:
         Coupled response with all modes.
     width, step : float
         Band width and step in Hz; ``edges`` the band-edge treatment.
+    interface : tuple of str, length n_j
+        Coupled interface DOFs of the source (e.g. ``hub:x`` ...); ``()`` when the map
+        was made without the interface forces (these four are read-only properties,
+        kept from the map's solve and not part of its export).
+    forces : ndarray, shape (n_N, n_f, n_j), or None
+        Interface forces ``g = (Y_jj^A + Y_jj^E)^-1 v_j`` (eqs. 2.37, 4.1) per retained
+        count, from the same solve as :attr:`response`.
+    forces_reference : ndarray, shape (n_f, n_j), or None
+        The same with all modes.
+    transfer : ndarray, shape (n_f, n_dof, n_j), or None
+        Receiver transfer mobility ``Y_ej^E`` from the interface to the responses:
+        ``response[i] == transfer @ forces[i]`` (the terms of eq. 4.1 are
+        ``transfer * forces[i][:, None, :]``, :func:`fbs_core.analysis.map_contributions`).
     """
 
     harmonic: int | None
@@ -86,6 +99,31 @@ class TruncationMap:
     width: float
     step: float
     edges: str
+    # the interface forces of the map's solve (properties below; not exported with the map)
+    _interface: tuple[str, ...] = ()
+    _forces: ComplexArray | None = None
+    _forces_reference: ComplexArray | None = None
+    _transfer: ComplexArray | None = None
+
+    @property
+    def interface(self) -> tuple[str, ...]:
+        """Coupled interface DOFs of the source (``()``: made without the forces)."""
+        return self._interface
+
+    @property
+    def forces(self) -> ComplexArray | None:
+        """Interface forces per retained count, shape ``(n_N, n_f, n_j)``, or None."""
+        return self._forces
+
+    @property
+    def forces_reference(self) -> ComplexArray | None:
+        """Interface forces with all modes, shape ``(n_f, n_j)``, or None."""
+        return self._forces_reference
+
+    @property
+    def transfer(self) -> ComplexArray | None:
+        """Receiver transfer mobility ``Y_ej^E``, shape ``(n_f, n_dof, n_j)``, or None."""
+        return self._transfer
 
     @property
     def max_error(self) -> FloatArray:
@@ -123,6 +161,17 @@ class TruncationMap:
             return self.reference
         hit = np.flatnonzero(self.n_modes == int(n_modes))
         return self.response[hit[0]] if hit.size else None
+
+    def forces_for(self, n_modes: int | None) -> ComplexArray | None:
+        """The interface forces with ``n_modes`` retained modes, shape ``(n_f, n_j)``, if
+        the map holds them (``None``: no row for that count, or a map made without the
+        forces); ``n_modes`` as in :meth:`response_for`."""
+        if self.forces is None or self.forces_reference is None:
+            return None
+        if n_modes is None or (self.n_modes_total is not None and n_modes >= self.n_modes_total):
+            return self.forces_reference
+        hit = np.flatnonzero(self.n_modes == int(n_modes))
+        return self.forces[hit[0]] if hit.size else None
 
     def suggest(self, threshold: float = 0.2, f_max: float = 160.0, dof: str | None = None) -> int:
         """Smallest retained-mode count from which the error stays below ``threshold``
@@ -211,6 +260,7 @@ def truncation_map_arrays(
     step: float = 1.0,
     edges: str = "clip",
     centres: ArrayLike | None = None,
+    interface: Sequence[str] | None = None,
 ) -> TruncationMap:
     """The error map from arrays (the kernel behind :func:`truncation_map`).
 
@@ -230,6 +280,9 @@ def truncation_map_arrays(
     n_modes : array_like of int, shape (n_N,)
     dofs : sequence of str, optional
         Response labels (default ``bushing:x`` ...).
+    interface : sequence of str, optional
+        Labels of the ``n_j`` interface DOFs (default ``hub:x`` ... for six of them,
+        ``interface:0`` ... otherwise).
 
     Returns
     -------
@@ -243,8 +296,11 @@ def truncation_map_arrays(
             f"YjjA has shape {YjjA.shape}, expected (n_N, n_f, n_j, n_j) with n_N = {n.size} "
             f"and n_f = {f.size}"
         )
-    resp = kernels.couple_response_kernel(YejE[None], YjjA, YjjE[None], vj)
-    ref = kernels.couple_response_kernel(YejE, YjjA_ref, YjjE, vj_ref)
+    # eq. 4.1 in two steps, keeping the interface forces g (eq. 2.37) for the contributions
+    g = kernels.solve_interface(YjjA + YjjE[None], vj[..., None])  # (n_N, n_f, n_j, 1)
+    g_ref = kernels.solve_interface(YjjA_ref + YjjE, vj_ref[..., None])
+    resp = (YejE[None] @ g)[..., 0]
+    ref = (YejE @ g_ref)[..., 0]
     if not (np.all(np.isfinite(resp)) and np.all(np.isfinite(ref))):
         bad = np.argwhere(~np.isfinite(resp))
         line = int(bad[0][1]) if bad.size else int(np.argwhere(~np.isfinite(ref))[0][0])
@@ -254,6 +310,15 @@ def truncation_map_arrays(
         dofs = tuple(f"bushing:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))[: ref.shape[-1]]
     if len(dofs) != ref.shape[-1]:
         raise DOFError(f"{len(dofs)} response labels for {ref.shape[-1]} response DOFs")
+    n_j = YjjE.shape[-1]
+    if interface is None:
+        interface = (
+            tuple(f"hub:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))
+            if n_j == 6
+            else tuple(f"interface:{k}" for k in range(n_j))
+        )
+    if len(interface) != n_j:
+        raise DOFError(f"{len(interface)} interface labels for {n_j} interface DOFs")
     return TruncationMap(
         harmonic=harmonic,
         n_modes=_ro(n, int),
@@ -267,6 +332,10 @@ def truncation_map_arrays(
         width=float(width),
         step=float(step),
         edges=edges,
+        _interface=tuple(interface),
+        _forces=_ro(g[..., 0]),
+        _forces_reference=_ro(g_ref[..., 0]),
+        _transfer=_ro(YejE),
     )
 
 
@@ -355,6 +424,7 @@ def truncation_map(
         step=step,
         edges=edges,
         centres=centres,
+        interface=[f"hub:{d}" for d in dirs],
     )
 
 
