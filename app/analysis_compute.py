@@ -31,13 +31,22 @@ __all__ = [
 
 # -- contributions of the interface forces (eq. 4.1 term by term) ----------------------------
 def contributions(harmonic: int, n_modes: int, coupling: str, models=None):
-    """:func:`fbs_core.analysis.bushing_contributions` on the harmonic's grid, cached."""
+    """The contributions of the interface forces on the harmonic's grid, cached.
+
+    For a count the harmonic's truncation map holds (N = 10, 20, ...: the N slider's
+    steps), read from the map's interface forces (:func:`fbs_core.analysis.
+    map_contributions`: a product, no tire synthesis); otherwise
+    :func:`fbs_core.analysis.bushing_contributions`. Both are eq. 4.1 term by term.
+    """
     models = _key(models)
     return _contributions(int(harmonic), _n(models, n_modes), coupling, models)
 
 
 @shared_cache(maxsize=16)
 def _contributions(harmonic, n_modes, coupling, models):
+    m = compute.error_map(harmonic, coupling, models)
+    if m.forces_for(n_modes) is not None:
+        return analysis.map_contributions(m, n_modes)
     return analysis.bushing_contributions(
         harmonic,
         n_modes=n_modes,
