@@ -85,11 +85,16 @@ class AnalysisResults(param.Parameterized):
     message = param.String(default="", doc="The last pin action's problem ('' if none).")
 
     #: Results published ahead of the main views when their tab is shown, and re-published
-    #: only for a new snapshot (they depend on nothing else).
-    SHOWN_FIRST = {"contributions": "contributions", "phase": "phase", "speed": "speed_map"}
+    #: only when what they are made of changed (:meth:`_inputs`).
+    SHOWN_FIRST = {
+        "contributions": "contributions",
+        "phase": "phase",
+        "speed": "speed_map",
+        "compare": "compare",
+    }
 
     def __init__(self, **params):
-        self._made: dict[str, AnalysisSnapshot] = {}  # the state of each result published
+        self._made: dict[str, tuple] = {}  # the inputs of each result published (_inputs)
         super().__init__(**params)
         self.store.first_publishers.append(self._publish_shown)
 
@@ -113,12 +118,22 @@ class AnalysisResults(param.Parameterized):
             s = AnalysisSnapshot.of(self.state)
             if tab is not None and s.tab != tab:
                 return False
+            inputs = self._inputs(name, s)
             if name in self.SHOWN_FIRST.values():
-                if self._made.get(name) == s and getattr(self, name) is not None:
-                    return False  # published for this very state already (ahead of the others)
+                made = self._made.get(name)
+                if made is not None and _same(made, inputs) and getattr(self, name) is not None:
+                    return False  # published for these very inputs already (ahead of the others)
             setattr(self, name, make(s))
-            self._made[name] = s
+            self._made[name] = inputs
             return True
+
+    def _inputs(self, name: str, s: AnalysisSnapshot) -> tuple:
+        """What result ``name`` is made of: the snapshot, and for the comparison also the
+        pins, the pin compared to and the current band (in the cache when computed)."""
+        if name == "compare":
+            band = compute.cached_band(s.base.band_key())
+            return (s, self.pins, self.state.analysis.compare_to, band)
+        return (s,)
 
     # -- results -----------------------------------------------------------------------------
     @param.depends(
@@ -317,6 +332,21 @@ class AnalysisResults(param.Parameterized):
 
 
 # -- helpers ----------------------------------------------------------------------------------
+def _same(a: tuple, b: tuple) -> bool:
+    """Inputs equal: snapshots and names by value, anything else (pins, bands) by identity."""
+    if len(a) != len(b):
+        return False
+    for x, y in zip(a, b, strict=True):
+        if x is y:
+            continue
+        if isinstance(x, tuple) and isinstance(y, tuple):
+            if len(x) != len(y) or any(p is not q for p, q in zip(x, y, strict=True)):
+                return False
+        elif not (isinstance(x, AnalysisSnapshot | str) and type(x) is type(y) and x == y):
+            return False
+    return True
+
+
 def nearest_order_line(wavelength, speed_range, speed_kmh: float, freq: float, tol: float):
     """The harmonic case whose line ``f = v / lambda`` passes within ``tol`` (relative) of
     ``(speed_kmh, freq)`` inside its speed range, or None."""

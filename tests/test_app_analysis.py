@@ -103,6 +103,11 @@ def test_phase_view_bode_real_imag_and_cursors(store):
     pm = a.peak_modes
     assert pm is not None and pm[0] is a.phase
     assert all("modes" in t for t in view._peaks.data["text"])
+    # labels arriving later change the labels only: the curves are not sent again
+    curves = view._src["b"].data
+    new = tuple(f"label {k}" for k in range(len(pm[1])))
+    a.peak_modes = (a.phase, new)
+    assert view._src["b"].data is curves and list(view._peaks.data["text"]) == list(new)
     # real / imaginary parts
     r.state.analysis.phase_mode = "real/imag"
     np.testing.assert_allclose(view._src["b"].data["top"], want.real, rtol=1e-9, atol=1e-13)
@@ -300,7 +305,12 @@ def test_peak_modes_are_the_nearest_coupled_modes_and_nearby_peaks_share_a_solve
 
 @pytest.mark.parametrize(
     ("tab", "name"),
-    [("speed", "speed_map"), ("contributions", "contributions"), ("phase", "phase")],
+    [
+        ("speed", "speed_map"),
+        ("contributions", "contributions"),
+        ("phase", "phase"),
+        ("compare", "compare"),
+    ],
 )
 def test_the_shown_analysis_view_is_published_before_the_main_views(store, tab, name):
     """The view the user looks at is computed (and so drawn) first on a change of the case,
@@ -313,9 +323,43 @@ def test_the_shown_analysis_view_is_published_before_the_main_views(store, tab, 
     r.state.case.dof = "x"
     assert order[0] == name and order.count(name) == 1, order
     assert "response" in order
-    # the published result is that of the new state (a second method: the core's solve)
-    assert getattr(a, name).meta["response DOF"] == "bushing:x"
+    # the published result is that of the new state
+    meta = getattr(a, name).meta
+    if name == "compare":
+        assert " bushing:x " in meta["curve 0"]
+        cur = getattr(a, name).draw["curves"][0]["level"]
+        ref = fbs_core.vocabulary.magnitude_db(
+            fbs_core.bushing_response(2, n_modes=60).sel(outputs="bushing:x").data[:, 0, 0]
+        )
+        np.testing.assert_allclose(cur, ref, rtol=1e-9)
+    else:
+        assert meta["response DOF"] == "bushing:x"
     r.state.analysis.tab = ""  # a closed card: the main views' order as before
     order.clear()
     r.state.case.dof = "y"
     assert name not in order and order[0] == "response", order
+
+
+def test_the_compare_result_shown_first_follows_its_pins_and_the_band(store):
+    """Compare, published ahead of the main views, is published again when anything else
+    it is made of changes (a new pin, the compared pin, the band arriving), and not again
+    by its own watcher for the same state."""
+    r, a = store
+    r.state.analysis.tab = "compare"
+    seen = []
+    a.param.watch(lambda e: seen.append(e.new), ["compare"])
+    a.pin("one")
+    assert len(seen) == 1 and len(seen[-1].draw["curves"]) == 2  # current + the new pin
+    # a new N: published for the new state ahead of the main views (no band of it yet),
+    # then again when its band arrives (without a server computed in the store's watcher)
+    r.state.case.n_modes = 80
+    assert len(seen) == 3
+    assert seen[1].draw["curves"][0]["band"] is None
+    assert seen[2].draw["curves"][0]["band"] is not None
+    assert "N=80" in seen[1].meta["curve 0"] and "N=80" in seen[2].meta["curve 0"]
+    a.pin("two")
+    assert len(seen) == 4 and len(seen[-1].draw["curves"]) == 3
+    a.state.analysis.compare_to = "two"
+    assert len(seen) == 5 and "'two'" in seen[-1].meta["difference map"]
+    a.state.analysis.cursor1 = 30.0  # not something the comparison is made of
+    assert len(seen) == 5

@@ -43,7 +43,8 @@ class PhaseView(AnalysisView):
     def __init__(self, **params):
         super().__init__(**params)
         self._next_cursor = 1
-        self.analysis.param.watch(lambda _e: self.redraw(), ["peak_modes"])
+        # the modes near the peaks arrive later: only the labels change (not the curves)
+        self.analysis.param.watch(lambda _e: self._on_document(self._apply_labels), ["peak_modes"])
 
     def _controls(self):
         a = self.store.state.analysis
@@ -222,16 +223,7 @@ class PhaseView(AnalysisView):
         unit = d["y_label"]
         self._top.yaxis.axis_label = unit if bode else "Real part"
         self._bottom.yaxis.axis_label = "Phase (deg, unwrapped)" if bode else "Imaginary part"
-        labels = list(d["labels"])
-        pm = self.analysis.peak_modes
-        if pm is not None and pm[0] is r:
-            labels = list(pm[1])
-        peaks = d["peaks"]
-        self._peaks.data = {
-            "freq": [p["freq"] for p in peaks] if bode else [],
-            "level": [p["level"] for p in peaks] if bode else [],
-            "text": labels if bode else [],
-        }
+        self._peaks.data = self._peak_data(r)
         cur = d["cursors"]
         for spans in self._cursor_spans:
             for k, s in enumerate(spans):
@@ -244,6 +236,27 @@ class PhaseView(AnalysisView):
         else:
             self._cursors.data = {"freq": [], "level": []}
         self._set_log(bool(d["log"]))
+
+    def _peak_data(self, r) -> dict:
+        """The peak labels of result ``r``, with the modes nearby once they arrived."""
+        d = r.draw
+        bode = d["mode"] == "bode"
+        labels = list(d["labels"])
+        pm = self.analysis.peak_modes
+        if pm is not None and pm[0] is r:
+            labels = list(pm[1])
+        peaks = d["peaks"]
+        return {
+            "freq": [p["freq"] for p in peaks] if bode else [],
+            "level": [p["level"] for p in peaks] if bode else [],
+            "text": labels if bode else [],
+        }
+
+    def _apply_labels(self) -> None:
+        r = self.result()
+        if self._layout is None or self.store.closed or r is None:
+            return
+        self._peaks.data = self._peak_data(r)
 
     def _draw_pick(self, pick):
         f = pick.get("freq")
