@@ -19,6 +19,7 @@ Usage::
     .venv/bin/python bench/bench_dashboard.py [--rounds 10000] [--samples 20]
     .venv/bin/python bench/bench_dashboard.py --tree /path/to/old/checkout --tree .
     .venv/bin/python bench/bench_dashboard.py --only-analysis --samples 14
+    .venv/bin/python bench/bench_dashboard.py --only-analysis --tabs phase,compare
 
 With several ``--tree`` (source checkouts of the project), one server per tree runs at the
 same time and the samples alternate between them: a before/after comparison under the same
@@ -192,8 +193,9 @@ JS_TAB_OPEN = """async ([tab, name, timeout]) => {
 }"""
 
 
-def analysis_bench(servers, measure, modes, n, rounds):
-    """Latency of the Analysis card's views (issue 18), printed like the others."""
+def analysis_bench(servers, measure, modes, n, rounds, only=None):
+    """Latency of the Analysis card's views (issue 18), printed like the others
+    (``only``: the tabs to measure, default all)."""
     harmonics = [int(h) for h in np.resize([2, 3, 4, 5, 6, 7, 1], n)]
     dofs = [int(d) for d in np.resize([0, 1, 3, 4, 5, 2], n)]
     views = {
@@ -203,6 +205,8 @@ def analysis_bench(servers, measure, modes, n, rounds):
         "compare": "compare.diff1",
     }
     for tab, name in views.items():
+        if only and tab not in only:
+            continue
         for _tree, page, _proc, port, *_ in servers:
             page.goto(
                 f"http://127.0.0.1:{port}/main?rounds={rounds}&atab={tab}",
@@ -228,6 +232,8 @@ def analysis_bench(servers, measure, modes, n, rounds):
         for k, v in res.items():
             for tree, ms in v.items():
                 print(f"[{tree.name}] {k:46s} {stats(ms)}")
+    if only:
+        return
     # opening a tab in a loaded page (the card open on another tab, caches warm)
     order = [
         ("Phase and peaks", "phase.b"),
@@ -256,6 +262,12 @@ def main():
     ap.add_argument("--no-warm", action="store_true")
     ap.add_argument("--analysis", action="store_true", help="also the Analysis card's views")
     ap.add_argument("--only-analysis", action="store_true", help="only the Analysis card")
+    ap.add_argument(
+        "--tabs",
+        default="",
+        help="with --analysis: these tabs only, comma-separated (phase,contributions,speed,"
+        "compare; no tab-opening figures)",
+    )
     ap.add_argument(
         "--tree",
         action="append",
@@ -315,7 +327,8 @@ def main():
             n = args.samples
             modes = [int(i) for i in np.resize(np.arange(1, 20), n)]  # index: N = 20 ... 200
             if args.analysis or args.only_analysis:
-                analysis_bench(servers, measure, modes, n, args.rounds)
+                only = {t.strip() for t in args.tabs.split(",") if t.strip()}
+                analysis_bench(servers, measure, modes, n, args.rounds, only)
             if args.only_analysis:
                 return
             res = {

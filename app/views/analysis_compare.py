@@ -18,7 +18,7 @@ from fbs_core.analysis import MAX_PINS
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .analysis_speed import _pick_spans
 from .common import COLORS, level_label
-from .plots import add_image, fit_range
+from .plots import add_image, fit_range, set_data
 
 __all__ = ["CompareView"]
 
@@ -196,11 +196,23 @@ class CompareView(AnalysisView):
         curves = d["curves"]
         fit_range(self.x_range, curves[0]["freq"])
         empty = {"freq": np.zeros(0), "level": np.zeros(0)}
+        # the curves and their differences first (what the tab is read for), then the bands
         for i, (src, item) in enumerate(self._curves):
             c = curves[i] if i < len(curves) else None
-            src.data = {"freq": c["freq"], "level": c["level"]} if c else empty
+            set_data(src, {"freq": c["freq"], "level": c["level"]} if c else empty)
             item.label = {"value": c["name"] if c else ("current" if i == 0 else f"pin {i}")}
             item.visible = c is not None
+        for i, (src, item) in enumerate(self._diffs, start=1):
+            c = curves[i] if i < len(curves) else None
+            set_data(
+                src,
+                {"freq": c["freq"], "diff": c["diff"]}
+                if c is not None
+                else {"freq": np.zeros(0), "diff": np.zeros(0)},
+            )
+            item.visible = c is not None
+            if c is not None:
+                item.label = {"value": c["name"]}
         for i, (src, item) in enumerate(self._bands):
             c = curves[i] if i < len(curves) else None
             if c is not None and c["band"] is not None:
@@ -210,18 +222,8 @@ class CompareView(AnalysisView):
                     "high": 20 * np.log10(c["band"][1]),
                 }
             else:
-                src.data = {"freq": np.zeros(0), "low": np.zeros(0), "high": np.zeros(0)}
+                set_data(src, {"freq": np.zeros(0), "low": np.zeros(0), "high": np.zeros(0)})
             item.visible = c is not None and c["band"] is not None
-        for i, (src, item) in enumerate(self._diffs, start=1):
-            c = curves[i] if i < len(curves) else None
-            src.data = (
-                {"freq": c["freq"], "diff": c["diff"]}
-                if c is not None
-                else {"freq": np.zeros(0), "diff": np.zeros(0)}
-            )
-            item.visible = c is not None
-            if c is not None:
-                item.label = {"value": c["name"]}
         m = d["map"]
         if m is not None:
             e = m["diff_pct"]

@@ -115,22 +115,25 @@ class ContributionsView(AnalysisView):
         f = c["freq_Hz"]
         fit_range(self.x_range, f)
         interface = [j.split(":")[1] for j in d["interface"]]
-        empty = np.full(f.size, np.nan)
-        for dof, src in self._terms.items():
-            src.data = {
-                "freq": f,
-                "level": c[f"hub_{dof}_dB"] if dof in interface else empty,
-            }
-        self._total.data = {"freq": f, "level": c["total_dB"]}
-        cum = np.zeros(f.size)
-        stack = {"freq": f, "c0": cum.copy()}
-        for k, dof in enumerate(DOFS):
-            share = percent(c[f"hub_{dof}_share"]) if dof in interface else np.zeros(f.size)
-            stack[f"s{k}"] = share
-            cum = cum + share
-            stack[f"c{k + 1}"] = cum.copy()
-        self._stack.data = stack
         stacked = d["mode"] == "stacked"
+        # only the shown figure's data travel (a change of mode is a new result: redrawn)
+        if not stacked:
+            empty = np.full(f.size, np.nan)
+            for dof, src in self._terms.items():
+                src.data = {
+                    "freq": f,
+                    "level": c[f"hub_{dof}_dB"] if dof in interface else empty,
+                }
+            self._total.data = {"freq": f, "level": c["total_dB"]}
+        else:
+            cum = np.zeros(f.size)
+            stack = {"freq": f, "c0": cum.copy()}
+            for k, dof in enumerate(DOFS):
+                share = percent(c[f"hub_{dof}_share"]) if dof in interface else np.zeros(f.size)
+                stack[f"s{k}"] = share
+                cum = cum + share
+                stack[f"c{k + 1}"] = cum.copy()
+            self._stack.data = stack
         self._stack_fig.visible = stacked
         self._lines_fig.visible = not stacked
         self._lines_fig.yaxis.axis_label = level_label(d["dof"])

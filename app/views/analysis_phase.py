@@ -26,7 +26,7 @@ from bokeh.models import (
 
 from .analysis_base import PICK_COLOR, AnalysisView
 from .common import COLORS, FREQ_LABEL
-from .plots import fit_range, frequency_range, new_figure
+from .plots import fit_range, frequency_range, new_figure, set_data
 
 __all__ = ["PhaseView"]
 
@@ -208,11 +208,10 @@ class PhaseView(AnalysisView):
         slots = {"a": names[0], "b": names[1] if len(names) > 1 else None}
         for key, name in slots.items():
             if name is None:
-                self._src[key].data = {
-                    "freq": np.zeros(0),
-                    "top": np.zeros(0),
-                    "bottom": np.zeros(0),
-                }
+                set_data(
+                    self._src[key],
+                    {"freq": np.zeros(0), "top": np.zeros(0), "bottom": np.zeros(0)},
+                )
                 continue
             c = curves[name]
             self._src[key].data = {

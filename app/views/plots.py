@@ -38,6 +38,7 @@ __all__ = [
     "frequency_range",
     "modes_range",
     "new_figure",
+    "set_data",
 ]
 
 TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
@@ -67,6 +68,20 @@ def fit_range(rng, values: np.ndarray) -> None:
         hi = lo + 1.0
     if (rng.start, rng.end, rng.reset_start, rng.reset_end) != (lo, hi, lo, hi):
         rng.update(start=lo, end=hi, reset_start=lo, reset_end=hi)
+
+
+def set_data(src, data: dict) -> bool:
+    """Assign ``data`` to the source ``src`` unless both are empty with the same columns
+    (an unused slot stays as it is: no patch sent to the page). Whether it was assigned."""
+    old = src.data
+    if (
+        set(old) == set(data)
+        and all(len(v) == 0 for v in data.values())
+        and all(len(v) == 0 for v in old.values())
+    ):
+        return False
+    src.data = data
+    return True
 
 
 def new_figure(
