@@ -194,7 +194,6 @@ class CompareView(AnalysisView):
     def _draw(self, r):
         d = r.draw
         curves = d["curves"]
-        fit_range(self.x_range, curves[0]["freq"])
         empty = {"freq": np.zeros(0), "level": np.zeros(0)}
         # the curves and their differences first (what the tab is read for), then the bands
         for i, (src, item) in enumerate(self._curves):
@@ -251,6 +250,8 @@ class CompareView(AnalysisView):
             }
             self._mp.title.text = "Error map: no difference map (pin a state of this harmonic)"
         self._lv.yaxis.axis_label = level_label(d["dof"])
+        # the shared range last: the page renders its linked plots once, with the new data
+        fit_range(self.x_range, curves[0]["freq"])
 
     def _draw_pick(self, pick):
         f = pick.get("freq")

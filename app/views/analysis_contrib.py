@@ -113,7 +113,6 @@ class ContributionsView(AnalysisView):
     def _draw(self, r):
         c, d = r.columns, r.draw
         f = c["freq_Hz"]
-        fit_range(self.x_range, f)
         interface = [j.split(":")[1] for j in d["interface"]]
         stacked = d["mode"] == "stacked"
         # only the shown figure's data travel (a change of mode is a new result: redrawn)
@@ -137,6 +136,8 @@ class ContributionsView(AnalysisView):
         self._stack_fig.visible = stacked
         self._lines_fig.visible = not stacked
         self._lines_fig.yaxis.axis_label = level_label(d["dof"])
+        # the shared range last: the page renders its linked plots once, with the new data
+        fit_range(self.x_range, f)
 
     def _draw_pick(self, pick):
         f = pick.get("freq")

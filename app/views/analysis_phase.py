@@ -201,7 +201,6 @@ class PhaseView(AnalysisView):
     def _draw(self, r):
         d = r.draw
         f = d["freq"]
-        fit_range(self.x_range, f)
         bode = d["mode"] == "bode"
         curves = d["curves"]
         names = list(curves)
@@ -235,6 +234,8 @@ class PhaseView(AnalysisView):
         else:
             self._cursors.data = {"freq": [], "level": []}
         self._set_log(bool(d["log"]))
+        # the shared range last: the page renders its linked plots once, with the new data
+        fit_range(self.x_range, f)
 
     def _peak_data(self, r) -> dict:
         """The peak labels of result ``r``, with the modes nearby once they arrived."""

@@ -59,7 +59,6 @@ class MobilityView(LiveView):
 
     def _draw(self, r):
         c = r.columns
-        fit_range(self.x_range, c["freq_Hz"])
         self._ref.data = {"freq": c["freq_Hz"], "level": c["reference_dB"]}
         self._tr.data = {"freq": c["freq_Hz"], "level": c["truncated_dB"]}
         self._fig.yaxis.axis_label = level_label(r.draw["dof"])
@@ -67,6 +66,8 @@ class MobilityView(LiveView):
         for item in self._fig.legend[0].items if label and self._fig.legend else ():
             if item.renderers and item.renderers[0].data_source is self._tr:
                 item.label = value(label)  # "N retained modes" or "... + residual"
+        # the shared range last: the page renders its linked plots once, with the new data
+        fit_range(self.x_range, c["freq_Hz"])
 
 
 class UncoupledView(LiveView):
@@ -126,7 +127,6 @@ class UncoupledView(LiveView):
     def _draw(self, r):
         c, d = r.columns, r.draw
         f = c["freq_Hz"]
-        fit_range(self.x_range, f)
         self._tire_ref.data = {"freq": f, "level": c["tire_reference_dB"]}
         self._tire_tr.data = {"freq": f, "level": c["tire_truncated_dB"]}
         self._chassis.data = {"freq": f, "level": c["chassis_dB"]}
@@ -134,3 +134,5 @@ class UncoupledView(LiveView):
         self._tire_fig.yaxis.axis_label = level_label(d["dof"])
         self._chassis_fig.title.text = d["chassis_title"]
         self._chassis_fig.yaxis.axis_label = d["chassis_label"]
+        # the shared range last: the page renders its linked plots once, with the new data
+        fit_range(self.x_range, f)

@@ -163,7 +163,6 @@ class ScatterBandView(LiveView):
     def _draw(self, r):
         d, single = r.draw["band"], r.draw["round"]
         f = d["freq"]
-        fit_range(self.x_range, f)
         self._minmax.data = {"freq": f, "lower": d["minimum_db"], "upper": d["maximum_db"]}
         self._pct.data = {"freq": f, "lower": d["pct_low_db"], "upper": d["pct_high_db"]}
         self._ref.data = {"freq": f, "level": d["reference_db"]}
@@ -179,3 +178,5 @@ class ScatterBandView(LiveView):
             for item, text in zip(leg.items, labels, strict=False):
                 if getattr(item.label, "value", None) != text:
                     item.label = value(text)
+        # the shared range last: the page renders its linked plots once, with the new data
+        fit_range(self.x_range, f)

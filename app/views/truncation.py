@@ -167,7 +167,6 @@ class TruncationView(LiveView):
         cols = image_columns(d["map"])
         nm = d["map"]["n_modes"]
         dn = float(nm[1] - nm[0]) if nm.size > 1 else 10.0
-        fit_range(self.x_range, d["freq"])
         top = cols["y"][0] + cols["dh"][0] + dn  # up to the all-modes count (no error)
         if self.n_axis == "log":  # rows uniform in log N: the image stretches linearly
             low, high, img = log_rows(nm, d["map"]["error_pct"], 512)
@@ -191,6 +190,8 @@ class TruncationView(LiveView):
             (self._chosen, float(d["n_modes"])),
         ):
             line.location = halo.location = loc
+        # the shared range last: the page renders its linked plots once, with the new data
+        fit_range(self.x_range, d["freq"])
 
 
 class SuggestedModesView(Viewer):
