@@ -10,7 +10,7 @@ document (the named ColumnDataSource of the view):
 - server start: process launch to "app running", and to the first rendered plot;
 - with ``--analysis``: the Analysis card's views (issue 18), each in a fresh page opened on
   its tab (``?atab=...``): N, harmonic and DOF changes until the view's own source changes
-  (phase: ``phase.b``; contributions: ``contributions.total``; across speed:
+  (phase: ``phase.b``; contributions: ``contributions.lines``; across speed:
   ``speedmap.image``; compare, one pin made first: ``compare.diff1``), and the time to
   open each tab in a loaded page. ``--only-analysis`` skips the other measurements.
 
@@ -200,7 +200,7 @@ def analysis_bench(servers, measure, modes, n, rounds, only=None):
     dofs = [int(d) for d in np.resize([0, 1, 3, 4, 5, 2], n)]
     views = {
         "phase": "phase.b",
-        "contributions": "contributions.total",
+        "contributions": "contributions.lines",
         "speed": "speedmap.image",
         "compare": "compare.diff1",
     }
@@ -237,7 +237,7 @@ def analysis_bench(servers, measure, modes, n, rounds, only=None):
     # opening a tab in a loaded page (the card open on another tab, caches warm)
     order = [
         ("Phase and peaks", "phase.b"),
-        ("Contributions", "contributions.total"),
+        ("Contributions", "contributions.lines"),
         ("Across speed", "speedmap.image"),
         ("Compare", "compare.curve0"),
     ]

@@ -55,15 +55,15 @@ def test_contributions_view_equals_the_terms_solved_by_hand(store, coupling):
     f, terms, kept = _terms_by_hand(2, 60, coupling)
     z = DIRS.index("z")
     for k, d in enumerate(kept):
-        plotted = view._terms[d].data["level"]
+        plotted = view._lines.data[f"hub_{d}"]
         np.testing.assert_allclose(plotted, 20 * np.log10(np.abs(terms[:, z, k])), atol=1e-8)
     if coupling == "5dof":
-        assert np.isnan(view._terms["ry"].data["level"]).all()  # released: no term
+        assert np.isnan(view._lines.data["hub_ry"]).all()  # released: no term
     # their sum is the coupled response
     want = fbs_core.bushing_response(2, n_modes=60, coupling=coupling)
     want = want.sel(outputs="bushing:z").data[:, 0, 0]
     np.testing.assert_allclose(terms[:, z].sum(-1), want, rtol=1e-9)
-    np.testing.assert_allclose(view._total.data["level"], 20 * np.log10(np.abs(want)), atol=1e-9)
+    np.testing.assert_allclose(view._lines.data["total"], 20 * np.log10(np.abs(want)), atol=1e-9)
     # stacked: shares of the total add up to 100 % at every line
     r.state.analysis.contrib_mode = "stacked"
     assert view._stack_fig.visible and not view._lines_fig.visible

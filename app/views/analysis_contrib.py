@@ -44,24 +44,32 @@ class ContributionsView(AnalysisView):
         self._lines_fig = fig = self._frequency_figure(
             "contributions.figure", level_label("z"), 400
         )
-        self._terms = {}
+        # one source for the six terms and the total: one patch per change
+        self._lines = ColumnDataSource(
+            {"freq": np.zeros(0), **{f"hub_{d}": np.zeros(0) for d in DOFS}, "total": np.zeros(0)},
+            name="contributions.lines",
+        )
         for d, color in zip(DOFS, TERM_COLORS, strict=True):
-            self._terms[d] = add_line(
+            add_line(
                 fig,
-                f"contributions.hub_{d}",
+                "",
+                y=f"hub_{d}",
+                source=self._lines,
                 color=color,
                 legend=f"hub:{d}",
                 width=1.6,
-                tooltips=level_tooltips(f"force at hub:{d}"),
+                tooltips=level_tooltips(f"force at hub:{d}", f"hub_{d}"),
                 legend_location="bottom_right",
             )
-        self._total = add_line(
+        add_line(
             fig,
-            "contributions.total",
+            "",
+            y="total",
+            source=self._lines,
             color=COLORS["reference"],
             legend="total (eq. 4.1)",
             width=2.6,
-            tooltips=level_tooltips("total"),
+            tooltips=level_tooltips("total", "total"),
             legend_location="bottom_right",
         )
         # stacked shares: one source, a varea per term between cumulative columns
@@ -118,12 +126,11 @@ class ContributionsView(AnalysisView):
         # only the shown figure's data travel (a change of mode is a new result: redrawn)
         if not stacked:
             empty = np.full(f.size, np.nan)
-            for dof, src in self._terms.items():
-                src.data = {
-                    "freq": f,
-                    "level": c[f"hub_{dof}_dB"] if dof in interface else empty,
-                }
-            self._total.data = {"freq": f, "level": c["total_dB"]}
+            self._lines.data = {
+                "freq": f,
+                **{f"hub_{d}": c[f"hub_{d}_dB"] if d in interface else empty for d in DOFS},
+                "total": c["total_dB"],
+            }
         else:
             cum = np.zeros(f.size)
             stack = {"freq": f, "c0": cum.copy()}

@@ -136,9 +136,13 @@ def add_line(
     dash: str = "solid",
     width: float = 2.0,
     legend_location: str = "bottom_left",
+    source: ColumnDataSource | None = None,
 ) -> ColumnDataSource:
-    """A line fed by a new named source with columns ``x``, ``y``; hover along x."""
-    src = ColumnDataSource({x: np.zeros(0), y: np.zeros(0)}, name=name)
+    """A line fed by a new named source with columns ``x``, ``y`` (or by column ``y`` of
+    ``source``, shared by several lines: one patch for all of them); hover along x."""
+    src = (
+        ColumnDataSource({x: np.zeros(0), y: np.zeros(0)}, name=name) if source is None else source
+    )
     kw = {"legend_label": legend} if legend else {}
     r = fig.line(x, y, source=src, line_color=color, line_width=width, line_dash=dash, **kw)
     fig.add_tools(HoverTool(renderers=[r], tooltips=list(tooltips), mode="vline"))
