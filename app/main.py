@@ -50,6 +50,7 @@ from app.views import (
 from app.views.analysis_base import analysis_card
 from app.views.campaign import campaign_card
 from app.views.landmarks import landmarks_card
+from app.views.live import DrawQueue
 from app.views.plots import frequency_range, modes_range
 from app.views.quality import TireQualityView
 
@@ -368,7 +369,7 @@ def create_app(
     if doc is not None:  # a served session, or a document built without one
         # bound now: Bokeh may clear the session's module namespace before its
         # session-destroyed callbacks run ("name 'close_page' is not defined", seen under load)
-        doc.on_session_destroyed(lambda _ctx, close=close_page: close(template))
+        doc.on_session_destroyed(lambda _ctx, close=close_page: close(template, doc))
     if served():
         closed_pages.quiet_closed_page_writes()  # once per process: the server's loop
         pn.state.onload(results.request_band)
@@ -379,9 +380,10 @@ def create_app(
     return template
 
 
-def close_page(page: pn.template.BootstrapTemplate) -> None:
+def close_page(page: pn.template.BootstrapTemplate, doc=None) -> None:
     """End a page of :func:`create_app`: its band is cancelled, nothing more is published,
-    and the watchers of its components are dropped.
+    the draws still waiting for its document ``doc`` are dropped and the watchers of its
+    components are dropped.
 
     Called with the document's session-destroyed callbacks. Panel drops the watchers of a
     served session's components itself; a page built in a document without a browser
@@ -391,6 +393,8 @@ def close_page(page: pn.template.BootstrapTemplate) -> None:
     its data alive for the life of the process (finding 2 of issue 20).
     """
     page.results.close()
+    if doc is not None:
+        DrawQueue.discard(doc)
     # the template's areas, not ``page.select()``: in a served page the template renders
     # Panel's BrowserInfo too, which has no ``select`` (the callback failed there, and the
     # watchers stayed)

@@ -168,6 +168,16 @@ class DrawQueue:
                 q = cls._queues[doc] = cls(doc)
             return q
 
+    @classmethod
+    def discard(cls, doc) -> None:
+        """Drop the draws still waiting for ``doc`` (its session ended: a next-tick callback
+        of a destroyed session may never run, and a waiting draw keeps its page alive)."""
+        with cls._queues_lock:
+            q = cls._queues.pop(doc, None)
+        if q is not None:
+            with q._lock:
+                q._fns.clear()
+
     def add(self, fn) -> None:
         """Run ``fn`` after the draws already waiting (from any thread)."""
         with self._lock:

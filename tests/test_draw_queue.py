@@ -1,0 +1,100 @@
+"""The session's draw queue (app.views.live.DrawQueue): draws in the order asked for, each
+one written before the next starts, a failing draw does not stop the others, and a page
+that ended keeps nothing alive through draws that never ran.
+
+The served document is stood in for by the two things the queue uses of it: Bokeh's
+``add_next_tick_callback`` and the session context's ``with_locked_document`` (whose
+awaiting stands for the socket writes of the draw's patches).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import gc
+import weakref
+
+from app.views.live import DrawQueue, on_document
+
+
+class _Context:
+    def __init__(self, doc, log):
+        self._doc, self.log = weakref.ref(doc), log
+
+    async def with_locked_document(self, func):
+        self.log.append("lock")
+        try:
+            func(self._doc())
+        finally:
+            await asyncio.sleep(0)  # the patches' writes: other tasks may run meanwhile
+            self.log.append("written")
+
+
+class _Doc:
+    def __init__(self, log):
+        self.session_context = _Context(self, log)
+        self.ticks = []
+
+    def add_next_tick_callback(self, cb):
+        self.ticks.append(cb)
+
+
+def _run(doc):
+    async def main():
+        while doc.ticks:
+            await doc.ticks.pop(0)()
+
+    asyncio.run(main())
+
+
+def test_draws_run_in_order_each_written_before_the_next_and_failures_stay_alone():
+    log = []
+    doc = _Doc(log)
+
+    def draw(name, fail=False):
+        def fn():
+            log.append(name)
+            if fail:
+                raise RuntimeError("broken view")
+
+        return fn
+
+    on_document(doc, draw("analysis"))
+    on_document(doc, draw("mobility", fail=True))
+    on_document(doc, draw("truncation"))
+    assert len(doc.ticks) == 1  # one drain for all waiting draws
+    _run(doc)
+    assert log == [
+        "lock", "analysis", "written",
+        "lock", "mobility", "written",
+        "lock", "truncation", "written",
+    ]  # fmt: skip
+    # a later draw starts a new drain
+    on_document(doc, draw("eigen"))
+    assert len(doc.ticks) == 1
+    _run(doc)
+    assert log[-3:] == ["lock", "eigen", "written"]
+
+
+def test_no_server_draws_at_once():
+    log = []
+    on_document(None, lambda: log.append("drawn"))
+    assert log == ["drawn"]
+
+
+def test_an_ended_page_is_not_kept_alive_by_draws_that_never_ran():
+    doc = _Doc([])
+
+    class View:  # a view holds its document, as LiveView does
+        def __init__(self, d):
+            self.doc = d
+
+        def apply(self):
+            pass
+
+    on_document(doc, View(doc).apply)
+    ref = weakref.ref(doc)
+    DrawQueue.discard(doc)
+    doc.ticks.clear()  # the destroyed session's callbacks never run
+    del doc
+    gc.collect()
+    assert ref() is None
