@@ -15,6 +15,7 @@ modules under ``app/views/``) add themselves with one line.
 from __future__ import annotations
 
 import functools
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -369,7 +370,15 @@ def create_app(
     if doc is not None:  # a served session, or a document built without one
         # bound now: Bokeh may clear the session's module namespace before its
         # session-destroyed callbacks run ("name 'close_page' is not defined", seen under load)
-        doc.on_session_destroyed(lambda _ctx, close=close_page: close(template, doc))
+        # (the document by weak reference: held strongly by its own session-destroyed
+        # callback it kept the page alive, tests/test_server_pages.py)
+        doc_ref = weakref.ref(doc)
+        doc.on_session_destroyed(
+            lambda _ctx, close=close_page, drop=DrawQueue.discard: (
+                drop(doc_ref()),
+                close(template),
+            )
+        )
     if served():
         closed_pages.quiet_closed_page_writes()  # once per process: the server's loop
         pn.state.onload(results.request_band)
@@ -380,10 +389,10 @@ def create_app(
     return template
 
 
-def close_page(page: pn.template.BootstrapTemplate, doc=None) -> None:
+def close_page(page: pn.template.BootstrapTemplate) -> None:
     """End a page of :func:`create_app`: its band is cancelled, nothing more is published,
-    the draws still waiting for its document ``doc`` are dropped and the watchers of its
-    components are dropped.
+    and the watchers of its components are dropped (the draws still waiting for its
+    document are dropped beside it, ``DrawQueue.discard``).
 
     Called with the document's session-destroyed callbacks. Panel drops the watchers of a
     served session's components itself; a page built in a document without a browser
@@ -393,8 +402,6 @@ def close_page(page: pn.template.BootstrapTemplate, doc=None) -> None:
     its data alive for the life of the process (finding 2 of issue 20).
     """
     page.results.close()
-    if doc is not None:
-        DrawQueue.discard(doc)
     # the template's areas, not ``page.select()``: in a served page the template renders
     # Panel's BrowserInfo too, which has no ``select`` (the callback failed there, and the
     # watchers stayed)

@@ -172,6 +172,8 @@ class DrawQueue:
     def discard(cls, doc) -> None:
         """Drop the draws still waiting for ``doc`` (its session ended: a next-tick callback
         of a destroyed session may never run, and a waiting draw keeps its page alive)."""
+        if doc is None:
+            return
         with cls._queues_lock:
             q = cls._queues.pop(doc, None)
         if q is not None:
