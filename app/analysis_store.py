@@ -15,6 +15,7 @@ to: the peak labels show at once and gain their modes when these arrive.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -197,7 +198,47 @@ class AnalysisResults(param.Parameterized):
         on_init=True,
     )
     def _speed_map(self):
-        self._publish("speed_map", "speed", speed_map_result)
+        if self._publish("speed_map", "speed", speed_map_result) and not self.store.closed:
+            self._prefetch_speed_maps()
+
+    #: The prefetch thread last started (tests join it).
+    prefetch_thread: threading.Thread | None = None
+
+    def _prefetch_speed_maps(self) -> None:
+        """The speed maps of the N slider's two neighbouring counts, computed ahead on a
+        low-priority thread while the speed tab is shown (served pages only).
+
+        A new N is a new speed map (the tire synthesised at 21 speeds: 40-300 ms by harmonic
+        and N), and the slider is moved a step at a time; a step then finds its map in the
+        cache. A jump to a far count still computes its map when asked. The thread stops
+        as soon as the session has moved on (another N, harmonic, tab) or closed.
+        """
+        later = bands.served() if self.store.background is None else self.store.background
+        if not later:
+            return
+        s = self._made["speed_map"][0].base
+        counts = list(self.state.case.param.n_modes.objects)
+        if s.n_modes not in counts:
+            return
+        i = counts.index(s.n_modes)
+        near = [counts[j] for j in (i + 1, i - 1) if 0 <= j < len(counts)]
+
+        def current() -> bool:
+            c = self.state.case
+            return (
+                not self.store.closed
+                and self.state.analysis.tab == "speed"
+                and (c.n_modes, c.harmonic, c.coupling, c.models)
+                == (s.n_modes, s.harmonic, s.coupling, s.models)
+            )
+
+        def work() -> None:
+            for n in near:
+                if not current():
+                    return
+                ac.speed_map(s.harmonic, n, s.coupling, s.models)
+
+        self.prefetch_thread = background.start(work, "fbs-prefetch")
 
     @param.depends("store.state.analysis.pins", watch=True, on_init=True)
     def _sync_pins(self):

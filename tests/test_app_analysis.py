@@ -364,3 +364,31 @@ def test_the_compare_result_shown_first_follows_its_pins_and_the_band(store):
     assert len(seen) == 5 and "'two'" in seen[-1].meta["difference map"]
     a.state.analysis.cursor1 = 30.0  # not something the comparison is made of
     assert len(seen) == 5
+
+
+def test_the_speed_tab_computes_the_slider_neighbours_ahead(store):
+    """Served, the speed tab computes the speed maps of the N slider's two neighbouring
+    counts on a background thread: the next step of the slider is a cache hit."""
+    from app import analysis_compute as ac
+
+    r, a = store
+    r.background = True  # as in a served page
+    try:
+        r.state.analysis.tab = "speed"
+        r.state.case.n_modes = 70
+        assert a.prefetch_thread is not None
+        a.prefetch_thread.join(timeout=300)
+        assert not a.prefetch_thread.is_alive()
+        for n in (80, 60):
+            before = ac._speed_map.cache_info()
+            m = ac.speed_map(2, n, "6dof", r.state.case.models)
+            after = ac._speed_map.cache_info()
+            assert (after.hits, after.misses) == (before.hits + 1, before.misses)
+            assert m.n_modes == n
+        # not served: nothing computed ahead
+        r.background = False
+        a.prefetch_thread = None
+        r.state.case.n_modes = 90
+        assert a.prefetch_thread is None
+    finally:
+        r.close()
