@@ -15,6 +15,7 @@ to: the peak labels show at once and gain their modes when these arrive.
 
 from __future__ import annotations
 
+import logging
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -34,6 +35,8 @@ from .analysis_state import check_pin_name, decode_pins, encode_pins
 from .store import Result, Results, Snapshot, chassis_label
 
 __all__ = ["AnalysisResults", "AnalysisSnapshot"]
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -198,47 +201,49 @@ class AnalysisResults(param.Parameterized):
         on_init=True,
     )
     def _speed_map(self):
+        before = self._made.get("speed_map")
         if self._publish("speed_map", "speed", speed_map_result) and not self.store.closed:
-            self._prefetch_speed_maps()
+            if before is not None:
+                self._prefetch_speed_map(before[0].base, self._made["speed_map"][0].base)
 
     #: The prefetch thread last started (tests join it).
     prefetch_thread: threading.Thread | None = None
 
-    def _prefetch_speed_maps(self) -> None:
-        """The speed maps of the N slider's two neighbouring counts, computed ahead on a
-        low-priority thread while the speed tab is shown (served pages only).
+    def _prefetch_speed_map(self, old: Snapshot, new: Snapshot) -> None:
+        """After a step of the N slider on the speed tab, the speed map of the next count in
+        the same direction, computed ahead on a thread of its own (served pages only).
 
         A new N is a new speed map (the tire synthesised at 21 speeds: 40-300 ms by harmonic
-        and N), and the slider is moved a step at a time; a step then finds its map in the
-        cache. A jump to a far count still computes its map when asked. The thread stops
-        as soon as the session has moved on (another N, harmonic, tab) or closed.
+        and N), and the slider moves a step at a time: the next step then finds its map in
+        the cache, or computed in part (a session asking for it waits for this thread
+        instead of computing it a second time beside it). A jump to a far count, a change
+        of harmonic or of anything else computes nothing ahead; the thread does nothing
+        once the session has moved on.
         """
         later = bands.served() if self.store.background is None else self.store.background
-        if not later:
+        same = (old.harmonic, old.coupling, old.models) == (new.harmonic, new.coupling, new.models)
+        if not later or not same or old.n_modes == new.n_modes:
             return
-        s = self._made["speed_map"][0].base
         counts = list(self.state.case.param.n_modes.objects)
-        if s.n_modes not in counts:
+        if old.n_modes not in counts or new.n_modes not in counts:
             return
-        i = counts.index(s.n_modes)
-        near = [counts[j] for j in (i + 1, i - 1) if 0 <= j < len(counts)]
-
-        def current() -> bool:
-            c = self.state.case
-            return (
-                not self.store.closed
-                and self.state.analysis.tab == "speed"
-                and (c.n_modes, c.harmonic, c.coupling, c.models)
-                == (s.n_modes, s.harmonic, s.coupling, s.models)
-            )
+        i, step = counts.index(new.n_modes), 1 if new.n_modes > old.n_modes else -1
+        if not 0 <= i + step < len(counts):
+            return
+        n = counts[i + step]
 
         def work() -> None:
-            for n in near:
-                if not current():
-                    return
-                ac.speed_map(s.harmonic, n, s.coupling, s.models)
+            c = self.state.case
+            if self.store.closed or self.state.analysis.tab != "speed" or c.n_modes != new.n_modes:
+                return
+            try:
+                ac.speed_map(new.harmonic, n, new.coupling, new.models)
+            except Exception:  # optional work: the session computes it itself when asked
+                log.exception("computing the speed map of N = %d ahead failed", n)
 
-        self.prefetch_thread = background.start(work, "fbs-prefetch")
+        t = threading.Thread(target=work, name="fbs-prefetch", daemon=True)
+        self.prefetch_thread = t
+        t.start()
 
     @param.depends("store.state.analysis.pins", watch=True, on_init=True)
     def _sync_pins(self):

@@ -366,29 +366,38 @@ def test_the_compare_result_shown_first_follows_its_pins_and_the_band(store):
     assert len(seen) == 5
 
 
-def test_the_speed_tab_computes_the_slider_neighbours_ahead(store):
-    """Served, the speed tab computes the speed maps of the N slider's two neighbouring
-    counts on a background thread: the next step of the slider is a cache hit."""
+def test_a_step_of_the_n_slider_on_the_speed_tab_computes_the_next_step_ahead(store):
+    """Served, a step of N on the speed tab computes the speed map of the next count in the
+    same direction on a thread of its own: the next step is a cache hit. A change of
+    harmonic computes nothing ahead."""
     from app import analysis_compute as ac
 
     r, a = store
     r.background = True  # as in a served page
+    models = r.state.case.models
+
+    def hit(n):
+        before = ac._speed_map.cache_info()
+        m = ac.speed_map(2, n, "6dof", models)
+        after = ac._speed_map.cache_info()
+        return m.n_modes == n and (after.hits, after.misses) == (before.hits + 1, before.misses)
+
+    ac._speed_map.cache_clear()  # a hit below is this test's own computation
     try:
-        r.state.analysis.tab = "speed"
-        r.state.case.n_modes = 70
-        assert a.prefetch_thread is not None
+        r.state.analysis.tab = "speed"  # N = 60
+        assert a.prefetch_thread is None  # the first map: no step yet
+        r.state.case.n_modes = 70  # up: 80 ahead
         a.prefetch_thread.join(timeout=300)
-        assert not a.prefetch_thread.is_alive()
-        for n in (80, 60):
-            before = ac._speed_map.cache_info()
-            m = ac.speed_map(2, n, "6dof", r.state.case.models)
-            after = ac._speed_map.cache_info()
-            assert (after.hits, after.misses) == (before.hits + 1, before.misses)
-            assert m.n_modes == n
+        assert not a.prefetch_thread.is_alive() and hit(80)
+        r.state.case.n_modes = 60  # down: 50 ahead
+        a.prefetch_thread.join(timeout=300)
+        assert hit(50)
+        a.prefetch_thread = None
+        r.state.case.harmonic = 3
+        assert a.prefetch_thread is None
         # not served: nothing computed ahead
         r.background = False
-        a.prefetch_thread = None
-        r.state.case.n_modes = 90
+        r.state.case.n_modes = 70
         assert a.prefetch_thread is None
     finally:
         r.close()
