@@ -401,3 +401,44 @@ def test_a_step_of_the_n_slider_on_the_speed_tab_computes_the_next_step_ahead(st
         assert a.prefetch_thread is None
     finally:
         r.close()
+
+
+def test_served_peak_modes_wait_for_a_quiet_moment_and_skip_superseded_results(store, monkeypatch):
+    """Served, the modes near the peaks are solved once the phase result stayed current for
+    MODES_QUIET; a result superseded meanwhile solves nothing, the current one gets them."""
+    import threading
+
+    import app.analysis_store as store_module
+    from app import analysis_compute as ac
+
+    r, a = store
+    solved, slept, results, published = [], [], [], []
+    a.param.watch(lambda e: published.append(e.new), ["phase"])
+    real = ac.peak_modes
+    monkeypatch.setattr(ac, "peak_modes", lambda *args, **kw: solved.append(args) or real(*args))
+
+    def quiet(seconds):  # the user changes the DOF during the first quiet period
+        slept.append(seconds)
+        if len(slept) == 1:
+            r.state.case.dof = "x"
+            results.append(a.phase)
+
+    monkeypatch.setattr(store_module.time, "sleep", quiet)
+    r.background = True
+    try:
+        r.state.case.harmonic = 3  # its bushing:z response has peaks to label
+        r.state.analysis.tab = "phase"
+        # the first result's thread starts the second's before it ends: two passes
+        for _ in range(2):
+            for t in [t for t in threading.enumerate() if t.name == "fbs-peak-modes"]:
+                t.join(timeout=300)
+        first, second = published
+        assert results == [second] and second.draw["modes_wanted"]
+        assert slept == [a.MODES_QUIET, a.MODES_QUIET]
+        assert a.peak_modes is not None and a.peak_modes[0] is second
+        # only the current result's peaks were solved, not the superseded one's
+        got = sorted(round(f, 6) for f, *_ in solved)
+        assert got == sorted(round(p["freq"], 6) for p in second.draw["peaks"])
+        assert got != sorted(round(p["freq"], 6) for p in first.draw["peaks"])
+    finally:
+        r.close()
