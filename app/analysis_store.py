@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import logging
 import threading
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -332,22 +331,11 @@ class AnalysisResults(param.Parameterized):
                 a.compare_to = ""
 
     # -- the modes near the peaks: after the labels, off the session's threads ----------------
-    #: Served, the modes are solved once the phase result has stayed current this long (s):
-    #: an eigenvalue solve (0.3-1 s of ARPACK iterations, much of it holding the GIL) started
-    #: while the user flips through DOFs or harmonics slowed their next changes, and was
-    #: superseded by them anyway.
-    MODES_QUIET = 0.3
-    #: The thread of the last modes search (tests join it).
-    modes_thread: threading.Thread | None = None
-
     def _find_modes(self, r: Result) -> None:
         peaks = r.draw["peaks"]
         s: Snapshot = r.draw["snapshot"]
-        later = bands.served() if self.store.background is None else self.store.background
 
         def work():
-            if later:
-                time.sleep(self.MODES_QUIET)
             labels = []
             for p in peaks:
                 if self.phase is not r or self.store.closed:
@@ -358,8 +346,9 @@ class AnalysisResults(param.Parameterized):
                 if self.phase is r and not self.store.closed:
                     self.peak_modes = (r, tuple(labels))
 
+        later = bands.served() if self.store.background is None else self.store.background
         if later:  # a thread of its own at a lower priority: the plots win the cores
-            self.modes_thread = background.start(work, "fbs-peak-modes")
+            background.start(work, "fbs-peak-modes")
         else:
             work()
 
