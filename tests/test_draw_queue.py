@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import asyncio
 import gc
+import threading
 import weakref
 
 from app.views.live import DrawQueue, on_document
@@ -39,11 +40,25 @@ class _Doc:
 
 
 def _run(doc):
+    """Run the scheduled callbacks on an event loop of their own, in a thread of their own
+    (an earlier test may have left a loop running in this one)."""
+
     async def main():
         while doc.ticks:
             await doc.ticks.pop(0)()
 
-    asyncio.run(main())
+    errors = []
+    t = threading.Thread(target=lambda: _capture(errors, lambda: asyncio.run(main())))
+    t.start()
+    t.join(timeout=60)
+    assert not t.is_alive() and errors == []
+
+
+def _capture(errors, fn):
+    try:
+        fn()
+    except Exception as e:  # reported by the test's thread
+        errors.append(e)
 
 
 def test_draws_run_in_order_each_written_before_the_next_and_failures_stay_alone():

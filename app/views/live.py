@@ -177,8 +177,12 @@ class DrawQueue:
         with cls._queues_lock:
             q = cls._queues.pop(doc, None)
         if q is not None:
-            with q._lock:
-                q._fns.clear()
+            q.clear()
+
+    def clear(self) -> None:
+        """Drop the draws waiting in this queue."""
+        with self._lock:
+            self._fns.clear()
 
     def add(self, fn) -> None:
         """Run ``fn`` after the draws already waiting (from any thread)."""
