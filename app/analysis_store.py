@@ -29,7 +29,7 @@ from fbs_core.errors import FBSError
 from fbs_core.vocabulary import magnitude_db, percent
 
 from . import analysis_compute as ac
-from . import background, bands, compute
+from . import background, compute
 from .analysis_pins import build_pin, compare_result, pin_result, pin_settings
 from .analysis_state import check_pin_name, decode_pins, encode_pins
 from .store import Result, Results, Snapshot, chassis_label
@@ -220,7 +220,7 @@ class AnalysisResults(param.Parameterized):
         of harmonic or of anything else computes nothing ahead; the thread does nothing
         once the session has moved on.
         """
-        later = bands.served() if self.store.background is None else self.store.background
+        later = self.store.threaded
         same = (old.harmonic, old.coupling, old.models) == (new.harmonic, new.coupling, new.models)
         if not later or not same or old.n_modes == new.n_modes:
             return
@@ -346,7 +346,7 @@ class AnalysisResults(param.Parameterized):
                 if self.phase is r and not self.store.closed:
                     self.peak_modes = (r, tuple(labels))
 
-        later = bands.served() if self.store.background is None else self.store.background
+        later = self.store.threaded
         if later:  # a thread of its own at a lower priority: the plots win the cores
             background.start(work, "fbs-peak-modes")
         else:

@@ -219,6 +219,12 @@ class Results(param.Parameterized):
         doc="Compute bands on a thread of their own (None: when the page is served).",
     )
 
+    @property
+    def threaded(self) -> bool:
+        """Whether longer work goes to threads of its own: ``background``, or when it is
+        None, whether the page is served (no server: tests, exports compute in place)."""
+        return bands.served() if self.background is None else bool(self.background)
+
     def __init__(self, state: DashboardState | None = None, **params):
         self._lock = threading.RLock()
         self._band_job: bands.Job | None = None
@@ -312,7 +318,7 @@ class Results(param.Parameterized):
         it is computed on a thread of its own (served pages: its seven residual maps must
         not delay the first page); the table is published again when it is ready."""
         args = (s.threshold, s.f_max, s.coupling, s.map_dof, s.models, True)
-        later = bands.served() if self.background is None else self.background
+        later = self.threaded
         if s.residual or not later or compute.suggested_table_ready(*args):
             return compute.suggested_table(*args)
         with self._lock:
@@ -410,7 +416,7 @@ class Results(param.Parameterized):
             job = self._band_job = bands.Job(key, owner=self, on_progress=self._band_progress)
             self.band_status = progress_status(s.rounds, 0, 0, None)
         if wait is None:
-            wait = not (bands.served() if self.background is None else self.background)
+            wait = not self.threaded
         if wait:
             bands.run(job, self._band_done, s)
         else:
