@@ -220,9 +220,8 @@ class AnalysisResults(param.Parameterized):
         of harmonic or of anything else computes nothing ahead; the thread does nothing
         once the session has moved on.
         """
-        later = self.store.threaded
         same = (old.harmonic, old.coupling, old.models) == (new.harmonic, new.coupling, new.models)
-        if not later or not same or old.n_modes == new.n_modes:
+        if not self.store.threaded or not same or old.n_modes == new.n_modes:
             return
         counts = list(self.state.case.param.n_modes.objects)
         if old.n_modes not in counts or new.n_modes not in counts:

@@ -18,7 +18,7 @@ from fbs_core.analysis import MAX_PINS
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .analysis_speed import _pick_spans
 from .common import COLORS, level_label
-from .plots import add_image, fit_range, set_data
+from .plots import add_image, set_data
 
 __all__ = ["CompareView"]
 
@@ -250,8 +250,7 @@ class CompareView(AnalysisView):
             }
             self._mp.title.text = "Error map: no difference map (pin a state of this harmonic)"
         self._lv.yaxis.axis_label = level_label(d["dof"])
-        # the shared range last: the page renders its linked plots once, with the new data
-        fit_range(self.x_range, curves[0]["freq"])
+        self._fit(self.x_range, curves[0]["freq"])
 
     def _draw_pick(self, pick):
         f = pick.get("freq")

@@ -16,7 +16,7 @@ from fbs_core.vocabulary import percent
 
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .common import COLORS, level_label, level_tooltips
-from .plots import add_line, fit_range
+from .plots import add_line
 
 __all__ = ["ContributionsView"]
 
@@ -143,8 +143,7 @@ class ContributionsView(AnalysisView):
         self._stack_fig.visible = stacked
         self._lines_fig.visible = not stacked
         self._lines_fig.yaxis.axis_label = level_label(d["dof"])
-        # the shared range last: the page renders its linked plots once, with the new data
-        fit_range(self.x_range, f)
+        self._fit(self.x_range, f)
 
     def _draw_pick(self, pick):
         f = pick.get("freq")

@@ -26,7 +26,7 @@ from bokeh.models import (
 
 from .analysis_base import PICK_COLOR, AnalysisView
 from .common import COLORS, FREQ_LABEL
-from .plots import fit_range, frequency_range, new_figure, set_data
+from .plots import frequency_range, new_figure, set_data
 
 __all__ = ["PhaseView"]
 
@@ -234,8 +234,7 @@ class PhaseView(AnalysisView):
         else:
             self._cursors.data = {"freq": [], "level": []}
         self._set_log(bool(d["log"]))
-        # the shared range last: the page renders its linked plots once, with the new data
-        fit_range(self.x_range, f)
+        self._fit(self.x_range, f)
 
     def _peak_data(self, r) -> dict:
         """The peak labels of result ``r``, with the modes nearby once they arrived."""

@@ -51,6 +51,7 @@ from ..panel_private import html_model, html_text
 from ..report.bokeh import TitleBlockModels, style_figure
 from ..report.live import page_url, view_title
 from ..store import Result, Results
+from .plots import fit_range
 
 
 def _plots_in(obj) -> list:
@@ -287,6 +288,7 @@ class LiveView(Viewer):
         self._guard = threading.Lock()
         self._figures: list = []
         self._titles: list[TitleBlockModels] = []
+        self._fits: list[tuple] = []  # ranges to fit after a draw's data (_fit)
 
     # -- what a subclass provides ----------------------------------------------------------
     def result(self) -> Result | None:
@@ -337,8 +339,17 @@ class LiveView(Viewer):
             return
         if self._caption is not None and r.caption:
             self._caption.text = f"<p>{inline_html(r.caption)}</p>"
+        self._fits = []
         self._draw(r)
+        for rng, values in self._fits:  # after the data: the page renders linked plots once
+            fit_range(rng, values)
         self._draw_title()
+
+    def _fit(self, rng, values) -> None:
+        """Fit the range ``rng`` to ``values`` once the draw has set its data (ranges are
+        shared by linked plots: set first, they made the page render every linked plot
+        with the old data before the new arrived)."""
+        self._fits.append((rng, values))
 
     # -- title block: what the plot shows, on the plot and in its saved PNG -----------------
     def _title_state(self):

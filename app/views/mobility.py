@@ -12,7 +12,7 @@ from bokeh.core.property.vectorization import value
 
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
 from .live import LiveView
-from .plots import add_line, fit_range, frequency_range, new_figure
+from .plots import add_line, frequency_range, new_figure
 
 
 class MobilityView(LiveView):
@@ -66,8 +66,7 @@ class MobilityView(LiveView):
         for item in self._fig.legend[0].items if label and self._fig.legend else ():
             if item.renderers and item.renderers[0].data_source is self._tr:
                 item.label = value(label)  # "N retained modes" or "... + residual"
-        # the shared range last: the page renders its linked plots once, with the new data
-        fit_range(self.x_range, c["freq_Hz"])
+        self._fit(self.x_range, c["freq_Hz"])
 
 
 class UncoupledView(LiveView):
@@ -134,5 +133,4 @@ class UncoupledView(LiveView):
         self._tire_fig.yaxis.axis_label = level_label(d["dof"])
         self._chassis_fig.title.text = d["chassis_title"]
         self._chassis_fig.yaxis.axis_label = d["chassis_label"]
-        # the shared range last: the page renders its linked plots once, with the new data
-        fit_range(self.x_range, f)
+        self._fit(self.x_range, f)

@@ -38,6 +38,7 @@ __all__ = [
     "frequency_range",
     "modes_range",
     "new_figure",
+    "same_columns",
     "set_data",
 ]
 
@@ -70,15 +71,24 @@ def fit_range(rng, values: np.ndarray) -> None:
         rng.update(start=lo, end=hi, reset_start=lo, reset_end=hi)
 
 
+def same_columns(old, new: dict) -> bool:
+    """True when a source's data ``old`` already hold ``new`` (column ``image``: its first
+    image compared)."""
+    if old.keys() != new.keys():
+        return False
+    for k, v in new.items():
+        a, b = old[k], v
+        if k == "image":
+            a, b = a[0], b[0]
+        if np.shape(a) != np.shape(b) or not np.array_equal(a, b, equal_nan=True):
+            return False
+    return True
+
+
 def set_data(src, data: dict) -> bool:
-    """Assign ``data`` to the source ``src`` unless both are empty with the same columns
-    (an unused slot stays as it is: no patch sent to the page). Whether it was assigned."""
-    old = src.data
-    if (
-        set(old) == set(data)
-        and all(len(v) == 0 for v in data.values())
-        and all(len(v) == 0 for v in old.values())
-    ):
+    """Assign ``data`` to the source ``src`` unless it holds them already (no patch sent to
+    the page for a transfer that changes nothing). Whether it was assigned."""
+    if same_columns(src.data, data):
         return False
     src.data = data
     return True

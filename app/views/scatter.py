@@ -16,7 +16,7 @@ from bokeh.events import Tap
 
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
 from .live import LiveText, LiveView, download_button, inline_html
-from .plots import add_band, add_line, fit_range, frequency_range, new_figure
+from .plots import add_band, add_line, frequency_range, new_figure
 
 #: Styles of the progress bar: hidden when idle (its box kept: no new layout of the page).
 IDLE = {"visibility": "hidden"}
@@ -178,5 +178,4 @@ class ScatterBandView(LiveView):
             for item, text in zip(leg.items, labels, strict=False):
                 if getattr(item.label, "value", None) != text:
                     item.label = value(text)
-        # the shared range last: the page renders its linked plots once, with the new data
-        fit_range(self.x_range, f)
+        self._fit(self.x_range, f)

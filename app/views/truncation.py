@@ -18,10 +18,10 @@ from .plots import (
     add_image,
     add_line,
     add_span,
-    fit_range,
     frequency_range,
     modes_range,
     new_figure,
+    set_data,
 )
 
 #: Eigenfrequency curves of fig. 5.8: column -> (legend, colour).
@@ -30,19 +30,6 @@ EIGEN_STYLES = {
     "f_80": ("80 km/h", "#1c7ed6"),
     "f_120": ("120 km/h", "#0b3d91"),
 }
-
-
-def _same_columns(old: dict, new: dict) -> bool:
-    """True when a source already holds ``new`` (skip a transfer that changes nothing)."""
-    if old.keys() != new.keys():
-        return False
-    for k, v in new.items():
-        a, b = old[k], v
-        if k == "image":
-            a, b = a[0], b[0]
-        if np.shape(a) != np.shape(b) or not np.array_equal(a, b, equal_nan=True):
-            return False
-    return True
 
 
 def image_columns(d: dict) -> dict:
@@ -171,11 +158,10 @@ class TruncationView(LiveView):
         if self.n_axis == "log":  # rows uniform in log N: the image stretches linearly
             low, high, img = log_rows(nm, d["map"]["error_pct"], 512)
             cols = {**cols, "image": [img], "y": [low], "dh": [high - low]}
-            fit_range(self.n_range, [low, top])
+            self._fit(self.n_range, [low, top])
         else:
-            fit_range(self.n_range, [cols["y"][0], top])
-        if not _same_columns(self._src.data, cols):
-            self._src.data = cols
+            self._fit(self.n_range, [cols["y"][0], top])
+        set_data(self._src, cols)
         thr = float(d["threshold"])
         m = d["map"]
         self._layers.update(m["centre_freq"], m["n_modes"], m["error_pct"], thr)
@@ -190,8 +176,7 @@ class TruncationView(LiveView):
             (self._chosen, float(d["n_modes"])),
         ):
             line.location = halo.location = loc
-        # the shared range last: the page renders its linked plots once, with the new data
-        fit_range(self.x_range, d["freq"])
+        self._fit(self.x_range, d["freq"])
 
 
 class SuggestedModesView(Viewer):
@@ -318,6 +303,5 @@ class EigenView(LiveView):
         d = r.draw["curves"]
         for k, src in self._srcs.items():
             new = {"n_modes": d["n_modes"], "eigenfrequency": d[k]}
-            if not _same_columns(src.data, new):
-                src.data = new
+            set_data(src, new)
         self._marker.location = float(r.draw["n_modes"])
