@@ -6,9 +6,20 @@ vibrations at the bushings", Chalmers MSc thesis (2018).
 
 from . import analysis as analysis
 from . import io as io
+from . import variants as variants
+from . import vehicle as vehicle
 from . import vocabulary as vocabulary
-from .analysis import bushing_contributions, campbell, peak_labels, speed_map
+from .analysis import (
+    bushing_contributions,
+    campbell,
+    mode_participation,
+    peak_labels,
+    select_modes,
+    speed_map,
+    wave_campbell,
+)
 from .chassis import ChassisModel, FRFChassis, reference_chassis
+from .chassis_modal import ModalChassis
 from .coupling import (
     couple_generalized,
     couple_impedance,
@@ -21,6 +32,7 @@ from .direct import SecondOrderSystem, assemble
 from .dofs import DIRECTIONS, node_labels, parse_label
 from .errors import (
     CampaignError,
+    ClusterUnavailable,
     CouplingOptionError,
     DataFormatError,
     DOFError,
@@ -30,6 +42,7 @@ from .errors import (
     ModalError,
     ModeCountError,
     OperatingPointError,
+    ParameterError,
     QuantityError,
     SingularInterfaceError,
     StudyCancelled,
@@ -40,10 +53,13 @@ from .io import load_frf, save_frf
 from .prediction import bushing_response
 from .studies import (
     Convergence,
+    FirstOrderBand,
     ModeFrequencies,
     ScatterBand,
     SuggestedModes,
     TruncationMap,
+    chassis_truncation_map,
+    first_order_band,
     floating_band_error,
     mode_frequencies,
     scatter_band,
@@ -51,6 +67,7 @@ from .studies import (
     truncation_map,
 )
 from .tire import TireModel, reference_tire
+from .vehicle import random_road_response, reference_vehicle, vehicle_response
 from .vocabulary import COUPLINGS, EIGEN_SPEEDS, magnitude_db, readonly
 
 __version__ = "0.1.0"
@@ -77,11 +94,13 @@ __all__ = [
     "QuantityError",
     "SingularInterfaceError",
     "CampaignError",
+    "ClusterUnavailable",
     "CouplingOptionError",
     "HarmonicError",
     "ModalError",
     "ModeCountError",
     "OperatingPointError",
+    "ParameterError",
     "StudyCancelled",
     "COUPLINGS",
     "EIGEN_SPEEDS",
@@ -97,11 +116,13 @@ __all__ = [
     "suggest_modes",
     "mode_frequencies",
     "scatter_band",
+    "first_order_band",
     "floating_band_error",
     "TruncationMap",
     "SuggestedModes",
     "ModeFrequencies",
     "ScatterBand",
+    "FirstOrderBand",
     "Convergence",
     "node_labels",
     "parse_label",
@@ -111,4 +132,12 @@ __all__ = [
     "campbell",
     "peak_labels",
     "speed_map",
+    "mode_participation",
+    "select_modes",
+    "wave_campbell",
+    "ModalChassis",
+    "chassis_truncation_map",
+    "reference_vehicle",
+    "vehicle_response",
+    "random_road_response",
 ]

@@ -46,6 +46,7 @@ from .frf import FRF, QUANTITIES, check_grid
 
 __all__ = [
     "ChassisParameters",
+    "ChassisVariantParameters",
     "ChassisModel",
     "reference_chassis",
     "carrier_mode_table",
@@ -97,6 +98,34 @@ class ChassisParameters:
     bushing_loss: float = 0.15
 
 
+@dataclass(frozen=True)
+class ChassisVariantParameters(ChassisParameters):
+    """:class:`ChassisParameters` plus the scales of a parameter variant (issue 32).
+
+    The reference chassis is a plain :class:`ChassisParameters` (its stored parameters and
+    numbers are unchanged); a variant of the corridor study (:mod:`fbs_core.variants`) may
+    also change the A-arm alone:
+
+    Attributes
+    ----------
+    arm_mass_scale : float
+        Factor on the density of the A-arm tubes (their mass; the cross-section and so the
+        stiffness unchanged), > 0.
+    arm_stiffness_scale : float
+        Factor on the Young's (and shear) modulus of the A-arm tubes (their axial, bending
+        and torsional stiffness; the mass unchanged), > 0.
+    """
+
+    arm_mass_scale: float = 1.0
+    arm_stiffness_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("arm_mass_scale", "arm_stiffness_scale"):
+            v = getattr(self, name)
+            if not np.isfinite(v) or v <= 0:
+                raise DataFormatError(f"chassis parameter {name} must be finite and > 0, got {v}")
+
+
 STEEL_E, STEEL_NU, STEEL_RHO = 210e9, 0.3, 7850.0
 
 
@@ -142,8 +171,12 @@ def build_chassis(p: ChassisParameters) -> FEModel:
     ):
         m.add_beam(a, b, cross, steel, _n_el(m.xyz(a), m.xyz(b), h), up, prefix=f"{a}-{b}.")
     tube = Section.tube(*p.arm_tube)
+    arm = steel
+    sm, sk = getattr(p, "arm_mass_scale", 1.0), getattr(p, "arm_stiffness_scale", 1.0)
+    if (sm, sk) != (1.0, 1.0):  # a variant (ChassisVariantParameters); the reference: steel
+        arm = Material(STEEL_E * sk, STEEL_NU, STEEL_RHO * sm, p.steel_loss)
     for root in ("root_f", "root_r"):
-        m.add_beam("apex", root, tube, steel, p.arm_elements, up, prefix=f"arm-{root}.")
+        m.add_beam("apex", root, tube, arm, p.arm_elements, up, prefix=f"arm-{root}.")
     # masses
     m.add_mass("spindle", rigid_body_mass(p.carrier_mass, p.carrier_inertia))
     for b in ("bracket_f", "bracket_r"):

@@ -1,9 +1,9 @@
 """DOF labels: ``"node:dir"`` strings such as ``"hub:z"`` or ``"bushing:rx"``.
 
 A label names one degree of freedom by the node it sits on and its direction,
-one of :data:`DIRECTIONS`. A label without a colon (for example ``"patch"``)
-names a generalised DOF, such as a distributed load whose spatial shape is part
-of the model rather than a single node.
+one of :data:`DIRECTIONS` (:data:`fbs_core.vocabulary.DIRECTIONS`). A label without
+a colon (for example ``"patch"``) names a generalised DOF, such as a distributed load
+whose spatial shape is part of the model rather than a single node.
 """
 
 from __future__ import annotations
@@ -12,11 +12,9 @@ import re
 from collections.abc import Iterable, Sequence
 
 from .errors import DOFError
+from .vocabulary import DIRECTIONS
 
 __all__ = ["DIRECTIONS", "parse_label", "validate_labels", "index_of", "node_labels"]
-
-#: Directions of a node: three translations and three rotations (thesis eq. 2.15).
-DIRECTIONS: tuple[str, ...] = ("x", "y", "z", "rx", "ry", "rz")
 
 _NODE = re.compile(r"^[A-Za-z0-9_.\-/\[\]]+$")
 

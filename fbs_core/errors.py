@@ -22,6 +22,8 @@ __all__ = [
     "ModeCountError",
     "ModalError",
     "CampaignError",
+    "ClusterUnavailable",
+    "ParameterError",
     "StudyCancelled",
 ]
 
@@ -75,6 +77,18 @@ class ModalError(FBSError):
 
 class CampaignError(FBSError):
     """A campaign file or result file that cannot be used (bad key, value or mismatch)."""
+
+
+class ClusterUnavailable(CampaignError):
+    """A Dask cluster cannot compute a study now (no workers, scheduler gone, block lost).
+
+    Raised by :func:`fbs_core.campaign.cluster.scatter_band_on`; the caller computes the
+    study in its own process instead.
+    """
+
+
+class ParameterError(FBSError):
+    """An unknown model parameter, a bad range or an unphysical value (fbs_core.variants)."""
 
 
 class StudyCancelled(Exception):  # noqa: N818  (a signal, not an error of the input)

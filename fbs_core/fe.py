@@ -302,7 +302,7 @@ class FEModel:
     Examples
     --------
     >>> m = FEModel()
-    >>> m.add_node("a", (0, 0, 0)); m.add_node("b", (1, 0, 0))
+    >>> a, b = m.add_node("a", (0, 0, 0)), m.add_node("b", (1, 0, 0))
     >>> s = m.add_spring("a", None, [1e3] * 6)
     >>> s = m.add_beam("a", "b", Section.rectangle(0.01, 0.04), Material(210e9, 0.3, 8000), 4)
     >>> m.system().n
@@ -424,6 +424,11 @@ class FEModel:
 
     def labels(self) -> tuple[str, ...]:
         return tuple(f"{n}:{d}" for n in self._xyz for d in DIRECTIONS)
+
+    def edges(self) -> tuple[tuple[str, str], ...]:
+        """Node pairs joined by a two-node block (a beam element or a spring), in the
+        order they were added: the lines that draw the model."""
+        return tuple((b[0][0], b[0][1]) for b in self._blocks if len(b[0]) == 2)
 
     def system(self) -> SecondOrderSystem:
         """Assemble sparse ``M`` and complex ``K`` into a :class:`SecondOrderSystem`."""

@@ -17,6 +17,8 @@ from numpy.typing import ArrayLike
 from ._typing import AnyArray, ComplexArray, FloatArray, IntArray
 from .dofs import index_of, validate_labels
 from .errors import DataFormatError, FrequencyGridError, QuantityError
+from .vocabulary import magnitude_db
+from .vocabulary import readonly as _frozen
 
 __all__ = ["FRF", "QUANTITIES", "UNITS", "check_grid"]
 
@@ -48,12 +50,6 @@ def _check_kinds(
         if lab in outs or lab in ins:
             out[str(lab)] = str(k)
     return out or None
-
-
-def _frozen(a: ArrayLike) -> AnyArray:
-    a = np.array(a, copy=True)
-    a.setflags(write=False)
-    return a
 
 
 def check_grid(freq: ArrayLike) -> FloatArray:
@@ -154,7 +150,7 @@ class FRF:
         if quantity not in QUANTITIES:
             raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
         object.__setattr__(self, "_freq", _frozen(f))
-        object.__setattr__(self, "_data", _frozen(d.astype(complex)))
+        object.__setattr__(self, "_data", _frozen(d, complex))  # one copy
         object.__setattr__(self, "_outputs", outs)
         object.__setattr__(self, "_inputs", ins)
         object.__setattr__(self, "_quantity", quantity)
@@ -162,6 +158,11 @@ class FRF:
 
     def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError("FRF objects are immutable; methods return new objects")
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as a call of the constructor (immutable: no state is set afterwards)."""
+        args = (self._freq, self._data, self._outputs, self._inputs, self._quantity, self._kinds)
+        return (type(self), args)
 
     # -- properties ----------------------------------------------------------------
     @property
@@ -410,6 +411,6 @@ class FRF:
         )
 
     def magnitude_db(self, ref: float = 1.0) -> FloatArray:
-        """``20 log10(|data| / ref)``, shape ``(n_freq, n_out, n_in)``."""
-        with np.errstate(divide="ignore"):
-            return 20 * np.log10(np.abs(self._data) / ref)
+        """``20 log10(|data| / ref)``, shape ``(n_freq, n_out, n_in)``; ``-inf`` where 0
+        (:func:`fbs_core.vocabulary.magnitude_db` without a floor)."""
+        return magnitude_db(self._data, ref, floor=None)

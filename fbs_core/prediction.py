@@ -34,11 +34,12 @@ from ._typing import ComplexArray, FloatArray, IntArray
 from .chassis import BUSHING, SPINDLE, ChassisModel, reference_chassis
 from .coupling import couple_response
 from .direct import SecondOrderSystem
-from .dofs import DIRECTIONS, node_labels
+from .dofs import node_labels
 from .errors import CouplingOptionError
 from .frf import FRF, check_grid
 from .harmonics import Harmonic, renamed_argument
 from .harmonics import harmonic as _harmonic
+from .vocabulary import COUPLED_DIRECTIONS
 from .vocabulary import COUPLINGS as _COUPLING_NAMES
 
 __all__ = ["bushing_response", "direct_bushing_response", "coupled_dofs", "COUPLED_DOFS", "HUB"]
@@ -48,9 +49,9 @@ HUB: tuple[str, ...] = node_labels("hub")
 
 #: The hub DOFs joined to the spindle for each coupling option
 #: (:data:`fbs_core.vocabulary.COUPLINGS`).
-COUPLED_DOFS: dict[str, tuple[str, ...]] = dict(
-    zip(_COUPLING_NAMES, (HUB, tuple(d for d in HUB if d != "hub:ry")), strict=True)
-)
+COUPLED_DOFS: dict[str, tuple[str, ...]] = {
+    c: node_labels("hub", dirs) for c, dirs in COUPLED_DIRECTIONS.items()
+}
 
 
 class ModalTire(Protocol):
@@ -115,7 +116,7 @@ def coupled_dofs(coupling: str) -> tuple[str, ...]:
 
 
 def _interface() -> list[tuple[str, str]]:
-    return [(f"hub:{d}", f"spindle:{d}") for d in DIRECTIONS]
+    return list(zip(HUB, node_labels("spindle"), strict=True))
 
 
 def _tire_frfs(

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 from .dofs import parse_label
 from .errors import QuantityError
+from .vocabulary import ROTATIONS
 
 __all__ = [
     "OUTPUT_KINDS",
@@ -59,8 +60,6 @@ QUANTITY_POWER: dict[str, int] = {"receptance": 0, "mobility": 1, "accelerance":
 #: Standard gravity in m/s^2 (the unit ``g`` of accelerometers), exact by definition.
 STANDARD_GRAVITY = 9.80665
 
-_ROT = ("rx", "ry", "rz")
-
 
 def output_kind(label: str, kinds: Mapping[str, str] | None = None) -> str:
     """Kind of an output DOF: ``translation``, ``rotation`` or ``generalised``.
@@ -77,7 +76,7 @@ def output_kind(label: str, kinds: Mapping[str, str] | None = None) -> str:
     if d is None:
         k = DEFAULT_KINDS.get(label)
         return k if k in OUTPUT_KINDS else "generalised"
-    return "rotation" if d in _ROT else "translation"
+    return "rotation" if d in ROTATIONS else "translation"
 
 
 def input_kind(label: str, kinds: Mapping[str, str] | None = None) -> str:
@@ -95,7 +94,7 @@ def input_kind(label: str, kinds: Mapping[str, str] | None = None) -> str:
     if d is None:
         k = DEFAULT_KINDS.get(label)
         return k if k in INPUT_KINDS else "generalised"
-    return "moment" if d in _ROT else "force"
+    return "moment" if d in ROTATIONS else "force"
 
 
 def _power(quantity: str) -> int:

@@ -1,7 +1,8 @@
 """The words of the domain, written once: DOF directions, couplings, speeds, dB, read-only arrays.
 
-Every module of :mod:`fbs_core` and of the dashboard takes these from here instead of
-spelling them again.
+Every module of :mod:`fbs_core` takes these from here instead of spelling them again
+(``tests/test_vocabulary.py`` scans the core's code for other spellings), and so does the
+dashboard.
 """
 
 from __future__ import annotations
@@ -11,12 +12,13 @@ from typing import TypeVar
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
-from .dofs import DIRECTIONS
-
 __all__ = [
+    "COUPLED_DIRECTIONS",
     "COUPLINGS",
     "DB_FLOOR",
     "DIRECTIONS",
+    "ROTATIONS",
+    "TRANSLATIONS",
     "EIGEN_SPEEDS",
     "HARMONIC_CASES",
     "fraction",
@@ -25,9 +27,22 @@ __all__ = [
     "readonly",
 ]
 
-#: Hub coupling options: ``"6dof"`` joins all six hub DOFs to the spindle (a braked
-#: wheel, as in the thesis); ``"5dof"`` releases the wheel spin ``hub:ry`` (free rolling).
-COUPLINGS: tuple[str, ...] = ("6dof", "5dof")
+#: Directions of a node: three translations and three rotations about the vehicle axes
+#: (thesis eq. 2.15; ISO 8855: x forward, y left, z up). DOF labels are ``"node:dir"``.
+DIRECTIONS: tuple[str, ...] = ("x", "y", "z", "rx", "ry", "rz")
+#: The translations of :data:`DIRECTIONS` (outputs in m, inputs forces).
+TRANSLATIONS: tuple[str, ...] = DIRECTIONS[:3]
+#: The rotations of :data:`DIRECTIONS` (outputs in rad, inputs moments).
+ROTATIONS: tuple[str, ...] = DIRECTIONS[3:]
+
+#: The hub directions each coupling option joins to the spindle: ``"6dof"`` all six (a
+#: braked wheel, as in the thesis), ``"5dof"`` all but the wheel spin ``ry`` (free rolling).
+COUPLED_DIRECTIONS: dict[str, tuple[str, ...]] = {
+    "6dof": DIRECTIONS,
+    "5dof": tuple(d for d in DIRECTIONS if d != "ry"),
+}
+#: Hub coupling options (the keys of :data:`COUPLED_DIRECTIONS`).
+COUPLINGS: tuple[str, ...] = tuple(COUPLED_DIRECTIONS)
 
 #: Operating speeds of the eigenfrequency-versus-N curves (thesis fig. 5.8), km/h.
 EIGEN_SPEEDS: tuple[float, ...] = (20.0, 80.0, 120.0)

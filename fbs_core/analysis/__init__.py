@@ -91,3 +91,44 @@ __all__ += [
     "pin_state",
     "remove_pin",
 ]
+from .participation import (  # noqa: E402
+    Participation,
+    coupled_mode_arrays,
+    mode_participation,
+    participation_from_terms,
+)
+from .selection import ModeSelection, prefix_responses, select_modes  # noqa: E402
+
+__all__ += [
+    "Participation",
+    "coupled_mode_arrays",
+    "mode_participation",
+    "participation_from_terms",
+    "ModeSelection",
+    "prefix_responses",
+    "select_modes",
+]
+from .shapes import (  # noqa: E402
+    BeltShape,
+    ChassisShape,
+    CoupledShape,
+    TireModeShape,
+    chassis_geometry,
+    coupled_mode_shapes,
+    operating_shape,
+    tire_mode_shape,
+)
+from .waves import WaveCampbell, wave_campbell  # noqa: E402
+
+__all__ += [
+    "BeltShape",
+    "ChassisShape",
+    "CoupledShape",
+    "TireModeShape",
+    "chassis_geometry",
+    "coupled_mode_shapes",
+    "operating_shape",
+    "tire_mode_shape",
+    "WaveCampbell",
+    "wave_campbell",
+]

@@ -2,10 +2,14 @@
 harmonic order lines ``f = v / lambda`` of the seven excitation cases.
 
 Branches are the tracked complex modes of the modal tire model (mode ``r`` is the
-same physical mode at every operating point, :func:`fbs_core.tire.track_modes`);
-their eigenfrequencies ``Im(lambda_r) / 2 pi`` are interpolated linearly in speed
-between the operating points, exactly as the model does for synthesis (thesis
-section 4.1.2).
+same tracked mode at every operating point, :func:`fbs_core.tire.track_modes`);
+their eigenfrequencies ``Im(lambda_r) / 2 pi`` are interpolated in speed exactly as the
+model does for synthesis (:meth:`fbs_core.tire.TireModel.poles_at`: cubic Lagrange
+weights by default, clusters through their characteristic polynomial; thesis section
+4.1.2). That tracking serves the interpolation (MAC and frequency distance between
+neighbouring operating points), not the waves: on the reference tire these branches
+do not follow the forward waves of ring orders 4-8 (docs/modes.md). A model with its
+matrices has :func:`fbs_core.analysis.wave_campbell`, whose branches are the waves.
 
 Forward or backward: in the space-fixed frame a wave travelling with the
 rotation is Doppler shifted up and one travelling against it down. For a ring of
@@ -34,11 +38,15 @@ Two criteria (``method=``):
   minus that, standing in between. It is exact for the ring (the gyroscopic split is
   odd in ``Omega`` and the ring's even part is small), but centrifugal softening and
   the veering of dense branches bias it in the full tire; the shape criterion does
-  not depend on the frequencies. On the reference tire the two agree on 86 % of the
-  branches that shift by more than 10 Hz over 20-120 km/h; the shape criterion costs
-  one dense complex-mode solve per operating point (about 40 s for the reference
-  tire on a loaded 2-core machine, then cached per model), the slope criterion
-  milliseconds.
+  not depend on the frequencies. On the reference tire the two agree on 73 % of the
+  103 branches that shift by more than 10 Hz over 20-120 km/h, and 35 branches
+  labelled standing by shape are called backward by slope
+  (``scripts/print_campbell_check.py``): the model's tracked modes pass between waves
+  at the veerings, 34 of those 35 flip between a forward and a backward wave along
+  the speeds (median ``|tau|`` 0.76 at an operating point, 0.09 averaged). The shape
+  criterion costs one dense complex-mode solve per
+  operating point (about 40 s for the reference tire on a loaded 2-core machine, then
+  cached per model), the slope criterion milliseconds.
 """
 
 from __future__ import annotations

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import DOFError, FBSError, FrequencyGridError, QuantityError
 from ..frf import FRF
+from ..vocabulary import magnitude_db
 
 __all__ = ["LevelDifference", "MapDifference", "db_difference", "truncation_map_difference"]
 
@@ -104,7 +105,7 @@ def db_difference(a: FRF, b: FRF) -> LevelDifference:
             "convert one with .to(...) first"
         )
     with np.errstate(divide="ignore", invalid="ignore"):
-        db = 20 * np.log10(np.abs(a.data)) - 20 * np.log10(np.abs(b.data))
+        db = magnitude_db(a.data, floor=None) - magnitude_db(b.data, floor=None)
         ph = np.degrees(np.angle(a.data * np.conj(b.data)))
     return LevelDifference(a.freq, a.outputs, a.inputs, db, ph)
 

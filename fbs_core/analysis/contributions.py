@@ -32,6 +32,7 @@ from ..frf import FRF, check_grid
 from ..harmonics import harmonic as _harmonic
 from ..harmonics import renamed_argument
 from ..prediction import coupled_dofs
+from ..vocabulary import magnitude_db, readonly
 
 __all__ = [
     "Contributions",
@@ -108,9 +109,7 @@ class Contributions:
 
     def __post_init__(self) -> None:
         for name in ("freq", "terms", "forces"):
-            a = np.array(getattr(self, name), copy=True)
-            a.setflags(write=False)
-            object.__setattr__(self, name, a)
+            object.__setattr__(self, name, readonly(getattr(self, name)))
 
     @property
     def total(self) -> FRF:
@@ -173,8 +172,7 @@ class Contributions:
     def levels_db(self, output: str, ref: float = 1.0) -> np.ndarray:
         """``20 log10 |term| / ref`` of every term at one response, shape ``(n_f, n_j)``."""
         i = index_of(self.outputs, output, "response DOF")[0]
-        with np.errstate(divide="ignore"):
-            return np.asarray(20 * np.log10(np.abs(self.terms[:, i, :]) / ref), float)
+        return magnitude_db(self.terms[:, i, :], ref, floor=None)
 
     def dominant(self, output: str) -> tuple[str, ...]:
         """Interface DOF with the largest term magnitude at every line for one response."""

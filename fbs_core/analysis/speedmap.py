@@ -38,6 +38,7 @@ from ..harmonics import Harmonic, renamed_argument
 from ..harmonics import harmonic as _harmonic
 from ..prediction import coupled_dofs
 from ..tire.model import ModeCountError, OperatingPointError
+from ..vocabulary import magnitude_db, readonly
 
 __all__ = ["SpeedMap", "speed_map", "default_speeds", "default_freq"]
 
@@ -150,9 +151,7 @@ class SpeedMap:
 
     def __post_init__(self) -> None:
         for name in ("speeds", "freq", "response"):
-            a = np.array(getattr(self, name), copy=True)
-            a.setflags(write=False)
-            object.__setattr__(self, name, a)
+            object.__setattr__(self, name, readonly(getattr(self, name)))
 
     @property
     def line_freq(self) -> np.ndarray:
@@ -175,16 +174,14 @@ class SpeedMap:
             For an unknown output.
         """
         i = index_of(self.outputs, output, "response DOF")[0]
-        with np.errstate(divide="ignore"):
-            return np.asarray(20 * np.log10(np.abs(self.response[:, :, i]) / ref), float)
+        return magnitude_db(self.response[:, :, i], ref, floor=None)
 
     def export_mapping(self, output: str | None = None) -> dict[str, Any]:
         """The map as a mapping for :func:`fbs_core.io.export_result` (level in dB and
         the complex response, axes speed and frequency)."""
         outs = self.outputs if output is None else (output,)
         idx = index_of(self.outputs, outs, "response DOF")
-        with np.errstate(divide="ignore"):
-            lv = 20 * np.log10(np.abs(self.response[:, :, idx]))
+        lv = magnitude_db(self.response[:, :, idx], floor=None)
         return {
             "level_db": (("speed_kmh", "freq", "output"), lv),
             "response": (("speed_kmh", "freq", "output"), self.response[:, :, idx]),

@@ -3,13 +3,14 @@ imaginary parts, and delta cursors between two frequencies.
 
 Small pure functions on the frequency-first data ``(n_f, n_out, n_in)`` of an
 :class:`~fbs_core.FRF` (thesis table 2.1 for the quantities). Levels are
-``20 log10(|H| / ref)``; the phase is ``angle(H)`` unwrapped along frequency, so
-that a transfer through several resonances keeps falling (-180, -360, ...)
-instead of jumping by 360 degrees.
+``20 log10(|H| / ref)`` (:func:`fbs_core.vocabulary.magnitude_db`); the phase is
+``angle(H)`` unwrapped along frequency, so that a transfer through several resonances
+keeps falling (-180, -360, ...) instead of jumping by 360 degrees.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -18,6 +19,7 @@ import numpy.typing as npt
 
 from ..errors import FrequencyGridError
 from ..frf import FRF
+from ..vocabulary import magnitude_db
 
 __all__ = [
     "Bode",
@@ -32,16 +34,16 @@ __all__ = [
 
 
 def level_db(h: npt.ArrayLike, ref: float = 1.0) -> np.ndarray:
-    """``20 log10(|h| / ref)``; ``-inf`` where ``h == 0``.
-
-    Parameters
-    ----------
-    h : array_like (complex)
-    ref : float
-        Reference value of 0 dB (in the unit of ``h``).
-    """
-    with np.errstate(divide="ignore"):
-        return np.asarray(20 * np.log10(np.abs(np.asarray(h)) / ref), float)
+    """Deprecated name of ``fbs_core.vocabulary.magnitude_db(h, ref, floor=None)``
+    (``20 log10(|h| / ref)``, ``-inf`` where ``h == 0``); a ``DeprecationWarning``,
+    removed in the next release."""
+    warnings.warn(
+        "fbs_core.analysis.level_db is deprecated; use "
+        "fbs_core.vocabulary.magnitude_db(h, ref, floor=None)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return np.asarray(magnitude_db(h, ref, floor=None), float)
 
 
 def phase_deg(h: npt.ArrayLike, unwrap: bool = True, axis: int = 0) -> np.ndarray:
@@ -118,7 +120,7 @@ def bode(frf: FRF, ref: float = 1.0, unwrap: bool = True) -> Bode:
         frf.freq,
         frf.outputs,
         frf.inputs,
-        level_db(frf.data, ref),
+        magnitude_db(frf.data, ref, floor=None),
         phase_deg(frf.data, unwrap, axis=0),
         float(ref),
         frf.quantity,
@@ -229,7 +231,7 @@ def delta_cursor(
         For an unknown label, or a missing one on a multi-DOF FRF.
     """
     h = _element(frf, output, input)
-    lv = level_db(h, ref)
+    lv = magnitude_db(h, ref, floor=None)
     return Delta(
         float(f1), float(f2), interp_level(frf.freq, lv, f1), interp_level(frf.freq, lv, f2)
     )

@@ -1,4 +1,4 @@
-"""Command line of the campaigns: ``python -m fbs_core.campaign {run,summary,plan} ...``.
+"""Command line of the campaigns: ``python -m fbs_core.campaign {run,summary,plan,corridor}``.
 
 ``run`` shows a progress bar (tasks done/total, rounds per second, time left); Ctrl-C
 stops cleanly (running tasks are cancelled, finished ones are in the result file) and the
@@ -18,6 +18,7 @@ from types import FrameType
 from .browse import open_campaign
 from .run import SCHEDULER_ENV, WRITING, n_lines, plan, run_campaign
 from .spec import BandCase, CampaignError, load_campaign
+from .variants import VariantsCase
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -41,7 +42,31 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("result", help="campaign result file (HDF5)")
     pl = sub.add_parser("plan", help="list the cases and tasks of a campaign without running")
     pl.add_argument("campaign")
+    co = sub.add_parser("corridor", help="corridor and sensitivity tables of a variants study")
+    co.add_argument("result", help="campaign result file (HDF5)")
+    co.add_argument("--case", help="the variants case (default: all)")
+    co.add_argument("--harmonic", type=int, help="one harmonic (default: all of the study)")
+    co.add_argument("--dofs", nargs="+", help="DOFs of the sensitivity tables (default: all)")
     return p
+
+
+def _corridor(args: argparse.Namespace) -> int:
+    from ..variants.report import corridor_text, sensitivity_text
+
+    res = open_campaign(args.result)
+    cases = [c for c in res.cases if c.kind == "variants"]
+    if args.case is not None:
+        cases = [res.case(args.case)]
+    if not cases:
+        raise CampaignError(f"{args.result} holds no variants study")
+    for c in cases:
+        st = res.variants(c.name)
+        print(f"{c.name}: {c.label()}")
+        for k in [args.harmonic] if args.harmonic is not None else st.settings.harmonics:
+            print(corridor_text(st.corridor(k, c.settings["percentiles"])))
+            if st.design.method == "saltelli":
+                print(sensitivity_text(st.sensitivity(k), args.dofs))
+    return 0
 
 
 def _plan(path: str) -> int:
@@ -59,6 +84,10 @@ def _plan(path: str) -> int:
             nl = n_lines(case.harmonic, case.df)
             nb = sum(1 for x in band if x.case is case)
             print(f"  {case.name}  {nl} lines in {nb} tasks  seed={case.seed}")
+        elif isinstance(case, VariantsCase):
+            mine = [x for x in tasks if x.case is case]
+            nv = sum(len(x.rows) for x in mine)
+            print(f"  {case.name}  {nv} variants in {len(mine)} tasks (by tire)  seed={case.seed}")
         else:
             print(f"  {case.name}")
     return 0
@@ -116,6 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 0
         if args.cmd == "plan":
             return _plan(args.campaign)
+        if args.cmd == "corridor":
+            return _corridor(args)
         return _run(args)
     except CampaignError as e:
         print(f"error: {e}", file=sys.stderr)

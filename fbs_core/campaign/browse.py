@@ -6,12 +6,20 @@ committed yet (a running or killed campaign is browsable too). Bands come back a
 with the case's seed, including :meth:`~fbs_core.ScatterBand.round` (the subsystem
 arrays are in the file); truncation cases as :class:`~fbs_core.TruncationMap` (when the
 responses were stored) or as the error map alone.
+
+A result file is data from outside the process (a disk, a volume other runs write to): every
+way it can be malformed (a case's settings that are not JSON or lack a key, a block of
+another name, an array of the wrong shape, a file that is not HDF5 ...) ends in a
+:class:`CampaignError` that names the file, the case or array and the problem, never in
+another exception.
 """
 
 from __future__ import annotations
 
 import json
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,8 +33,80 @@ from .store import CampaignStore
 if TYPE_CHECKING:
     from ..studies.scatter import ScatterBand
     from ..studies.truncation import TruncationMap
+    from ..variants import VariantStudy
 
 __all__ = ["open_campaign", "CampaignResult", "CaseEntry", "TruncationEntry"]
+
+
+#: What reading a malformed file raises in h5py, numpy and the standard library.
+_MALFORMED = (ValueError, TypeError, KeyError, IndexError, AttributeError, OSError, RuntimeError)
+
+#: Settings each kind of case must hold, and their types (a bool is not a number here).
+_SETTINGS: dict[str, dict[str, tuple[type, ...]]] = {
+    "scatter": {
+        "harmonic": (int,),
+        "noise": (int, float),
+        "target": (str,),
+        "frequency_dependent": (bool,),
+        "rounds": (int,),
+        "seed": (int,),
+        "percentiles": (list,),
+        "coupling": (str,),
+        "tire": (str,),
+        "chassis": (str,),
+    },
+    "truncation": {
+        "harmonic": (int,),
+        "n_modes": (list,),
+        "coupling": (str,),
+        "tire": (str,),
+        "chassis": (str,),
+    },
+    "variants": {
+        "study": (str,),
+        "parameters": (list,),
+        "design": (str,),
+        "n": (int,),
+        "seed": (int,),
+        "harmonics": (list,),
+        "coupling": (str,),
+        "percentiles": (list,),
+    },
+}
+
+
+@contextmanager
+def _readable(path: Path, what: str = "") -> Iterator[None]:
+    """Turn the errors of reading a malformed ``path`` into :class:`CampaignError`."""
+    try:
+        yield
+    except CampaignError:
+        raise
+    except _MALFORMED as e:
+        where = f"{path}: {what}" if what else str(path)
+        raise CampaignError(f"{where} is malformed ({type(e).__name__}: {e})") from None
+
+
+def _check_settings(path: Path, name: str, kind: Any, settings: Any) -> dict[str, Any]:
+    """The case's settings, checked against :data:`_SETTINGS` (CampaignError naming what)."""
+    if kind not in _SETTINGS:
+        raise CampaignError(
+            f"{path}: case {name!r} is of kind {kind!r}; known kinds: {', '.join(_SETTINGS)}"
+        )
+    if not isinstance(settings, dict):
+        raise CampaignError(
+            f"{path}: case {name!r} has no settings (got {type(settings).__name__})"
+        )
+    for key, types in _SETTINGS[kind].items():
+        if key not in settings:
+            raise CampaignError(f"{path}: case {name!r}: its settings lack {key!r}")
+        v = settings[key]
+        if isinstance(v, bool) and bool not in types or not isinstance(v, types):
+            raise CampaignError(
+                f"{path}: case {name!r}: setting {key!r} = {v!r} is not of type "
+                f"{' or '.join(t.__name__ for t in types)}"
+            )
+    return settings
 
 
 def _attr(v: Any) -> Any:
@@ -51,11 +131,12 @@ class CaseEntry:
     Attributes
     ----------
     name : str
-    kind : {"scatter", "truncation"}
+    kind : {"scatter", "truncation", "variants"}
     settings : dict
         Everything the case was computed with (harmonic, noise, target, rounds, seed ...).
     lines_done, n_lines : int
-        Frequency lines stored and in all (truncation: 1 and 1 when done).
+        Frequency lines stored and in all (truncation: 1 and 1 when done; variants: the
+        variants and the nominal models stored and in all).
     complete : bool
     """
 
@@ -71,6 +152,12 @@ class CaseEntry:
 
     def label(self) -> str:
         s = self.settings
+        if self.kind == "variants":
+            return (
+                f"variants {s['design']} n={s['n']} of "
+                f"{', '.join(s['parameters'])}; h{','.join(map(str, s['harmonics']))} "
+                f"{s['coupling']}"
+            )
         if self.kind == "scatter":
             return (
                 f"h{s['harmonic']} noise {100 * s['noise']:g} % {s['target']:<7s} "
@@ -111,6 +198,18 @@ class TruncationEntry:
     map: TruncationMap | None
 
 
+def _groups(h: Any, key: str, path: Path) -> list[tuple[str, Any]]:
+    """The members of group ``h[key]`` (none when absent; CampaignError when not a group)."""
+    import h5py
+
+    if key not in h:
+        return []
+    g = h[key]
+    if not isinstance(g, h5py.Group):
+        raise CampaignError(f"{path}: {g.name!r} is not a group")
+    return list(g.items())
+
+
 class CampaignResult:
     """A campaign result file opened for reading (see :func:`open_campaign`)."""
 
@@ -131,35 +230,56 @@ class CampaignResult:
                 h = h5py.File(p, "r")
             except OSError as e:
                 raise CampaignError(f"{p}: not a readable HDF5 file ({e})") from None
-            with h:
+            with h, _readable(p):
                 if p == self.path:
                     if h.attrs.get("content") != "campaign":
                         raise CampaignError(f"{p}: not a campaign result file")
                     self.attrs = {k: _attr(v) for k, v in h.attrs.items()}
-                for name, g in h.get("cases", {}).items():
-                    d = cases.setdefault(name, {"attrs": {}, "blocks": {}, "result": None})
-                    for k, v in g.attrs.items():
-                        d["attrs"].setdefault(k, _json(v))
-                    for b in g.get("blocks", {}):
-                        a, z = (int(x) for x in b.split("_"))
-                        d["blocks"].setdefault((a, z), p)
-                    if "result" in g:
-                        d["result"] = p
-                for name in h.get("inputs", {}):
+                for name, g in _groups(h, "cases", p):
+                    with _readable(p, f"case {name!r}"):
+                        d = cases.setdefault(name, {"attrs": {}, "blocks": {}, "result": None})
+                        for k, v in g.attrs.items():
+                            d["attrs"].setdefault(k, _json(v))
+                        for b, _ in _groups(g, "blocks", p):
+                            a, z = (int(x) for x in b.split("_"))
+                            if not 0 <= a < z:
+                                raise ValueError(f"block {b!r} is not a range of lines")
+                            d["blocks"].setdefault((a, z), p)
+                        if "result" in g:
+                            d["result"] = p
+                        for t, u in _groups(g, "tires", p):  # a variants study's tasks
+                            d.setdefault("tires", {}).setdefault(t, int(u.attrs.get("n_rows", 0)))
+                        if "nominal" in g:
+                            d["tires"] = d.get("tires", {}) | {"": 1}
+                for name, _ in _groups(h, "inputs", p):
                     self._where.setdefault(f"inputs/{name}", p)
-                for name, g in h.get("runs", {}).items():
-                    self.runs.append({k: _json(v) for k, v in g.attrs.items()} | {"id": name})
+                for name, g in _groups(h, "runs", p):
+                    with _readable(p, f"run {name!r}"):
+                        self.runs.append({k: _json(v) for k, v in g.attrs.items()} | {"id": name})
         self._cases = cases
         entries = []
         for name, d in sorted(cases.items()):
             a = d["attrs"]
-            st = dict(a.get("settings") or {})
-            if a.get("kind") == "scatter":
-                n = int(a.get("n_lines", 0))
-                got = sum(z - x for x, z in d["blocks"])
-            else:
-                n, got = 1, int(d["result"] is not None)
-            entries.append(CaseEntry(name, str(a.get("kind")), st, got, n))
+            with _readable(self.path, f"case {name!r}"):
+                st = _check_settings(self.path, name, a.get("kind"), a.get("settings"))
+                if a.get("kind") == "scatter":
+                    n = int(a.get("n_lines", 0))
+                    got = sum(z - x for x, z in d["blocks"])
+                    if n < 1 or got > n:
+                        raise CampaignError(
+                            f"{self.path}: case {name!r} has {got} of n_lines = {n} lines stored"
+                        )
+                elif a.get("kind") == "variants":  # the variants and the nominal models
+                    n = int(a.get("n_variants", 0)) + 1
+                    got = sum(d.get("tires", {}).values())
+                    if n < 2 or got > n:
+                        raise CampaignError(
+                            f"{self.path}: case {name!r} has {got} of {n} variants "
+                            "(with the nominal models) stored"
+                        )
+                else:
+                    n, got = 1, int(d["result"] is not None)
+            entries.append(CaseEntry(name, str(a.get("kind")), dict(st), got, n))
         self.cases: tuple[CaseEntry, ...] = tuple(entries)
         self.runs.sort(key=lambda r: str(r.get("started", "")))
 
@@ -196,10 +316,10 @@ class CampaignResult:
         p = self._where.get(f"inputs/{name}")
         if p is None:
             raise CampaignError(f"{self.path}: the subsystem arrays {name!r} are missing")
-        with h5py.File(p, "r") as h:
+        with _readable(p, f"subsystem arrays {name!r}"), h5py.File(p, "r") as h:
             g = h["inputs"][name]
             arr = {k: g[k][()] for k in ("freq", "YjjA", "vj", "YjjE", "YejE", "reference")}
-            dofs = tuple(_json(g.attrs["dofs"]))
+            dofs = tuple(str(x) for x in _json(g.attrs["dofs"]))
         return arr, dofs
 
     def band(self, name: str) -> ScatterBand:
@@ -213,7 +333,7 @@ class CampaignResult:
         """
         import h5py
 
-        from .work import BLOCK_KEYS, assemble_band
+        from .work import BLOCK_KEYS
 
         c = self.case(name)
         if c.kind != "scatter":
@@ -225,15 +345,39 @@ class CampaignResult:
             )
         d = self._cases[name]
         st = c.settings
-        arr, dofs = self._inputs(d["attrs"]["inputs"])
+        with _readable(self.path, f"case {name!r}"):
+            arr, dofs = self._inputs(str(d["attrs"]["inputs"]))
         blocks = []
         for (a, z), p in sorted(d["blocks"].items()):
-            with h5py.File(p, "r") as h:
+            with _readable(p, f"case {name!r} block {a}_{z}"), h5py.File(p, "r") as h:
                 g = h["cases"][name]["blocks"][f"{a}_{z}"]
                 b = {k: (g[k][()] if k in g else None) for k in (*BLOCK_KEYS, "checkpoints")}
             blocks.append(b | {"l0": a, "l1": z})
         if any(b["lower"] is None for b in blocks):
             raise CampaignError(f"case {name} was stored without its band ([outputs] scatter)")
+        with _readable(self.path, f"case {name!r} (its band)"):
+            return self._assemble(arr, dofs, blocks, st)
+
+    @staticmethod
+    def _assemble(
+        arr: dict[str, AnyArray],
+        dofs: tuple[str, ...],
+        blocks: list[dict[str, Any]],
+        st: dict[str, Any],
+    ) -> ScatterBand:
+        from .work import assemble_band
+
+        n = np.asarray(arr["freq"]).shape[0]
+        for b in blocks:
+            for k in ("lower", "upper"):
+                shape = np.shape(b[k])
+                if len(shape) != 2 or shape[0] != b["l1"] - b["l0"] or shape[1] != len(dofs):
+                    raise ValueError(
+                        f"block {b['l0']}_{b['l1']} {k!r} has shape {shape}, expected "
+                        f"({b['l1'] - b['l0']}, {len(dofs)})"
+                    )
+        if blocks[-1]["l1"] != n:
+            raise ValueError(f"the blocks end at line {blocks[-1]['l1']} of {n}")
         band: ScatterBand = assemble_band(
             arr["freq"],
             dofs,
@@ -253,23 +397,56 @@ class CampaignResult:
         )
         return band
 
+    def variants(self, name: str) -> VariantStudy:
+        """The :class:`~fbs_core.variants.VariantStudy` of a complete variants case: the
+        design and every variant's response (its corridor and sensitivities follow).
+
+        Raises
+        ------
+        CampaignError
+            For an unknown, other or incomplete case.
+        """
+        from .variants import study_from_file
+
+        c = self.case(name)
+        if c.kind != "variants":
+            raise CampaignError(f"case {name} is a {c.kind} case, not a variants study")
+        if not c.complete:
+            raise CampaignError(
+                f"case {name} is not complete: {c.lines_done} of {c.n_lines} variants "
+                "(and the nominal models); rerun the campaign to finish it"
+            )
+        with _readable(self.path, f"case {name!r}"):
+            return study_from_file(self.path, name)
+
     def truncation(self, name: str) -> TruncationEntry:
         """The stored truncation case (error map, suggested modes, the map when stored)."""
-        import h5py
-
-        from ..studies.truncation import TruncationMap
-
         c = self.case(name)
         if c.kind != "truncation":
             raise CampaignError(f"case {name} is a {c.kind} case, not a truncation case")
         if not c.complete:
             raise CampaignError(f"case {name} is not computed yet; rerun the campaign")
         p = self._cases[name]["result"]
+        with _readable(p, f"case {name!r} (its map)"):
+            return self._truncation(p, name, c)
+
+    def _truncation(self, p: Path, name: str, c: CaseEntry) -> TruncationEntry:
+        import h5py
+
+        from ..studies.truncation import TruncationMap
+
         with h5py.File(p, "r") as h:
             g = h["cases"][name]["result"]
             get = {k: g[k][()] for k in g}
             at = {k: _json(v) for k, v in g.attrs.items()}
-        dofs = tuple(at["dofs"])
+        dofs = tuple(str(x) for x in at["dofs"])
+        n_n, n_c = np.shape(get["n_modes"])[0], np.shape(get["centres"])[0]
+        want = (n_n, n_c, len(dofs))
+        if "error" in get and np.shape(get["error"]) != want:
+            raise ValueError(f"'error' has shape {np.shape(get['error'])}, expected {want}")
+        sugg = (len(at["thresholds"]), len(at["f_max"]))
+        if "suggested" in get and np.shape(get["suggested"]) != sugg:
+            raise ValueError(f"'suggested' has shape {np.shape(get['suggested'])}, expected {sugg}")
         m = None
         if "response" in get and "error" in get:
             m = TruncationMap(
@@ -307,19 +484,22 @@ class CampaignResult:
         except CampaignError:
             return None
 
-    def summary(self) -> str:
-        """One line per case (status, settings, band width or suggested modes)."""
+    def headline(self, planned: bool = True) -> str:
+        """The first line of :meth:`summary`: cases complete, partial and not started
+        (``planned=False``: of the cases stored, without reading the campaign's TOML)."""
         name = self.attrs.get("campaign_name", self.path.stem)
         done = sum(c.complete for c in self.cases)
-        planned = self.planned()
-        total = (
-            len(self.cases) if planned is None else len(set(planned) | {c.name for c in self.cases})
-        )
+        names = self.planned() if planned else None
+        total = len(self.cases) if names is None else len(set(names) | {c.name for c in self.cases})
         partial = sum(0 < c.lines_done < c.n_lines for c in self.cases)
-        out = [
+        return (
             f"campaign {name!r}: {done} of {total} cases complete, {partial} partial, "
             f"{total - len(self.cases)} not started ({self.path})"
-        ]
+        )
+
+    def summary(self) -> str:
+        """One line per case (status, settings, band width or suggested modes)."""
+        out = [self.headline()]
         if self.runs:
             r = self.runs[-1]
             out.append(
@@ -328,7 +508,8 @@ class CampaignResult:
                 f"({r.get('scheduler')})"
             )
         for c in self.cases:
-            status = "done" if c.complete else f"{c.lines_done}/{c.n_lines} lines"
+            unit = "variants" if c.kind == "variants" else "lines"
+            status = "done" if c.complete else f"{c.lines_done}/{c.n_lines} {unit}"
             extra = ""
             if c.kind == "truncation" and c.complete:
                 t = self.truncation(c.name)

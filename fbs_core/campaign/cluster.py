@@ -12,24 +12,40 @@ While the blocks run, ``progress(done, total)`` (frequency lines of the finished
 :func:`fbs_core.scatter_band` reports them) is called as they finish and ``cancel()`` is
 asked every ``poll`` seconds: when it returns True the block futures (and the scattered
 arrays) are cancelled on the cluster and :class:`~fbs_core.StudyCancelled` is raised.
+
+A cluster that cannot compute the band raises :class:`ClusterUnavailable` (the caller
+computes it in its own process instead): a scheduler without workers (checked before the
+blocks are sent, and whenever no block finished for ``stall_s`` seconds), a scheduler that
+went away (the client's connection closed), a block lost with its worker.
 """
 
 from __future__ import annotations
 
+import concurrent.futures
 import threading
+import time
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import FBSError, StudyCancelled
+from ..errors import ClusterUnavailable, FBSError, StudyCancelled
 from . import work
 from .run import block_lines
 
 if TYPE_CHECKING:
     from ..studies.scatter import ScatterBand
 
-__all__ = ["line_blocks", "scatter_band_on"]
+__all__ = ["ClusterUnavailable", "line_blocks", "scatter_band_on"]
+
+
+def has_workers(client: Any) -> bool:
+    """Whether the client's scheduler is connected and has at least one worker."""
+    try:
+        return client.status == "running" and bool(client.scheduler_info().get("workers"))
+    except Exception:  # noqa: BLE001 (a closed or broken connection: no)
+        return False
+
 
 #: Round-lines of a dashboard block: about 1.6 s on one core (0.81 us per round-line,
 #: docs/deployment.md), so progress moves and a cancel frees the workers within a block.
@@ -62,6 +78,7 @@ def scatter_band_on(
     progress: Callable[[int, int], None] | None = None,
     cancel: Callable[[], bool] | None = None,
     poll: float = 0.1,
+    stall_s: float = 10.0,
 ) -> ScatterBand:
     """:func:`fbs_core.scatter_band` computed on the workers of ``client`` (see the module).
 
@@ -78,6 +95,9 @@ def scatter_band_on(
         block.
     cancel : callable, optional
         Asked every ``poll`` seconds; True cancels the futures.
+    stall_s : float
+        Seconds without a finished block after which the scheduler is asked whether it
+        still has workers (none, or no connection: :class:`ClusterUnavailable`).
 
     Returns
     -------
@@ -87,20 +107,26 @@ def scatter_band_on(
     ------
     StudyCancelled
         When ``cancel()`` returned True (nothing is left running on the cluster).
+    ClusterUnavailable
+        When the cluster cannot compute the band (see the module); nothing is left
+        running on it.
     FBSError
         For bad settings (as the in-process band) or a failed block.
     """
     from ..studies import scatter as _sc
+    from ..studies.band_kernel import noise_flags
 
     if cancel is not None and cancel():
         raise StudyCancelled("scatter band cancelled before it started")
-    _sc._flags(target)  # a bad target is refused here, not on every worker
+    noise_flags(target)  # a bad target is refused here, not on every worker
     if isinstance(rounds, bool) or not isinstance(rounds, int | np.integer) or rounds < 1:
         raise FBSError(f"rounds must be a positive integer, got {rounds!r}")
     if rounds > _sc.MAX_ROUNDS:
         raise FBSError(f"rounds must be at most {_sc.MAX_ROUNDS:,}, got {rounds:,}")
     if not 0.0 <= noise < 1.0:
         raise FBSError(f"noise must be in [0, 1) (0.1 = +-10 %), got {noise!r}")
+    if not has_workers(client):
+        raise ClusterUnavailable("the Dask scheduler has no workers (or no connection)")
     inp = work.prepare_inputs(
         "reference" if tire is None else tire,
         "reference" if chassis is None else chassis,
@@ -136,19 +162,34 @@ def scatter_band_on(
             for l0, l1 in blocks
         ]
         n_done = 0
+        moved = time.monotonic()
         while n_done < total:
             if cancel is not None and cancel():
                 raise StudyCancelled(f"scatter band cancelled after {n_done} of {total} blocks")
             stop.wait(poll)
             finished = [f.done() for f in futures]
             if sum(finished) != n_done:
-                n_done = sum(finished)
+                n_done, moved = sum(finished), time.monotonic()
                 if progress is not None:
                     lines = sum(b - a for (a, b), ok in zip(blocks, finished, strict=True) if ok)
                     progress(lines, inp.n_lines)
-        results = client.gather(futures)  # raises the first failed block's error
+            elif time.monotonic() - moved > stall_s:
+                if not has_workers(client):
+                    raise ClusterUnavailable(
+                        f"the Dask scheduler lost its workers or its connection after "
+                        f"{n_done} of {total} blocks"
+                    )
+                moved = time.monotonic()
+        try:
+            results = client.gather(futures)  # raises the first failed block's error
+        except (OSError, TimeoutError, concurrent.futures.CancelledError) as e:
+            # the connection closed, or a block was lost with the scheduler or its worker
+            raise ClusterUnavailable(f"the Dask cluster failed the band ({e!r})") from e
     except BaseException:
-        client.cancel([f for f in (*futures, shipped) if f is not None], force=True)
+        try:
+            client.cancel([f for f in (*futures, shipped) if f is not None], force=True)
+        except Exception:  # noqa: BLE001 (a closed connection: nothing left to cancel)
+            pass
         raise
     band: ScatterBand = work.assemble_band(
         inp.freq,

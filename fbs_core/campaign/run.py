@@ -32,12 +32,14 @@ import numpy as np
 
 import fbs_core
 
+from . import variants as _variants
 from . import work
 from .spec import BandCase, Campaign, CampaignError, TruncationCase
 from .store import CampaignStore, file_sha256
 
 if TYPE_CHECKING:
     from ..frf import FRF
+    from .variants import VariantsCase
 
 __all__ = ["Task", "plan", "run_campaign", "RunReport", "make_client", "SCHEDULER_ENV"]
 
@@ -50,16 +52,18 @@ WRITING = threading.Event()
 
 @dataclass(frozen=True)
 class Task:
-    """One unit of work: ``kind`` is "band" or "truncation"."""
+    """One unit of work: ``kind`` is "band", "truncation" or "variants" (the design's
+    ``rows`` sharing one tire, none: the nominal models)."""
 
     kind: str
     unit: str
-    case: BandCase | TruncationCase
+    case: BandCase | TruncationCase | VariantsCase
     l0: int = 0
     l1: int = 0
     inputs: str = ""
     rounds: float = 0.0  # rounds of its case this task computes (lines / n_lines x R)
     work: float = 0.0  # rounds x lines
+    rows: tuple[int, ...] = ()
 
 
 @dataclass
@@ -132,6 +136,14 @@ def plan(campaign: Campaign, done: set[str] | None = None) -> tuple[list[Task], 
             covered.setdefault(parts[1], []).append((int(sa), int(sb)))
     tasks: list[Task] = []
     for c in campaign.cases:
+        if isinstance(c, _variants.VariantsCase):  # a corridor study: a task per tire
+            for unit, rows in _variants.groups(c):
+                if unit in done:
+                    n_done += 1
+                else:
+                    w = max(1, len(rows)) * _variants.VARIANT_WORK
+                    tasks.append(Task("variants", unit, c, rows=tuple(rows), work=w))
+            continue
         if isinstance(c, TruncationCase):
             unit = f"cases/{c.name}/result"
             if unit in done:
@@ -174,15 +186,21 @@ def make_client(scheduler: str | None = None, workers: int | None = None) -> tup
         except OSError as e:
             raise CampaignError(f"cannot reach the Dask scheduler at {addr}: {e}") from None
     if workers:
+        # the scheduler, the workers and the diagnostics dashboard on the loopback
+        # interface only: a Dask scheduler runs what any client that reaches it sends
         cluster = LocalCluster(
             n_workers=int(workers),
             threads_per_worker=1,
             processes=True,
-            dashboard_address=":0",
+            host="127.0.0.1",
+            dashboard_address="127.0.0.1:0",
         )
     else:
         cluster = LocalCluster(
-            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
+            n_workers=1,
+            threads_per_worker=1,
+            processes=False,
+            dashboard_address="127.0.0.1:0",
         )
     return Client(cluster), cluster
 
@@ -285,6 +303,11 @@ def _write_inputs(store: CampaignStore, name: str, c: BandCase, inp: work.BandIn
 
 
 def _write(store: CampaignStore, campaign: Campaign, t: Task, res: dict[str, Any]) -> None:
+    if t.kind == "variants":
+        assert isinstance(t.case, _variants.VariantsCase)
+        _variants.write_result(store, t.case, t.unit, list(t.rows), res)
+        return
+    assert isinstance(t.case, BandCase | TruncationCase)
     parents = {f"cases/{t.case.name}": _case_attrs(t.case)}
     prov: dict[str, Any] = {k: res.pop(k) for k in ("worker", "host", "pid", "seconds") if k in res}
     if t.kind == "band":
@@ -426,6 +449,7 @@ def run_campaign(
     store.commit(_root_attrs(campaign))  # leftovers of a killed run; creates the file
     done = store.done()
     _model_units(campaign, store, done)
+    _variants.write_designs(campaign, store, done)
     tasks, n_skipped = plan(campaign, done)
     todo = [t for t in tasks if t.unit not in done]
     bar = Progress(len(todo), sum(t.work for t in todo)) if progress is True else None
@@ -454,7 +478,10 @@ def run_campaign(
             grids: dict[tuple[int, float, str], FRF] = {}
             inputs_f: dict[str, Any] = {}
             for t in tasks:
+                if t.kind == "variants":  # no subsystem arrays: the task builds its models
+                    continue
                 c = t.case
+                assert isinstance(c, BandCase | TruncationCase)
                 g = (c.harmonic, c.df, c.chassis)
                 if g not in grids:
                     f = fbs_core.harmonic(c.harmonic).frequencies(c.df)
@@ -478,6 +505,11 @@ def run_campaign(
             t_submit = time.perf_counter()
             for t in tasks:
                 c = t.case
+                if t.kind == "variants":
+                    fut = _variants.submit(client, t, numba_threads, token)
+                    futures[fut] = t
+                    continue
+                assert isinstance(c, BandCase | TruncationCase)
                 if t.kind == "band":
                     assert isinstance(c, BandCase)
                     fut = client.submit(

@@ -2,8 +2,10 @@
 
 A campaign is the cross product of the settings listed in its ``[scatter]`` table (noise
 scatter bands, thesis 5.2, eqs. 5.2-5.4) and its ``[truncation]`` table (truncation error
-maps and suggested mode counts, thesis 5.1, eq. 5.1 and table 5.1). The layout, with every
-key and its default, is documented in ``campaigns/example.toml``::
+maps and suggested mode counts, thesis 5.1, eq. 5.1 and table 5.1), plus an optional
+``[variants]`` table: a corridor study of physical parameters (issue 32, :mod:`.variants`,
+``campaigns/corridor.toml``). The layout, with every key and its default, is documented in
+``campaigns/example.toml``::
 
     [campaign]
     name = "example"
@@ -38,11 +40,15 @@ import zlib
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from ..errors import CampaignError
+from ..vocabulary import COUPLINGS
+
+if TYPE_CHECKING:
+    from .variants import VariantsCase
 
 __all__ = [
     "CampaignError",
@@ -60,13 +66,21 @@ TARGET_NAMES = {"tire": "tire", "chassis": "chassis", "vehicle": "chassis", "bot
 #: A case's name (and so its seed, :func:`case_seed`) spells the chassis target as the first
 #: release did, so a campaign file gives the same cases and numbers as before.
 _NAME_TOKENS = {"chassis": "vehicle"}
-COUPLINGS = ("6dof", "5dof")
 SEED_MODES = ("per-case", "common")
 OUTPUTS = {
     "scatter": ("band", "percentiles", "convergence"),
     "truncation": ("error", "suggested", "responses"),
 }
-_TOP = ("campaign", "models", "grid", "scatter", "truncation", "outputs", "execution")
+_TOP = (
+    "campaign",
+    "models",
+    "grid",
+    "scatter",
+    "truncation",
+    "variants",
+    "outputs",
+    "execution",
+)
 
 
 @dataclass(frozen=True)
@@ -155,7 +169,7 @@ class Campaign:
         The result file (HDF5).
     tires, chassis : dict of str to str
         Model variants: name -> ``"reference"`` or an absolute file path.
-    cases : tuple of BandCase and TruncationCase
+    cases : tuple of BandCase, TruncationCase and VariantsCase
     outputs : dict of str to tuple of str
         What is stored of each kind of case.
     task_round_lines : int
@@ -172,7 +186,7 @@ class Campaign:
     output: Path
     tires: dict[str, str]
     chassis: dict[str, str]
-    cases: tuple[BandCase | TruncationCase, ...]
+    cases: tuple[BandCase | TruncationCase | VariantsCase, ...]
     outputs: dict[str, tuple[str, ...]]
     task_round_lines: int
     max_chunk_bytes: float
@@ -185,6 +199,13 @@ class Campaign:
     @property
     def truncation_cases(self) -> tuple[TruncationCase, ...]:
         return tuple(c for c in self.cases if isinstance(c, TruncationCase))
+
+    @property
+    def variants_cases(self) -> tuple[VariantsCase, ...]:
+        """The corridor studies (``[variants]``, :mod:`.variants`)."""
+        from .variants import VariantsCase
+
+        return tuple(c for c in self.cases if isinstance(c, VariantsCase))
 
 
 def _digest(settings: dict[str, Any]) -> str:
@@ -335,7 +356,7 @@ def parse_campaign(text: str, base: Path | str = ".") -> Campaign:
     _known(g, ("df",), "[grid]")
     df = _float(g.get("df", 0.5), "[grid] df", 0.01, 10.0)
 
-    cases: list[BandCase | TruncationCase] = []
+    cases: list[BandCase | TruncationCase | VariantsCase] = []
     s = _table(d, "scatter", "top level")
     if s:
         w = "[scatter]"
@@ -438,8 +459,15 @@ def parse_campaign(text: str, base: Path | str = ".") -> Campaign:
                         cases.append(
                             TruncationCase(h, counts, cp, t, ch, width, step, ths, fmx, df)
                         )
+    va = _table(d, "variants", "top level")
+    if va:
+        from .variants import parse_variants
+
+        cases.append(parse_variants(va, seed, seeds, df))
     if not cases:
-        raise CampaignError("campaign file defines no cases: add a [scatter] or [truncation] table")
+        raise CampaignError(
+            "campaign file defines no cases: add a [scatter], [truncation] or [variants] table"
+        )
     names = [x.name for x in cases]
     if len(set(names)) != len(names):  # pragma: no cover - the loops make names unique
         raise CampaignError("campaign file defines the same case twice")

@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike
 
 from .._typing import ComplexArray, FloatArray
 from ..errors import FBSError
+from ..vocabulary import readonly
 
 if TYPE_CHECKING:
     from ..frf import FRF
@@ -86,17 +87,14 @@ class BandInputs:
         YejE: ArrayLike,
         n_modes_total: int,
     ) -> None:
-        from ..studies import scatter as _sc
+        from ..studies.band_kernel import kernel_arrays, reference_response
 
-        self.freq = _sc._ro(freq)
+        self.freq = readonly(freq)
         self.dofs = tuple(dofs)
-        self.YjjA, self.vj, self.YjjE, self.YejE = (_sc._ro(x) for x in (YjjA, vj, YjjE, YejE))
+        self.YjjA, self.vj, self.YjjE, self.YejE = (readonly(x) for x in (YjjA, vj, YjjE, YejE))
         self.n_modes_total = int(n_modes_total)
-        self.arrays = _sc._check_inputs(self.YjjA, self.vj, self.YjjE, self.YejE)
-        ref = _sc._run_complex(
-            self.arrays, np.uint64(0), np.zeros(1, np.int64), 0.0, False, False, False
-        )
-        self.reference = _sc._ro(ref[0])
+        self.arrays = kernel_arrays(self.YjjA, self.vj, self.YjjE, self.YejE)
+        self.reference = readonly(reference_response(self.arrays))
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         # arrays arrive writeable from pickling: read-only again, so that the compiled
@@ -223,9 +221,8 @@ def band_block(
         ``(n_k, n_l, n_e)``, ``checkpoints``, ``l0``, ``l1`` and the provenance of the run
         (``worker``, ``host``, ``pid``, ``seconds``).
     """
-    from ..studies import _noise_kernels
-    from ..studies import scatter as _sc
-    from ..studies._rng import seed_key
+    from ..studies.band_kernel import BandStats, band_lines, noise_flags, seed_key
+    from ..studies.scatter import default_checkpoints
 
     t0 = time.perf_counter()
     if numba_threads:
@@ -238,51 +235,33 @@ def band_block(
         raise FBSError(f"line block {l0}..{l1} outside 0..{nf}")
     if not 0.0 <= noise < 1.0:
         raise FBSError(f"noise must be in [0, 1), got {noise!r}")
-    tire, vehicle = _sc._flags(target)
+    tire, chassis = noise_flags(target)
     rounds = int(rounds)
     qs = np.asarray(percentiles, float)
-    ck = _sc.default_checkpoints(rounds)
+    ck = default_checkpoints(rounds)
     key = seed_key(seed)
     nl = l1 - l0
-    lo = np.empty((nl, ne))
-    hi = np.empty((nl, ne))
-    alo = np.empty((nl, ne), np.int64)
-    ahi = np.empty((nl, ne), np.int64)
-    pct = np.empty((qs.size, nl, ne))
-    clo = np.empty((ck.size, nl, ne))
-    chi = np.empty((ck.size, nl, ne))
+    st = BandStats.empty(nl, ne, qs.size, ck.size)
     chunk = int(max(1, min(nl, max_chunk_bytes // (8 * ne * rounds))))
     mag = np.empty((chunk, ne, rounds))
     rids = np.arange(rounds, dtype=np.int64)
     for a in range(l0, l1, chunk):
         b = min(l1, a + chunk)
-        m = mag[: b - a]
-        with _sc._LOCK:
-            _noise_kernels.noisy_block_run(
-                *inputs.arrays,
-                a,
-                b,
-                key,
-                rids,
-                float(noise),
-                tire,
-                vehicle,
-                bool(frequency_dependent),
-                m,
-                _sc._EMPTY_CPLX,
-            )
-            _noise_kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, a - l0)
+        band_lines(
+            inputs.arrays, a, b, key, rids, noise, tire, chassis, bool(frequency_dependent), qs,
+            ck, st, row=a - l0, work=mag,
+        )  # fmt: skip
     return {
         "l0": int(l0),
         "l1": int(l1),
-        "lower": lo,
-        "upper": hi,
-        "argmin_round": alo,
-        "argmax_round": ahi,
-        "percentiles": pct,
+        "lower": st.minimum,
+        "upper": st.maximum,
+        "argmin_round": st.argmin_round,
+        "argmax_round": st.argmax_round,
+        "percentiles": st.percentiles,
         "checkpoints": ck,
-        "conv_lower": clo,
-        "conv_upper": chi,
+        "conv_lower": st.conv_minimum,
+        "conv_upper": st.conv_maximum,
         "seconds": time.perf_counter() - t0,
         **_where(),
     }
@@ -326,8 +305,8 @@ def assemble_band(
         When an edge is not finite (as :func:`fbs_core.scatter_band`).
     """
     from ..errors import CampaignError, SingularInterfaceError
-    from ..studies import scatter as _sc
-    from ..studies._rng import seed_key
+    from ..studies.band_kernel import kernel_arrays, target_name
+    from ..studies.scatter import Convergence, ScatterBand
 
     blocks = sorted(blocks, key=lambda b: int(b["l0"]))
     nf = int(np.asarray(freq).size)
@@ -360,26 +339,24 @@ def assemble_band(
                 f"{what} of the scatter band is not finite at {freq[line]:g} Hz: the (noisy) "
                 "interface matrix Y_jj^A + Y_jj^E is singular there"
             )
-    seed = int(seed)
-    arrays = _sc._check_inputs(YjjA, vj, YjjE, YejE)
-    return _sc.ScatterBand(
-        freq=_sc._ro(np.asarray(freq)),
+    return ScatterBand.of_kernel(
+        kernel_arrays(YjjA, vj, YjjE, YejE),
+        int(seed),
+        freq=readonly(np.asarray(freq)),
         dofs=tuple(dofs),
-        reference=_sc._ro(np.asarray(reference)),
-        minimum=_sc._ro(lo),
-        maximum=_sc._ro(hi),
-        argmin_round=_sc._ro(cat("argmin_round", 0)),
-        argmax_round=_sc._ro(cat("argmax_round", 0)),
-        q=_sc._ro(qs),
-        percentiles=_sc._ro(pct),
-        convergence=_sc.Convergence(_sc._ro(np.asarray(ck)), _sc._ro(clo), _sc._ro(chi)),
+        reference=readonly(np.asarray(reference)),
+        minimum=readonly(lo),
+        maximum=readonly(hi),
+        argmin_round=readonly(cat("argmin_round", 0)),
+        argmax_round=readonly(cat("argmax_round", 0)),
+        q=readonly(qs),
+        percentiles=readonly(pct),
+        convergence=Convergence(readonly(np.asarray(ck)), readonly(clo), readonly(chi)),
         noise=float(noise),
-        target=_sc.target_name(str(target), warn=False),  # "vehicle" in older files
+        target=target_name(str(target), warn=False),  # "vehicle" in older files
         rounds=int(rounds),
         frequency_dependent=bool(frequency_dependent),
-        seed=seed,
         harmonic=None if harmonic is None else int(harmonic),
-        _inputs=(arrays, seed_key(seed)),
     )
 
 

@@ -11,19 +11,28 @@ Entry points (all accept a path, or the bytes of an upload plus its file name):
 * :func:`export_result` - coupled and study results to CSV, UFF 58 or HDF5 with
   metadata (harmonic, N, noise, seed, fbs_core version) for traceability.
 
+How a file is read: its bytes once, under a size limit (:func:`.checks.read_source`);
+its format, the row of :data:`REGISTRY` (:mod:`.formats`) that its ending or
+``format=`` names, checked against its first bytes; the row's reader, which parses the
+layout in the sandbox process and ends in the one assembly step of every FRF
+(:mod:`.assembly`: labels, units, quantity, SI); then the summary (:mod:`.imported`).
+Writing and exporting call the row's writer or exporter. The layouts: :mod:`.uff`,
+:mod:`.matlab`, :mod:`.csv`, :mod:`.hdf5`; tire models :mod:`.modal`; results
+:mod:`.results`; input checks :mod:`.checks` and :mod:`.units`; the parser process
+:mod:`._sandbox`, :mod:`._worker`, :mod:`._textparse`.
+
 Every kind of bad input ends in a subclass of :class:`fbs_core.errors.FBSError`
 (mostly :class:`~fbs_core.errors.DataFormatError`) with a message naming the file
-and the problem. Nothing is executed or unpickled from a file; the binary parsers
-run in a separate process (:mod:`fbs_core.io._sandbox`). Loading never writes
-anything but private temporary files. File formats: ``docs/file-formats.md``.
+and the problem. Nothing is executed or unpickled from a file; every format is parsed
+in a separate process (:mod:`fbs_core.io._sandbox`). Loading never writes anything but
+private temporary files. File formats: ``docs/file-formats.md``.
 """
 
 from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeAlias, overload
 
@@ -32,18 +41,16 @@ from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT
 from .checks import (
     DEFAULT_MAX_BYTES,
-    FORMATS,
-    Source,
     check_quantity_arg,
     common_grid,
     describe,
-    detect_format,
     interface_check,
     prepare_chassis,
-    quantity_notes,
     read_source,
     require_dofs,
 )
+from .formats import FORMATS, REGISTRY, FileFormat, detect_format, format_of
+from .imported import ImportResult, frf_import, tire_import
 from .results import ResultData, as_result_data
 
 if TYPE_CHECKING:
@@ -57,7 +64,9 @@ PathLike: TypeAlias = "str | os.PathLike[str]"
 __all__ = [
     "DEFAULT_MAX_BYTES",
     "FORMATS",
+    "FileFormat",
     "ImportResult",
+    "REGISTRY",
     "ResultData",
     "as_result_data",
     "common_grid",
@@ -72,81 +81,6 @@ __all__ = [
     "require_dofs",
     "save_frf",
 ]
-
-
-@dataclass(frozen=True)
-class ImportResult:
-    """What an importer read.
-
-    Attributes
-    ----------
-    frf : FRF or None
-        The FRF (None for a tire model).
-    model : TireModel or None
-        The tire model (None for an FRF).
-    summary : str
-        Short human-readable description: quantity, DOFs, frequency range,
-        operating points; with the notes appended.
-    notes : tuple of str
-        Conversions applied, records skipped, plausibility warnings.
-    metadata : dict
-        Provenance stored in the file.
-    source : str
-        File name; ``format`` the format it was read as.
-    """
-
-    frf: FRF | None
-    summary: str
-    notes: tuple[str, ...] = ()
-    metadata: dict[str, Any] = field(default_factory=dict)
-    source: str = ""
-    format: str = ""
-    model: object | None = None
-
-    def __iter__(self) -> Iterator[Any]:
-        """Unpack as ``frf, summary = load_frf(...)``."""
-        return iter((self.frf if self.model is None else self.model, self.summary))
-
-
-def _finish(
-    frf: FRF,
-    notes: list[str],
-    meta: dict[str, Any],
-    name: str,
-    fmt: str,
-    require_outputs: Iterable[str] = (),
-    require_inputs: Iterable[str] = (),
-) -> ImportResult:
-    require_dofs(frf, require_outputs, require_inputs, what=f"{name!r}")
-    notes = list(notes) + quantity_notes(frf)
-    text = f"{name} ({fmt}): " + describe(frf)
-    if notes:
-        text += "\nnotes: " + "; ".join(notes)
-    return ImportResult(frf, text, tuple(notes), dict(meta), name, fmt)
-
-
-#: How an import names each format in its summary (MATLAB by its container version).
-_LABELS = {
-    "uff": "UFF 58",
-    "csv": "CSV",
-    "hdf5": "HDF5",
-    "mat5": "MATLAB v5",
-    "mat73": "MATLAB v7.3",
-}
-
-
-def _open(
-    source: SourceLike, filename: str | None, format: str | None, max_bytes: int
-) -> tuple[Source, str, str, str]:
-    """The source read once and its format: ``(source, format, kind, label)``.
-
-    What every importer does before its parser runs in the sandbox: the size limit, the
-    format from the ending or ``format``, the magic bytes checked against it, and the
-    format's name for the summary.
-    """
-    src = read_source(source, filename, max_bytes)
-    fmt, kind = detect_format(src, format)
-    return src, fmt, kind, _LABELS[kind if fmt == "mat" else fmt]
 
 
 def load_frf(
@@ -219,47 +153,16 @@ def load_frf(
     ('spindle:z',)
     """
     check_quantity_arg(quantity)
-    src, fmt, kind, label = _open(source, filename, format, max_bytes)
-    if freq is not None and fmt != "uff":
-        raise DataFormatError("freq= applies to UFF files only; use FRF.interpolate after loading")
-    if name is not None and fmt != "hdf5":
-        raise DataFormatError("name= applies to HDF5 files only")
-    if fmt == "uff":
-        from .uff import read_uff
-
-        frf, notes, meta = read_uff(src, nodes=nodes, quantity=quantity, freq=freq, timeout=timeout)
-    elif fmt == "mat":
-        from .matlab import read_mat
-
-        frf, notes, meta = read_mat(src, kind, nodes=nodes, quantity=quantity, timeout=timeout)
-    elif fmt == "csv":
-        from .csv import read_csv
-
-        frf, notes, meta = read_csv(src, nodes=nodes, quantity=quantity, timeout=timeout)
-    else:
-        from .hdf5 import read_hdf5
-
-        frf, notes, meta = read_hdf5(
-            src, nodes=nodes, quantity=quantity, name=name, timeout=timeout
-        )
-    return _finish(frf, notes, meta, src.name, label, require_outputs, require_inputs)
-
-
-def _format_for(path: PathLike | None, format: str | None) -> str:
-    if format is not None:
-        if format not in FORMATS:
-            raise DataFormatError(f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
-        return format
-    if path is None:
-        raise DataFormatError(f"pass format=... (one of {', '.join(FORMATS)}) or a path")
-    suffix = Path(path).suffix.lower()
-    for fmt, ends in FORMATS.items():
-        if suffix in ends:
-            return fmt
-    raise DataFormatError(
-        f"cannot tell the format from {str(path)!r}; known endings: "
-        f"{', '.join(e for ends in FORMATS.values() for e in ends)}"
-    )
+    src = read_source(source, filename, max_bytes)
+    fmt, content = detect_format(src, format)
+    options = {k: v for k, v in (("freq", freq), ("name", name)) if v is not None}
+    for key in options.keys() - set(fmt.read_options):
+        having = " or ".join(f.label for f in REGISTRY.values() if key in f.read_options)
+        hint = "; use FRF.interpolate after loading" if key == "freq" else ""
+        raise DataFormatError(f"{key}= applies to {having} files only{hint}")
+    frf, notes, meta = fmt.read(src, nodes=nodes, quantity=quantity, timeout=timeout, **options)
+    label = fmt.contents[content]
+    return frf_import(frf, notes, meta, src.name, label, require_outputs, require_inputs)
 
 
 @overload
@@ -339,25 +242,11 @@ def save_frf(
     """
     if not isinstance(frf, FRF):
         raise DataFormatError(f"save_frf needs an FRF, got {type(frf).__name__}")
-    fmt = _format_for(path, format)
-    if fmt == "uff":
-        from .uff import write_uff
-
-        raw = write_uff(
-            frf, nodes=nodes, metadata=metadata, binary=binary, round_abscissa=round_abscissa
-        )
-    elif fmt == "mat":
-        from .matlab import write_mat
-
-        raw = write_mat(frf, version=mat_version, metadata=metadata)
-    elif fmt == "csv":
-        from .csv import write_csv
-
-        raw = write_csv(frf, metadata=metadata)
-    else:
-        from .hdf5 import write_hdf5
-
-        raw = write_hdf5(frf, metadata=metadata)
+    fmt = format_of(path, format)
+    given = {"nodes": nodes, "mat_version": mat_version, "binary": binary}
+    given["round_abscissa"] = round_abscissa
+    options = {fmt.write_options[k]: v for k, v in given.items() if k in fmt.write_options}
+    raw = fmt.write(frf, metadata=metadata, **options)
     return _deliver(raw, path)
 
 
@@ -415,22 +304,17 @@ def export_result(
         For unknown formats, objects that cannot be flattened, or UFF export of a
         result without a function of frequency.
     """
-    fmt = _format_for(path, format)
-    res = as_result_data(result, metadata)
-    if fmt == "csv":
-        from .results import result_to_csv
-
-        raw = result_to_csv(res)
-    elif fmt == "uff":
-        from .results import result_to_uff
-
-        raw = result_to_uff(res, nodes=nodes, round_abscissa=round_abscissa)
-    elif fmt == "hdf5":
-        from .results import result_to_hdf5
-
-        raw = result_to_hdf5(res)
-    else:
-        raise DataFormatError(f"results are exported as csv, uff or hdf5, not {fmt!r}")
+    fmt = format_of(path, format)
+    if fmt.export is None:
+        can = [f.name for f in REGISTRY.values() if f.export is not None]
+        raise DataFormatError(
+            f"results are exported as {', '.join(can[:-1])} or {can[-1]}, not {fmt.name!r}"
+        )
+    given = {"nodes": nodes, "round_abscissa": round_abscissa}
+    raw = fmt.export(
+        as_result_data(result, metadata),
+        **{k: v for k, v in given.items() if k in fmt.export_options},
+    )
     return _deliver(raw, path)
 
 
@@ -460,10 +344,10 @@ def load_result(
     DataFormatError
         For other formats or layouts and damaged files.
     """
-    src = read_source(source, filename, max_bytes)
-    fmt, _ = detect_format(src, None if src.suffix in FORMATS["hdf5"] else "hdf5")
     from .hdf5 import read_hdf5_result
 
+    src = read_source(source, filename, max_bytes)
+    detect_format(src, "hdf5")
     return read_hdf5_result(src, timeout=timeout)
 
 
@@ -496,28 +380,13 @@ def import_tire_model(
     DataFormatError
         For damaged files, missing variables, wrong shapes, non-finite values.
     """
-    src, fmt, kind, label = _open(source, filename, format, max_bytes)
-    if fmt == "mat":
-        from .modal import read_tire_mat
-
-        model = read_tire_mat(src, kind, timeout=timeout)
-    elif fmt == "hdf5":
-        from .modal import read_tire_native
-
-        model = read_tire_native(src, timeout=timeout)
-        label = "tire-fbs tire model"
-    else:
-        raise DataFormatError(
-            f"tire models are read from MATLAB (.mat) or the project's format (.h5), not {fmt!r}"
-        )
-    return ImportResult(
-        None,
-        f"{src.name} ({label}): " + describe_tire(model),
-        (),
-        dict(model.meta),
-        src.name,
-        label,
-        model,
+    src = read_source(source, filename, max_bytes)
+    fmt, content = detect_format(src, format)
+    if fmt.read_tire is None:
+        can = [f"{f.label} ({', '.join(f.suffixes)})" for f in REGISTRY.values() if f.read_tire]
+        raise DataFormatError(f"tire models are read from {' or '.join(can)}, not {fmt.name!r}")
+    return tire_import(
+        fmt.read_tire(src, timeout=timeout), src.name, fmt.tire_label or fmt.contents[content]
     )
 
 
@@ -538,22 +407,4 @@ def load_tire_model(
     )
     return import_tire_model(
         source, filename=filename, format=format, max_bytes=max_bytes, timeout=timeout
-    )
-
-
-def describe_tire(model: Any) -> str:
-    """Short summary of a tire model: operating points, modes, frequencies, wavelengths."""
-    import numpy as np
-
-    f = np.abs(np.asarray(model.poles).imag) / (2 * np.pi)
-    return "\n".join(
-        [
-            f"modal tire model, {model.n_modes} complex modes ({model.n_modes // 2} pairs), "
-            f"eigenfrequencies {f.min():.1f}-{f.max():.1f} Hz",
-            "operating points: " + ", ".join(f"{v:g}" for v in model.speeds) + " km/h",
-            "hub DOFs: " + ", ".join(model.hub_dofs),
-            "patch participation for wavelengths: "
-            + ", ".join(f"{w:g}" for w in model.wavelengths)
-            + " m",
-        ]
     )

@@ -220,6 +220,11 @@ def _split58(vals: np.ndarray, d: dict[str, Any]) -> tuple[np.ndarray, np.ndarra
 def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any], list[np.ndarray]]:
     """Split a Universal File into datasets and read 58/58b, 164 and 151.
 
+    The steps, dataset by dataset: where it opens (:func:`_opening`), its type line
+    (:func:`_type_of`), the announced extent of binary data (:func:`_binary_extent`),
+    where it closes (:func:`_closing`), then its content (:func:`_header_of_58` and
+    :func:`_values_of_58`, :func:`_units_164`, :func:`_header_151`).
+
     Parameters
     ----------
     raw : bytes
@@ -235,142 +240,36 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
     """
     sets: list[dict[str, Any]] = []
     arrays: list[np.ndarray] = []
+    lines = _Lines(raw)
     pos = 0
-    n = len(raw)
     empty = 0
     total = 0
-    mark = [0, 1]  # a position and its line number: lines are counted once, forwards
-
-    def line_at(q: int) -> int:
-        if q < mark[0]:
-            return _line_no(raw, q)
-        mark[1] += raw.count(b"\n", mark[0], q)
-        mark[0] = q
-        return mark[1]
-
-    while True:
-        m = _DELIM.search(raw, pos)
-        if m is None:
-            rest = raw[pos:]
-            if rest.strip():
-                ln = _line_no(raw, pos + len(rest) - len(rest.lstrip()))
-                raise ParseError(
-                    f"text after the last dataset at line {ln} ({_text(rest.strip()[:40])!r}"
-                    "...): every dataset must lie between two '    -1' lines; the file may be "
-                    "truncated or damaged"
-                )
-            break
-        junk = raw[pos : m.start()]
-        if junk.strip():
-            ln = _line_no(raw, pos + len(junk) - len(junk.lstrip()))
-            raise ParseError(
-                f"text outside a dataset at line {ln} ({_text(junk.strip()[:40])!r}): every "
-                "dataset must lie between two '    -1' lines"
-            )
-        p = m.end() + 1  # after the newline of the opening "-1"
-        if p > n:
-            raise ParseError(
-                f"the file ends at its line {_line_no(raw, n)} right after a '-1' line that "
-                "opens a dataset; it is truncated"
-            )
-        type_line, after_type = _next_line(raw, p)
+    while (p := _opening(raw, pos)) is not None:
+        type_line, body_start = _next_line(raw, p)
         if _DELIM.fullmatch(type_line):  # "-1" twice: an empty dataset
             empty += 1
-            pos = after_type
+            pos = body_start
             continue
-        tm = _TYPE.match(type_line)
-        if tm is None:
-            raise ParseError(
-                f"line {_line_no(raw, p)}: {_text(type_line[:40])!r} is not a dataset type "
-                "number (the line after '    -1' names the dataset, e.g. '    58')"
-            )
-        dtype = int(tm.group(1))
-        binary = bool(tm.group(2))
-        k = len(sets) + 1
-        line = line_at(p)
-        where = f"dataset {k} (type {dtype}{'b' if binary else ''}, line {line})"
-        body_start = after_type
-        bin_range = None
-        if binary:
-            if dtype != 58:
-                raise ParseError(f"{where}: binary datasets other than 58b are not read")
-            f = _text(tm.group(3))
-            try:
-                bo, fp, n_ascii, n_bytes = (int(x) for x in f.split()[:4])
-            except ValueError:
-                raise ParseError(f"{where}: damaged 58b header {_text(type_line)!r}") from None
-            if bo not in (1, 2) or fp != 2 or not 0 < n_ascii < 100 or n_bytes < 0:
-                raise ParseError(
-                    f"{where}: 58b header announces byte order {bo}, floating-point format "
-                    f"{fp}, {n_ascii} header lines; readable are byte order 1 (little "
-                    "endian) or 2 (big endian), format 2 (IEEE 754)"
-                )
-            q = body_start
-            lines = []
-            for _ in range(n_ascii):
-                if q >= n:
-                    raise ParseError(
-                        f"{where}: the file ends at its line {_line_no(raw, n)} inside the "
-                        "header of this dataset; it is truncated"
-                    )
-                hl, q = _next_line(raw, q)
-                lines.append(_text(hl))
-            if n_ascii < 11:
-                raise ParseError(f"{where}: the 58b header has {n_ascii} of 11 lines")
-            d58 = _header58(lines[:11], where)
-            size = 8 if d58["ord_data_type"] in (4, 6) else 4
-            need = _values_count(d58) * size
-            if need > n_bytes:
-                n_bytes = need  # some writers announce the count of one part only
-            if q + need > n:
-                raise ParseError(
-                    f"{where}: the binary data need {need} bytes but the file ends after "
-                    f"{n - q} of them (line {_line_no(raw, n)}, byte {n}); it is truncated"
-                )
-            bin_range = (q, q + need, bo)
-            search_from = q + need
-        else:
-            search_from = body_start
-        e = _CLOSE_BIN.match(raw, search_from) if binary else None
-        if e is None:
-            e = _DELIM.search(raw, search_from)
-        if e is None:
-            raise ParseError(
-                f"{where} has no closing '    -1' line: the file ends at its line "
-                f"{_line_no(raw, n)} (byte {n}) inside it; the file is truncated (nothing of "
-                "it is read rather than losing this dataset silently)"
-            )
+        dtype, binary, rest = _type_of(raw, p, type_line)
+        line = lines.at(p)
+        where = f"dataset {len(sets) + 1} (type {dtype}{'b' if binary else ''}, line {line})"
+        extent = _binary_extent(raw, body_start, dtype, rest, type_line, where) if binary else None
+        e = _closing(raw, body_start, extent, where)
         entry: dict[str, Any] = {"type": dtype, "binary": int(binary), "line": line}
         if dtype == 58:
-            hdr_end = body_start
-            lines = []
-            for _ in range(11):
-                if hdr_end >= (bin_range[0] if bin_range else e.start()):
-                    break
-                hl, hdr_end = _next_line(raw, hdr_end)
-                lines.append(_text(hl))
-            if len(lines) < 11:
-                raise ParseError(f"{where}: the header has {len(lines)} of 11 records")
-            d = _header58(lines, where)
-            want = _values_count(d)
-            total += want
+            d, data_start = _header_of_58(
+                raw, body_start, extent[0] if extent else e.start(), where
+            )
+            total += _values_count(d)
             if max_values is not None and total > max_values:
                 raise ParseError(
                     f"the datasets 58 hold more than {max_values} numbers, more than this "
                     "tool accepts from one file"
                 )
-            if bin_range:
-                a, b, bo = bin_range
-                size = 8 if d["ord_data_type"] in (4, 6) else 4
-                if want * size > b - a:
-                    raise ParseError(
-                        f"{where}: record 7 announces {d['num_pts']} values ({want * size} "
-                        f"bytes) but the binary data hold {b - a} bytes"
-                    )
-                dt = np.dtype(("<" if bo == 1 else ">") + ("f8" if size == 8 else "f4"))
-                vals = np.frombuffer(raw, dtype=dt, count=want, offset=a).astype(float)
+            if extent:
+                vals = _binary_values(raw, extent, d, where)
             else:
-                vals = _ascii_values(raw[hdr_end : e.start()], d, where, line_at(hdr_end))
+                vals = _ascii_values(raw[data_start : e.start()], d, where, lines.at(data_start))
             x, y = _split58(vals, d)
             d["data"] = len(arrays)
             arrays.append(y)
@@ -379,31 +278,188 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
                 arrays.append(x)
             entry.update(d)
         elif dtype == 164:
-            body = raw[body_start : e.start()].splitlines()
-            if len(body) < 3:
-                raise ParseError(f"{where}: a units dataset needs 3 lines, it has {len(body)}")
-            first = _text(body[0])
-            nums = _text(b" ".join(body[1:])).replace("D", "E").replace("d", "e").split()
-            try:
-                factors = [float(v) for v in nums[:4]]
-            except ValueError:
-                raise ParseError(f"{where}: damaged unit factors {nums[:4]}") from None
-            if len(factors) < 3:
-                raise ParseError(f"{where}: needs length, force and temperature factors")
-            entry.update(
-                units_code=_int(first[:10], where),
-                units_description=first[10:30].strip(),
-                temp_mode=_int(first[30:40], where) if first[30:40].strip() else 0,
-                length=factors[0],
-                force=factors[1],
-                temp=factors[2],
-                temp_offset=factors[3] if len(factors) > 3 else 0.0,
-            )
+            entry.update(_units_164(raw[body_start : e.start()].splitlines(), where))
         elif dtype == 151:
             body = raw[body_start : e.start()].splitlines()
             entry.update({f"line{i + 1}": _text(b).rstrip()[:80] for i, b in enumerate(body[:7])})
         sets.append(entry)
         pos = e.end()
+    return {"format": "uff", "sets": sets, "empty": empty, "contents": _contents(sets)}, arrays
+
+
+class _Lines:
+    """Line numbers of positions, counted once, forwards (positions mostly increase)."""
+
+    def __init__(self, raw: bytes) -> None:
+        self.raw = raw
+        self.mark = [0, 1]  # a position and its line number
+
+    def at(self, q: int) -> int:
+        if q < self.mark[0]:
+            return _line_no(self.raw, q)
+        self.mark[1] += self.raw.count(b"\n", self.mark[0], q)
+        self.mark[0] = q
+        return self.mark[1]
+
+
+def _opening(raw: bytes, pos: int) -> int | None:
+    """Where the next dataset's type line starts (after its opening ``-1`` line), or
+    None at the end of the file.
+
+    Raises
+    ------
+    ParseError
+        For text outside a dataset, and a file that ends right after an opening ``-1``.
+    """
+    m = _DELIM.search(raw, pos)
+    if m is None:
+        rest = raw[pos:]
+        if rest.strip():
+            ln = _line_no(raw, pos + len(rest) - len(rest.lstrip()))
+            raise ParseError(
+                f"text after the last dataset at line {ln} ({_text(rest.strip()[:40])!r}"
+                "...): every dataset must lie between two '    -1' lines; the file may be "
+                "truncated or damaged"
+            )
+        return None
+    junk = raw[pos : m.start()]
+    if junk.strip():
+        ln = _line_no(raw, pos + len(junk) - len(junk.lstrip()))
+        raise ParseError(
+            f"text outside a dataset at line {ln} ({_text(junk.strip()[:40])!r}): every "
+            "dataset must lie between two '    -1' lines"
+        )
+    p = m.end() + 1  # after the newline of the opening "-1"
+    if p > len(raw):
+        raise ParseError(
+            f"the file ends at its line {_line_no(raw, len(raw))} right after a '-1' line "
+            "that opens a dataset; it is truncated"
+        )
+    return p
+
+
+def _type_of(raw: bytes, p: int, type_line: bytes) -> tuple[int, bool, bytes]:
+    """Dataset type, binary flag (``58b``) and the rest of the type line."""
+    tm = _TYPE.match(type_line)
+    if tm is None:
+        raise ParseError(
+            f"line {_line_no(raw, p)}: {_text(type_line[:40])!r} is not a dataset type "
+            "number (the line after '    -1' names the dataset, e.g. '    58')"
+        )
+    return int(tm.group(1)), bool(tm.group(2)), tm.group(3)
+
+
+def _binary_extent(
+    raw: bytes, body_start: int, dtype: int, rest: bytes, type_line: bytes, where: str
+) -> tuple[int, int, int]:
+    """Start, end and byte order (1 little, 2 big endian) of a 58b dataset's binary data,
+    from its type line and header (so that bytes looking like ``-1`` inside the data do
+    not end the dataset)."""
+    n = len(raw)
+    if dtype != 58:
+        raise ParseError(f"{where}: binary datasets other than 58b are not read")
+    try:
+        bo, fp, n_ascii, n_bytes = (int(x) for x in _text(rest).split()[:4])
+    except ValueError:
+        raise ParseError(f"{where}: damaged 58b header {_text(type_line)!r}") from None
+    if bo not in (1, 2) or fp != 2 or not 0 < n_ascii < 100 or n_bytes < 0:
+        raise ParseError(
+            f"{where}: 58b header announces byte order {bo}, floating-point format "
+            f"{fp}, {n_ascii} header lines; readable are byte order 1 (little "
+            "endian) or 2 (big endian), format 2 (IEEE 754)"
+        )
+    q = body_start
+    lines = []
+    for _ in range(n_ascii):
+        if q >= n:
+            raise ParseError(
+                f"{where}: the file ends at its line {_line_no(raw, n)} inside the "
+                "header of this dataset; it is truncated"
+            )
+        hl, q = _next_line(raw, q)
+        lines.append(_text(hl))
+    if n_ascii < 11:
+        raise ParseError(f"{where}: the 58b header has {n_ascii} of 11 lines")
+    d58 = _header58(lines[:11], where)
+    need = _values_count(d58) * (8 if d58["ord_data_type"] in (4, 6) else 4)
+    # some writers announce the count of one part only: the header's count is what counts
+    if q + need > n:
+        raise ParseError(
+            f"{where}: the binary data need {need} bytes but the file ends after "
+            f"{n - q} of them (line {_line_no(raw, n)}, byte {n}); it is truncated"
+        )
+    return q, q + need, bo
+
+
+def _closing(
+    raw: bytes, body_start: int, extent: tuple[int, int, int] | None, where: str
+) -> re.Match[bytes]:
+    """The ``-1`` line that closes the dataset (after its binary data, if any)."""
+    e = _CLOSE_BIN.match(raw, extent[1]) if extent else None
+    if e is None:
+        e = _DELIM.search(raw, extent[1] if extent else body_start)
+    if e is None:
+        raise ParseError(
+            f"{where} has no closing '    -1' line: the file ends at its line "
+            f"{_line_no(raw, len(raw))} (byte {len(raw)}) inside it; the file is truncated "
+            "(nothing of it is read rather than losing this dataset silently)"
+        )
+    return e
+
+
+def _header_of_58(raw: bytes, start: int, stop: int, where: str) -> tuple[dict[str, Any], int]:
+    """Records 1-11 of a dataset 58 (up to ``stop``) and where its data start."""
+    lines = []
+    pos = start
+    for _ in range(11):
+        if pos >= stop:
+            break
+        hl, pos = _next_line(raw, pos)
+        lines.append(_text(hl))
+    if len(lines) < 11:
+        raise ParseError(f"{where}: the header has {len(lines)} of 11 records")
+    return _header58(lines, where), pos
+
+
+def _binary_values(
+    raw: bytes, extent: tuple[int, int, int], d: dict[str, Any], where: str
+) -> np.ndarray:
+    a, b, bo = extent
+    want = _values_count(d)
+    size = 8 if d["ord_data_type"] in (4, 6) else 4
+    if want * size > b - a:
+        raise ParseError(
+            f"{where}: record 7 announces {d['num_pts']} values ({want * size} "
+            f"bytes) but the binary data hold {b - a} bytes"
+        )
+    dt = np.dtype(("<" if bo == 1 else ">") + ("f8" if size == 8 else "f4"))
+    return np.frombuffer(raw, dtype=dt, count=want, offset=a).astype(float)
+
+
+def _units_164(body: list[bytes], where: str) -> dict[str, Any]:
+    if len(body) < 3:
+        raise ParseError(f"{where}: a units dataset needs 3 lines, it has {len(body)}")
+    first = _text(body[0])
+    nums = _text(b" ".join(body[1:])).replace("D", "E").replace("d", "e").split()
+    try:
+        factors = [float(v) for v in nums[:4]]
+    except ValueError:
+        raise ParseError(f"{where}: damaged unit factors {nums[:4]}") from None
+    if len(factors) < 3:
+        raise ParseError(f"{where}: needs length, force and temperature factors")
+    return dict(
+        units_code=_int(first[:10], where),
+        units_description=first[10:30].strip(),
+        temp_mode=_int(first[30:40], where) if first[30:40].strip() else 0,
+        length=factors[0],
+        force=factors[1],
+        temp=factors[2],
+        temp_offset=factors[3] if len(factors) > 3 else 0.0,
+    )
+
+
+def _contents(sets: list[dict[str, Any]]) -> dict[str, int]:
+    """How many datasets of each kind (FRFs, spectra, ... by function type) the file holds."""
     counts: dict[str, int] = {}
     for s in sets:
         if s["type"] == 58:
@@ -411,10 +467,16 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
         else:
             key = f"dataset {s['type']}"
         counts[key] = counts.get(key, 0) + 1
-    return {"format": "uff", "sets": sets, "empty": empty, "contents": counts}, arrays
+    return counts
 
 
 # -- CSV ---------------------------------------------------------------------------------
+#: Most columns of a CSV file: 10,000 complex FRF columns (e.g. 1,666 output DOFs x 6
+#: inputs). Each column becomes labels and Python objects in the server process: a file of
+#: 100,000 columns (4 MB) took 17 s and 160 MB there (issue 28).
+MAX_COLUMNS = 20_000
+
+
 def parse_csv(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any], list[np.ndarray]]:
     """The ``#`` header lines, the column-header row and the data rows of a CSV file.
 
@@ -433,6 +495,7 @@ def parse_csv(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
     """
     if raw.startswith(b"\xef\xbb\xbf"):
         raw = raw[3:]
+    raw = _lf(raw)
     nul = raw.find(b"\x00")
     if nul >= 0:
         raise ParseError(f"contains NUL bytes (line {_line_no(raw, nul)}); not a text file")
@@ -455,6 +518,11 @@ def parse_csv(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
         raise ParseError("has no header row (after the '#' lines)")
     htext = _utf8(header, line)
     delim = max((",", ";", "\t"), key=htext.count)
+    if htext.count(delim) >= MAX_COLUMNS:
+        raise ParseError(
+            f"has {htext.count(delim) + 1:,} columns (line {line}), more than the "
+            f"{MAX_COLUMNS:,} this tool reads from one CSV file"
+        )
     cells = next(csv.reader([htext], delimiter=delim))
     ncol = len(cells)
     body_start = nxt
@@ -497,6 +565,14 @@ def parse_csv(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
         },
         [a.reshape(-1, ncol) if a.size else np.empty((0, ncol))],
     )
+
+
+def _lf(raw: bytes) -> bytes:
+    """Lines of a file that ends them with CR alone (classic Mac OS, some exporters) as LF
+    lines; other files as they are (CRLF lines are read as they are)."""
+    if b"\r" in raw and b"\n" not in raw:
+        return raw.replace(b"\r", b"\n")
+    return raw
 
 
 def _utf8(b: bytes, line: int) -> str:

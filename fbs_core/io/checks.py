@@ -1,5 +1,8 @@
 """Input checks shared by the importers: size, magic bytes, labels, DOFs, grids.
 
+Which format a file is (its ending, checked against what :func:`sniff` finds): see
+:mod:`fbs_core.io.formats`.
+
 Units and quantities are checked in :mod:`fbs_core.io.units` (re-exported here).
 
 Every check raises a subclass of :class:`~fbs_core.errors.FBSError` whose
@@ -48,11 +51,9 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_MAX_BYTES",
-    "FORMATS",
     "Source",
     "read_source",
     "sniff",
-    "detect_format",
     "normalize_label",
     "rename_node",
     "Units",
@@ -78,14 +79,6 @@ __all__ = [
 
 #: Default upper limit of a file's size in bytes (100 MiB).
 DEFAULT_MAX_BYTES = 100 * 1024 * 1024
-
-#: File formats by name and the file-name endings that select them.
-FORMATS: dict[str, tuple[str, ...]] = {
-    "uff": (".uff", ".unv", ".uf", ".58"),
-    "mat": (".mat",),
-    "csv": (".csv", ".txt"),
-    "hdf5": (".h5", ".hdf5", ".hdf"),
-}
 
 
 @dataclass(frozen=True)
@@ -208,60 +201,6 @@ def sniff(raw: bytes) -> str:
     if first.strip() == "-1":
         return "uff"
     return "text"
-
-
-_EXPECTED = {
-    "uff": ("uff",),
-    "mat": ("mat5", "mat73"),
-    "csv": ("text",),
-    "hdf5": ("hdf5", "mat73"),
-}
-_NAMES = {
-    "uff": "Universal File (dataset 58)",
-    "mat": "MATLAB MAT-file (v5 or v7.3)",
-    "csv": "CSV text file",
-    "hdf5": "HDF5 file",
-    "mat5": "a MATLAB v5 MAT-file",
-    "mat73": "a MATLAB v7.3 MAT-file",
-    "hdf5-content": "an HDF5 file",
-    "text": "a text file",
-}
-
-
-def detect_format(src: Source, format: str | None = None) -> tuple[str, str]:
-    """Choose the format from ``format`` or the file-name ending and check the content.
-
-    Returns
-    -------
-    (format, kind) : tuple of str
-        ``format`` in :data:`FORMATS`; ``kind`` what :func:`sniff` found.
-
-    Raises
-    ------
-    DataFormatError
-        For an unknown format or ending, or content that is not what the name says
-        (e.g. a ZIP archive named ``.uff``).
-    """
-    if format is None:
-        for fmt, endings in FORMATS.items():
-            if src.suffix in endings:
-                format = fmt
-                break
-        else:
-            known = ", ".join(e for ends in FORMATS.values() for e in ends)
-            raise DataFormatError(
-                f"cannot tell the format of {src.name!r} from its name; "
-                f"known endings: {known} (or pass format=...)"
-            )
-    if format not in FORMATS:
-        raise DataFormatError(f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
-    kind = sniff(src.raw)
-    if kind not in _EXPECTED[format]:
-        found = _NAMES.get(kind, _NAMES.get(kind + "-content", kind))
-        raise DataFormatError(
-            f"file {src.name!r} should be a {_NAMES[format]} but its content is {found}"
-        )
-    return format, kind
 
 
 # -- DOF labels ------------------------------------------------------------------------

@@ -25,34 +25,20 @@ UTF-8.
 
 from __future__ import annotations
 
-import csv as _csv
-import io
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
 
 from ..errors import DataFormatError
 from ..frf import FRF
+from ..units import Units, kinds_of, parse_units
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
-from .checks import (
-    Source,
-    Units,
-    frequency_from_units,
-    kinds_text,
-    missing_pairs,
-    normalize_label,
-    parse_kinds,
-    parse_units,
-    reconcile_quantity,
-    rename_node,
-    si_factors,
-    units_line,
-    units_note,
-)
+from .assembly import FileUnits, assemble, dof_labels
+from .checks import Source, frequency_from_units, kinds_text, missing_pairs, units_line
 
-__all__ = ["read_csv", "write_csv", "write_csv_tables"]
+__all__ = ["read_csv", "write_csv", "safe_cell", "safe_text"]
 
 _COL = re.compile(
     r"^\s*(re|im|mag|abs|phase|ph)\s*[\(\[]\s*(.+?)\s*[\)\]]\s*(?:\[\s*([^\]]*?)\s*\])?\s*$", re.I
@@ -70,6 +56,14 @@ def _split_pair(text: str, where: str) -> tuple[str, str]:
     return o.strip(), i.strip()
 
 
+#: Header keys that describe the layout; every other ``# key: value`` line is metadata.
+_LAYOUT_KEYS = ("quantity", "units", "layout", "phase_unit", "freq_unit", "kinds")
+_PARTS = {"re": "re", "im": "im", "mag": "mag", "abs": "mag", "phase": "ph", "ph": "ph"}
+#: Columns of one output/input pair as written: part ("re", "im", "mag", "ph") -> column.
+_Columns = dict[str, int]
+_Pair = tuple[str, str]
+
+
 def read_csv(
     src: Source,
     *,
@@ -81,7 +75,10 @@ def read_csv(
 
     The numbers are parsed in the sandbox process (:func:`._textparse.parse_csv`, under
     its time and memory limits); this process receives the header lines and one float
-    array.
+    array. Steps: the ``#`` lines (:func:`_key_values`), the column header
+    (:func:`_value_columns`), the data block by output/input pair (:func:`_pairs`,
+    :func:`_matrix`), then :func:`.assembly.assemble` and the check of the column units
+    (:func:`_check_column_units`).
 
     Raises
     ------
@@ -90,47 +87,112 @@ def read_csv(
     """
     name = src.name
     parsed, (a,) = parse_isolated("csv", src.raw, f"CSV file {name!r}", timeout=timeout)
-    meta: dict[str, str] = {}
-    for body in parsed["comments"]:
-        if ":" in body:
-            key, _, val = body.partition(":")
-            meta[key.strip().lower()] = val.strip()
-    k = int(parsed["header_line"]) - 1
+    meta = _key_values(parsed["comments"])
+    line = int(parsed["header_line"])
     header = [str(h).strip() for h in parsed["header"]]
     m = _FREQ.match(header[0]) if header else None
     if not m:
         raise DataFormatError(
-            f"{name!r} line {k + 1}: the first column must be the frequency ('freq' or "
+            f"{name!r} line {line}: the first column must be the frequency ('freq' or "
             f"'freq [Hz]'), got {header[0] if header else ''!r}"
         )
-    freq_unit = m.group(2) or meta.get("freq_unit")
-    layout = meta.get("layout", "").lower()
     phase_unit = meta.get("phase_unit", "deg").lower()
     if phase_unit not in ("deg", "rad"):
         raise DataFormatError(f"{name!r}: phase_unit {phase_unit!r}; allowed: deg, rad")
-    cols: dict[tuple[str, str], dict[str, int]] = {}
-    col_units: dict[tuple[str, str], str] = {}  # optional "[unit]" after a column name
+    cols, col_units, layout = _value_columns(header, line, name, meta.get("layout", ""))
+    if a.shape[0] == 0:
+        raise DataFormatError(f"{name!r} has no data rows")
+    if not np.all(np.isfinite(a)):
+        r, c = np.argwhere(~np.isfinite(a))[0]
+        raise DataFormatError(
+            f"{name!r}: non-finite value (NaN or inf) in data row {r + 1}, column {c + 1} "
+            f"({header[c]!r})"
+        )
+    freq = frequency_from_units(a[:, 0], m.group(2) or meta.get("freq_unit"), repr(name))
+    pairs, entry_units = _pairs(cols, col_units, nodes, name)
+    outputs = list(dict.fromkeys(o for o, _ in pairs))
+    inputs = list(dict.fromkeys(i for _, i in pairs))
+    n_missing, missing = missing_pairs(outputs, inputs, pairs)
+    if n_missing:
+        shown = ", ".join(f"{o} / {i}" for o, i in missing)
+        raise DataFormatError(
+            f"{name!r}: {n_missing} output/input pairs have no columns: {shown}; a full "
+            "matrix of outputs x inputs is needed"
+        )
+    data, signs = _matrix(a, pairs, outputs, inputs, layout, phase_unit)
+    line_label = meta.get("units") or None
+    if line_label is None and entry_units and len(entry_units) != len(pairs):
+        # no unit line: the columns' own units say it (all of them, or it is ambiguous)
+        raise DataFormatError(
+            f"{name!r}: {len(entry_units)} of {len(pairs)} output/input pairs give a "
+            "unit after their column name and there is no '# units:' line; give every "
+            "pair its unit, or the unit line"
+        )
+    stated = {pair: _parse_column_unit(pair, text, name) for pair, text in entry_units.items()}
+    if line_label is None:
+        units = FileUnits(dict(entry_units))
+    else:  # the line governs; the columns serve only where the line is not understood
+        units = FileUnits(line_label, stated or None)
+    frf, notes = assemble(
+        freq,
+        data,
+        outputs,
+        inputs,
+        where=repr(name),
+        quantity=quantity,
+        declared=meta.get("quantity") or None,
+        units=units,
+        kinds=meta.get("kinds"),
+        signs=signs,
+    )
+    if stated:
+        notes += _check_column_units(stated, frf, parse_units(line_label), name)
+    return frf, notes, {k: v for k, v in meta.items() if k not in _LAYOUT_KEYS}
+
+
+def _key_values(comments: Iterable[str]) -> dict[str, str]:
+    """The ``key: value`` pairs of the ``#`` lines (keys in lower case)."""
+    meta: dict[str, str] = {}
+    for body in comments:
+        if ":" in body:
+            key, _, val = body.partition(":")
+            meta[key.strip().lower()] = val.strip()
+    return meta
+
+
+def _value_columns(
+    header: list[str], line: int, name: str, layout: str
+) -> tuple[dict[_Pair, _Columns], dict[_Pair, str], str]:
+    """The FRF columns of the header row by output/input pair as written, the unit written
+    after them (``[unit]``), and the layout (``"re-im"`` or ``"mag-phase"``).
+
+    Raises
+    ------
+    DataFormatError
+        For a header that is not ``Re(out / in)`` ..., a column given twice, two units of
+        one pair, pairs without both parts or of mixed layouts, or a layout line that
+        contradicts the columns.
+    """
+    cols: dict[_Pair, _Columns] = {}
+    col_units: dict[_Pair, str] = {}
     for c, h in enumerate(header[1:], start=1):
         mm = _COL.match(h)
         if not mm:
             raise DataFormatError(
-                f"{name!r} line {k + 1} column {c + 1}: header {h!r} is not Re(out / in), "
+                f"{name!r} line {line} column {c + 1}: header {h!r} is not Re(out / in), "
                 "Im(out / in), Mag(out / in) or Phase(out / in)"
             )
-        part = {"re": "re", "im": "im", "mag": "mag", "abs": "mag", "phase": "ph", "ph": "ph"}[
-            mm.group(1).lower()
-        ]
-        o, i = _split_pair(mm.group(2), f"{name!r} column {c + 1}")
-        key = (o, i)
+        part = _PARTS[mm.group(1).lower()]
+        key = _split_pair(mm.group(2), f"{name!r} column {c + 1}")
         if part in cols.setdefault(key, {}):
             raise DataFormatError(f"{name!r}: column {h!r} appears twice")
         cols[key][part] = c
-        if mm.group(3) and part in ("re", "im", "mag"):
-            if col_units.setdefault(key, mm.group(3)) != mm.group(3):
-                raise DataFormatError(
-                    f"{name!r}: the columns of {o} / {i} give two units, "
-                    f"{col_units[key]!r} and {mm.group(3)!r}"
-                )
+        unit = mm.group(3)
+        if unit and part in ("re", "im", "mag") and col_units.setdefault(key, unit) != unit:
+            raise DataFormatError(
+                f"{name!r}: the columns of {key[0]} / {key[1]} give two units, "
+                f"{col_units[key]!r} and {unit!r}"
+            )
     if not cols:
         raise DataFormatError(f"{name!r} has a frequency column but no FRF columns")
     kinds = {frozenset(v) for v in cols.values()}
@@ -144,154 +206,125 @@ def read_csv(
             f"{name!r}: pair {bad[0]} / {bad[1]} has columns {sorted(cols[bad])}; every pair "
             "needs Re and Im, or Mag and Phase, and all pairs the same layout"
         )
-    if layout and layout != got:
-        raise DataFormatError(f"{name!r}: header says layout {layout!r} but columns are {got}")
-
-    if a.shape[0] == 0:
-        raise DataFormatError(f"{name!r} has no data rows")
-    if not np.all(np.isfinite(a)):
-        r, c = np.argwhere(~np.isfinite(a))[0]
+    if layout and layout.lower() != got:
         raise DataFormatError(
-            f"{name!r}: non-finite value (NaN or inf) in data row {r + 1}, column {c + 1} "
-            f"({header[c]!r})"
+            f"{name!r}: header says layout {layout.lower()!r} but columns are {got}"
         )
-    freq = frequency_from_units(a[:, 0], freq_unit, repr(name))
+    return cols, col_units, got
 
-    norm = {}
-    labels: dict[tuple[str, str], tuple[str, int]] = {}
 
-    def norm_label(text: str, what: str) -> tuple[str, int]:
-        key = (text, what)
-        if key not in labels:
-            lab, sign = normalize_label(text, what)
-            labels[key] = (rename_node(lab, nodes), sign)
-        return labels[key]
+def _pairs(
+    cols: Mapping[_Pair, _Columns],
+    col_units: Mapping[_Pair, str],
+    nodes: Mapping[Any, Any] | None,
+    name: str,
+) -> tuple[dict[_Pair, tuple[_Columns, float]], dict[_Pair, str]]:
+    """The columns and sign of every pair by its normalised labels
+    (:func:`.assembly.dof_labels`), and the units written after the columns by pair.
 
-    entry_units: dict[tuple[str, str], str] = {}
+    Raises
+    ------
+    DOFError
+        For labels that are not DOF labels.
+    DataFormatError
+        For two column pairs that name the same output/input pair.
+    """
+    o_text = list(dict.fromkeys(o for o, _ in cols))
+    i_text = list(dict.fromkeys(i for _, i in cols))
+    outs = dict(zip(o_text, zip(*dof_labels(o_text, "output", nodes), strict=True), strict=True))
+    ins = dict(zip(i_text, zip(*dof_labels(i_text, "input", nodes), strict=True), strict=True))
+    pairs: dict[_Pair, tuple[_Columns, float]] = {}
+    units: dict[_Pair, str] = {}
     for (o, i), v in cols.items():
-        (lo, so), (li, si) = norm_label(o, "output"), norm_label(i, "input")
-        key = (lo, li)
-        if key in norm:
-            raise DataFormatError(f"{name!r}: two column pairs for {key[0]} / {key[1]}")
-        norm[key] = (v, so * si)
+        (lo, so), (li, si) = outs[o], ins[i]
+        if (lo, li) in pairs:
+            raise DataFormatError(f"{name!r}: two column pairs for {lo} / {li}")
+        pairs[(lo, li)] = (v, float(so * si))
         if (o, i) in col_units:
-            entry_units[key] = col_units[(o, i)]
-    outputs = list(dict.fromkeys(o for o, _ in norm))
-    inputs = list(dict.fromkeys(i for _, i in norm))
-    n_missing, missing = missing_pairs(outputs, inputs, norm)
-    if n_missing:
-        shown = ", ".join(f"{o} / {i}" for o, i in missing)
-        raise DataFormatError(
-            f"{name!r}: {n_missing} output/input pairs have no columns: {shown}; a full "
-            "matrix of outputs x inputs is needed"
-        )
+            units[(lo, li)] = col_units[(o, i)]
+    return pairs, units
+
+
+def _matrix(
+    a: np.ndarray,
+    pairs: Mapping[_Pair, tuple[_Columns, float]],
+    outputs: list[str],
+    inputs: list[str],
+    layout: str,
+    phase_unit: str,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The data block ``(n_freq, n_out, n_in)`` from the columns of ``a`` and the sign of
+    every entry ``(n_out, n_in)``."""
     o_pos = {o: k for k, o in enumerate(outputs)}
     i_pos = {i: k for k, i in enumerate(inputs)}
-    first, second = ("re", "im") if got == "re-im" else ("mag", "ph")
-    c1 = np.fromiter((v[first] for v, _ in norm.values()), np.intp, len(norm))
-    c2 = np.fromiter((v[second] for v, _ in norm.values()), np.intp, len(norm))
-    sg = np.fromiter((s for _, s in norm.values()), float, len(norm))
-    oi = np.fromiter((o_pos[o] for o, _ in norm), np.intp, len(norm))
-    ii = np.fromiter((i_pos[i] for _, i in norm), np.intp, len(norm))
-    if got == "re-im":
+    n = len(pairs)
+    first, second = ("re", "im") if layout == "re-im" else ("mag", "ph")
+    c1 = np.fromiter((v[first] for v, _ in pairs.values()), np.intp, n)
+    c2 = np.fromiter((v[second] for v, _ in pairs.values()), np.intp, n)
+    oi = np.fromiter((o_pos[o] for o, _ in pairs), np.intp, n)
+    ii = np.fromiter((i_pos[i] for _, i in pairs), np.intp, n)
+    if layout == "re-im":
         z = a[:, c1] + 1j * a[:, c2]
     else:
         z = a[:, c1] * np.exp(1j * a[:, c2] * (np.pi / 180 if phase_unit == "deg" else 1.0))
     data = np.empty((a.shape[0], len(outputs), len(inputs)), dtype=complex)
-    data[:, oi, ii] = z * sg
-    notes = []
-    units = parse_units(meta.get("units"))
-    if meta.get("units") and units is None:
-        notes.append(f"units {meta['units']!r} not understood; not checked")
-    if not meta.get("units") and entry_units:
-        # no unit line: the columns' own units say it (all of them, or it is ambiguous)
-        if len(entry_units) != len(norm):
-            raise DataFormatError(
-                f"{name!r}: {len(entry_units)} of {len(norm)} output/input pairs give a "
-                "unit after their column name and there is no '# units:' line; give every "
-                "pair its unit, or the unit line"
-            )
-    declared = units
-    if not meta.get("units") and entry_units:
-        declared = _parse_column_unit(next(iter(entry_units.items())), name)
-    q = reconcile_quantity(
-        meta.get("quantity") or None, declared, quantity, repr(name), meta.get("units")
-    )
-    frf = FRF(freq, data, outputs, inputs, q, kinds=parse_kinds(meta.get("kinds"), repr(name)))
-    notes += units_note(units)
-    factors = None
-    if units is not None:
-        factors = si_factors(units, outputs, inputs, frf.kinds, q)
-    if entry_units:
-        factors, differ = _column_factors(entry_units, factors, frf, q, o_pos, i_pos, name)
-        if differ:
-            notes.append(
-                f"the unit line {meta['units']!r} governs; {len(differ)} column pairs state "
-                f"another scale, e.g. {differ[0]}"
-            )
-        else:
-            notes.append(f"units of {len(entry_units)} column pairs checked")
-    if factors is not None and not np.all(factors == 1.0):
-        frf = frf.replace(data=frf.data * factors[None])
-        came = units.label if units is not None else "the column units"
-        notes.append(f"converted from {came} to SI ({frf.unit()})")
-    extra = {
-        k: v
-        for k, v in meta.items()
-        if k not in ("quantity", "units", "layout", "phase_unit", "freq_unit", "kinds")
-    }
-    return frf, notes, extra
+    data[:, oi, ii] = z
+    signs = np.ones((len(outputs), len(inputs)))
+    signs[oi, ii] = np.fromiter((s for _, s in pairs.values()), float, n)
+    return data, signs
 
 
-def _parse_column_unit(item: tuple[tuple[str, str], str], name: str) -> Units:
-    (o, i), text = item
+def _parse_column_unit(pair: _Pair, text: str, name: str) -> Units:
     u = parse_units(text)
     if u is None or u.quantity is None:
         raise DataFormatError(
-            f"{name!r}: the unit {text!r} after the columns of {o} / {i} is not understood "
-            "as an FRF unit (known: m mm cm um in ft / N kN mN lbf / s ms / rad deg / g, "
-            "e.g. '(m/s)/m', 'rad/(N m s)', 'mm/(s N)')"
+            f"{name!r}: the unit {text!r} after the columns of {pair[0]} / {pair[1]} is not "
+            "understood as an FRF unit (known: m mm cm um in ft / N kN mN lbf / s ms / rad "
+            "deg / g, e.g. '(m/s)/m', 'rad/(N m s)', 'mm/(s N)')"
         )
     return u
 
 
-def _column_factors(
-    entry_units: Mapping[tuple[str, str], str],
-    factors: np.ndarray | None,
-    frf: FRF,
-    q: str,
-    o_pos: Mapping[str, int],
-    i_pos: Mapping[str, int],
-    name: str,
-) -> tuple[np.ndarray, list[str]]:
-    """SI factors from the unit written after each column name, checked against the kind
-    of each entry (a rotation is not in m). Where the file has a unit line, that line
-    governs the scale (a file whose unit line was edited by hand reads as the line says);
-    the pairs whose column unit gives another scale are returned for the import notes."""
-    from ..units import input_kind, output_kind
+def _check_column_units(
+    stated: Mapping[_Pair, Units], frf: FRF, line: Units | None, name: str
+) -> list[str]:
+    """Check the unit written after each column name against the kind of its entry (a
+    rotation is not in m) and the quantity; where the file has a unit line understood,
+    that line governs the scale (a file whose unit line was edited by hand reads as the
+    line says) and the pairs whose column unit gives another scale are noted.
 
-    out = np.ones((len(o_pos), len(i_pos))) if factors is None else factors.copy()
+    Raises
+    ------
+    DataFormatError
+        For a column unit of another kind or quantity than its entry.
+    """
+    ok, ik = kinds_of(frf.outputs, frf.inputs, frf.kinds)
+    o_pos = {o: k for k, o in enumerate(frf.outputs)}
+    i_pos = {i: k for k, i in enumerate(frf.inputs)}
+    q = frf.quantity
     differ: list[str] = []
-    for (o, i), text in entry_units.items():
-        u = _parse_column_unit(((o, i), text), name)
-        ok, ik = output_kind(o, frf.kinds), input_kind(i, frf.kinds)
-        if u.kinds is not None and u.kinds != (ok, ik):
+    for (o, i), u in stated.items():
+        kinds = (ok[o_pos[o]], ik[i_pos[i]])
+        if u.kinds is not None and u.kinds != kinds:
             raise DataFormatError(
-                f"{name!r}: the unit {text!r} of {o} / {i} is that of a {u.kinds[0]} per "
-                f"{u.kinds[1]}, but {o} is a {ok} and {i} a {ik}"
+                f"{name!r}: the unit {u.label!r} of {o} / {i} is that of a {u.kinds[0]} per "
+                f"{u.kinds[1]}, but {o} is a {kinds[0]} and {i} a {kinds[1]}"
             )
         if u.quantity != q:
             raise DataFormatError(
-                f"{name!r}: the unit {text!r} of {o} / {i} is that of a {u.quantity}, the "
+                f"{name!r}: the unit {u.label!r} of {o} / {i} is that of a {u.quantity}, the "
                 f"file holds a {q}"
             )
-        f = u.factor(ok, ik, q)
-        a, b = o_pos[o], i_pos[i]
-        if factors is None:
-            out[a, b] = f
-        elif not np.isclose(f, factors[a, b], rtol=1e-9, atol=0.0):
-            differ.append(f"{o} / {i} [{text}]")
-    return out, differ
+        if line is not None and not np.isclose(
+            u.factor(*kinds, q), line.factor(*kinds, q), rtol=1e-9, atol=0.0
+        ):
+            differ.append(f"{o} / {i} [{u.label}]")
+    if differ and line is not None:
+        return [
+            f"the unit line {line.label!r} governs; {len(differ)} column pairs state another "
+            f"scale, e.g. {differ[0]}"
+        ]
+    return [f"units of {len(stated)} column pairs checked"]
 
 
 def _header(metadata: Mapping[str, Any] | None, title: str) -> list[str]:
@@ -348,33 +381,3 @@ def write_csv(frf: FRF, *, metadata: Mapping[str, Any] | None = None) -> bytes:
     block[:, 1::2], block[:, 2::2] = d.real, d.imag
     lines += [",".join(map(repr, row)) for row in block.tolist()]
     return ("\n".join(lines) + "\n").encode()
-
-
-def write_csv_tables(
-    tables: list[tuple[str, list[str], np.ndarray]],
-    metadata: Mapping[str, Any] | None = None,
-    title: str = "result",
-) -> bytes:
-    """Several tables in one CSV text, each introduced by ``# table: <name>``.
-
-    ``tables`` holds ``(name, column_names, rows)`` with ``rows`` a 2-D array;
-    tables are separated by a blank line.
-    """
-    out = io.StringIO()
-    out.write("\n".join(_header(metadata, title)) + "\n")
-    for name, columns, rows in tables:
-        out.write(f"\n# table: {name}\n")
-        w = _csv.writer(out, lineterminator="\n")
-        w.writerow(columns)
-        for row in np.atleast_2d(rows):
-            w.writerow(
-                [
-                    safe_cell(x)
-                    if isinstance(x, str)
-                    else repr(float(x))
-                    if np.isreal(x)
-                    else repr(complex(x))
-                    for x in row
-                ]
-            )
-    return out.getvalue().encode()

@@ -28,23 +28,11 @@ import numpy as np
 from ..errors import DataFormatError
 from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
+from .assembly import FileUnits, assemble, dof_labels, metadata_from_json
+from .checks import Source, check_finite, frequency_from_units, kinds_text, units_line
 
 if TYPE_CHECKING:
     from .results import ResultData
-from .checks import (
-    Source,
-    check_finite,
-    frequency_from_units,
-    kinds_text,
-    normalize_label,
-    parse_kinds,
-    parse_units,
-    reconcile_quantity,
-    rename_node,
-    si_factors,
-    units_line,
-    units_note,
-)
 
 __all__ = ["read_hdf5", "read_hdf5_result", "write_hdf5", "write_hdf5_result", "root_attrs"]
 
@@ -203,39 +191,27 @@ def read_hdf5(
             f"{what}: {base}/data has shape {data.shape}, expected (n_freq, n_out, n_in) = "
             f"{expected} from freq, outputs and inputs"
         )
-    (outs, so), (ins, si) = (
-        zip(*(normalize_label(x, w) for x in lab), strict=True)
-        for lab, w in ((raw_o, "output"), (raw_i, "input"))
+    outs, so = dof_labels(raw_o, "output", nodes)
+    ins, si = dof_labels(raw_i, "input", nodes)
+
+    def text(key: str) -> str | None:
+        value = attrs.get(key)
+        return value if isinstance(value, str) else None
+
+    frf, notes = assemble(
+        freq,
+        data,
+        outs,
+        ins,
+        where=what,
+        quantity=quantity,
+        declared=text("quantity") or None,
+        units=FileUnits(text("units")),
+        kinds=attrs.get("kinds"),
+        signs=np.outer(so, si),
     )
-    outs = tuple(rename_node(x, nodes) for x in outs)
-    ins = tuple(rename_node(x, nodes) for x in ins)
-    notes: list[str] = []
-    ul = attrs.get("units")
-    units = parse_units(ul if isinstance(ul, str) else None)
-    if isinstance(ul, str) and ul.strip() and units is None:
-        notes.append(f"units {ul!r} not understood; not checked")
-    decl = attrs.get("quantity")
-    q = reconcile_quantity(
-        decl if isinstance(decl, str) and decl else None,
-        units,
-        quantity,
-        what,
-        ul if isinstance(ul, str) else None,
-    )
-    frf = FRF(
-        freq, data * np.outer(so, si)[None], outs, ins, q, parse_kinds(attrs.get("kinds"), what)
-    )
-    notes += units_note(units)
-    if units is not None and not units.is_si:
-        frf = frf.replace(data=frf.data * si_factors(units, outs, ins, frf.kinds, q)[None])
-        notes.append(f"converted from {units.label} to SI ({frf.unit()})")
-    md: dict[str, Any] = {}
     root = groups.get("/", {})
-    if isinstance(root.get("metadata"), str):
-        try:
-            md = json.loads(root["metadata"])
-        except ValueError:
-            md = {"metadata": root["metadata"]}
+    md = metadata_from_json(root.get("metadata"))
     for k in ("fbs_core_version", "created"):
         if k in root:
             md.setdefault(k, root[k])

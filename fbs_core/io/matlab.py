@@ -36,20 +36,8 @@ import numpy as np
 from ..errors import DataFormatError
 from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
-from .checks import (
-    Source,
-    check_finite,
-    frequency_from_units,
-    kinds_text,
-    normalize_label,
-    parse_kinds,
-    parse_units,
-    reconcile_quantity,
-    rename_node,
-    si_factors,
-    units_line,
-    units_note,
-)
+from .assembly import FileUnits, assemble, dof_labels, metadata_from_json
+from .checks import Source, check_finite, frequency_from_units, kinds_text, sniff, units_line
 
 __all__ = ["read_mat_vars", "read_mat", "write_mat", "frf_from_vars", "MatVars"]
 
@@ -135,8 +123,11 @@ def _chars(h5_codes: np.ndarray) -> list[str]:
     return ["".join(chr(int(v)) for v in row if 0 < int(v) < 0x110000).rstrip() for row in c]
 
 
-def read_mat_vars(src: Source, kind: str, *, timeout: float = DEFAULT_TIMEOUT) -> MatVars:
-    """Variables of a MAT-file (``kind`` ``"mat5"`` or ``"mat73"`` from :func:`sniff`).
+def read_mat_vars(
+    src: Source, kind: str | None = None, *, timeout: float = DEFAULT_TIMEOUT
+) -> MatVars:
+    """Variables of a MAT-file (``kind`` ``"mat5"`` or ``"mat73"``; default what
+    :func:`~.checks.sniff` finds in the content).
 
     Raises
     ------
@@ -144,6 +135,7 @@ def read_mat_vars(src: Source, kind: str, *, timeout: float = DEFAULT_TIMEOUT) -
         For damaged files and refused classes, naming the variable.
     """
     what = f"MATLAB file {src.name!r}"
+    kind = kind or sniff(src.raw)
     if kind == "mat5":
         meta, arrays = parse_isolated("mat5", src.raw, what, timeout=timeout)
         return {
@@ -202,7 +194,6 @@ def frf_from_vars(
     quantity: str | None = None,
 ) -> tuple[FRF, list[str], dict[str, Any]]:
     """Build the FRF from MAT-file variables in the documented layout."""
-    notes: list[str] = []
     if "freq" not in v:
         raise DataFormatError(
             f"MATLAB file {name!r} lacks the variable 'freq' (found: {', '.join(v) or 'none'})"
@@ -232,46 +223,33 @@ def frf_from_vars(
             f"n_freq x n_out x n_in = {'x'.join(map(str, expected))} from 'freq', "
             "'outputs' and 'inputs'"
         )
-    H = H.reshape(expected).astype(complex)
-    outs, so = zip(*(normalize_label(s, "output") for s in raw_o), strict=True)
-    ins, si = zip(*(normalize_label(s, "input") for s in raw_i), strict=True)
-    outs = tuple(rename_node(s, nodes) for s in outs)
-    ins = tuple(rename_node(s, nodes) for s in ins)
-    sign = np.outer(so, si)
-    if np.any(sign < 0):
-        notes.append("labels with a '-' direction: their sign was flipped")
-    units_label = _text(v, "units", name)
-    units = parse_units(units_label)
-    if units_label and units is None:
-        notes.append(f"units {units_label!r} not understood; not checked")
-    q = reconcile_quantity(
-        _text(v, "quantity", name) or None, units, quantity, repr(name), units_label
+    outs, so = dof_labels(raw_o, "output", nodes)
+    ins, si = dof_labels(raw_i, "input", nodes)
+    frf, notes = assemble(
+        f,
+        H.reshape(expected).astype(complex),
+        outs,
+        ins,
+        where=repr(name),
+        quantity=quantity,
+        declared=_text(v, "quantity", name) or None,
+        units=FileUnits(_text(v, "units", name)),
+        kinds=_text(v, "kinds", name),
+        signs=np.outer(so, si),
     )
-    kinds = parse_kinds(_text(v, "kinds", name), repr(name))
-    frf = FRF(f, H * sign[None], outs, ins, q, kinds)
-    notes += units_note(units)
-    if units is not None and not units.is_si:
-        frf = frf.replace(data=frf.data * si_factors(units, outs, ins, frf.kinds, q)[None])
-        notes.append(f"converted from {units.label} to SI ({frf.unit()})")
-    meta: dict[str, Any] = {}
-    mtext = _text(v, "metadata", name)
-    if mtext:
-        try:
-            meta = json.loads(mtext)
-        except ValueError:
-            meta = {"metadata": mtext}
-    return frf, notes, meta
+    return frf, notes, metadata_from_json(_text(v, "metadata", name))
 
 
 def read_mat(
     src: Source,
-    kind: str,
+    kind: str | None = None,
     *,
     nodes: Mapping[Any, Any] | None = None,
     quantity: str | None = None,
     timeout: float = DEFAULT_TIMEOUT,
 ) -> tuple[FRF, list[str], dict[str, Any]]:
-    """Read an FRF from a MAT-file in the documented layout."""
+    """Read an FRF from a MAT-file in the documented layout (``kind`` as in
+    :func:`read_mat_vars`)."""
     return frf_from_vars(
         read_mat_vars(src, kind, timeout=timeout), src.name, nodes=nodes, quantity=quantity
     )

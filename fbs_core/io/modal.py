@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..dofs import node_labels
 from ..errors import DataFormatError, FBSError
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .checks import Source, check_finite, normalize_label
@@ -90,7 +91,7 @@ def tire_from_vars(v: MatVars, name: str) -> TireModel:
         name,
         "n_speeds x n_wavelengths x n_modes",
     )
-    hub = tuple(f"hub:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))
+    hub = node_labels("hub")
     if "hub_dofs" in v:
         labels = v["hub_dofs"]
         if not isinstance(labels, list) or len(labels) != 6:
@@ -110,8 +111,11 @@ def tire_from_vars(v: MatVars, name: str) -> TireModel:
         raise DataFormatError(f"tire model {name!r}: {e}") from None
 
 
-def read_tire_mat(src: Source, kind: str, *, timeout: float = DEFAULT_TIMEOUT) -> TireModel:
-    """Read a tire model from a MAT-file (v5 or v7.3) in the documented layout."""
+def read_tire_mat(
+    src: Source, kind: str | None = None, *, timeout: float = DEFAULT_TIMEOUT
+) -> TireModel:
+    """Read a tire model from a MAT-file (v5 or v7.3, ``kind`` as in
+    :func:`~.matlab.read_mat_vars`) in the documented layout."""
     return tire_from_vars(read_mat_vars(src, kind, timeout=timeout), src.name)
 
 

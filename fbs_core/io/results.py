@@ -325,8 +325,10 @@ def result_to_uff(
     FRFs are written as FRF records (function type 4). Every other array with a
     frequency axis (:data:`FREQ_DIMS`) is written slice by slice as general functions
     (type 0): ID line 1 names the array and the slice, e.g. ``upper [dofs=bushing:z]``;
-    when a slice has a DOF label it is the record's response DOF. Arrays without a
-    frequency axis cannot be carried by dataset 58 and are listed in ID line 5.
+    when a slice has a DOF label it is the record's response DOF. ID lines 2-4 hold the
+    producer, the date and the metadata (whole ``key=value`` pairs), line 5 the node map
+    of the file (one numbering for all records). Arrays without a frequency axis cannot
+    be carried by dataset 58 and are listed in ID line 4 of the first record.
 
     Raises
     ------
@@ -340,14 +342,30 @@ def result_to_uff(
         _node_numbers,
         frf_records,
         id_lines,
+        node_map_line,
+        pack_items,
         write_uff_records,
     )
 
     md = {k: v for k, v in res.metadata.items() if _scalar(v)}
     ids = id_lines(md)
+    # one numbering of the nodes for the whole file, written in every record's ID line 5
+    labels = [lab for frf in res.frfs.values() for lab in (*frf.outputs, *frf.inputs)]
+    for dims, _v in res.arrays.values():
+        for d in dims:
+            for val in res.coords.get(d, ()):
+                if isinstance(val, str | np.str_):
+                    try:
+                        parse_label(str(val))
+                        labels.append(str(val))
+                    except DOFError:
+                        pass
+    numbers = _node_numbers(labels, nodes)
+    nodes = {n: name for name, n in numbers.items()}
+    id5 = node_map_line(numbers)
     recs = []
-    for frf in res.frfs.values():
-        recs += frf_records(frf, nodes=nodes, id_lines=ids, round_abscissa=round_abscissa)
+    for key, frf in res.frfs.items():
+        recs += frf_records(frf, nodes=nodes, id_lines=ids, round_abscissa=round_abscissa, name=key)
     skipped = []
     for name, (dims, values) in res.arrays.items():
         v = np.asarray(values)
@@ -388,8 +406,8 @@ def result_to_uff(
                     id1=f"{name} [{', '.join(parts)}]"[:80],
                     id2=ids[0][:80],
                     id3=ids[1][:80],
-                    id4=(ids[2] if len(ids) > 2 else "NONE")[:80],
-                    id5="NONE",
+                    id4=ids[2][:80],
+                    id5=id5,
                     rsp_node=node,
                     rsp_dir=code,
                     rsp_ent_name=ent,
@@ -411,6 +429,6 @@ def result_to_uff(
             f"the {res.kind} has no function of frequency; UFF 58 cannot carry it "
             "(export as CSV or HDF5)"
         )
-    if skipped:
-        recs[0]["id5"] = ("not in this file: " + ", ".join(skipped))[:80]
+    if skipped:  # said in ID line 4 of the first record (line 5 is the node map)
+        recs[0]["id4"] = pack_items(["not in this file: " + ", ".join(skipped)], lines=1)[0][0]
     return write_uff_records(recs)

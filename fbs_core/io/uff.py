@@ -1,12 +1,13 @@
 """Universal File Format dataset 58 ("function at nodal DOF"): FRFs in and out.
 
-Reading and writing go through pyuff; this module adds the checks. One dataset
-58 record holds one function between a response DOF and a reference DOF
-(record 6: node numbers and direction codes 1..3 = +X..+Z translation,
-4..6 = +X..+Z rotation, negative = opposite sign, 0 = scalar). Records 9 and 10
-say what the ordinate is (specific data type 8 displacement, 11 velocity,
-12 acceleration over 13 excitation force), which decides receptance, mobility
-or accelerance (thesis table 2.1). Dataset 164, when present, gives the unit
+Reading goes through the sandbox's own parser (:func:`._textparse.parse_uff`, in the
+parser process), writing through pyuff; this module checks the records and makes the
+FRF of them (:func:`.assembly.assemble`). One dataset 58 record holds one function
+between a response DOF and a reference DOF (record 6: node numbers and direction codes
+1..3 = +X..+Z translation, 4..6 = +X..+Z rotation, negative = opposite sign, 0 =
+scalar). Records 9 and 10 say what the ordinate is (specific data type 8 displacement,
+11 velocity, 12 acceleration over 13 excitation force), which decides receptance,
+mobility or accelerance (thesis table 2.1). Dataset 164, when present, gives the unit
 system. Abscissa values are single precision in the format (E13.5).
 """
 
@@ -18,27 +19,21 @@ import tempfile
 import time
 import warnings
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..dofs import DIRECTIONS, parse_label
+from ..dofs import parse_label
 from ..errors import DataFormatError, DOFError, FBSError, FrequencyGridError, QuantityError
 from ..frf import FRF
 from ..units import response_unit
+from ..vocabulary import DIRECTIONS
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
-from .checks import (
-    Source,
-    Units,
-    check_finite,
-    frequency_from_units,
-    missing_pairs,
-    parse_units,
-    reconcile_quantity,
-    units_note,
-)
+from .assembly import FileUnits, assemble
+from .checks import Source, Units, check_finite, frequency_from_units, missing_pairs, parse_units
 
 __all__ = ["read_uff", "write_uff", "write_uff_records", "DIR_CODES"]
 
@@ -205,6 +200,27 @@ def _units_label(s: dict[str, Any]) -> str:
     return f"({num})/({den})"
 
 
+@dataclass(frozen=True)
+class _Record:
+    """One FRF record (dataset 58, function type 4) as read, checked on its own."""
+
+    output: str
+    input: str
+    #: -1 when one of its direction codes is negative (the opposite direction)
+    sign: int
+    #: frequencies in Hz
+    x: np.ndarray
+    y: np.ndarray
+    #: the quantity records 9 and 10 declare
+    quantity: str | None
+    #: its units label (:func:`_units_label`), "" for none
+    units: str
+    #: the ordinate was real (data types 2, 4)
+    real: bool
+    #: how messages name it
+    what: str
+
+
 def read_uff(
     src: Source,
     *,
@@ -214,6 +230,12 @@ def read_uff(
     timeout: float = DEFAULT_TIMEOUT,
 ) -> tuple[FRF, list[str], dict[str, Any]]:
     """Read the FRF records (dataset 58, function type 4) of a Universal File.
+
+    The steps: the datasets parsed in the sandbox (:func:`_read_sets`), the FRF records
+    among them (:func:`_frf_sets`), each record checked and labelled (:func:`_record`),
+    the records on one grid (:func:`_same_grid`) and put in a matrix (:func:`_matrix`),
+    the unit system of dataset 164 (:func:`_unit_system`), then the FRF assembled with
+    the quantity and units of the records (:func:`.assembly.assemble`).
 
     Parameters
     ----------
@@ -242,6 +264,56 @@ def read_uff(
     ------
     DataFormatError, DOFError, FrequencyGridError, QuantityError
     """
+    _check_node_map(nodes)
+    sets, contents = _read_sets(src, timeout)
+    notes: list[str] = []
+    frf_sets = _frf_sets(sets, contents, src.name, notes)
+    ent_names = {} if nodes else _entity_names(frf_sets)
+    records: dict[tuple[str, str], _Record] = {}
+    for k, s in enumerate(frf_sets):
+        r = _record(s, f"{src.name!r} FRF record {k + 1}", nodes, ent_names)
+        if (r.output, r.input) in records:
+            raise DataFormatError(f"{r.what}: a second record for the same output/input pair")
+        if records and freq is None:
+            _same_grid(r, next(iter(records.values())))
+        records[(r.output, r.input)] = r
+    if any(r.real for r in records.values()):
+        notes.append("real-valued records were read as complex with zero imaginary part")
+    if nodes:
+        notes += _node_map_note(nodes, frf_sets)
+    target, data, signs = _matrix(records, freq, src.name, notes)
+    declared = {r.quantity for r in records.values() if r.quantity}
+    if len(declared) > 1:
+        raise QuantityError(
+            f"{src.name!r} mixes quantities across records: {', '.join(sorted(declared))}"
+        )
+    units = FileUnits({pair: r.units for pair, r in records.items()})
+    system = _unit_system([s for s in sets if s.get("type") == 164], src.name)
+    if system is not None and not system.is_si:
+        # the records' own labels say the units; the unit system serves records without
+        if any(not u.is_si for u in units.understood):
+            notes.append(f"{system.label} ignored: the records' unit labels are not SI")
+        else:
+            notes.append(f"{system.label}: {system.summary()} (converted to SI)")
+            units = FileUnits(units.labels, system)
+    frf, notes = assemble(
+        target,
+        data,
+        list(dict.fromkeys(o for o, _ in records)),
+        list(dict.fromkeys(i for _, i in records)),
+        where=repr(src.name),
+        quantity=quantity,
+        declared=next(iter(declared), None),
+        units=units,
+        signs=signs,
+        notes=notes,
+    )
+    first = frf_sets[0]
+    meta = {f"id{k}": str(first.get(f"id{k}", "")).strip() for k in range(1, 6)}
+    return frf, notes, meta
+
+
+def _check_node_map(nodes: Mapping[Any, Any] | None) -> None:
     if nodes:
         bad = [k for k in nodes if not (isinstance(k, int) or str(k).strip().isdigit())]
         if bad:
@@ -249,9 +321,18 @@ def read_uff(
                 f"nodes maps UFF node numbers to names, e.g. {{1: 'spindle', 2: 'bushing'}}; "
                 f"got keys {', '.join(map(repr, bad[:4]))}"
             )
-    sets, contents = _read_sets(src, timeout)
-    notes: list[str] = []
-    units164 = [s for s in sets if s.get("type") == 164]
+
+
+def _frf_sets(
+    sets: list[dict[str, Any]], contents: Mapping[str, int], name: str, notes: list[str]
+) -> list[dict[str, Any]]:
+    """The FRF records among the datasets; notes what else the file holds.
+
+    Raises
+    ------
+    DataFormatError
+        For a dataset 58 that lacks a field, and a file without FRF records.
+    """
     f58 = [s for s in sets if s.get("type") == 58]
     other = sorted({int(s.get("type", -1)) for s in sets} - {58, 164})
     if other:
@@ -259,9 +340,7 @@ def read_uff(
     for k, s in enumerate(f58):
         lacks = [key for key in _REQUIRED if key not in s]
         if lacks:
-            raise DataFormatError(
-                f"{src.name!r}: dataset 58 number {k + 1} lacks {', '.join(lacks)}"
-            )
+            raise DataFormatError(f"{name!r}: dataset 58 number {k + 1} lacks {', '.join(lacks)}")
     frf_sets = [s for s in f58 if int(s["func_type"]) == 4]
     if len(frf_sets) < len(f58):
         kinds = sorted(
@@ -275,174 +354,132 @@ def read_uff(
     if not frf_sets:
         held = ", ".join(f"{n} {what}" for what, n in contents.items()) or "nothing"
         raise DataFormatError(
-            f"{src.name!r} holds no FRF records (dataset 58 with function type 4); it holds {held}"
+            f"{name!r} holds no FRF records (dataset 58 with function type 4); it holds {held}"
         )
-    ent_names = {} if nodes else _entity_names(frf_sets)
+    return frf_sets
 
-    entries: dict[tuple[str, str], tuple[np.ndarray, np.ndarray]] = {}
-    outputs: dict[str, None] = {}
-    inputs: dict[str, None] = {}
-    grid: np.ndarray | None = None
-    declared: set[str] = set()
-    unit_labels: set[str] = set()
-    rec_labels: dict[tuple[str, str], str] = {}
-    n_flipped = 0
-    for k, s in enumerate(frf_sets):
-        what = f"{src.name!r} FRF record {k + 1}"
-        out, so = _dof(s["rsp_node"], s["rsp_dir"], s.get("rsp_ent_name"), what, nodes, ent_names)
-        inp, si = _dof(s["ref_node"], s["ref_dir"], s.get("ref_ent_name"), what, nodes, ent_names)
-        what = f"{what} ({out} / {inp})"
-        x = np.asarray(s["x"])
-        y = np.asarray(s["data"])
-        n = int(s["num_pts"])
-        if x.ndim != 1 or y.ndim != 1 or x.size != y.size or y.size != n or n < 1:
-            raise DataFormatError(
-                f"{what}: the header announces {n} values but {y.size} ordinates and "
-                f"{x.size} abscissae were read (truncated or damaged file?)"
-            )
-        odt = int(s["ord_data_type"])
-        if odt not in (2, 4, 5, 6):
-            raise DataFormatError(f"{what}: ordinate data type {odt}; allowed: 2, 4, 5, 6")
-        if odt in (2, 4) and "real-valued" not in " ".join(notes):
-            notes.append("real-valued records were read as complex with zero imaginary part")
-        check_finite(x, f"{what} abscissa")
-        check_finite(y, f"{what} ordinate")
-        ast = int(s.get("abscissa_spec_data_type", 0) or 0)
-        if ast not in (0, 1, 18):
-            raise DataFormatError(
-                f"{what}: the abscissa has specific data type {ast} (17 time, 19 rpm, "
-                "20 order); an FRF needs frequency (18)"
-            )
-        x = frequency_from_units(x, s.get("abscissa_axis_units_lab"), what)
-        q = _quantity_of(s, what)
-        if q:
-            declared.add(q)
-        lab = _units_label(s)
-        if lab:
-            unit_labels.add(lab)
-        rec_labels[(out, inp)] = lab
-        if (out, inp) in entries:
-            raise DataFormatError(f"{what}: a second record for the same output/input pair")
-        if grid is None:
-            grid = x
-        elif x.shape != grid.shape or not np.allclose(x, grid, rtol=1e-9, atol=0):
-            if freq is None:
-                raise FrequencyGridError(
-                    f"{what} is on a different frequency grid ({x.size} lines "
-                    f"{x[0]:g}-{x[-1]:g} Hz) than record 1 ({grid.size} lines "
-                    f"{grid[0]:g}-{grid[-1]:g} Hz); pass freq=<common grid> to interpolate "
-                    "all records onto it explicitly"
-                )
-        if so * si < 0:
-            n_flipped += 1
-        entries[(out, inp)] = (x, y.astype(complex) * so * si)
-        outputs.setdefault(out, None)
-        inputs.setdefault(inp, None)
-    if n_flipped:
-        notes.append(f"{n_flipped} records had negative direction codes; their sign was flipped")
-    if nodes:
-        present = {str(int(s[k])) for s in frf_sets for k in ("rsp_node", "ref_node")}
-        unused = [str(k) for k in nodes if str(k) not in present]
-        if unused:
-            notes.append(
-                f"node numbers {', '.join(unused)} of the node map are not in the file "
-                f"(nodes in the file: {', '.join(sorted(present, key=int))})"
-            )
 
-    n_missing, missing = missing_pairs(outputs, inputs, entries)
+def _record(
+    s: dict[str, Any],
+    what: str,
+    nodes: Mapping[Any, Any] | None,
+    ent_names: dict[int, str],
+) -> _Record:
+    """One FRF record: its DOF labels, values, frequencies in Hz, quantity and units.
+
+    Raises
+    ------
+    DataFormatError, DOFError, FrequencyGridError, QuantityError
+        Naming the record and its output/input pair.
+    """
+    out, so = _dof(s["rsp_node"], s["rsp_dir"], s.get("rsp_ent_name"), what, nodes, ent_names)
+    inp, si = _dof(s["ref_node"], s["ref_dir"], s.get("ref_ent_name"), what, nodes, ent_names)
+    what = f"{what} ({out} / {inp})"
+    x = np.asarray(s["x"])
+    y = np.asarray(s["data"])
+    n = int(s["num_pts"])
+    if x.ndim != 1 or y.ndim != 1 or x.size != y.size or y.size != n or n < 1:
+        raise DataFormatError(
+            f"{what}: the header announces {n} values but {y.size} ordinates and "
+            f"{x.size} abscissae were read (truncated or damaged file?)"
+        )
+    odt = int(s["ord_data_type"])
+    if odt not in (2, 4, 5, 6):
+        raise DataFormatError(f"{what}: ordinate data type {odt}; allowed: 2, 4, 5, 6")
+    check_finite(x, f"{what} abscissa")
+    check_finite(y, f"{what} ordinate")
+    ast = int(s.get("abscissa_spec_data_type", 0) or 0)
+    if ast not in (0, 1, 18):
+        raise DataFormatError(
+            f"{what}: the abscissa has specific data type {ast} (17 time, 19 rpm, "
+            "20 order); an FRF needs frequency (18)"
+        )
+    x = frequency_from_units(x, s.get("abscissa_axis_units_lab"), what)
+    return _Record(
+        out, inp, so * si, x, y, _quantity_of(s, what), _units_label(s), odt in (2, 4), what
+    )
+
+
+def _same_grid(r: _Record, first: _Record) -> None:
+    x, grid = r.x, first.x
+    if x.shape != grid.shape or not np.allclose(x, grid, rtol=1e-9, atol=0):
+        raise FrequencyGridError(
+            f"{r.what} is on a different frequency grid ({x.size} lines "
+            f"{x[0]:g}-{x[-1]:g} Hz) than record 1 ({grid.size} lines "
+            f"{grid[0]:g}-{grid[-1]:g} Hz); pass freq=<common grid> to interpolate "
+            "all records onto it explicitly"
+        )
+
+
+def _node_map_note(nodes: Mapping[Any, Any], frf_sets: list[dict[str, Any]]) -> list[str]:
+    present = {str(int(s[k])) for s in frf_sets for k in ("rsp_node", "ref_node")}
+    unused = [str(k) for k in nodes if str(k) not in present]
+    if not unused:
+        return []
+    return [
+        f"node numbers {', '.join(unused)} of the node map are not in the file "
+        f"(nodes in the file: {', '.join(sorted(present, key=int))})"
+    ]
+
+
+def _matrix(
+    records: Mapping[tuple[str, str], _Record],
+    freq: ArrayLike | None,
+    name: str,
+    notes: list[str],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The grid, the data block ``(n_freq, n_out, n_in)`` of the records (interpolated
+    onto ``freq`` when given) and the sign of every entry ``(n_out, n_in)``.
+
+    Raises
+    ------
+    DataFormatError
+        Naming the output/input pairs without a record.
+    FrequencyGridError
+        For a ``freq`` a record does not cover.
+    """
+    outputs = {o: k for k, o in enumerate(dict.fromkeys(o for o, _ in records))}
+    inputs = {i: k for k, i in enumerate(dict.fromkeys(i for _, i in records))}
+    n_missing, missing = missing_pairs(outputs, inputs, records)
     if n_missing:
         shown = ", ".join(f"{o}/{i}" for o, i in missing)
         more = f" and {n_missing - 8} more" if n_missing > 8 else ""
         raise DataFormatError(
-            f"{src.name!r}: {n_missing} of {len(outputs) * len(inputs)} output/input "
+            f"{name!r}: {n_missing} of {len(outputs) * len(inputs)} output/input "
             f"pairs have no record: {shown}{more}; a full matrix of outputs x inputs is needed"
         )
-    assert grid is not None  # there is at least one FRF record
+    grid = next(iter(records.values())).x
     target = grid if freq is None else np.asarray(freq, dtype=float)
-    data: np.ndarray = np.empty((len(target), len(outputs), len(inputs)), dtype=complex)
-    o_pos = {o: k for k, o in enumerate(outputs)}
-    i_pos = {i: k for k, i in enumerate(inputs)}
-    for (o, i), (x, y) in entries.items():
+    data = np.empty((len(target), len(outputs), len(inputs)), dtype=complex)
+    signs = np.ones((len(outputs), len(inputs)))
+    for (o, i), r in records.items():
+        y = r.y
         if freq is not None:
             try:
-                y = FRF(x, y[:, None, None], ["a"], ["b"]).interpolate(target).data[:, 0, 0]
+                y = FRF(r.x, y[:, None, None], ["a"], ["b"]).interpolate(target).data[:, 0, 0]
             except FBSError as e:
-                raise type(e)(f"{src.name!r} record {o}/{i}: {e}") from None
-        data[:, o_pos[o], i_pos[i]] = y
+                raise type(e)(f"{name!r} record {o}/{i}: {e}") from None
+        data[:, outputs[o], inputs[i]] = y
+        signs[outputs[o], inputs[i]] = r.sign
     if freq is not None:
         notes.append(f"records interpolated onto the requested grid of {len(target)} lines")
+    return target, data, signs
 
-    if len(declared) > 1:
-        raise QuantityError(
-            f"{src.name!r} mixes quantities across records: {', '.join(sorted(declared))}"
-        )
-    parsed = {lab: parse_units(lab) for lab in unit_labels}
-    by_q = {u.quantity for u in parsed.values() if u is not None and u.quantity}
-    if len(by_q) > 1:
-        raise QuantityError(
-            f"{src.name!r} mixes units across records: "
-            + ", ".join(
-                f"{lab!r} ({u.quantity})" for lab, u in sorted(parsed.items()) if u is not None
-            )
-        )
-    unread = sorted(lab for lab, u in parsed.items() if u is None)
-    if unread:
-        notes.append(f"units {', '.join(map(repr, unread))} not understood; not checked")
-    understood = [u for u in parsed.values() if u is not None]
-    units = next((u for u in understood if u.quantity), understood[0] if understood else None)
-    sys164 = None
-    if units164:
-        u164 = units164[0]
-        try:
-            lf, ff = float(u164["length"]), float(u164["force"])
-        except (KeyError, TypeError, ValueError):
-            raise DataFormatError(f"{src.name!r}: damaged units dataset 164") from None
-        if not (lf > 0 and ff > 0 and math.isfinite(lf) and math.isfinite(ff)):
-            raise DataFormatError(f"{src.name!r}: dataset 164 has invalid unit factors")
-        # dataset 164 gives the factors that turn SI into file units (1000 for mm)
-        sys164 = Units(
-            f"dataset 164 ({str(u164.get('units_description', '')).strip()})",
-            None,
-            1.0 / lf,
-            1.0 / ff,
-        )
-    q = reconcile_quantity(
-        next(iter(declared)) if declared else None,
-        units,
-        quantity,
-        repr(src.name),
-        unread[0] if unread and not understood else None,
-    )
-    frf = FRF(target, data, list(outputs), list(inputs), q)
-    # every record by its own label (and kinds); records without a label understood
-    # take the unit system of dataset 164 when the labels say nothing else
-    fac = np.ones((len(outputs), len(inputs)))
-    ok, ik = frf.output_kinds, frf.input_kinds
-    any_labels = any(not u.is_si for u in understood)
-    for (o, i), lab in rec_labels.items():
-        a, b = o_pos[o], i_pos[i]
-        u = parsed.get(lab) if lab else None
-        if u is None and sys164 is not None and not any_labels:
-            u = sys164
-        if u is not None:
-            fac[a, b] = u.factor(ok[a], ik[b], q)
-    notes += units_note(units)
-    if sys164 is not None and not sys164.is_si:
-        if any_labels:
-            notes.append(f"{sys164.label} ignored: the records' unit labels are not SI")
-        else:
-            notes.append(f"{sys164.label}: {sys164.summary()} (converted to SI)")
-    if np.any(fac != 1.0):
-        frf = frf.replace(data=frf.data * fac[None])
-        if units is not None and any_labels:
-            label = units.label
-        else:
-            assert sys164 is not None  # factors != 1 without labels come from dataset 164
-            label = sys164.label
-        notes.append(f"converted from {label} to SI ({frf.unit()})")
-    first = frf_sets[0]
-    meta = {f"id{k}": str(first.get(f"id{k}", "")).strip() for k in range(1, 6)}
-    return frf, notes, meta
+
+def _unit_system(units164: list[dict[str, Any]], name: str) -> Units | None:
+    """The unit system of the first dataset 164, as the factors that turn file units into
+    SI (dataset 164 gives those that turn SI into file units: 1000 for mm)."""
+    if not units164:
+        return None
+    u164 = units164[0]
+    try:
+        lf, ff = float(u164["length"]), float(u164["force"])
+    except (KeyError, TypeError, ValueError):
+        raise DataFormatError(f"{name!r}: damaged units dataset 164") from None
+    if not (lf > 0 and ff > 0 and math.isfinite(lf) and math.isfinite(ff)):
+        raise DataFormatError(f"{name!r}: dataset 164 has invalid unit factors")
+    description = str(u164.get("units_description", "")).strip()
+    return Units(f"dataset 164 ({description})", None, 1.0 / lf, 1.0 / ff)
 
 
 # -- writing ---------------------------------------------------------------------------
@@ -521,11 +558,18 @@ def frf_records(
     nodes: Mapping[Any, Any] | None = None,
     id_lines: Sequence[str] = (),
     round_abscissa: bool = False,
+    name: str = "",
 ) -> list[dict[str, Any]]:
-    """pyuff dictionaries of one dataset 58 per output/input pair of ``frf``."""
+    """pyuff dictionaries of one dataset 58 per output/input pair of ``frf``.
+
+    ID line 1: ``name`` (when given), the quantity and the pair; lines 2-4: ``id_lines``
+    (:func:`id_lines`); line 5: the node map (:func:`node_map_line`).
+    """
     even = _abscissa(frf.freq, round_abscissa)
     numbers = _node_numbers(frf.outputs + frf.inputs, nodes)
-    ids = list(id_lines)[:4] + ["NONE"] * 4
+    ids = list(id_lines)[:3] + ["NONE"] * 3
+    id5 = node_map_line(numbers)
+    label = f"{name}: " if name else ""
     recs = []
     ok, ik = frf.output_kinds, frf.input_kinds
     for o, out in enumerate(frf.outputs):
@@ -536,11 +580,11 @@ def frf_records(
                     func_type=4,
                     ver_num=0,
                     load_case_id=0,
-                    id1=f"{frf.quantity} {out} / {inp}"[:80],
+                    id1=f"{label}{frf.quantity} {out} / {inp}"[:80],
                     id2=ids[0][:80],
                     id3=ids[1][:80],
                     id4=ids[2][:80],
-                    id5=ids[3][:80],
+                    id5=id5,
                     rsp_node=numbers[no],
                     rsp_dir=DIR_CODES.get(do, 0) if do is not None else 0,
                     rsp_ent_name=_ent(no),
@@ -577,7 +621,8 @@ def write_uff(
 
     Node names become entity names (when at most 10 characters) and node numbers from
     ``nodes`` (number -> name) or 1, 2, ... in order of appearance. ID line 1 holds
-    the quantity and the pair, lines 2-5 the producer, date and ``metadata``.
+    the quantity and the pair, line 2 the producer and date, lines 3-4 ``metadata`` as
+    whole ``key=value`` pairs, line 5 the node map (``nodes: 1=bushing 2=patch``).
 
     Raises
     ------
@@ -590,13 +635,57 @@ def write_uff(
     )
 
 
+def pack_items(items: Sequence[str], lines: int = 2, width: int = 80) -> tuple[list[str], int]:
+    """``items`` joined by ``"; "`` into at most ``lines`` lines of ``width`` characters,
+    an item never split across two lines or cut (a reader of one ID line reads whole
+    values); returns the lines and the number of items left out (longer than a line, or
+    beyond the last line; the last line says how many when there is room).
+
+    Examples
+    --------
+    >>> pack_items(["a=1", "b=22", "c=333"], lines=1, width=9)
+    (['a=1; b=22'], 1)
+    """
+    out: list[str] = []
+    cur = ""
+    left = 0
+    for item in items:
+        if len(item) > width:
+            left += 1
+        elif not cur:
+            cur = item
+        elif len(cur) + 2 + len(item) <= width:
+            cur += "; " + item
+        elif len(out) + 1 < lines:
+            out.append(cur)
+            cur = item
+        else:
+            left += 1
+    if cur:
+        out.append(cur)
+    more = f"; +{left} more"
+    if left and out and len(out[-1]) + len(more) <= width:
+        out[-1] += more
+    return out, left
+
+
+def node_map_line(numbers: Mapping[str, int], width: int = 80) -> str:
+    """ID line 5 of every record: the node numbers of the file's node names, e.g.
+    ``"nodes: 1=bushing 2=patch"`` (whole pairs only; ``read_uff(nodes=...)`` takes the
+    same map back)."""
+    pairs = [f"{n}={name}" for name, n in sorted(numbers.items(), key=lambda kv: kv[1])]
+    line, left = pack_items(pairs, lines=1, width=width - len("nodes: "))
+    return "nodes: " + (line[0].replace("; ", " ") if line else "none")
+
+
 def id_lines(metadata: Mapping[str, Any] | None) -> list[str]:
-    """ID lines 2-5: producer and date, then ``key=value`` pairs of ``metadata``."""
+    """ID lines 2-4: producer and date, then ``key=value`` pairs of ``metadata`` packed
+    whole into lines 3 and 4 (never split, never into line 5, which holds the node map:
+    :func:`node_map_line`)."""
     from .. import __version__
 
     lines = [f"tire-fbs fbs_core {__version__}", time.strftime("%d-%b-%y %H:%M:%S")]
-    text = "; ".join(f"{k}={v}" for k, v in (metadata or {}).items())
-    while text and len(lines) < 4:
-        lines.append(text[:80])
-        text = text[80:]
-    return lines
+    items = [f"{k}={v}" for k, v in (metadata or {}).items()]
+    packed, _ = pack_items(items, lines=2)
+    lines = [" ".join(lines)[:80], *packed]
+    return lines + ["NONE"] * (3 - len(lines))

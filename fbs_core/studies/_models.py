@@ -26,16 +26,14 @@ from ..dofs import DIRECTIONS, parse_label
 from ..errors import DOFError, FBSError, FrequencyGridError
 from ..frf import FRF
 from ..harmonics import Harmonic
-from ..vocabulary import COUPLINGS
+from ..vocabulary import COUPLED_DIRECTIONS, COUPLINGS
 
 
 def coupled_directions(coupling: str | Sequence[str]) -> tuple[str, ...]:
     """Directions coupled at the hub for ``coupling`` ("6dof", "5dof" or a sequence)."""
     if isinstance(coupling, str):
-        if coupling == "6dof":
-            return DIRECTIONS
-        if coupling == "5dof":
-            return tuple(d for d in DIRECTIONS if d != "ry")
+        if coupling in COUPLED_DIRECTIONS:
+            return COUPLED_DIRECTIONS[coupling]
         raise FBSError(
             f"unknown coupling {coupling!r}; allowed: {', '.join(COUPLINGS)} or a sequence of "
             f"directions from {', '.join(DIRECTIONS)}"

@@ -59,6 +59,9 @@ _ONE = np.uint64(1)
 _S32 = np.uint64(32)
 _LO32 = np.uint64(0xFFFFFFFF)
 _INV32 = 2.0**-32
+#: The bits of the float64 2**52 (its exponent); OR-ed with a 32-bit ``u`` they are 2**52 + u.
+_EXP52 = np.uint64(0x4330000000000000)
+_TWO52 = 2.0**52
 
 
 def n_elements(nj: int, ne: int) -> int:
@@ -82,22 +85,31 @@ def _lane_factors(
     base: NDArray[np.uint64],
 ) -> None:
     """Factors of words ``k0 .. k1-1`` of the ``LANES`` rounds ``rids`` at stream line ``line``
-    into ``s (n_el, LANES)``; ``nv`` (valid lanes) is unused: padded lanes cost nothing extra."""
+    into ``s (n_el, LANES)``; ``nv`` (valid lanes) is unused: padded lanes cost nothing extra.
+
+    ``base (3, LANES)`` is workspace: the lanes' stream bases, then the two halves of a
+    word as the bits of ``2**52 + u`` (``u`` the 32-bit half), read back as float64 and
+    less ``2**52``: exactly ``float(u)``, without the scalar integer conversion AVX2 lacks,
+    so that the words of all lanes are hashed and converted in vector registers.
+    """
     n_el = s.shape[0]
     for v in range(LANES):
-        base[v] = stream_base(key, rids[v], line)
+        base[0, v] = stream_base(key, rids[v], line)
+    as_float = base.view(np.float64)
     for k in range(k0, k1):
         kk = (np.uint64(k) + _ONE) * GOLDEN
         e = 2 * k
+        for v in range(LANES):
+            w = mix64(base[0, v] + kk)
+            base[1, v] = (w >> _S32) | _EXP52
+            base[2, v] = (w & _LO32) | _EXP52
+        se = s[e]
+        for v in range(LANES):
+            se[v] = 1.0 + p * (2.0 * ((as_float[1, v] - _TWO52) * _INV32) - 1.0)
         if e + 1 < n_el:
+            so = s[e + 1]
             for v in range(LANES):
-                w = mix64(base[v] + kk)
-                s[e, v] = 1.0 + p * (2.0 * (np.float64(w >> _S32) * _INV32) - 1.0)
-                s[e + 1, v] = 1.0 + p * (2.0 * (np.float64(w & _LO32) * _INV32) - 1.0)
-        else:
-            for v in range(LANES):
-                w = mix64(base[v] + kk)
-                s[e, v] = 1.0 + p * (2.0 * (np.float64(w >> _S32) * _INV32) - 1.0)
+                so[v] = 1.0 + p * (2.0 * ((as_float[2, v] - _TWO52) * _INV32) - 1.0)
 
 
 @njit(**_JIT)
@@ -238,7 +250,7 @@ def _workspace(
     FloatArray, NDArray[np.uint64], FloatArray, FloatArray, FloatArray, IntArray, FloatArray
 ]:
     s = np.ones((n_el, LANES))
-    base = np.empty(LANES, np.uint64)
+    base = np.empty((3, LANES), np.uint64)
     W = np.empty((2, nj, nj, LANES))
     X = np.empty((4, nj, LANES))
     Y = np.empty((2, ne, LANES))

@@ -153,47 +153,46 @@ def floating_band_error(
 ) -> tuple[FloatArray, FloatArray]:
     """Thesis eq. 5.1 over a floating band: error versus centre frequency.
 
-        Parameters
-        ----------
-        freq : array_like, shape (n_f,)
-            Frequency lines in Hz (strictly increasing).
-        v_ref : array_like, shape (n_f, ...)
-            True (reference) response ``v_T``, complex or real, frequency first.
-        v_mod : array_like, shape (..., n_f, ...)
-            Modified response ``v_M``; broadcasts against ``v_ref`` from the right, so
-            e.g. ``(n_N, n_f, n_dof)`` against ``(n_f, n_dof)``.
-        width, step : float
-            Band width and step in Hz (thesis: 12 Hz and 1 Hz).
-        edges : {"clip", "valid"}
-            Band-edge treatment at the ends of the range (module docstring).
-        centres : array_like, optional
-            Centre frequencies in Hz; default :func:`band_centres`.
+    Parameters
+    ----------
+    freq : array_like, shape (n_f,)
+        Frequency lines in Hz (strictly increasing).
+    v_ref : array_like, shape (n_f, ...)
+        True (reference) response ``v_T``, complex or real, frequency first.
+    v_mod : array_like, shape (..., n_f, ...)
+        Modified response ``v_M``; broadcasts against ``v_ref`` from the right, so
+        e.g. ``(n_N, n_f, n_dof)`` against ``(n_f, n_dof)``.
+    width, step : float
+        Band width and step in Hz (thesis: 12 Hz and 1 Hz).
+    edges : {"clip", "valid"}
+        Band-edge treatment at the ends of the range (module docstring).
+    centres : array_like, optional
+        Centre frequencies in Hz; default :func:`band_centres`.
 
-        Returns
-        -------
-        centres : ndarray, shape (n_c,)
-        error : ndarray, shape (..., n_c, ...)
-            Relative error (0.2 = 20 %); the frequency axis of the inputs becomes the
-            centre axis. Where the reference has no power in a band the error is 0 if
-            the modified curve has none either, else ``inf``.
+    Returns
+    -------
+    centres : ndarray, shape (n_c,)
+    error : ndarray, shape (..., n_c, ...)
+        Relative error (0.2 = 20 %); the frequency axis of the inputs becomes the
+        centre axis. Where the reference has no power in a band the error is 0 if
+        the modified curve has none either, else ``inf``.
 
-        Raises
-        ------
-        FBSError
-            For a non-positive width or step, an unknown ``edges``, or (``"valid"``)
-            explicit centres whose band leaves the range.
-        FrequencyGridError, DataFormatError
-            For a bad grid or shapes that do not match it.
+    Raises
+    ------
+    FBSError
+        For a non-positive width or step, an unknown ``edges``, or (``"valid"``)
+        explicit centres whose band leaves the range.
+    FrequencyGridError, DataFormatError
+        For a bad grid or shapes that do not match it.
 
-        Examples
-        --------
-        >>> import numpy as np
-    from numpy.typing import ArrayLike
-        >>> f = np.arange(0.0, 50.0, 0.5)
-        >>> v = 1 / (1 + 1j * (f - 20))
-        >>> c, e = floating_band_error(f, v, 1.1 * v)
-        >>> bool(np.allclose(e, 0.21))
-        True
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.arange(0.0, 50.0, 0.5)
+    >>> v = 1 / (1 + 1j * (f - 20))
+    >>> c, e = floating_band_error(f, v, 1.1 * v)
+    >>> bool(np.allclose(e, 0.21))
+    True
     """
     f = check_grid(freq)
     _check_band(width, step, edges)

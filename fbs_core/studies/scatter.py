@@ -30,7 +30,6 @@ rounds are processed in chunks of lines whose size is bounded by ``max_chunk_byt
 from __future__ import annotations
 
 import threading
-import time
 import warnings
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
@@ -39,14 +38,28 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, DTypeLike
+from numpy.typing import ArrayLike
 
-from .._typing import AnyArray, ComplexArray, FloatArray, IntArray
+from .._typing import ComplexArray, FloatArray, IntArray
 from ..errors import DataFormatError, FBSError, SingularInterfaceError, StudyCancelled
 from ..frf import check_grid
 from ..harmonics import Harmonic
+from ..vocabulary import DIRECTIONS, magnitude_db
+from ..vocabulary import readonly as _ro
 from . import _models, _noise_kernels
 from ._rng import as_seed, seed_key
+from .band_kernel import (
+    LOCK,
+    TARGETS,
+    BandStats,
+    KernelArrays,
+    band_lines,
+    kernel_arrays,
+    noise_flags,
+    reference_response,
+    responses,
+    target_name,
+)
 
 #: Largest number of Monte-Carlo rounds of one band (one line's working memory,
 #: ``8 R n_e`` bytes, stays below 50 MB for six responses).
@@ -61,16 +74,6 @@ __all__ = [
     "target_name",
 ]
 
-#: Where the noise goes: the tire, the chassis (the thesis' "vehicle") or both.
-TARGETS = ("tire", "chassis", "both")
-#: Deprecated spellings of a target (one release).
-_OLD_TARGETS = {"vehicle": "chassis"}
-
-_EMPTY_MAG = np.empty((0, 0, 0))
-# one compiled parallel run at a time (some numba threading layers abort on concurrent
-# launches from several Python threads, e.g. a dashboard serving two sessions); the
-# serial kernel (single rounds, the reference) runs without it
-_LOCK = threading.Lock()
 #: Default bound of one chunk's duration (s): the band asks ``cancel`` (and takes its
 #: turn) between chunks, so this is how long a cancel or another study waits at most.
 CHUNK_SECONDS = 0.1
@@ -79,28 +82,9 @@ CHUNK_SECONDS = 0.1
 _RATE: dict[tuple[int, int, bool], float] = {}
 #: Rounds x lines of a first chunk when no rate is known yet (a few ms of work)
 _PROBE = 50_000
-_EMPTY_CPLX = np.empty((0, 0, 0), np.complex128)
-
-#: The kernel inputs of a band (real and imaginary parts of the four matrices and the
-#: pivot order, see :func:`_check_inputs`) and its 64-bit key.
-_KernelArrays = tuple[
-    FloatArray,
-    FloatArray,
-    FloatArray,
-    FloatArray,
-    FloatArray,
-    FloatArray,
-    FloatArray,
-    FloatArray,
-    IntArray,
-]
-_Inputs = tuple[_KernelArrays, np.uint64]
-
-
-def _ro(a: ArrayLike, dtype: DTypeLike | None = None) -> AnyArray:
-    a = np.array(a, dtype=dtype, copy=True)
-    a.setflags(write=False)
-    return a
+#: The process-wide lock of the parallel kernel (:data:`.band_kernel.LOCK`, the same object)
+_LOCK = LOCK
+_Inputs = tuple[KernelArrays, np.uint64]
 
 
 def _renamed_edge(cls: str, old: str, new: str) -> None:
@@ -113,8 +97,7 @@ def _renamed_edge(cls: str, old: str, new: str) -> None:
 
 
 def _db(x: FloatArray) -> FloatArray:
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return 20 * np.log10(x)
+    return magnitude_db(x, floor=None)  # ratios of magnitudes: -inf at 0, no floor
 
 
 @dataclass(frozen=True, eq=False)
@@ -225,6 +208,14 @@ class ScatterBand:
     harmonic: int | None
     _inputs: _Inputs
 
+    @classmethod
+    def of_kernel(cls, arrays: KernelArrays, seed: int, **fields: Any) -> ScatterBand:
+        """The band of the statistics ``fields`` (all attributes but ``seed``) whose rounds
+        :meth:`round` regenerates from the kernel arrays of :func:`.band_kernel.kernel_arrays`
+        and the seed (e.g. a band assembled from blocks of lines computed elsewhere)."""
+        seed = int(seed)
+        return cls(seed=seed, _inputs=(arrays, seed_key(seed)), **fields)
+
     @property
     def lower(self) -> FloatArray:
         """Deprecated name of :attr:`minimum` (one release)."""
@@ -279,14 +270,21 @@ class ScatterBand:
     def _round_cache(self) -> tuple[OrderedDict[int, ComplexArray], threading.Lock]:
         return OrderedDict(), threading.Lock()
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled without the cache of regenerated rounds and its lock (a band crosses to
+        another process with a report's data; the rounds are regenerated there)."""
+        state = dict(self.__dict__)
+        state.pop("_round_cache", None)
+        return state
+
     def rounds_response(self, rounds: ArrayLike) -> ComplexArray:
         """Complex responses of several rounds, shape ``(n, n_f, n_dof)``."""
         rids = np.atleast_1d(np.asarray(rounds, np.int64))
         if rids.ndim != 1 or np.any((rids < 0) | (rids >= self.rounds)):
             raise FBSError(f"round indices must be in 0..{self.rounds - 1}, got {rids.tolist()}")
         arrays, key = self._inputs
-        tire, vehicle = _flags(self.target)
-        return _run_complex(arrays, key, rids, self.noise, tire, vehicle, self.frequency_dependent)
+        tire, chassis = noise_flags(self.target)
+        return responses(arrays, key, rids, self.noise, tire, chassis, self.frequency_dependent)
 
     def peak_round(self, freq: float, dof: str | int, which: str = "max") -> int:
         """The round giving the highest (``"max"``) or lowest (``"min"``) ``|v_e|`` at the
@@ -303,7 +301,7 @@ class ScatterBand:
         (1 where no noise is applied; ``line`` is ignored without frequency dependence)."""
         arrays, key = self._inputs
         nj, ne = arrays[2].shape[1], arrays[6].shape[1]
-        tire, vehicle = _flags(self.target)
+        tire, vehicle = noise_flags(self.target)
         stream_line = line if self.frequency_dependent else 0
         s = _noise_kernels.noise_factors(
             key, np.array([r], np.int64), np.array([stream_line]), self.noise, nj, ne, tire, vehicle
@@ -320,59 +318,6 @@ def split_factors(s: FloatArray, nj: int, ne: int) -> dict[str, FloatArray]:
         "Yjj_E": s[..., o2:o3].reshape(s.shape[:-1] + (nj, nj)),
         "Yej_E": s[..., o3 : o3 + ne * nj].reshape(s.shape[:-1] + (ne, nj)),
     }
-
-
-def target_name(target: str, *, warn: bool = True) -> str:
-    """The name in :data:`TARGETS` of a noise target; ``"vehicle"`` is the deprecated name of
-    ``"chassis"`` (a ``DeprecationWarning`` when ``warn``; bands stored with it still load).
-
-    Raises
-    ------
-    FBSError
-        For an unknown target, naming the allowed ones.
-    """
-    if target in _OLD_TARGETS:
-        if warn:
-            warnings.warn(
-                f"noise target {target!r} is deprecated; use {_OLD_TARGETS[target]!r}",
-                DeprecationWarning,
-                stacklevel=3,
-            )
-        return _OLD_TARGETS[target]
-    if target not in TARGETS:
-        raise FBSError(f"unknown noise target {target!r}; allowed: {', '.join(TARGETS)}")
-    return target
-
-
-def _flags(target: str) -> tuple[bool, bool]:
-    """Which subsystems get noise: ``(tire, chassis)``."""
-    t = target_name(target, warn=False)
-    return t in ("tire", "both"), t in ("chassis", "both")
-
-
-def _split(z: ComplexArray) -> tuple[FloatArray, FloatArray]:
-    # read-only, C-contiguous: one compiled signature for the band and single rounds
-    return _ro(np.ascontiguousarray(z.real, float)), _ro(np.ascontiguousarray(z.imag, float))
-
-
-def _run_complex(
-    arrays: _KernelArrays,
-    key: np.uint64,
-    rids: IntArray,
-    p: float,
-    tire: bool,
-    vehicle: bool,
-    freq_dep: bool,
-) -> ComplexArray:
-    nf, ne = arrays[0].shape[0], arrays[6].shape[1]
-    out = np.empty((rids.size, nf, ne), np.complex128)
-    args = (*arrays, 0, nf, key, rids, float(p), tire, vehicle, freq_dep, _EMPTY_MAG, out)
-    if rids.size <= _noise_kernels.LANES:  # one block: one thread either way, no lock needed
-        _noise_kernels.noisy_block_run_serial(*args)
-    else:
-        with _LOCK:
-            _noise_kernels.noisy_block_run(*args)
-    return out
 
 
 def _chunk_lines(seconds: float | None, rate: float | None, rounds: int, max_lines: int) -> int:
@@ -394,28 +339,6 @@ def default_checkpoints(rounds: int) -> IntArray:
         out += [m * dec for m in (1, 2, 5) if m * dec < rounds]
         dec *= 10
     return np.array(out + [rounds], np.int64)
-
-
-def _check_inputs(
-    YjjA_in: ArrayLike, vj_in: ArrayLike, YjjE_in: ArrayLike, YejE_in: ArrayLike
-) -> _KernelArrays:
-    YjjA, vj, YjjE, YejE = (np.asarray(x) for x in (YjjA_in, vj_in, YjjE_in, YejE_in))
-    if YjjA.ndim != 3 or YjjA.shape[1] != YjjA.shape[2]:
-        raise DataFormatError(f"YjjA must have shape (n_f, n_j, n_j), got {YjjA.shape}")
-    nf, nj = YjjA.shape[:2]
-    if vj.shape != (nf, nj):
-        raise DataFormatError(f"vj must have shape (n_f, n_j) = {(nf, nj)}, got {vj.shape}")
-    if YjjE.shape != (nf, nj, nj):
-        raise DataFormatError(f"YjjE must have shape {(nf, nj, nj)}, got {YjjE.shape}")
-    if YejE.ndim != 3 or YejE.shape[0] != nf or YejE.shape[2] != nj:
-        raise DataFormatError(
-            f"YejE must have shape (n_f, n_e, {nj}) with n_f = {nf}, got {YejE.shape}"
-        )
-    for name, x in (("YjjA", YjjA), ("vj", vj), ("YjjE", YjjE), ("YejE", YejE)):
-        if not np.all(np.isfinite(x)):
-            raise DataFormatError(f"{name} contains non-finite values")
-    order = _ro(_noise_kernels.pivot_order(YjjA, YjjE))
-    return (*_split(YjjA), *_split(vj), *_split(YjjE), *_split(YejE), order)
 
 
 def scatter_band_arrays(
@@ -498,13 +421,13 @@ def scatter_band_arrays(
     SingularInterfaceError
         If the (noisy) interface matrix is singular at some line.
     """
-    arrays = _check_inputs(YjjA, vj, YjjE, YejE)
+    arrays = kernel_arrays(YjjA, vj, YjjE, YejE)
     nf, nj = arrays[2].shape
     ne = arrays[6].shape[1]
     if not (0.0 <= noise < 1.0):
         raise FBSError(f"noise must be in [0, 1) (0.1 = +-10 %), got {noise!r}")
     target = target_name(target)
-    tire, vehicle = _flags(target)
+    tire, chassis = noise_flags(target)
     if isinstance(rounds, bool) or not isinstance(rounds, int | np.integer) or rounds < 1:
         raise FBSError(f"rounds must be a positive integer, got {rounds!r}")
     if rounds > MAX_ROUNDS:
@@ -528,21 +451,15 @@ def scatter_band_arrays(
     if f.size != nf:
         raise DataFormatError(f"{f.size} frequencies for {nf} lines")
     if dofs is None:
-        dofs = tuple(f"bushing:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))[:ne]
+        dofs = tuple(f"bushing:{d}" for d in DIRECTIONS)[:ne]
     dofs = tuple(dofs)
     if len(dofs) != ne:
         raise DataFormatError(f"{len(dofs)} response labels for {ne} response DOFs")
     seed = as_seed(seed)
     key = seed_key(seed)
 
-    ref = _run_complex(arrays, key, np.zeros(1, np.int64), 0.0, False, False, False)[0]
-    lo = np.empty((nf, ne))
-    hi = np.empty((nf, ne))
-    alo = np.empty((nf, ne), np.int64)
-    ahi = np.empty((nf, ne), np.int64)
-    pct = np.empty((qs.size, nf, ne))
-    clo = np.empty((ck.size, nf, ne))
-    chi = np.empty((ck.size, nf, ne))
+    ref = reference_response(arrays)
+    st = BandStats.empty(nf, ne, qs.size, ck.size)
     per_line = 8 * ne * rounds
     max_lines = int(max(1, min(nf, max_chunk_bytes // per_line)))
     mag = np.empty((max_lines, ne, rounds))
@@ -559,24 +476,10 @@ def scatter_band_arrays(
         l1 = min(nf, l0 + chunk)
         if nf - l1 < chunk // 4:  # no short tail chunk (one turn more for a few lines)
             l1 = min(nf, l0 + max_lines)
-        m = mag[: l1 - l0]
-        with _LOCK:
-            t0 = time.perf_counter()
-            _noise_kernels.noisy_block_run(
-                *arrays,
-                l0,
-                l1,
-                key,
-                rids,
-                float(noise),
-                tire,
-                vehicle,
-                bool(frequency_dependent),
-                m,
-                _EMPTY_CPLX,
-            )
-            _noise_kernels.band_stats(m, qs, ck, lo, hi, alo, ahi, pct, clo, chi, l0)
-            spent = time.perf_counter() - t0
+        spent = band_lines(
+            arrays, l0, l1, key, rids, noise, tire, chassis, bool(frequency_dependent), qs, ck, st,
+            row=l0, work=mag,
+        )  # fmt: skip
         if max_chunk_seconds is not None:
             rate = _RATE[shape] = max(spent, 1e-9) / ((l1 - l0) * rounds)
             chunk = _chunk_lines(max_chunk_seconds, rate, rounds, max_lines)
@@ -584,6 +487,7 @@ def scatter_band_arrays(
             progress(l1, nf)
         l0 = l1
     del mag
+    lo, hi = st.minimum, st.maximum
     for name, x in (("reference", np.abs(ref)), ("upper edge", hi), ("lower edge", lo)):
         if not np.all(np.isfinite(x)):
             line = int(np.argwhere(~np.isfinite(x))[0][0])
@@ -597,11 +501,11 @@ def scatter_band_arrays(
         reference=_ro(ref),
         minimum=_ro(lo),
         maximum=_ro(hi),
-        argmin_round=_ro(alo),
-        argmax_round=_ro(ahi),
+        argmin_round=_ro(st.argmin_round),
+        argmax_round=_ro(st.argmax_round),
         q=_ro(qs),
-        percentiles=_ro(pct),
-        convergence=Convergence(_ro(ck), _ro(clo), _ro(chi)),
+        percentiles=_ro(st.percentiles),
+        convergence=Convergence(_ro(ck), _ro(st.conv_minimum), _ro(st.conv_maximum)),
         noise=float(noise),
         target=target,
         rounds=rounds,

@@ -18,14 +18,16 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, DTypeLike
+from numpy.typing import ArrayLike
 
 from .. import kernels
-from .._typing import AnyArray, ComplexArray, FloatArray, IntArray
+from .._typing import ComplexArray, FloatArray, IntArray
 from ..errors import DOFError, FBSError, HarmonicError
 from ..frf import check_grid
 from ..harmonics import Harmonic
-from . import _models
+from ..vocabulary import DIRECTIONS
+from ..vocabulary import readonly as _ro
+from . import _coupling_kernels, _models
 from .metric import floating_band_error
 
 __all__ = [
@@ -38,12 +40,6 @@ __all__ = [
     "suggest_modes",
     "mode_frequencies",
 ]
-
-
-def _ro(a: ArrayLike, dtype: DTypeLike | None = None) -> AnyArray:
-    a = np.array(a, dtype=dtype, copy=True)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, eq=False)
@@ -297,23 +293,21 @@ def truncation_map_arrays(
             f"and n_f = {f.size}"
         )
     # eq. 4.1 in two steps, keeping the interface forces g (eq. 2.37) for the contributions
-    g = kernels.solve_interface(YjjA + YjjE[None], vj[..., None])  # (n_N, n_f, n_j, 1)
-    g_ref = kernels.solve_interface(YjjA_ref + YjjE, vj_ref[..., None])
-    resp = (YejE[None] @ g)[..., 0]
-    ref = (YejE @ g_ref)[..., 0]
+    g, resp = _couple(YjjA, vj, YjjE, YejE)  # (n_N, n_f, n_j), (n_N, n_f, n_e)
+    g_ref, ref = (x[0] for x in _couple(YjjA_ref[None], vj_ref[None], YjjE, YejE))
     if not (np.all(np.isfinite(resp)) and np.all(np.isfinite(ref))):
         bad = np.argwhere(~np.isfinite(resp))
         line = int(bad[0][1]) if bad.size else int(np.argwhere(~np.isfinite(ref))[0][0])
         raise FBSError(f"coupled response is not finite at {f[line]:g} Hz (singular interface?)")
     c, err = floating_band_error(f, ref, resp, width, step, edges, centres)
     if dofs is None:
-        dofs = tuple(f"bushing:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))[: ref.shape[-1]]
+        dofs = tuple(f"bushing:{d}" for d in DIRECTIONS)[: ref.shape[-1]]
     if len(dofs) != ref.shape[-1]:
         raise DOFError(f"{len(dofs)} response labels for {ref.shape[-1]} response DOFs")
     n_j = YjjE.shape[-1]
     if interface is None:
         interface = (
-            tuple(f"hub:{d}" for d in ("x", "y", "z", "rx", "ry", "rz"))
+            tuple(f"hub:{d}" for d in DIRECTIONS)
             if n_j == 6
             else tuple(f"interface:{k}" for k in range(n_j))
         )
@@ -333,10 +327,22 @@ def truncation_map_arrays(
         step=float(step),
         edges=edges,
         _interface=tuple(interface),
-        _forces=_ro(g[..., 0]),
-        _forces_reference=_ro(g_ref[..., 0]),
+        _forces=_ro(g),
+        _forces_reference=_ro(g_ref),
         _transfer=_ro(YejE),
     )
+
+
+def _couple(
+    YjjA: ComplexArray, vj: ComplexArray, YjjE: ComplexArray, YejE: ComplexArray
+) -> tuple[ComplexArray, ComplexArray]:
+    """Interface forces and responses (eqs. 2.37, 4.1) of every count: the compiled small
+    solves; a singular interface is reported by :func:`fbs_core.kernels.solve_interface`."""
+    g, resp, singular = _coupling_kernels.couple_many(YjjA, vj, YjjE, YejE)
+    if singular:  # raises SingularInterfaceError naming the line
+        g = kernels.solve_interface(YjjA + YjjE[None], vj[..., None])[..., 0]
+        resp = (YejE[None] @ g[..., None])[..., 0]
+    return g, resp
 
 
 def default_n_modes(n_total: int, step: int = 10) -> IntArray:

@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike
 
 __all__ = [
     "Cluster",
+    "Interval",
     "residue_change",
     "find_clusters",
     "cluster_ends",
@@ -80,6 +81,38 @@ class Cluster:
     z: np.ndarray
 
 
+@dataclass(frozen=True)
+class Interval:
+    """A tire model between two neighbouring operating points: what interpolates it.
+
+    Built by :meth:`fbs_core.tire.TireModel.interval`; between the operating points
+    ``speeds[e0]`` and ``speeds[e0 + 1]`` of the stencil a mode outside every cluster
+    has the pole ``w @ poles[:, r]`` and the residue ``w @ residues[:, r]``
+    (``w = lagrange_weights(speeds, v)``), the modes of a cluster come from
+    :func:`cluster_at` (roots and partial fractions).
+
+    Attributes
+    ----------
+    speeds : ndarray, shape (n_nodes,)
+        Speeds (km/h) of the interpolation nodes (2 for linear, 4 for cubic).
+    poles : ndarray, complex, shape (n_nodes, n_m)
+        All poles at the nodes, stored (tracked) order.
+    columns : ndarray of int, shape (n_c,)
+        Residue columns: ``0..35`` the hub receptance 6 x 6 (row major), ``36 + 6 h + i``
+        the hub response ``i`` to the patch load of wavelength ``h``.
+    residues : ndarray, complex, shape (n_nodes, n_m, n_c)
+        Those columns of every mode's residue at the nodes.
+    clusters : tuple of Cluster
+        The interval's clusters of close modes, their moments of those columns.
+    """
+
+    speeds: np.ndarray
+    poles: np.ndarray
+    columns: np.ndarray
+    residues: np.ndarray
+    clusters: tuple[Cluster, ...]
+
+
 def residue_change(R0: np.ndarray, R1: np.ndarray) -> np.ndarray:
     """``|R1 - R0| / max(|R0|, |R1|)`` per mode (rows), 0 for modes without residues."""
     n0 = np.linalg.norm(R0, axis=-1)
@@ -92,26 +125,25 @@ def residue_change(R0: np.ndarray, R1: np.ndarray) -> np.ndarray:
 def _components(
     lam0: np.ndarray, lam1: np.ndarray, idx: np.ndarray, kappa: float, moving: np.ndarray
 ) -> list[np.ndarray]:
-    n = idx.size
-    parent = np.arange(n)
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
+    """Connected groups of the modes ``idx``: pairs closer than ``kappa`` at either end,
+    one of them moving; groups ordered by their first mode."""
+    mv = moving[idx]
+    near = np.zeros((idx.size, idx.size), bool)
     for lam in (lam0[idx], lam1[idx]):
         d = np.abs(lam[:, None] - lam[None, :])
         w = kappa * (np.abs(lam.real)[:, None] + np.abs(lam.real)[None, :])
-        mv = moving[idx]
-        near = (d < w) & (mv[:, None] | mv[None, :])
-        for i, j in zip(*np.nonzero(np.triu(near, 1)), strict=True):
-            a, b = find(int(i)), find(int(j))
-            if a != b:
-                parent[max(a, b)] = min(a, b)
-    roots = np.array([find(i) for i in range(n)])
-    return [idx[roots == r] for r in np.unique(roots)]
+        near |= (d < w) & (mv[:, None] | mv[None, :])
+    near |= near.T
+    # the first mode of every mode's group: the least label among the neighbours, then
+    # the label's own label (pointer jumping), until nothing changes
+    first = np.arange(idx.size)
+    while True:
+        nxt = np.minimum(first, np.where(near, first[None, :], idx.size).min(axis=1))
+        nxt = nxt[nxt]
+        if np.array_equal(nxt, first):
+            break
+        first = nxt
+    return [idx[first == f] for f in np.unique(first)]
 
 
 def find_clusters(
@@ -187,7 +219,7 @@ def _poly(z: np.ndarray) -> np.ndarray:
 def cluster_ends(
     groups: Sequence[np.ndarray],
     lam: np.ndarray,
-    R: np.ndarray,
+    R: np.ndarray | None,
     ends: tuple[int, int] = (0, -1),
 ) -> list[Cluster]:
     """Interpolation data of clusters from their poles and residues at the nodes.
@@ -198,8 +230,9 @@ def cluster_ends(
         Member indices of every cluster.
     lam : ndarray, shape (n_nodes, n_m)
         All poles at the interpolation nodes (2 for linear, 4 for cubic).
-    R : ndarray, shape (n_nodes, n_m, n_res)
-        All residues at the nodes.
+    R : ndarray, shape (n_nodes, n_m, n_res), or None
+        All residues at the nodes; None: no moments (``n_res = 0``: poles only, or the
+        moments folded into the coefficients as :mod:`.sums` does).
     ends : pair of int
         The nodes bounding the interval (they set the centre, scale and order).
 
@@ -219,8 +252,11 @@ def cluster_ends(
         rho = np.maximum(np.abs(both - c[:, None]).max(axis=1), 1e-3 * np.abs(c))
         rho = np.maximum(rho, 1e-12)
         z = (lam[:, mem] - c[None, :, None]) / rho[None, :, None]  # (n_nodes, n_c, k)
-        pw = z[:, :, None, :] ** np.arange(k)[None, None, :, None]  # (n_nodes, n_c, j, k)
-        m = np.einsum("ncjr,ncrx->cnjx", pw, R[:, mem])  # moments, cluster-major
+        if R is None:
+            m = np.zeros((mem.shape[0], lam.shape[0], k, 0), complex)
+        else:
+            pw = z[:, :, None, :] ** np.arange(k)[None, None, :, None]  # (n_nodes, n_c, j, k)
+            m = np.einsum("ncjr,ncrx->cnjx", pw, R[:, mem])  # moments, cluster-major
         out.append(Cluster(mem, c, rho, _poly(z), np.ascontiguousarray(m), z))
     return out
 
@@ -292,7 +328,7 @@ def cluster_sum(
     if per_cluster:
         n_c = cl.members.shape[0]
         g = np.moveaxis(g.reshape(n_l, n_c, -1), 1, 0)  # (n_c, n_l, n_nodes k)
-        tot: np.ndarray = np.moveaxis(g @ cl.m.reshape(n_c, n_nodes * k, -1), 0, 1)
+        tot: np.ndarray = np.moveaxis(g @ cl.m.reshape(n_c, n_nodes * k, cl.m.shape[-1]), 0, 1)
         return tot if cols is None else tot[..., cols]
     m = cl.m if cols is None else cl.m[..., cols]  # only the columns wanted
     out: np.ndarray = g.reshape(n_l, -1) @ m.reshape(-1, m.shape[-1])
@@ -340,8 +376,8 @@ def cluster_at(
     h = b[..., k - 1 :: -1] / dp[..., None]  # (n_l, n_c, k_root, k_q)
     g = wa[:, None, None, :, None] * h[:, :, :, None, :]  # (n_l, n_c, k_root, n_nodes, k_q)
     g = np.moveaxis(g, 1, 0).reshape(n_c, n_l * k, n_nodes * k)
-    r = g @ cl.m.reshape(n_c, n_nodes * k, -1)  # (n_c, n_l * k_root, n_res)
-    r = np.moveaxis(r.reshape(n_c, n_l, k, -1), 0, 1)
+    r = g @ cl.m.reshape(n_c, n_nodes * k, cl.m.shape[-1])  # (n_c, n_l * k_root, n_res)
+    r = np.moveaxis(r.reshape(n_c, n_l, k, r.shape[-1]), 0, 1)
     if cols is not None:
         r = r[..., cols]
     return cl.c[None, :, None] + cl.rho[None, :, None] * z, r

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from ..vocabulary import DIRECTIONS, ROTATIONS, TRANSLATIONS, magnitude_db
 from .params import DEFAULT_PARAMETERS, TireParameters
 
 __all__ = [
@@ -93,8 +94,6 @@ NOTES: dict[str, str] = {
     "fig_5_3_case5_z_160": "as table 5.1 at 160 Hz (round belt: 80)",
 }
 
-_DOFS = ("x", "y", "z", "rx", "ry", "rz")
-
 
 def _peaks(f: np.ndarray, a: np.ndarray, floor: float = 0.1) -> tuple[float, ...]:
     """Local maxima of ``a`` above ``floor`` times its maximum."""
@@ -131,8 +130,8 @@ class Landmarks:
     def rows(self) -> list[tuple[str, str]]:
         """``(landmark, value)`` rows in the order of :data:`THESIS`."""
         lv = self.bushing_level_db
-        tr = max(("x", "y", "z"), key=lambda d: lv[d])
-        rot = max(("rx", "ry", "rz"), key=lambda d: lv[d])
+        tr = max(TRANSLATIONS, key=lambda d: lv[d])
+        rot = max(ROTATIONS, key=lambda d: lv[d])
 
         def fmt(p: tuple[float, ...]) -> str:
             return ", ".join(f"{x:.1f}" for x in p) if p else "-"
@@ -142,11 +141,11 @@ class Landmarks:
             ("bushing_z_peaks_hz", fmt(self.bushing_peaks["z"])),
             (
                 "bushing_translation_largest",
-                f"{tr} ({', '.join(f'{d} {lv[d]:.0f}' for d in ('x', 'y', 'z'))} dB)",
+                f"{tr} ({', '.join(f'{d} {lv[d]:.0f}' for d in TRANSLATIONS)} dB)",
             ),
             (
                 "bushing_rotation_largest",
-                f"{rot} ({', '.join(f'{d} {lv[d]:.0f}' for d in ('rx', 'ry', 'rz'))} dB); "
+                f"{rot} ({', '.join(f'{d} {lv[d]:.0f}' for d in ROTATIONS)} dB); "
                 f"rx peaks {fmt(self.bushing_peaks['rx'])}",
             ),
             ("bushing_rz", f"{lv['rz'] - lv[rot]:+.0f} dB re {rot}"),
@@ -179,13 +178,13 @@ def landmarks(tire: Any = None, chassis: Any = None) -> Landmarks:
     # a DOF 160 dB below the largest carries round-off only (a symmetric tire's y, rx, rz)
     hub = {
         d: _peaks(f, v[:, k], 0.3) if v[:, k].max() > 1e-8 * v.max() else ()
-        for k, d in enumerate(_DOFS)
+        for k, d in enumerate(DIRECTIONS)
     }
     r = bushing_response(1, tire=tire, chassis=chassis)
     vb = np.abs(r.data[:, :, 0])
     names = [o.split(":")[1] for o in r.outputs]
     bpk = {d: _peaks(r.freq, vb[:, k], 0.1) for k, d in enumerate(names)}
-    lv = {d: float(20 * np.log10(vb[:, k].max())) for k, d in enumerate(names)}
+    lv = {d: float(magnitude_db(vb[:, k].max(), floor=None)) for k, d in enumerate(names)}
     s160 = suggest_modes(0.2, 160.0, tire=tire, chassis=chassis)
     s130 = suggest_modes(0.2, 130.0, maps=s160.maps, tire=tire)
     z5 = suggest_modes(0.2, 160.0, maps=s160.maps[4:5], dof="bushing:z", tire=tire)
@@ -291,10 +290,10 @@ FINDING = (
     "the hub only through the belt's n = 0, 1 content (the sidewall foundation is uniform and "
     "massless); the contact and the pre-stress couple the higher orders to it only weakly, so "
     "modes above ~250 Hz add little to the hub response below 160 Hz (residual compensation "
-    "saves 0-20 modes). The thesis' counts say its supplier model kept converging with modes "
-    "up to 500-570 Hz: a stiff local path from the patch to the rim spread over many high "
-    "modes, e.g. sidewalls meshed as a continuum. That is an inference from the counts, not "
-    "measured here."
+    "saves 0-40 modes per case). The thesis' counts say its supplier model kept converging "
+    "with modes up to 500-570 Hz: a stiff local path from the patch to the rim spread over "
+    "many high modes, e.g. sidewalls meshed as a continuum. That is an inference from the "
+    "counts, not measured here."
 )
 
 

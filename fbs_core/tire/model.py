@@ -24,7 +24,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal, TypeAlias, overload
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,8 +33,9 @@ from ..errors import DataFormatError, FBSError, ModeCountError, OperatingPointEr
 from ..frf import FRF, check_grid
 from ..harmonics import Harmonic
 from ..harmonics import harmonic as _harmonic
-from . import interp
-from .interp import cluster_at, cluster_ends, cluster_sum, find_clusters, lagrange_weights
+from ..vocabulary import readonly as _ro
+from . import interp, sums
+from .interp import Interval, cluster_at, cluster_ends, find_clusters, lagrange_weights
 from .params import TireParameters
 from .ring import HUB_DOFS, build_tire_system
 from .ring import patch_load as _patch_load
@@ -43,26 +44,12 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from .interp import Cluster
-
-#: A truncation plan of :meth:`TireModel._plan`: the truncation order and, per cluster
-#: batch, its members, the clusters whole inside a block and those split by a block edge
-#: (with their members ranked).
-#: Where the modes of an interval go for some blocks (see TireModel._layout).
-_Layout: TypeAlias = tuple[
-    np.ndarray, np.ndarray, list[tuple[int, np.ndarray]], list[tuple[int, Any]]
-]
-_Plan: TypeAlias = (
-    "tuple[np.ndarray, list[tuple[np.ndarray, Cluster | None, Cluster | None, np.ndarray | None]]]"
-)
+    from .sums import Flat
 
 __all__ = ["TireModel", "OperatingPointError", "ModeCountError", "INTERPOLATIONS"]
 
 #: Interpolation schemes between operating points.
 INTERPOLATIONS = ("cubic", "cluster", "linear")
-
-
-#: Lines per chunk of the modal sums (bounds the memory of the (lines, modes) terms).
-_CHUNK = 512
 
 
 def _renamed(
@@ -81,12 +68,6 @@ def _renamed(
     if harmonic is None:
         raise FBSError("harmonic is required: a case 1..7 or a Harmonic")
     return harmonic
-
-
-def _ro(a: ArrayLike) -> np.ndarray:
-    a = np.array(a, copy=True)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,9 +125,9 @@ class TireModel:
         _clusters: tuple[tuple[Cluster, ...], ...] = field(init=False)
         _nodes: tuple[slice, ...] = field(init=False)
         _order: np.ndarray = field(init=False)
-        _plans: dict[tuple[int, int, tuple[int, ...]], _Plan] = field(init=False)
-        _columns: dict[tuple[int, bytes], np.ndarray] = field(init=False)
-        _layouts: dict[tuple[int, int, tuple[int, ...]], _Layout] = field(init=False)
+        _Z_parts: tuple[np.ndarray, np.ndarray] = field(init=False)
+        _rank: np.ndarray = field(init=False)
+        _flat_cache: list[Flat] = field(init=False)
 
     def __post_init__(self) -> None:
         if self.interpolation not in INTERPOLATIONS:
@@ -206,6 +187,10 @@ class TireModel:
         Z = np.concatenate([R, Q], axis=2)
         Z.setflags(write=False)
         object.__setattr__(self, "_Z", Z)
+        parts = (np.ascontiguousarray(Z.real), np.ascontiguousarray(Z.imag))
+        for p in parts:
+            p.setflags(write=False)
+        object.__setattr__(self, "_Z_parts", parts)  # for the kernel (sums.truncated_sums)
         nodes: list[slice] = []
         for k in range(n_s - 1):
             nd = slice(k, k + 2)
@@ -221,9 +206,11 @@ class TireModel:
         order = np.stack([2 * pairs, 2 * pairs + 1], axis=-1).reshape(n_s, -1)
         order.setflags(write=False)
         object.__setattr__(self, "_order", order)
-        object.__setattr__(self, "_plans", {})  # cache of truncation plans (see _plan)
-        object.__setattr__(self, "_columns", {})  # residue columns per interval (_node_columns)
-        object.__setattr__(self, "_layouts", {})  # modes per block of a plan (_layout)
+        rank = np.empty_like(order)
+        np.put_along_axis(rank, order, np.arange(n_m)[None].repeat(n_s, 0), axis=1)
+        rank.setflags(write=False)
+        object.__setattr__(self, "_rank", rank)  # rank of every mode at every point
+        object.__setattr__(self, "_flat_cache", [])  # the kernel's cluster arrays (_flat)
 
     def _clusters_of(self, k: int) -> tuple[Cluster, ...]:
         """Clusters of interval ``k`` (:mod:`.interp`), found on first use and kept.
@@ -242,9 +229,49 @@ class TireModel:
             groups = find_clusters(poles[k, 0::2], poles[k + 1, 0::2], moving=moving)
         e = (k - nd.start, k + 1 - nd.start)
         groups = [2 * g + par for g in groups for par in (0, 1)]
-        out = tuple(cluster_ends(groups, self.poles[nd], self._Z[nd], e))
+        out = tuple(cluster_ends(groups, self.poles[nd], None, e))  # poles only: no moments
         self._clusters[k] = out
         return out
+
+    def interval_of(self, speed_kmh: ArrayLike) -> np.ndarray:
+        """Interval of the operating points holding every speed, shape (n_v,): ``k`` for
+        ``speeds[k] <= v < speeds[k + 1]`` (the last interval includes its end).
+
+        Raises
+        ------
+        OperatingPointError
+            For a speed outside the operating points.
+        """
+        return self._weights(speed_kmh)[0]
+
+    def interval(self, k: int, columns: ArrayLike | None = None) -> Interval:
+        """What interpolates the model in interval ``k`` (:class:`.interp.Interval`): the
+        stencil's speeds, poles and residue ``columns`` (default: the hub receptance,
+        0..35), and its clusters of close modes with their moments of those columns,
+        computed anew (the model keeps only the clusters' poles).
+
+        Raises
+        ------
+        FBSError
+            For an interval or columns out of range.
+        """
+        n_res = self._Z.shape[2]
+        cols = np.arange(36) if columns is None else np.asarray(columns)
+        if not 0 <= k < self.speeds.size - 1 or not (
+            cols.ndim == 1
+            and np.issubdtype(cols.dtype, np.integer)
+            and np.all((cols >= 0) & (cols < n_res))
+        ):
+            raise FBSError(
+                f"interval {k!r} must be 0..{self.speeds.size - 2} and columns integers "
+                f"0..{n_res - 1} (hub receptance 0..35, then 6 per wavelength)"
+            )
+        nd = self._nodes[k]
+        Zc = np.ascontiguousarray(self._Z[nd][:, :, cols])
+        groups = [m for cl in self._clusters_of(k) for m in cl.members]
+        e = (k - nd.start, k + 1 - nd.start)
+        clusters = tuple(cluster_ends(groups, self.poles[nd], Zc, e))
+        return Interval(_ro(self.speeds[nd]), _ro(self.poles[nd]), _ro(cols), _ro(Zc), clusters)
 
     # -- basic information -----------------------------------------------------------
     @property
@@ -283,9 +310,12 @@ class TireModel:
     def poles_at(self, speed_kmh: float) -> np.ndarray:
         """Poles at ``speed_kmh``, shape (n_m,), in the stored (tracked) order.
 
-        Linear in speed between the operating points, except for clusters of
-        close modes (:mod:`.interp`), whose poles are the roots of the
-        interpolated characteristic polynomial.
+        Interpolated in speed between the operating points with the model's weights
+        (``interpolation="cubic"``, the default: cubic Lagrange on the four nearest
+        operating points, linear in the first and last interval; ``"cluster"`` and
+        ``"linear"``: linear), exactly as the synthesis; the poles of a cluster of
+        close modes (:mod:`.interp`) are the roots of its interpolated characteristic
+        polynomial.
         """
         k, t = self._weights(speed_kmh)
         p: np.ndarray = self._poles_at(int(k[0]), t[:1])[0]
@@ -328,20 +358,36 @@ class TireModel:
         return int(i[0])
 
     # -- modal synthesis -------------------------------------------------------------
-    def _total(self, k: int, t: np.ndarray, s: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """Receptance sum over all modes at lines of interval ``k``: linear part by
-        matrix products, every cluster by its rational form (no roots needed)."""
-        nd = self._nodes[k]
-        v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
-        w = lagrange_weights(self.speeds[nd], v)
-        T = 1.0 / (s[:, None] - w @ self.poles[nd])  # (n_l, n_m)
-        for cl in self._clusters_of(k):
-            T[:, cl.members.ravel()] = 0.0
-        Zn = self._Z[nd]  # (n_nodes, n_m, n_res), a view
-        tot: np.ndarray = sum(w[:, i, None] * (T @ Zn[i]) for i in range(Zn.shape[0]))[:, cols]
-        for cl in self._clusters_of(k):
-            tot = tot + cluster_sum(cl, w, s, cols)
-        return tot
+    def _flat(self) -> Flat:
+        """The clusters of all intervals in the compiled kernel's arrays (:mod:`.sums`),
+        found on first use and kept; deterministic, so a race costs time only."""
+        hit = self._flat_cache
+        if hit:
+            return hit[0]
+        flat = sums.flatten(
+            self._nodes,
+            self.n_modes,
+            [self._clusters_of(k) for k in range(self.speeds.size - 1)],
+        )
+        hit.append(flat)
+        return flat
+
+    def _line_weights(self, k: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Weights ``(n_l, 4)`` of every line's interval nodes (zero past the stencil):
+        :func:`.interp.lagrange_weights`, the same operations, all lines at once."""
+        flat = self._flat()
+        v = self.speeds[k] + t * (self.speeds[k + 1] - self.speeds[k])
+        w = np.zeros((k.size, 4))
+        for m in np.unique(flat.n_nodes[k]):
+            sel = flat.n_nodes[k] == m
+            x = self.speeds[flat.node0[k[sel], None] + np.arange(m)]  # (n_sel, m)
+            ws = np.ones((x.shape[0], m))
+            for i in range(m):
+                for j in range(m):
+                    if i != j:
+                        ws[:, i] *= (v[sel] - x[:, j]) / (x[:, i] - x[:, j])
+            w[sel, :m] = ws
+        return w
 
     def _sums(
         self,
@@ -359,212 +405,50 @@ class TireModel:
         at the operating points, where the modes are delivered). With ``residual``
         every mode left out of a truncation still enters with its quasi-static
         part ``R_r / (-lambda_r)`` (upper residual flexibility, docs/tire-model.md).
+        The blocks of modes between the counts are summed by the compiled kernel of
+        :mod:`.sums`, every line on its own (its numbers do not depend on the others).
         """
         f = np.asarray(freq, float)
         k, t = self._weights(speeds)
         s = 2j * np.pi * f
-        cols = np.arange(36)
-        if h_index is not None:
-            cols = np.r_[cols, 36 + 6 * h_index + np.arange(6)]
+        patch = None if h_index is None else 36 + 6 * h_index  # its columns of _Z
         n_list = list(n_list)
-        only_all = n_list == [self.n_modes]
         edges = np.r_[0, n_list]
-        out = np.zeros((len(n_list), f.size, cols.size), complex)
         want = bool(residual)
-        residual = want and not only_all
-        if residual:
-            sta = np.zeros_like(out)  # static parts of the blocks
-            tot = np.zeros((f.size, cols.size), complex)  # static part of all modes
-        for kk in np.unique(k):
-            lines = np.flatnonzero(k == kk)
-            if only_all:
-                for idx in np.array_split(lines, max(1, int(np.ceil(lines.size / _CHUNK)))):
-                    out[0, idx] = self._total(int(kk), t[idx], s[idx], cols)
-                continue
-            for near in (0, 1):  # lines nearer the lower / upper operating point
-                sel = lines[(t[lines] >= 0.5) == bool(near)]
-                for idx in np.array_split(sel, max(1, int(np.ceil(sel.size / _CHUNK)))):
-                    if not idx.size:
-                        continue
-                    if residual:
-                        # one more block up to all modes, so that the static part of
-                        # every mode (zero poles: none) comes from the same sums
-                        full = edges if edges[-1] == self.n_modes else np.r_[edges, self.n_modes]
-                        dyn, st = self._blocks(
-                            int(kk), near, t[idx], s[idx], cols, full, static=True
-                        )
-                        nb = len(edges) - 1
-                        out[:, idx], sta[:, idx] = dyn[:nb], st[:nb]
-                        tot[idx] = st.sum(axis=0)
-                    else:
-                        out[:, idx] = self._blocks(int(kk), near, t[idx], s[idx], cols, edges)
-        out = np.cumsum(out, axis=0)
-        if residual:  # + the quasi-static part of the modes left out
-            out += tot[None] - np.cumsum(sta, axis=0)
-        if want and self.residual is not None:  # + that of the modes not delivered
+        residual = want and n_list != [self.n_modes]
+        if residual and edges[-1] != self.n_modes:
+            # one more block up to all modes, so that the static part of every mode
+            # (zero poles: none) comes from the same sums
+            edges = np.r_[edges, self.n_modes]
+        block = np.searchsorted(edges, self._rank, side="right") - 1
+        block[self._rank >= edges[-1]] = -1  # beyond the largest count: left out
+        w = self._line_weights(k, t)
+        extra = None
+        if want and self.residual is not None:  # + the static part of modes not delivered
+            cols = np.r_[np.arange(36), [] if patch is None else patch + np.arange(6)]
+            extra = np.zeros((f.size, cols.size), complex)
             for kk in np.unique(k):
                 idx = np.flatnonzero(k == kk)
                 nd = self._nodes[kk]
-                v = self.speeds[kk] + t[idx] * (self.speeds[kk + 1] - self.speeds[kk])
-                w = lagrange_weights(self.speeds[nd], v)
-                out[:, idx] += (w @ self.residual[nd][:, cols])[None]
-        out *= s[None, :, None]  # mobility = j omega H
-        Y = out[:, :, :36].reshape(len(n_list), f.size, 6, 6)
-        v = out[:, :, 36:] if h_index is not None else None
-        return Y, v
-
-    def _plan(self, k: int, near: int, edges: np.ndarray) -> _Plan:
-        """Truncation order at operating point ``k + near`` and, per cluster batch, the
-        clusters inside one block of ``edges`` and those split by a block edge (with
-        their members ranked at that point). Cached: it depends on the counts only."""
-        key = (k, near, tuple(int(e) for e in edges))
-        hit = self._plans.get(key)
-        if hit is not None:
-            return hit
-        order = self._order[k + near]
-        rank = np.empty_like(order)
-        rank[order] = np.arange(order.size)
-        block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
-        plan = []
-        for cl in self._clusters_of(k):
-            b = block[cl.members]
-            whole = np.all(b == b[:, :1], axis=1)  # cluster inside one block
-            w_sub = interp.subset(cl, whole) if whole.any() else None
-            s_sub = interp.subset(cl, ~whole) if (~whole).any() else None
-            # the lowest root goes to the member ranked lowest at the operating point
-            s_mem = None
-            if s_sub is not None:
-                s_mem = np.take_along_axis(s_sub.members, np.argsort(rank[s_sub.members], 1), 1)
-            plan.append((cl.members.ravel(), w_sub, s_sub, s_mem))
-        if len(self._plans) > 4 * len(self._clusters):
-            self._plans.clear()
-        self._plans[key] = (order, plan)
-        return order, plan
-
-    @overload
-    def _blocks(
-        self,
-        k: int,
-        near: int,
-        t: np.ndarray,
-        s: np.ndarray,
-        cols: np.ndarray,
-        edges: np.ndarray,
-        static: Literal[False] = False,
-    ) -> np.ndarray: ...
-    @overload
-    def _blocks(
-        self,
-        k: int,
-        near: int,
-        t: np.ndarray,
-        s: np.ndarray,
-        cols: np.ndarray,
-        edges: np.ndarray,
-        static: Literal[True],
-    ) -> tuple[np.ndarray, np.ndarray]: ...
-    def _blocks(
-        self,
-        k: int,
-        near: int,
-        t: np.ndarray,
-        s: np.ndarray,
-        cols: np.ndarray,
-        edges: np.ndarray,
-        static: bool = False,
-    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-        """Receptance sums over the blocks of retained modes ``edges`` (n_N, n_l, n_cols),
-        modes ranked at operating point ``k + near``; with ``static`` also the sums of
-        their quasi-static parts ``R_r / (-lambda_r)`` (same shape).
-
-        The modes are interpolated to every line's speed (weights ``w_i`` of the
-        interval's nodes), yet the interpolated residues ``sum_i w_i Z_i`` are never
-        formed per line: the modal sum of eq. 2.5 over a block ``b`` is
-        ``sum_i w_i (T_b @ Z_i,b)`` with ``T = 1 / (s - lambda)``, a few matrix products.
-        Clusters of veering modes enter by their rational form (whole in a block) or by
-        their interpolated roots (split by a block edge).
-        """
-        order, plan = self._plan(k, near, edges)
-        nd = self._nodes[k]
-        v = self.speeds[k] + np.asarray(t, float) * (self.speeds[k + 1] - self.speeds[k])
-        w = lagrange_weights(self.speeds[nd], v)
-        n_l, n_b = t.size, len(edges) - 1
-        Zc = self._node_columns(k, cols)  # (n_nodes, n_m, n_cols)
-        block, used, per_block, wholes = self._layout(k, near, edges, order, plan)
-        lam = w @ self.poles[nd][:, used]
-        X = 1.0 / (s[:, None] - lam)  # (n_l, n_used)
-        if static:  # -R / lambda below the dynamic terms; a zero pole has no static part
-            X = np.vstack([X, np.divide(-1.0, lam, out=np.zeros_like(lam), where=lam != 0)])
-        wx = np.vstack([w, w]) if static else w
-        out = np.zeros((n_b, X.shape[0], cols.size), complex)
-        for b, j in per_block:  # j: columns of X in block b
-            Xb, modes = X[:, j], used[j]
-            for i in range(Zc.shape[0]):
-                out[b] += wx[:, i, None] * (Xb @ Zc[i, modes])
-        zero = np.zeros_like(s)
-        for b, sub in wholes:  # a whole cluster's sum goes to the block of its first member
-            out[b, :n_l] += cluster_sum(sub, w, s, cols)
-            if static:
-                out[b, n_l:] += cluster_sum(sub, w, zero, cols)
-        for _members, _whole, split, split_members in plan:
-            if split is not None:  # split by a block edge: every member on its own
-                # roots by frequency, lowest first; lines at one speed share them
-                wu, inv = np.unique(w, axis=0, return_inverse=True)
-                p, r = cluster_at(split, wu, cols)
-                p, r = p[inv.ravel()], r[inv.ravel()]
-                bs = block[split_members]  # (n_c, k)
-                keep = bs >= 0
-                dyn = r / (s[:, None, None, None] - p[..., None])  # (n_l, n_c, k, n_cols)
-                np.add.at(out[:, :n_l], bs[keep], np.moveaxis(dyn[:, keep], 1, 0))
-                if static:
-                    sta = np.moveaxis((-r / p[..., None])[:, keep], 1, 0)
-                    np.add.at(out[:, n_l:], bs[keep], sta)
-        if not static:
-            return out
-        return out[:, :n_l], out[:, n_l:]
-
-    def _layout(
-        self, k: int, near: int, edges: np.ndarray, order: np.ndarray, plan: list[Any]
-    ) -> _Layout:
-        """Where every mode of interval ``k`` goes for the blocks ``edges`` (cached with the
-        plan: it depends on the counts only): the block of every mode (-1: left out), the
-        modes summed term by term (outside every cluster), their columns per block, and
-        the whole clusters of each block."""
-        key = (k, near, tuple(int(e) for e in edges))
-        hit = self._layouts.get(key)
-        if hit is not None:
-            return hit
-        rank = np.empty_like(order)
-        rank[order] = np.arange(order.size)
-        block = np.searchsorted(edges, rank, side="right") - 1  # block of every mode
-        block[rank >= edges[-1]] = -1  # beyond the largest count: left out
-        lone = np.ones(order.size, bool)  # modes outside every cluster
-        for members, _whole, _split, _members in plan:
-            lone[members] = False
-        used = np.flatnonzero((block >= 0) & lone)  # the terms summed one by one
-        per_block = [(b, np.flatnonzero(block[used] == b)) for b in range(len(edges) - 1)]
-        wholes = []
-        for _members, whole, _split, _sm in plan:
-            if whole is not None:
-                bw = block[whole.members[:, 0]]
-                wholes += [(int(b), interp.subset(whole, bw == b)) for b in np.unique(bw[bw >= 0])]
-        out = (block, used, [(b, j) for b, j in per_block if j.size], wholes)
-        if len(self._layouts) > 4 * len(self._clusters):
-            self._layouts.clear()
-        self._layouts[key] = out
-        return out
-
-    def _node_columns(self, k: int, cols: np.ndarray) -> np.ndarray:
-        """The residues of interval ``k``'s nodes, columns ``cols`` (cached, read-only)."""
-        key = (k, cols.tobytes())
-        hit = self._columns.get(key)
-        if hit is None:
-            if len(self._columns) > 64:
-                self._columns.clear()
-            hit = np.ascontiguousarray(self._Z[self._nodes[k]][:, :, cols])
-            hit.setflags(write=False)
-            self._columns[key] = hit
-        return hit
+                extra[idx] = w[idx, : nd.stop - nd.start] @ self.residual[nd][:, cols.astype(int)]
+        return sums.truncated_sums(
+            self._flat(),
+            self.poles,
+            *self._Z_parts,
+            s,
+            k,
+            w,
+            k + (t >= 0.5),  # the nearer operating point ranks the modes
+            self._order,
+            block,
+            self._rank,
+            int(edges[-1]),
+            patch,
+            len(edges) - 1,
+            len(n_list),
+            residual,
+            extra,
+        )
 
     def synthesis(
         self,
@@ -596,37 +480,96 @@ class TireModel:
         Y, v = self._sums(f, sp, [self._check_n(n_modes)], harmonic_index)
         return Y[0], (None if v is None else v[0])
 
-    def truncated(self, n_modes: int) -> TireModel:
-        """The first ``n_modes`` stored modes plus the residual of all the others.
+    def subset(self, modes: Sequence[int] | np.ndarray, *, residual: bool = True) -> TireModel:
+        """The stored mode pairs ``modes`` plus the residual of all the others.
 
-        What a supplier with the full modal set delivers to save size: per operating
-        point the upper residual flexibility ``-sum_(r > N) R_r / lambda_r`` of the
-        modes left out (hub mobility and patch residues, added to any residual this
-        model already carries). Synthesis with ``residual=True`` uses it.
+        What a supplier with the full modal set delivers to save size, choosing the
+        modes by their stored (tracked) index: the lowest ones (``range(N // 2)``) or the
+        ones that matter for a case (:func:`fbs_core.analysis.select_modes`). Per
+        operating point the upper residual flexibility ``-sum_(r left out) R_r /
+        lambda_r`` of the modes left out (hub mobility and patch residues, added to
+        any residual this model already carries) is stored; synthesis with
+        ``residual=True`` uses it.
+
+        Note the rule: a subset keeps the same tracked modes at every speed, whereas
+        ``n_modes=N`` of the syntheses keeps the ``N / 2`` pairs of lowest
+        eigenfrequency at the nearest operating point, which are not the same
+        ``N / 2`` stored pairs at every speed.
 
         Parameters
         ----------
-        n_modes : int
-            Even count of stored modes kept (in the stored, speed-averaged order).
+        modes : sequence of int
+            Stored pair indices (0 .. n_modes / 2 - 1; pair ``m`` is modes ``2 m``,
+            ``2 m + 1``), each at most once; kept in the stored order.
+        residual : bool
+            Keyword only: store the residual of the pairs left out (default).
+
+        Raises
+        ------
+        ModeCountError
+            For an empty selection, repeated or out-of-range pair indices.
         """
-        n = self._check_n(n_modes)
-        p = self.poles[:, n:]
-        inv = np.divide(-1.0, p, out=np.zeros_like(p), where=p != 0)  # zero poles: none
-        rest = (self._Z[:, n:] * inv[:, :, None]).sum(axis=1)
-        res = rest if self.residual is None else rest + self.residual
+        idx = np.asarray(modes)
+        n_p = self.n_modes // 2
+        if (
+            idx.ndim != 1
+            or idx.size == 0
+            or not np.issubdtype(idx.dtype, np.integer)
+            or np.any((idx < 0) | (idx >= n_p))
+            or np.unique(idx).size != idx.size
+        ):
+            raise ModeCountError(
+                f"modes must be distinct stored pair indices 0..{n_p - 1} (at least one), got "
+                f"{np.asarray(modes).tolist()!r}"
+            )
+        keep = np.zeros(n_p, bool)
+        keep[idx] = True
+        cols = np.stack([keep, keep], axis=-1).ravel()  # both members of every pair
+        res = self.residual
+        if residual and not cols.all():
+            p = self.poles[:, ~cols]
+            inv = np.divide(-1.0, p, out=np.zeros_like(p), where=p != 0)  # zero poles: none
+            rest = (self._Z[:, ~cols] * inv[:, :, None]).sum(axis=1)
+            res = rest if res is None else rest + res
         return TireModel(
             self.speeds,
-            self.poles[:, :n],
-            self.psi[:, :n],
-            self.chi[:, :n],
+            self.poles[:, cols],
+            self.psi[:, cols],
+            self.chi[:, cols],
             self.wavelengths,
-            self.participation[:, :, :n],
+            self.participation[:, :, cols],
             params=self.params,
-            meta={**self.meta, "truncated_from": int(self.n_modes)},
+            meta={
+                **self.meta,
+                "subset_of": int(self.n_modes),
+                "pairs": np.flatnonzero(keep).tolist(),
+            },
             hub_dofs=self.hub_dofs,
             interpolation=self.interpolation,
             residual=res,
         )
+
+    def truncated(self, n_modes: int) -> TireModel:
+        """Deprecated: :meth:`subset` of the first ``n_modes // 2`` *stored* pairs.
+
+        The name hid the rule: it keeps the first stored modes (speed-averaged order),
+        while ``n_modes=N`` of the syntheses keeps the lowest pairs at the nearest
+        operating point (at 60 km/h with N = 40 one of the 20 pairs differs, and the
+        hub mobility by 14 % of its peak). Use ``subset(range(n_modes // 2))``.
+
+        Parameters
+        ----------
+        n_modes : int
+            Even count of stored modes kept.
+        """
+        warnings.warn(
+            "TireModel.truncated(N) is deprecated: it keeps the first N stored modes, not the "
+            "lowest of each operating point; use TireModel.subset(range(N // 2))",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        n = self._check_n(n_modes)
+        return self.subset(np.arange(n // 2))
 
     def hub_mobility(
         self,

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import FBSError
+from ..vocabulary import magnitude_db
 
 if TYPE_CHECKING:
     from ..harmonics import Harmonic
@@ -88,8 +89,8 @@ def level_errors(
     if p.shape != t.shape or p.ndim != 2:
         raise FBSError(f"pred and true must have one shape (n_f, n_dof), got {p.shape}, {t.shape}")
     tiny = np.finfo(float).tiny
-    lt = 20 * np.log10(np.maximum(np.abs(t), tiny))
-    lp = 20 * np.log10(np.maximum(np.abs(p), tiny))
+    lt = magnitude_db(t, floor=tiny)
+    lp = magnitude_db(p, floor=tiny)
     rel = lt - lt.max(axis=0)
     err = np.abs(lp - lt)
     near = np.where(rel >= -within_db, err, -np.inf)
@@ -230,8 +231,8 @@ def interpolation_quality(
             Y, x = tire.synthesis(f, [v], hi)  # stored: exact at the operating point
             Yp, xp = part.synthesis(f, [v], hi)
             assert x is not None and xp is not None  # a harmonic index was given
-            mob[a, j] = 20 * np.log10(1 + np.linalg.norm(Yp - Y) / np.linalg.norm(Y))
-            pat[a, j] = 20 * np.log10(1 + np.linalg.norm(xp - x) / np.linalg.norm(x))
+            mob[a, j] = magnitude_db(1 + np.linalg.norm(Yp - Y) / np.linalg.norm(Y))
+            pat[a, j] = magnitude_db(1 + np.linalg.norm(xp - x) / np.linalg.norm(x))
     both = np.fmax(mob, pat)
     worst = np.array([np.nanmax(r) if np.isfinite(r).any() else np.nan for r in both])
     ro = [np.array(a) for a in (sp[inner], mob, pat, worst)]
