@@ -3,50 +3,63 @@
 Like :mod:`app.compute` (whose caches and model tokens it shares): process-wide caches
 keyed by the session's ``Models`` token, so reference results are shared by all sessions
 and uploads never mix. The expensive ones (the speed map, the coupled modes near a peak)
-are only asked for when their tab is shown; the Campbell diagram depends on the tire only.
-No numerics here beyond picking rows and the dB conversion: everything comes from the core.
+are only asked for when their tab is shown (:mod:`app.store`); the Campbell diagram
+depends on the tire only. No numerics here beyond picking rows: everything comes from the
+core.
 """
 
 from __future__ import annotations
 
-import numpy as np
+import threading
+from collections import OrderedDict
 
 from fbs_core import FRF, analysis
 from fbs_core.errors import FBSError
-from fbs_core.vocabulary import DIRECTIONS, magnitude_db
 
 from . import compute
-from .compute import _key, _models_kw, _n, _tire, shared_cache
+from .compute import _key, _models_kw, _n, shared_cache
 
 __all__ = [
     "campbell",
     "contributions",
-    "coupled_frf",
     "peak_modes",
     "peaks",
-    "phase_frfs",
     "speed_map",
+    "uncoupled_frfs",
 ]
 
 
 # -- contributions of the interface forces (eq. 4.1 term by term) ----------------------------
-def contributions(harmonic: int, n_modes: int, coupling: str, models=None):
+def contributions(harmonic: int, n_modes: int, coupling: str, models=None, residual=False):
     """The contributions of the interface forces on the harmonic's grid, cached.
 
     For a count the harmonic's truncation map holds (N = 10, 20, ...: the N slider's
     steps), read from the map's interface forces (:func:`fbs_core.analysis.
     map_contributions`: a product, no tire synthesis); otherwise
     :func:`fbs_core.analysis.bushing_contributions`. Both are eq. 4.1 term by term.
+    ``residual``: of the residual-compensated response (read from the residual map, which
+    holds every count below the tire's total: the others have no mode left out).
+
+    Raises
+    ------
+    FBSError
+        For residual compensation of a count the residual map does not hold.
     """
     models = _key(models)
-    return _contributions(int(harmonic), _n(models, n_modes), coupling, models)
+    n = _n(models, n_modes)
+    return _contributions(int(harmonic), n, coupling, models, bool(residual) and n is not None)
 
 
 @shared_cache(maxsize=16)
-def _contributions(harmonic, n_modes, coupling, models):
-    m = compute.error_map(harmonic, coupling, models)
+def _contributions(harmonic, n_modes, coupling, models, residual=False):
+    m = compute.error_map(harmonic, coupling, models, residual)
     if m.forces_for(n_modes) is not None:
         return analysis.map_contributions(m, n_modes)
+    if residual:
+        raise FBSError(
+            f"no contributions with residual compensation for N = {n_modes}: the residual "
+            f"map holds N = {', '.join(str(int(n)) for n in m.n_modes)}"
+        )
     return analysis.bushing_contributions(
         harmonic,
         n_modes=n_modes,
@@ -57,23 +70,12 @@ def _contributions(harmonic, n_modes, coupling, models):
 
 
 # -- phase views ------------------------------------------------------------------------------
-def coupled_frf(harmonic: int, n_modes: int | None, dof: str, coupling: str, models=None) -> FRF:
-    """The coupled response v_e* at ``bushing:<dof>`` as an FRF (``n_modes=None``: all)."""
-    v = compute.coupled_response(harmonic, n_modes, coupling, models)[:, DIRECTIONS.index(dof)]
-    return FRF(compute.frequencies(harmonic), v[:, None, None], [f"bushing:{dof}"], ["patch"])
-
-
-def phase_frfs(
-    harmonic: int, n_modes: int, dof: str, coupling: str, which: str, spindle_input: str, models
-) -> dict:
-    """The FRFs of the phase view: ``{"all modes": FRF, "N modes": FRF}`` for the coupled
-    response or the tire's free hub velocity, ``{"chassis": FRF}`` for the chassis."""
+def uncoupled_frfs(
+    harmonic: int, n_modes: int, dof: str, which: str, spindle_input: str, models
+) -> dict[str, FRF]:
+    """The uncoupled FRFs of the phase view: ``{"all modes", "N modes"}`` of the tire's
+    free hub velocity (``which="tire"``), ``{"chassis": FRF}`` for the chassis mobility."""
     f = compute.frequencies(harmonic)
-    if which == "coupled":
-        return {
-            "all modes": coupled_frf(harmonic, None, dof, coupling, models),
-            "N modes": coupled_frf(harmonic, n_modes, dof, coupling, models),
-        }
     d = compute.uncoupled_data(harmonic, n_modes, dof, spindle_input, models)
     if which == "tire":
         return {
@@ -100,19 +102,38 @@ PEAK_SNAP_KMH = 0.5
 PEAK_CANDIDATES = 6
 
 
-def peak_modes(freq: float, speed_kmh: float, coupling: str, models=None, n: int = 2) -> tuple:
+#: Coupled modes solved so far (snapped point -> candidates), looked up without solving.
+_KNOWN: OrderedDict = OrderedDict()
+_KNOWN_LOCK = threading.Lock()
+KNOWN_SIZE = 256
+
+
+def peak_modes(
+    freq: float, speed_kmh: float, coupling: str, models=None, n: int = 2, known_only=False
+) -> tuple | None:
     """The ``n`` modes of the assembled tire + chassis nearest a peak.
 
     The system is the one at the peak's speed rounded to :data:`PEAK_SNAP_KMH`, solved
     (cached) for the :data:`PEAK_CANDIDATES` modes nearest the peak's frequency rounded
     to :data:`PEAK_SNAP_HZ`; of those, the ``n`` nearest the peak itself are returned.
     Returns ``()`` for models without the physical system (an uploaded modal tire or an
-    FRF chassis: the coupled eigenvalues need the assembled system).
+    FRF chassis: the coupled eigenvalues need the assembled system). ``known_only``:
+    None instead of solving when the modes are not known yet.
     """
     f = float(freq)
     f_snap = max(PEAK_SNAP_HZ, round(f / PEAK_SNAP_HZ) * PEAK_SNAP_HZ)
     v_snap = round(float(speed_kmh) / PEAK_SNAP_KMH) * PEAK_SNAP_KMH
-    cand = _peak_modes(f_snap, v_snap, coupling, _key(models), max(PEAK_CANDIDATES, n))
+    args = (f_snap, v_snap, coupling, _key(models), max(PEAK_CANDIDATES, n))
+    with _KNOWN_LOCK:
+        cand = _KNOWN.get(args)
+    if cand is None:
+        if known_only:
+            return None
+        cand = _peak_modes(*args)
+        with _KNOWN_LOCK:
+            _KNOWN[args] = cand
+            while len(_KNOWN) > KNOWN_SIZE:
+                _KNOWN.popitem(last=False)
     return tuple(sorted(cand, key=lambda m: abs(m.freq - f))[:n])
 
 
@@ -152,12 +173,3 @@ def speed_map(harmonic: int, n_modes: int, coupling: str, models=None):
 @shared_cache(maxsize=16)
 def _speed_map(harmonic, n_modes, coupling, models):
     return analysis.speed_map(harmonic, n_modes, coupling=coupling, **_models_kw(models))
-
-
-def tire_speeds(models=None) -> np.ndarray:
-    """The operating points of the session's tire in km/h."""
-    return np.asarray(_tire(models).speeds, float)
-
-
-def db(x) -> np.ndarray:
-    return magnitude_db(x)

@@ -1,9 +1,10 @@
-"""Cached calls into :mod:`fbs_core`, shaped for the views.
+"""Cached calls into the core's studies, shaped for the results of :mod:`app.results`.
 
-This is the only module of the app that calls the core library. Results are cached per
-argument tuple (the core result objects are immutable), so that a control change that only
-selects (another response DOF, another N of the truncation map) costs a lookup. The only
-arithmetic done here is the conversion to dB for display (``20 log10 |v|``).
+The studies the dashboard shows are computed here (:mod:`app.analysis_compute` for the
+Analysis card's): results are cached per argument tuple (the core result objects are
+immutable), so that a control change that only selects (another response DOF, another N
+of the truncation map) costs a lookup. The only arithmetic done here is the conversion
+to dB for display (:func:`fbs_core.vocabulary.magnitude_db`).
 
 The coupled response for N retained modes is read from the harmonic's truncation map
 (:func:`fbs_core.studies.truncation_map` computes the eq. 4.1 response for every
@@ -19,7 +20,9 @@ results nor with each other's.
 from __future__ import annotations
 
 import threading
+import time
 from collections import OrderedDict
+from dataclasses import dataclass
 from functools import lru_cache, wraps
 
 import numpy as np
@@ -42,16 +45,20 @@ __all__ = [
     "EIGEN_SPEEDS",
     "PERCENTILE_BANDS",
     "Q_LEVELS",
+    "BandTime",
+    "CONVERGENCE_WITHIN_DB",
     "band",
+    "band_computed",
     "band_data",
     "coupled_response",
-    "db",
     "eigen_curves",
     "error_map",
     "error_map_data",
     "frequencies",
     "level_unit",
     "mobility_data",
+    "percentile_confidence_db",
+    "percentile_interval_db",
     "single_round_data",
     "suggested_table",
     "suggested_table_ready",
@@ -69,7 +76,7 @@ _thread_kind = threading.local()
 
 
 def mark_background() -> None:
-    """Mark the calling thread as background work (app/background.py): a session's thread
+    """Mark the calling thread as background work (app/runtime/background.py): a session's thread
     that needs a result such a thread is computing computes it itself (see shared_cache)."""
     _thread_kind.background = True
 
@@ -103,7 +110,7 @@ def shared_cache(maxsize: int):
             done, by_background = entry
             if not mine:
                 if by_background and not me:
-                    # never wait for a low-priority thread (app/background.py): on a busy
+                    # never wait for a low-priority thread (app/runtime/background.py): on a busy
                     # machine it runs at a fraction of a core; compute it here instead
                     return cached(*args)
                 done.wait()
@@ -124,11 +131,6 @@ def shared_cache(maxsize: int):
 
 def version() -> str:
     return str(getattr(fbs_core, "__version__", "unknown"))
-
-
-def db(x: np.ndarray) -> np.ndarray:
-    """``20 log10 |x|`` (dB re 1 unit), magnitudes floored at :data:`DB_FLOOR`."""
-    return magnitude_db(x)
 
 
 def level_unit(dof: str) -> str:
@@ -236,10 +238,6 @@ def coupled_response(
     return _bushing_response(harmonic, n, coupling, models, residual)
 
 
-def _dof_index(dof: str) -> int:
-    return DIRECTIONS.index(dof)
-
-
 def mobility_data(
     harmonic: int, n_modes: int, dof: str, coupling: str, models=None, residual: bool = False
 ) -> dict:
@@ -252,15 +250,15 @@ def mobility_data(
         ``freq`` (Hz), ``reference`` and ``truncated`` (complex v_e*), ``reference_db`` and
         ``truncated_db`` (dB), each of shape ``(n_freq,)``.
     """
-    j = _dof_index(dof)
+    j = DIRECTIONS.index(dof)
     ref = coupled_response(harmonic, None, coupling, models)[:, j]
     trunc = coupled_response(harmonic, int(n_modes), coupling, models, residual)[:, j]
     return {
         "freq": np.asarray(error_map(harmonic, coupling, models).freq, float),
         "reference": ref,
         "truncated": trunc,
-        "reference_db": db(ref),
-        "truncated_db": db(trunc),
+        "reference_db": magnitude_db(ref),
+        "truncated_db": magnitude_db(trunc),
     }
 
 
@@ -297,7 +295,8 @@ def suggested_table(
     """Suggested number of modes for all seven harmonics (thesis table 5.1).
 
     ``dof=None`` judges the maximum error over the 6 DOFs (as the thesis' table);
-    ``residual``: judged on the residual-compensated responses.
+    ``residual``: judged on the residual-compensated responses. ``result`` is the core's
+    :class:`~fbs_core.studies.SuggestedModes` the columns come from.
     """
     key = (float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual))
     out = _suggested_table(*key)
@@ -340,6 +339,7 @@ def _suggested_table(threshold_pct, f_max, coupling, dof, models, residual=False
         "n_modes": np.asarray(s.n_modes, int),
         "eigenfrequency": np.asarray(s.eigenfrequency, float),
         "speed": float(s.speed),
+        "result": s,
     }
 
 
@@ -402,14 +402,16 @@ def _tire_quality(models) -> dict:
 
 
 def eigen_curves(models=None) -> dict:
-    """Highest retained eigenfrequency versus N at 20, 80, 120 km/h (thesis fig. 5.8)."""
+    """Highest retained eigenfrequency versus N at 20, 80, 120 km/h (thesis fig. 5.8):
+    ``n_modes``, ``f_20``, ``f_80``, ``f_120`` and the core's ``result``
+    (:class:`~fbs_core.studies.ModeFrequencies`)."""
     return _eigen_curves(_key(models))
 
 
 @shared_cache(maxsize=8)
 def _eigen_curves(models) -> dict:
     mf = studies.mode_frequencies(EIGEN_SPEEDS, tire=None if models is None else models.tire)
-    out = {"n_modes": np.asarray(mf.n_modes, int)}
+    out: dict = {"n_modes": np.asarray(mf.n_modes, int), "result": mf}
     for v, row in zip(mf.speeds, mf.frequency, strict=True):
         out[f"f_{int(v)}"] = np.asarray(row, float)
     return out
@@ -451,9 +453,9 @@ def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str, mo
         "tire_reference": t_ref,
         "tire_truncated": t_tr,
         "chassis": ch,
-        "tire_reference_db": db(t_ref),
-        "tire_truncated_db": db(t_tr),
-        "chassis_db": db(ch),
+        "tire_reference_db": magnitude_db(t_ref),
+        "tire_truncated_db": magnitude_db(t_tr),
+        "chassis_db": magnitude_db(ch),
     }
 
 
@@ -474,10 +476,15 @@ def band_key(
     rounds: int,
     seed: int,
     models=None,
+    vehicle: tuple | None = None,
 ) -> tuple:
-    """The settings that define a scatter band (its cache key), normalised."""
+    """The settings that define a scatter band (its cache key), normalised.
+
+    ``vehicle``: ``(wheels, track relation, response point)`` of a car's band (vehicle
+    scope, :mod:`app.vehicle_compute`); a corner's key is the nine settings alone.
+    """
     models = _key(models)
-    return (
+    corner = (
         int(harmonic),
         _n(models, n_modes),
         str(coupling),
@@ -488,6 +495,7 @@ def band_key(
         int(seed),
         models,
     )
+    return corner if vehicle is None else (*corner, tuple(vehicle))
 
 
 def cached_band(key: tuple):
@@ -505,13 +513,20 @@ def band(*args, cancel=None, progress=None, **kwargs):
     ``cancel`` is handed to :func:`fbs_core.scatter_band` (asked between chunks of lines;
     :class:`fbs_core.StudyCancelled` when it returns True), and ``progress`` (called with
     the lines done and the total after each chunk). Sessions asking for the same missing
-    band at once share one computation (:class:`app.bands.SharedRun`).
+    band at once share one computation (:class:`app.runtime.bands.SharedRun`).
     """
     key = band_key(*args, **kwargs)
     res = cached_band(key)
     if res is not None:
         return res
+    if len(key) > 9:  # a car's band (vehicle scope)
+        from . import vehicle_compute
+
+        res = vehicle_compute.band(key, cancel=cancel, progress=progress)
+        remember_band(key, res)
+        return res
     harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models = key
+    t0 = time.perf_counter()
     res = studies.scatter_band(
         harmonic,
         noise=fraction(noise_pct),
@@ -526,26 +541,80 @@ def band(*args, cancel=None, progress=None, **kwargs):
         progress=progress,
         **_models_kw(models),
     )
-    remember_band(key, res)
+    remember_band(key, res, time.perf_counter() - t0)
     return res
 
 
-def remember_band(key: tuple, res) -> None:
-    """Cache the band ``res`` of :func:`band_key` ``key`` (computed here or on a cluster)."""
+def remember_band(key: tuple, res, seconds: float | None = None) -> None:
+    """Cache the band ``res`` of :func:`band_key` ``key`` (computed here or on a cluster in
+    ``seconds``: :func:`band_computed`)."""
     with _bands_lock:
         _bands[key] = res
+        _band_times[key] = BandTime(seconds, time.monotonic())
         _bands.move_to_end(key)
         while len(_bands) > BAND_CACHE_SIZE:
-            _bands.popitem(last=False)
+            old, _ = _bands.popitem(last=False)
+            _band_times.pop(old, None)
+
+
+@dataclass(frozen=True)
+class BandTime:
+    """When a cached band was computed: its wall time (None: not known) and the
+    ``time.monotonic()`` at which it was ready."""
+
+    seconds: float | None
+    ready: float
+
+
+_band_times: dict = {}
+
+
+def band_computed(key: tuple) -> BandTime | None:
+    """When the cached band of ``key`` was computed (None: not cached)."""
+    with _bands_lock:
+        return _band_times.get(key)
+
+
+def _label(dof: str) -> str:
+    """A response DOF's label: a direction is the bushing's (``z`` -> ``bushing:z``)."""
+    return dof if ":" in dof else f"bushing:{dof}"
+
+
+def first_order(
+    harmonic: int,
+    n_modes: int | None,
+    coupling: str,
+    noise_pct: float,
+    target: str,
+    models=None,
+):
+    """The first-order band (:func:`fbs_core.first_order_band`) of a scatter band's settings
+    (its rounds, seed and frequency dependence do not enter), cached."""
+    models = _key(models)
+    return _first_order(
+        int(harmonic), _n(models, n_modes), str(coupling), float(noise_pct), str(target), models
+    )
+
+
+@shared_cache(maxsize=16)
+def _first_order(harmonic, n_modes, coupling, noise_pct, target, models):
+    return studies.first_order_band(
+        harmonic,
+        noise=fraction(noise_pct),
+        target=target,
+        n_modes=n_modes,
+        coupling=coupling,
+        **_models_kw(models),
+    )
 
 
 def band_data(result, dof: str, percentile: float = 90) -> dict:
-    """Columns of the scatter-band view for one bushing DOF.
+    """Columns of the scatter-band view for one response DOF (a direction: the bushing's).
 
     ``percentile`` is the width of the central band in percent (one of
     :data:`PERCENTILE_BANDS`; 90 -> the 5 % and 95 % percentiles).
     """
-    j = result.dofs.index(f"bushing:{dof}")
+    j = result.dofs.index(_label(dof))
     lo, hi = (100 - percentile) / 2, (100 + percentile) / 2
     q = list(np.asarray(result.q, float))
     ref = result.reference[:, j]
@@ -558,23 +627,99 @@ def band_data(result, dof: str, percentile: float = 90) -> dict:
         "pct_high": np.asarray(result.percentiles[q.index(hi), :, j], float),
     }
     for k in ("reference", "minimum", "maximum", "pct_low", "pct_high"):
-        cols[f"{k}_db"] = db(cols[k])
+        cols[f"{k}_db"] = magnitude_db(cols[k])
     return cols
 
 
 def single_round_data(result, index: int, dof: str) -> dict:
-    """One regenerated polluted round (thesis figs. 5.10-5.11) for one bushing DOF."""
-    j = result.dofs.index(f"bushing:{dof}")
+    """One regenerated polluted round (thesis figs. 5.10-5.11) for one response DOF."""
+    j = result.dofs.index(_label(dof))
     v = result.round(int(index))[:, j]
-    return {"freq": np.asarray(result.freq, float), "round": v, "round_db": db(v)}
+    return {"freq": np.asarray(result.freq, float), "round": v, "round_db": magnitude_db(v)}
 
 
 def peak_round(result, freq: float, dof: str, which: str = "max") -> int:
     """The round with the highest (lowest) level at the line nearest ``freq``."""
-    return int(result.peak_round(float(freq), f"bushing:{dof}", which))
+    return int(result.peak_round(float(freq), _label(dof), which))
 
 
 def convergence_db(result) -> float:
-    """Largest change of either band edge (dB) between the last two checkpoints."""
+    """Largest change of either band edge (dB) between the last two checkpoints.
+
+    Of the minimum and maximum over the rounds: extreme values, driven by the rare rounds
+    that move an antiresonance or a resonance; they do not settle as rounds are added (29.5
+    dB at 10,000 rounds, 36.5 dB at 100,000, harmonic 1), so the page judges the band by
+    :func:`percentile_confidence_db` instead.
+    """
     step = np.asarray(result.convergence.step_change_db, float)
     return float(step[-1]) if step.size else float("nan")
+
+
+#: The lines a band's convergence is judged on: within this many dB of the peak of the
+#: unpolluted response at each DOF (the deep antiresonances, where a level in dB swings
+#: from round to round, are left out).
+CONVERGENCE_WITHIN_DB = 30.0
+#: Normal quantile of the two-sided 95 % confidence of :func:`percentile_confidence_db`.
+Z95 = 1.959964
+
+
+def percentile_interval_db(result, edge: float, z: float = Z95) -> tuple:
+    """The confidence interval (dB) of the band's ``edge`` % percentile at every line and
+    DOF: ``(low, high)``, arrays of shape ``(n_f, n_dof)``.
+
+    The rank of the empirical q-quantile of R independent rounds is binomial, so the true
+    quantile lies between the empirical quantiles of ``q -+ z sqrt(q (1 - q) / R)`` with
+    the normal confidence of ``z`` (1.96: 95 %; distribution-free, from order statistics);
+    those are read off the band's stored percentiles, interpolated linearly in ``q`` (and
+    clipped to the stored ones).
+    """
+    q = np.asarray(result.q, float)
+    lv = magnitude_db(np.asarray(result.percentiles, float))  # (n_q, n_f, n_dof)
+    r = max(int(result.rounds), 1)
+    dq = 100 * z * np.sqrt(edge / 100 * (1 - edge / 100) / r)
+    at = (np.clip(edge - dq, q[0], q[-1]), np.clip(edge + dq, q[0], q[-1]))
+    return _interp_levels(q, lv, float(at[0])), _interp_levels(q, lv, float(at[1]))
+
+
+def percentile_confidence_db(
+    result, width: float = 90, within_db: float = CONVERGENCE_WITHIN_DB
+) -> float:
+    """How well R rounds fix the central percentile band: the largest 95 % confidence
+    half-width (dB, :func:`percentile_interval_db`) of its two edges over the lines within
+    ``within_db`` of each DOF's peak. It falls as ``1 / sqrt(R)``: four times the rounds
+    halve it.
+
+    Parameters
+    ----------
+    result : fbs_core.ScatterBand
+        A band with the percentiles ``(100 -+ width) / 2`` and neighbours on both sides.
+    width : float
+        The central band in percent (90: the 5 % and 95 % percentiles).
+    within_db : float
+        Lines more than this below a DOF's peak reference level are left out.
+
+    Returns
+    -------
+    float
+        dB; NaN when no line qualifies.
+    """
+    q = np.asarray(result.q, float)
+    lv = magnitude_db(np.asarray(result.percentiles, float))
+    ref = magnitude_db(np.abs(np.asarray(result.reference)))  # (n_f, n_dof)
+    keep = ref >= np.nanmax(ref, axis=0, keepdims=True) - within_db
+    worst = np.nan
+    for edge in ((100 - width) / 2, (100 + width) / 2):
+        at = lv[int(np.argmin(np.abs(q - edge)))]
+        low, high = percentile_interval_db(result, edge)
+        half = np.where(keep, np.maximum(at - low, high - at), np.nan)
+        if np.isfinite(half).any():
+            worst = float(np.nanmax(half)) if worst != worst else max(worst, np.nanmax(half))
+    return float(worst)
+
+
+def _interp_levels(q: np.ndarray, lv: np.ndarray, x: float) -> np.ndarray:
+    """The levels ``lv`` (n_q, ...) at the percentile ``x``, linear between stored ones."""
+    i = int(np.clip(np.searchsorted(q, x) - 1, 0, q.size - 2))
+    t = (x - q[i]) / (q[i + 1] - q[i])
+    out: np.ndarray = (1 - t) * lv[i] + t * lv[i + 1]
+    return out

@@ -3,7 +3,7 @@
 Every browser session gets its own :class:`~app.state.DashboardState`, synchronised with the
 URL query (``?h=5&N=150&dof=z...``), so that a link reproduces the view; the page layout
 (presentation view, data card, N-axis scale, the uploads a link needs) is in the link too
-(:class:`~app.report.page.PageState`).
+(:class:`~app.page.layout.PageState`).
 
 Layout, top to bottom: the page bar (report, help, layout switches), the notice of a link
 that needs uploads, the first plot row (coupled response, error map: on the first screen
@@ -15,6 +15,8 @@ modules under ``app/views/``) add themselves with one line.
 from __future__ import annotations
 
 import functools
+import sys
+import urllib.parse
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -23,10 +25,8 @@ from typing import Any
 import panel as pn
 import param
 
-from app import background, closed_pages
-from app.bands import served
-from app.report.live import page_url
-from app.report.page import (
+from app.page.chrome import data_key, help_page, link_notice, link_notice_html, report_buttons
+from app.page.layout import (
     CARD_CSS,
     PAGE_CSS,
     PAGE_URL_KEYS,
@@ -34,8 +34,11 @@ from app.report.page import (
     PageState,
     present_css,
 )
-from app.report.panel import data_key, help_page, link_notice, report_buttons
-from app.report.session import provenance_of, session_snapshot, store_sections
+from app.page.titles import page_url
+from app.public_url import public_base
+from app.report.session import provenance_of, report_data
+from app.runtime import background, closed_pages
+from app.runtime.draw import DrawQueue, served
 from app.state import URL_KEYS, DashboardState
 from app.store import Results
 from app.views import (
@@ -51,11 +54,22 @@ from app.views import (
 from app.views.analysis_base import analysis_card
 from app.views.campaign import campaign_card
 from app.views.landmarks import landmarks_card
-from app.views.live import DrawQueue
+from app.views.layout import (
+    HIDE_TEMPLATE_TOGGLE_CSS,
+    PANEL_CONFIG,
+    VIEW_SIDEBAR_JS,
+    font,
+    layout_css,
+    sidebar_toggle,
+    sized,
+)
 from app.views.plots import frequency_range, modes_range
 from app.views.quality import TireQualityView
+from app.views.wheels import wheels_card
 
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
+public_base()  # a wrong FBS_PUBLIC_URL stops the server at start, naming the variable
+pn.config.param.update(**PANEL_CONFIG)  # stated sizing modes hold (app/views/layout.py)
 
 ACCENT = "#1c7ed6"
 
@@ -68,9 +82,17 @@ every view downloads its data as CSV; the URL holds the page state. **Help** exp
 method and how to read each view.
 """
 
-#: Plot card heights (px) in the normal view; the presentation view adds PRESENT_EXTRA.
-PLOT_HEIGHT = 580
-PRESENT_EXTRA = 140
+#: The link notice's colours (Bootstrap's warning alert; the page's CSS does not reach a pane).
+NOTICE_STYLE = {
+    "background": "#fff3cd",
+    "color": "#664d03",
+    "border": "1px solid #ffecb5",
+    "border-radius": "6px",
+    "padding": "2px 12px",
+}
+
+#: Height of a plot card's content: the window's height within limits (app/views/layout.py).
+PLOT_ROW = "plot"
 
 
 def apply_valid(obj: param.Parameterized, values: dict) -> list[str]:
@@ -89,11 +111,29 @@ def apply_valid(obj: param.Parameterized, values: dict) -> list[str]:
     return refused
 
 
+def drop_unreadable_numbers(loc) -> list[str]:
+    """Remove from ``loc.search`` the keys whose value Panel cannot read; return them.
+
+    Panel reads a value of digits with ``int()``, which refuses more than
+    ``sys.get_int_max_str_digits()`` digits (4,300) with a ``ValueError`` that would stop the
+    page build: a 5 KB link would break the page. No setting of the page takes such a number,
+    so the key is dropped and the setting keeps its default.
+    """
+    limit = sys.get_int_max_str_digits()
+    pairs = urllib.parse.parse_qsl((loc.search or "").lstrip("?"), keep_blank_values=True)
+    bad = [k for k, v in pairs if v.isdigit() and limit and len(v) > limit]
+    if bad:
+        kept = [(k, v) for k, v in pairs if k not in bad]
+        loc.search = "?" + urllib.parse.urlencode(kept) if kept else ""
+    return bad
+
+
 def sync_url(state: DashboardState, location=None) -> None:
     """Keep the state in the URL query (only when served, or with a given ``location``)."""
     loc = pn.state.location if location is None else location
     if loc is None:
         return
+    drop_unreadable_numbers(loc)
     for group, keys in URL_KEYS.items():
         obj = getattr(state, group)
         loc.sync(obj, keys, on_error=functools.partial(apply_valid, obj))
@@ -124,18 +164,22 @@ class PageParts:
         assert state is not None  # a Results always owns a state
         return state
 
-    def card(self, title: str, view, height: int | None = PLOT_HEIGHT, **kw) -> pn.Card:
-        """A collapsible card of the page's style; plot cards grow in the presentation view
-        (larger type, the same plot area)."""
-        if height is not None and self.page.view == "present":
-            height += PRESENT_EXTRA
+    def card(self, title: str, view, height: int | str | None = PLOT_ROW, **kw) -> pn.Card:
+        """A collapsible card of the page's style.
+
+        ``height``: of its content, "plot" (the plot rows' height, which follows the window,
+        :mod:`app.views.layout`), a number of px, or None (as tall as its content).
+        """
         kw.setdefault("css_classes", [])
         kw["css_classes"] = [*kw["css_classes"], "fbs-card"]
+        if isinstance(height, str):
+            view = sized(view, row=height)
+        elif height is not None:
+            view = pn.Column(view, height=height, sizing_mode="stretch_width", margin=0)
         return pn.Card(
             view,
             title=title,
             collapsible=True,
-            height=height,
             sizing_mode="stretch_width",
             header_background="#dee2e6",
             margin=(4, 4),
@@ -147,8 +191,9 @@ class PageParts:
 #: Further cards, below the built-in plots, in this order: ``builder(parts) -> panel object``
 #: (None: nothing). A view in its own module under ``app/views/`` adds its builder here.
 EXTRA_CARDS: list[Callable[[PageParts], Any]] = []
+EXTRA_CARDS.append(wheels_card)  # issue 31: per-wheel contributions (vehicle scope)
 EXTRA_CARDS.append(  # issue 18: compare, phase and peaks, across speed, contributions
-    lambda parts: analysis_card(parts.results, parts.freq)
+    lambda parts: analysis_card(parts.results, parts.freq, page=parts.page)
 )
 EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (when set)
 EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to this tire's
@@ -168,7 +213,11 @@ class PlotViews:
         self.mobility = MobilityView(store=r, x_range=parts.freq, mode=mode)
         self.scatter = ScatterBandView(store=r, x_range=parts.freq, mode=mode)
         self.eigen = EigenView(store=r, n_range=parts.modes, mode=mode)
-        self.truncation = pn.Column(self._map(p.n_axis), sizing_mode="stretch_both")
+        # the views themselves are kept: a layout holds what a view's __panel__ returned, so
+        # the error map in its column never heard of the Presentation button (issue 29)
+        self.map_view = self._map(p.n_axis)
+        self.uncoupled_view: UncoupledView | None = None
+        self.truncation = pn.Column(self.map_view, sizing_mode="stretch_both")
         self.suggested = SuggestedModesView(store=r)
         # the uncoupled subsystems are built on first request (two plots less per page load)
         self.uncoupled = pn.Row(
@@ -192,41 +241,50 @@ class PlotViews:
         )
 
     def _rebuild_map(self, n_axis: str) -> None:  # the axis scale is fixed at build
-        self.truncation.objects = [self._map(n_axis)]
+        self.map_view = self._map(n_axis)
+        self.truncation.objects = [self.map_view]
 
     def _show_uncoupled(self, show: bool) -> None:
-        if show and not self.uncoupled.objects:
+        if show and self.uncoupled_view is None:
             pa = self.parts
-            view = UncoupledView(store=pa.results, x_range=pa.freq, mode=pa.page.view)
+            self.uncoupled_view = view = UncoupledView(
+                store=pa.results, x_range=pa.freq, mode=pa.page.view
+            )
             self.uncoupled.append(
-                pa.card("Uncoupled subsystems: tire hub and chassis spindle-to-bushing", view, 420)
+                pa.card("Uncoupled subsystems: tire hub and chassis spindle-to-bushing", view)
             )
 
     def live(self) -> list:
         """The plot views now on the page."""
-        unc = [c.objects[0] for c in self.uncoupled.objects]
-        return [self.mobility, self.scatter, self.eigen, *self.truncation.objects, *unc]
+        unc = [] if self.uncoupled_view is None else [self.uncoupled_view]
+        return [self.mobility, self.scatter, self.eigen, self.map_view, *unc]
 
     def _restyle(self, view: str) -> None:
         for v in self.live():
             v.mode = view
 
 
-def plot_rows(parts: PageParts, views: PlotViews) -> list:
-    """The built-in plots: coupled response and error map first (on the first screen)."""
+def plot_rows(parts: PageParts, views: PlotViews) -> tuple[list, list]:
+    """The built-in plots: the rows above the data card and those below it.
+
+    Above: the coupled response and the error map (on the first screen), the uncoupled
+    subsystems when asked for, then the rest of the truncation study (the suggested modes
+    and the eigenfrequencies, one screen down). Below: the noise study.
+    """
     card = parts.card
-    return [
+    above = [
         pn.Row(
             card("Coupled response at the bushing (thesis eq. 4.1)", views.mobility),
-            card("Truncation error map (thesis eq. 5.1, figs. 5.3, 5.6, 5.7)", views.truncation),
+            card("Truncation error map (eq. 5.1, figs. 5.3, 5.6, 5.7)", views.truncation),
         ),
         views.uncoupled,
         pn.Row(
-            card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", views.scatter),
+            card("Suggested number of modes (thesis table 5.1)", views.suggested),
             card("Eigenfrequency versus number of modes (fig. 5.8)", views.eigen),
         ),
-        pn.Row(card("Suggested number of modes (thesis table 5.1)", views.suggested, 360)),
     ]
+    below = [pn.Row(card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", views.scatter))]
+    return above, below
 
 
 def data_card(parts: PageParts) -> pn.Card:
@@ -252,17 +310,23 @@ def data_card(parts: PageParts) -> pn.Card:
     return upload
 
 
-def link_notice_pane(parts: PageParts) -> pn.pane.Alert:
+def link_notice_pane(parts: PageParts) -> pn.pane.HTML:
     """The notice of a link made with uploads this session lacks; the link names the
-    uploads in use."""
+    uploads in use. An HTML pane of escaped text, not Markdown: the notice repeats the
+    link's value, which must stay text (issue 28, finding 2)."""
     state, page = parts.state, parts.page
-    notice = pn.pane.Alert(
-        "", alert_type="warning", visible=False, css_classes=["link-notice"], margin=(4, 8)
+    notice = pn.pane.HTML(
+        "",
+        visible=False,
+        css_classes=["link-notice"],
+        margin=(4, 8),
+        styles=NOTICE_STYLE,
+        sizing_mode="stretch_width",
     )
 
     def check(*_):  # the link's uploads (from the URL) vs the session's
         text = link_notice(page.data, provenance_of(state.data.models))
-        notice.param.update(object=text, visible=bool(text))
+        notice.param.update(object=link_notice_html(text) if text else "", visible=bool(text))
 
     def data_in_use(*_):  # the link names the uploads now in use
         page.data = data_key(provenance_of(state.data.models))
@@ -273,7 +337,7 @@ def link_notice_pane(parts: PageParts) -> pn.pane.Alert:
     return notice
 
 
-def page_bar(parts: PageParts, snapshot: Callable, open_help: Callable) -> pn.Row:
+def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
     """Report downloads, help and the layout switches (presentation view, N axis)."""
     page = parts.page
     help_button = pn.widgets.Button(
@@ -287,22 +351,42 @@ def page_bar(parts: PageParts, snapshot: Callable, open_help: Callable) -> pn.Ro
         css_classes=["ctl-page-view"],
         width=220,
     )
-    view_switch.jscallback(value=VIEW_SWITCH_JS)  # the page's type at once (page.py)
+    # the page's type (page.py) and the sidebar at once
+    view_switch.jscallback(value=VIEW_SWITCH_JS + VIEW_SIDEBAR_JS)
+    reports = report_buttons(report)
+    n_axis = pn.widgets.RadioButtonGroup.from_param(
+        page.param.n_axis,
+        name="N axis",
+        options={"N linear": "linear", "N log": "log"},
+        css_classes=["ctl-page-naxis"],
+        width=150,
+    )
+    sidebar = sidebar_toggle(page)
+
+    def fit(view: str) -> None:  # the buttons as wide as their labels in the view's type
+        w = BAR_WIDTHS[view]
+        sidebar.width, help_button.width, view_switch.width, n_axis.width = w[:4]
+        for b in reports.objects:
+            b.width = w[4]
+        reports.param.update(sizing_mode=None, width=2 * w[4] + 20)
+
+    fit(page.view)
+    page.param.watch(lambda e: fit(e.new), "view")
     return pn.Row(
-        report_buttons(snapshot),
+        sidebar,
+        reports,
         help_button,
         view_switch,
-        pn.widgets.RadioButtonGroup.from_param(
-            page.param.n_axis,
-            name="N axis",
-            options={"N linear": "linear", "N log": "log"},
-            css_classes=["ctl-page-naxis"],
-            width=150,
-        ),
+        n_axis,
         css_classes=["page-bar"],
         sizing_mode="stretch_width",
         margin=(2, 4),
     )
+
+
+#: Widths (px) of the page bar's buttons: sidebar switch, help, view switch, N axis switch
+#: and each report button, in the normal and the presentation view's type.
+BAR_WIDTHS = {"normal": (100, 70, 220, 150, 140), "present": (115, 80, 285, 190, 165)}
 
 
 def create_app(
@@ -324,16 +408,8 @@ def create_app(
     parts = PageParts(results=results, page=page, freq=frequency_range(), modes=modes_range())
     views = PlotViews(parts)
 
-    def snapshot():
-        band = results.band
-        return session_snapshot(
-            state,
-            url=page_url(),
-            band=band.result if band is not None else None,
-            band_n_modes=band.settings.n_modes if band is not None else None,
-            n_axis=page.n_axis,
-            extra=store_sections(results),  # what other views publish in the store
-        )
+    def report():  # the page's published results, as they are when the button is clicked
+        return report_data(results, url=page_url(), n_axis=page.n_axis)
 
     # the modal's own close control (Panel's public close_modal); a button in the page is
     # reachable by keyboard and by tests, unlike the template's icon or the Escape key
@@ -342,18 +418,22 @@ def create_app(
     )
     template = pn.template.BootstrapTemplate(
         title="Tire-chassis FBS: bushing vibration dashboard",
-        sidebar=[pn.pane.Markdown(INTRO, styles={"font-size": "0.85em"}), Controls(state=state)],
+        sidebar=[
+            pn.pane.Markdown(INTRO, styles={"font-size": font("0.85em")}),
+            Controls(state=state),
+        ],
         modal=[help_close, help_page()],
         header_background=ACCENT,
         sidebar_width=340,
+        collapsed_sidebar=page.sidebar_collapsed,
     )
-    first, *rest = plot_rows(parts, views)
+    above, below = plot_rows(parts, views)
     main = pn.Column(
-        page_bar(parts, snapshot, template.open_modal),
+        page_bar(parts, report, template.open_modal),
         link_notice_pane(parts),
-        first,  # a plot on the first screen, also at 1280x720
+        *above,  # a plot on the first screen, also at 1280x720
         data_card(parts),
-        *rest,
+        *below,
         *extra_cards(parts),
         sizing_mode="stretch_width",
     )
@@ -362,6 +442,8 @@ def create_app(
     template.config.raw_css.append(PAGE_CSS)
     # the presentation view's larger type follows the view switch without a reload
     template.config.raw_css.append(present_css(page.view == "present"))
+    template.config.raw_css.append(layout_css(page.view == "present"))
+    template.config.raw_css.append(HIDE_TEMPLATE_TOGGLE_CSS)
     template.page = page
     template.state = state  # for tests and benchmarks
     template.results = results

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import param
 
+from fbs_core.vehicle import RESPONSE_NODES, WHEELS
 from fbs_core.vocabulary import COUPLINGS, DIRECTIONS
 
 from .analysis_state import AnalysisState
 from .datasource import REFERENCE, DataSource, Models
+from .params import Integer, Number
 
 __all__ = [
     "DIRECTIONS",
@@ -20,9 +22,15 @@ __all__ = [
     "MODE_COUNTS",
     "MAP_MODES",
     "NOISE_TARGETS",
+    "SCOPES",
+    "TRACK_RELATIONS",
+    "VEHICLE_ROUNDS",
+    "WHEELS",
+    "RESPONSE_NODES",
     "CaseState",
     "NoiseState",
     "TruncationState",
+    "ResponsePlotState",
     "DashboardState",
     "URL_KEYS",
 ]
@@ -39,6 +47,31 @@ MAX_NOISE_PCT = 99.99
 MAX_SEED = 2**32 - 1
 #: What the truncation error map shows.
 MAP_MODES = ("selected DOF", "max over 6 DOFs")
+#: What is coupled: the thesis' rear corner (one tire) or the whole car (four tires, issue 31).
+SCOPES = ("corner", "vehicle")
+#: How the right track's road relates to the left one's (docs/vehicle-model.md, "The road as
+#: each wheel sees it"): in phase (coherency 1), anti-phase (-1) or a coherency in [-1, 1].
+TRACK_RELATIONS = ("in phase", "anti-phase", "coherence")
+#: Default rounds of the scatter band: a car's band costs ~33x a corner's per round (a dense
+#: 24 x 24 interface per round, docs/vehicle-model.md "Speed"), so vehicle scope starts at
+#: fewer rounds (the scope switch moves a default count to the other scope's default).
+CORNER_ROUNDS = 10_000
+VEHICLE_ROUNDS = 1_000
+
+
+class _WheelsSelector(param.ListSelector):
+    """The wheels whose road input is on: a list of distinct names of ``WHEELS``, kept in
+    their order (a link's repeated or unknown name, or a value that is not a list, is
+    refused like any other value out of range)."""
+
+    def __set__(self, obj: object, val: object) -> None:
+        if isinstance(val, list | tuple):
+            if len(set(val)) != len(val) or not all(isinstance(w, str) for w in val):
+                raise ValueError(
+                    f"wheels must be distinct names among {', '.join(WHEELS)}, got {val!r}"
+                )
+            val = [w for w in WHEELS if w in val] + [w for w in val if w not in WHEELS]
+        super().__set__(obj, val)
 
 
 class _TargetSelector(param.Selector):
@@ -51,9 +84,7 @@ class _TargetSelector(param.Selector):
 class CaseState(param.Parameterized):
     """The prediction case: harmonic, retained tire modes, response DOF, hub coupling."""
 
-    harmonic = param.Integer(
-        default=1, bounds=(1, 7), doc="Harmonic excitation case (thesis fig. 4.4)."
-    )
+    harmonic = Integer(default=1, bounds=(1, 7), doc="Harmonic excitation case (thesis fig. 4.4).")
     n_modes = param.Selector(
         default=50,
         objects=list(MODE_COUNTS),
@@ -80,6 +111,36 @@ class CaseState(param.Parameterized):
         "quasi-static part (upper residual flexibility, docs/tire-model.md); acts on the "
         "coupled response, the error map and the suggested N it marks.",
     )
+    scope = param.Selector(
+        default="corner",
+        objects=list(SCOPES),
+        doc="Corner: the thesis' tire on the rear corner. Vehicle: the reference car with the "
+        "tire on all four wheels (docs/vehicle-model.md).",
+    )
+    wheels = _WheelsSelector(
+        default=list(WHEELS),
+        objects=list(WHEELS),
+        doc="Vehicle scope: the wheels whose road input is on (the others still carry their tire).",
+    )
+    tracks = param.Selector(
+        default="in phase",
+        objects=list(TRACK_RELATIONS),
+        doc="Vehicle scope: the right track's road against the left's: in phase, in "
+        "anti-phase, or partially coherent (the coherence value).",
+    )
+    coherence = Number(
+        default=0.5,
+        bounds=(-1.0, 1.0),
+        step=0.05,
+        doc="Vehicle scope: coherency of the two tracks when the relation is 'coherence' "
+        "(1 in phase, -1 anti-phase, 0 independent).",
+    )
+    point = param.Selector(
+        default="bushing_rl",
+        objects=list(RESPONSE_NODES),
+        doc="Vehicle scope: the response point (six DOFs; the response DOF picks one). "
+        "bushing_rl is the thesis' bushing on the car.",
+    )
     models = param.ClassSelector(
         class_=Models,
         default=REFERENCE,
@@ -93,7 +154,7 @@ class CaseState(param.Parameterized):
 class NoiseState(param.Parameterized):
     """Monte-Carlo noise study settings (thesis section 5.2)."""
 
-    noise = param.Number(
+    noise = Number(
         default=10.0,
         bounds=(0.0, MAX_NOISE_PCT),
         softbounds=(0.0, 10.0),
@@ -108,17 +169,17 @@ class NoiseState(param.Parameterized):
         default=False,
         doc="New scaling matrix at every frequency line (else one per round).",
     )
-    rounds = param.Integer(
-        default=10_000,
+    rounds = Integer(
+        default=CORNER_ROUNDS,
         bounds=(1, 200_000),
         doc="Number of Monte-Carlo rounds R.",
     )
-    seed = param.Integer(
+    seed = Integer(
         default=0,
         bounds=(0, MAX_SEED),
         doc="Random seed of the study (up to 2**32 - 1: exact in a browser's numbers).",
     )
-    single_round = param.Integer(
+    single_round = Integer(
         default=0,
         bounds=(0, 200_000 - 1),
         doc="Index of the single polluted round drawn inside the band (0-based).",
@@ -127,6 +188,12 @@ class NoiseState(param.Parameterized):
         default=90,
         objects=[50, 80, 90, 95, 99],
         doc="Width of the central percentile band in percent (90 -> 5-95 %).",
+    )
+    first_order = param.Boolean(
+        default=False,
+        doc="Overlay the first-order (linearised) band of the same noise on the scatter "
+        "band: |v| +- k std with k the Gaussian quantile of the central percentile band "
+        "(docs/corridor.md section 6; computed only while shown).",
     )
 
     @param.depends("rounds", watch=True, on_init=True)
@@ -140,14 +207,14 @@ class NoiseState(param.Parameterized):
 class TruncationState(param.Parameterized):
     """Truncation study settings (thesis section 5.1)."""
 
-    threshold = param.Number(
+    threshold = Number(
         default=20.0,
         bounds=(0.1, 1000.0),
         softbounds=(1.0, 50.0),
         step=1.0,
         doc="Error threshold in percent: colour cap of the map and criterion of the table.",
     )
-    f_max = param.Number(
+    f_max = Number(
         default=160.0,
         bounds=(1.0, 1000.0),
         softbounds=(50.0, 450.0),
@@ -161,6 +228,37 @@ class TruncationState(param.Parameterized):
     )
 
 
+#: Level axes of the coupled-response plot: dB (a logarithmic level) or the magnitude.
+LEVEL_SCALES = ("dB", "linear")
+
+
+class ResponsePlotState(param.Parameterized):
+    """The coupled-response plot as in a test lab's FRF display: DOFs overlaid, the level
+    axis, two labelled cursors with a readout (issue 29)."""
+
+    overlay = param.ListSelector(
+        default=[],
+        objects=list(DIRECTIONS),
+        doc="Further bushing DOFs overlaid on the coupled response (their curves with N "
+        "modes); the selected DOF is always shown.",
+    )
+    level_scale = param.Selector(
+        default="dB",
+        objects=list(LEVEL_SCALES),
+        doc="Level axis: dB (20 log10 |v|) or the magnitude |v| on a linear axis.",
+    )
+    cursor1 = Number(
+        default=0.0, bounds=(0.0, 1000.0), doc="Cursor 1 on the coupled response in Hz (0: off)."
+    )
+    cursor2 = Number(
+        default=0.0, bounds=(0.0, 1000.0), doc="Cursor 2 on the coupled response in Hz (0: off)."
+    )
+    snap = param.Boolean(
+        default=False,
+        doc="The cursors snap to the nearest peak of the selected DOF's curve with N modes.",
+    )
+
+
 class DashboardState(param.Parameterized):
     """All state of one browser session."""
 
@@ -169,6 +267,11 @@ class DashboardState(param.Parameterized):
     truncation = param.ClassSelector(class_=TruncationState, instantiate=False)
     analysis = param.ClassSelector(
         class_=AnalysisState, instantiate=False, doc="The Analysis card (issue 18)."
+    )
+    plot = param.ClassSelector(
+        class_=ResponsePlotState,
+        instantiate=False,
+        doc="The coupled-response plot's overlays, level axis and cursors (issue 29).",
     )
     data = param.ClassSelector(
         class_=DataSource,
@@ -182,9 +285,17 @@ class DashboardState(param.Parameterized):
         params.setdefault("truncation", TruncationState())
         params.setdefault("data", DataSource())
         params.setdefault("analysis", AnalysisState())
+        params.setdefault("plot", ResponsePlotState())
         super().__init__(**params)
         self.case.models = self.data.models
         self.data.param.watch(self._use_models, "models")
+        self.case.param.watch(self._scope_rounds, "scope")
+
+    def _scope_rounds(self, event):
+        # a scope's default round count follows the scope (a count the user chose stays)
+        defaults = {"corner": CORNER_ROUNDS, "vehicle": VEHICLE_ROUNDS}
+        if self.noise.rounds == defaults.get(event.old):
+            self.noise.rounds = defaults[event.new]
 
     def _use_models(self, event):
         self.case.models = event.new
@@ -200,6 +311,11 @@ URL_KEYS: dict[str, dict[str, str]] = {
         "show_uncoupled": "uncoupled",
         "spindle_input": "input",
         "residual": "res",
+        "scope": "scope",
+        "wheels": "wheels",
+        "tracks": "tracks",
+        "coherence": "coh",
+        "point": "point",
     },
     "noise": {
         "noise": "noise",
@@ -209,6 +325,7 @@ URL_KEYS: dict[str, dict[str, str]] = {
         "seed": "seed",
         "single_round": "round",
         "percentile": "pct",
+        "first_order": "fo",
     },
     "truncation": {"threshold": "thr", "f_max": "fmax", "map_mode": "map"},
     "analysis": {
@@ -223,5 +340,16 @@ URL_KEYS: dict[str, dict[str, str]] = {
         "contrib_mode": "acontrib",
         "pins": "pins",
         "compare_to": "cmp",
+        "mode_pick": "mode",
+        "mode_speed": "mv",
+        "mode_rank": "mrank",
+        "waves_all": "wall",
+    },
+    "plot": {
+        "overlay": "over",
+        "level_scale": "lvl",
+        "cursor1": "mc1",
+        "cursor2": "mc2",
+        "snap": "snap",
     },
 }

@@ -1,398 +1,649 @@
-"""One session's results: computed from its state, published as parameters.
+"""One session's results, declared as a table, computed and published by one store.
 
-:class:`Results` is the only place a session computes anything. It owns the session's
-:class:`~app.state.DashboardState` (the controls and the data source) and publishes one
-:class:`Result` per view as a parameter. Each result is declared once, next to the method
-that computes it, with the state parameters it depends on::
+Every number the page shows, exports and reports is a published result of the session's
+:class:`Results`. Each result is one :class:`Row` of :data:`TABLE`:
 
-    @param.depends("state.case.harmonic", "state.case.dof", watch=True, on_init=True)
-    def _response(self):
-        self._publish("response", lambda s: ...)
+- its **name** (the parameter of :class:`Results` it is published as),
+- the **snapshot fields it depends on** (settings of the state, and the published band or
+  pins it is made of),
+- the **pure function of one** :class:`~app.results.Snapshot` that makes it
+  (:mod:`app.results`),
+- **when** it is computed: always, only while its tab of the Analysis card (or the
+  uncoupled subsystems) is shown, or on a thread of its own (the scatter band), and the
+  part done later in the background (the column with residuals of the suggested modes,
+  the coupled modes near the peaks) or ahead (the speed map of the next N).
 
-so that adding a published result is a parameter and a method, and adding a view of it is a
-:class:`~app.views.live.LiveView` subclass that draws it.
+The store derives its watchers from the table: a change of a state field recomputes the
+rows that depend on it (and the rows made of those), nothing else. "Does this output
+depend on that setting?" is answered by reading one row (:func:`depends`), and
+``tests/test_app_consistency.py`` walks the table and changes every field.
 
-Ordering: every result is computed and published under the session's one lock, and it
-reads the state *inside* that lock. Control changes of one session arrive on several
-worker threads in any order; whichever thread publishes last read the state last, so the
-newest state always lands last (no tickets, no tokens).
+Guarantees (docs/architecture.md, "The dashboard: data flow and concurrency"):
 
-Consistency: a :class:`Result` carries its data *and* their description (the settings it was
-computed for, the CSV header, the file name, the caption) from one snapshot of the state,
-so a view or an export can never pair data with another state's description.
-
-The scatter band is the one long computation: it runs on its own thread
-(:mod:`app.bands`), one live band per session (a newer request cancels the older one
-between the kernel's chunks), and bands of all sessions take turns chunk by chunk.
+- **newest state lands last**: a change's results are computed from one snapshot read
+  inside the session's lock and published before it is released; control changes arrive
+  on several worker threads in any order, whichever publishes last read the state last. A
+  row whose fields changed again meanwhile is left to the pass of that newer change;
+- **what the user looks at first**: in a pass the rows of the shown analysis tab come
+  first (after the results they are made of), so that view is computed and drawn before
+  the main views;
+- **not published twice**: a row is published only when the values it depends on changed
+  (the row's key), so a view is not redrawn for the same inputs;
+- **the band on its own thread** (:mod:`app.runtime.bands`): one live band per session,
+  turns between sessions, one run shared by the sessions asking for the same band;
+- **background work bounded** (:mod:`app.runtime.background`): at most one task per
+  session and row waits, a newer one replaces it, one thread of the process runs them;
+- **a closed page** computes and publishes nothing more.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import threading
 import time
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import panel as pn
 import param
 
-from fbs_core.units import frf_unit, input_kind, output_kind
-from fbs_core.vocabulary import EIGEN_SPEEDS
+from fbs_core.analysis import add_pin, pin_state, remove_pin
+from fbs_core.errors import FBSError
 
-from . import background, bands, compute
-from .state import DashboardState
+from . import compute
+from .analysis_state import check_pin_name, encode_pins
+from .results import (
+    FIELDS,
+    Band,
+    BandStatus,
+    Result,
+    Snapshot,
+    analysis,
+    main,
+    modes,
+    pins,
+    response_plot,
+    vehicle,
+)
+from .results.base import VEHICLE_FIELDS, progress_status
+from .runtime import background, bands
+from .runtime.draw import served
+from .state import MODE_COUNTS, DashboardState
 
-__all__ = ["Result", "Results", "Snapshot", "BandStatus", "progress_status"]
+__all__ = ["ALWAYS", "TABLE", "Results", "Row", "depends"]
+
+#: When a row is computed: on every change of what it depends on.
+ALWAYS = "always"
+#: ... only while the uncoupled subsystems are shown.
+SHOWN_UNCOUPLED = "while the uncoupled subsystems are shown"
+#: ... only while the first-order band is overlaid on the scatter band.
+SHOWN_FIRST_ORDER = "while the first-order band is shown"
+#: The state field that switches each of those on.
+_SHOWN_BY = {SHOWN_UNCOUPLED: "show_uncoupled", SHOWN_FIRST_ORDER: "first_order"}
+#: ... on a thread of its own (the scatter band), not when the store is made.
+OWN_THREAD = "on a thread of its own"
+#: ... only in vehicle scope (the whole car, issue 31).
+IN_VEHICLE = "in vehicle scope"
+_TAB = "while the Analysis tab is shown: "
 
 
-@dataclass(frozen=True, eq=False)
-class Result:
-    """What one view shows: data and their description, from one state.
+def while_tab(tab: str) -> str:
+    """When a row is computed: only while ``tab`` of the Analysis card is shown."""
+    return _TAB + tab
+
+
+@dataclass(frozen=True)
+class Row:
+    """One published result: its name, what it depends on, how and when it is made.
 
     Attributes
     ----------
-    columns : mapping of str to 1-D ndarray
-        The data as exported (CSV columns, equal length).
-    meta : mapping of str to object
-        The CSV header: the settings these data were computed for.
-    filename : str
-        The CSV file name.
-    caption : str
-        One line for the page (``**bold**`` and ``&middot;`` allowed; escaped as text).
-    draw : mapping
-        Anything else the view needs to draw these data (curves in dB, axis labels,
-        marker positions).
+    name : str
+        The parameter of :class:`Results` it is published as.
+    depends : tuple of str
+        Fields of :class:`~app.results.Snapshot` (settings, or the published ``band`` /
+        ``pins``) and names of rows it is made of.
+    make : callable or None
+        ``make(snapshot) -> value``, pure (None: the scatter band, see :meth:`Results.
+        request_band`).
+    when : str
+        :data:`ALWAYS`, :data:`SHOWN_UNCOUPLED`, :data:`SHOWN_FIRST_ORDER`, :func:`while_tab`
+        or :data:`OWN_THREAD`.
+    slow : callable, optional
+        ``slow(snapshot) -> work | None``: what the value still lacks (``make`` uses what
+        is computed), done on the background worker (in place without a server), after
+        which the row is published again.
+    ahead : callable, optional
+        ``ahead(previous, snapshot) -> work | None``: computed ahead of the next change
+        (``previous``: the snapshot of the value published before, None the first time).
+    kind : type
+        The published value's type (:class:`~app.results.Result`, a tuple of them, ...).
+    problem : bool
+        A :class:`~fbs_core.errors.FBSError` of ``make`` is shown as the store's
+        ``message`` and the value stays as it was (a malformed link).
+    doc : str
     """
 
-    columns: Mapping[str, np.ndarray] = field(default_factory=dict)
-    meta: Mapping[str, Any] = field(default_factory=dict)
-    filename: str = "data.csv"
-    caption: str = ""
-    draw: Mapping[str, Any] = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
-class Snapshot:
-    """The state of a session at one moment (plain values, read under the lock)."""
-
-    harmonic: int
-    n_modes: int
-    dof: str
-    coupling: str
-    show_uncoupled: bool
-    spindle_input: str
-    models: Any
-    noise: float
-    target: str
-    frequency_dependent: bool
-    rounds: int
-    seed: int
-    single_round: int
-    percentile: int
-    threshold: float
-    f_max: float
-    map_mode: str
-    residual: bool = False
-
-    @classmethod
-    def of(cls, state: DashboardState) -> Snapshot:
-        c, n, t = state.case, state.noise, state.truncation
-        return cls(
-            harmonic=int(c.harmonic),
-            n_modes=int(c.n_modes),
-            dof=c.dof,
-            coupling=c.coupling,
-            show_uncoupled=bool(c.show_uncoupled),
-            spindle_input=c.spindle_input,
-            models=c.models,
-            noise=float(n.noise),
-            target=n.target,
-            frequency_dependent=bool(n.frequency_dependent),
-            rounds=int(n.rounds),
-            seed=int(n.seed),
-            single_round=int(n.single_round),
-            percentile=int(n.percentile),
-            threshold=float(t.threshold),
-            f_max=float(t.f_max),
-            map_mode=t.map_mode,
-            residual=bool(c.residual),
-        )
+    name: str
+    depends: tuple[str, ...]
+    make: Callable[[Snapshot], Any] | None
+    when: str = ALWAYS
+    slow: Callable[[Snapshot], Callable[[], Any] | None] | None = None
+    ahead: Callable[[Snapshot, Snapshot], Callable[[], Any] | None] | None = None
+    kind: type = Result
+    problem: bool = False
+    doc: str = ""
+    vehicle_only: tuple[str, ...] = ()
 
     @property
-    def map_dof(self) -> str | None:
-        """The DOF the error map and the suggestion judge (None: max over the 6 DOFs)."""
-        return self.dof if self.map_mode == "selected DOF" else None
-
-    def band_key(self) -> tuple:
-        return compute.band_key(
-            self.harmonic,
-            self.n_modes,
-            self.coupling,
-            self.noise,
-            self.target,
-            self.frequency_dependent,
-            self.rounds,
-            self.seed,
-            self.models,
-        )
-
-
-@dataclass(frozen=True, eq=False)
-class Band:
-    """A finished scatter band and the settings it was computed for."""
-
-    result: Any  # fbs_core.ScatterBand
-    settings: Snapshot
-    seconds: float
-
-
-@dataclass(frozen=True)
-class BandStatus:
-    """Whether a band is being computed, and the line the page shows about it.
-
-    During a computation ``done`` of ``total`` frequency lines are done (0 of 0 before the
-    kernel's first report) and ``seconds_left`` estimates the rest (None: not yet known).
-    """
-
-    busy: bool = False
-    text: str = ""
-    done: int = 0
-    total: int = 0
-    seconds_left: float | None = None
+    def tab(self) -> str | None:
+        """The Analysis tab the row is computed on (None: not a tab's row)."""
+        return self.when[len(_TAB) :] if self.when.startswith(_TAB) else None
 
     @property
-    def percent(self) -> int:
-        return int(100 * self.done / self.total) if self.total else 0
-
-
-def duration_text(seconds: float) -> str:
-    """``"about 1 min 10 s"``, ``"about 8 s"``, ``"under a second"``."""
-    if seconds < 1:
-        return "under a second"
-    s = int(round(seconds))
-    return f"about {s // 60} min {s % 60} s" if s >= 60 else f"about {s} s"
-
-
-def progress_status(rounds: int, done: int, total: int, seconds_left) -> BandStatus:
-    """The status of a running band: done/total lines and the time left."""
-    text = f"Computing {rounds:,} rounds ..."
-    if total:
-        text = (
-            f"Computing {rounds:,} rounds: {int(100 * done / total)} % "
-            f"({done} of {total} frequency lines)"
+    def triggers(self) -> tuple[str, ...]:
+        """The snapshot fields whose change makes the store look at this row."""
+        flag = _SHOWN_BY.get(self.when)
+        extra = (
+            ("tab",)
+            if self.tab
+            else (flag,)
+            if flag
+            else ("scope",)
+            if self.when == IN_VEHICLE
+            else ()
         )
-        if seconds_left is not None:
-            text += f", {duration_text(seconds_left)} left"
-    return BandStatus(True, text, done, total, seconds_left)
+        return self.depends + extra
+
+    def shown(self, s: Snapshot) -> bool:
+        """Whether the row is computed in the state ``s``."""
+        if self.tab is not None:
+            return s.tab == self.tab
+        if self.when == IN_VEHICLE:
+            return s.vehicle
+        flag = _SHOWN_BY.get(self.when)
+        return bool(getattr(s, flag)) if flag else True
+
+    def key(self, s: Snapshot) -> tuple:
+        """The values of ``s`` the row is made of (published again only when they change):
+        in corner scope the fields of the car (and ``vehicle_only``) count as None, so a
+        corner's result is not made again when they change; the coherence value counts only
+        with the relation 'coherence'."""
+        return tuple(_value(s, f, self.vehicle_only) for f in self.depends)
+
+    def parameter(self) -> param.Parameter:
+        if self.kind is tuple:
+            return param.Parameter(default=(), doc=self.doc)
+        return param.ClassSelector(class_=self.kind, allow_None=True, doc=self.doc)
+
+
+def _value(s: Snapshot, f: str, vehicle_only: tuple[str, ...] = ()) -> Any:
+    """A snapshot field as a row's key holds it (see :meth:`Row.key`)."""
+    if f in VEHICLE_FIELDS or f in vehicle_only:
+        if not s.vehicle or (f == "coherence" and s.tracks != "coherence"):
+            return None
+    return getattr(s, f)
+
+
+def scoped(corner: Callable[[Snapshot], Any], car: Callable[[Snapshot], Any]):
+    """A maker of the corner's result in corner scope and of the car's in vehicle scope."""
+
+    def make(s: Snapshot) -> Any:
+        return car(s) if s.vehicle else corner(s)
+
+    make.__name__ = f"{getattr(corner, '__name__', 'make')}_scoped"
+    return make
+
+
+#: The case of a coupled response.
+CASE = ("harmonic", "n_modes", "dof", "coupling", "residual", "models")
+#: The whole car's fields (vehicle scope, issue 31).
+VEHICLE = ("scope", *VEHICLE_FIELDS)
+#: The settings of a scatter band (its cache key).
+BAND = (
+    "harmonic",
+    "n_modes",
+    "coupling",
+    "models",
+    "noise",
+    "target",
+    "frequency_dependent",
+    "rounds",
+    "seed",
+    *VEHICLE,
+)
+#: The FRFs of the phase view.
+PHASE = (*CASE, "spindle_input", "frf")
+#: The participation of the tire modes: the harmonic's band up to f_max, every mode.
+MODES = ("harmonic", "dof", "coupling", "f_max", "models", "mode_rank")
+#: The criterion of table 5.1 and of the selections.
+CRITERION = ("harmonic", "coupling", "residual", "models", "map_mode", "dof", "threshold", "f_max")
+
+#: Every result of a session (in the order a change publishes them, after those of the
+#: shown analysis tab and after the results they are made of).
+TABLE: tuple[Row, ...] = (
+    Row(
+        "pins",
+        ("pin_text", "models"),
+        pins.build_pins,
+        kind=tuple,
+        problem=True,
+        doc="The pinned baselines (app.results.pins.Pin), from the pins of the link.",
+    ),
+    Row(
+        "response",
+        (*CASE, *VEHICLE),
+        scoped(main.response_result, vehicle.response_result),
+        problem=True,
+        doc="Coupled response v_e* (eq. 4.1): the corner's at the bushing, or the car's at "
+        "the response point.",
+    ),
+    Row(
+        "response_plot",
+        (*CASE, "overlay", "level_scale", "mcursor1", "mcursor2", "snap"),
+        response_plot.response_plot_result,
+        doc="The response plot's overlaid DOFs, level axis and cursor readout.",
+    ),
+    Row(
+        "error_map",
+        (*CASE, "map_mode", "threshold", "f_max", *VEHICLE),
+        scoped(main.error_map_result, vehicle.error_map_result),
+        problem=True,
+        doc="Truncation error map (eq. 5.1); the car's needs a coherent road.",
+    ),
+    Row(
+        "suggested",
+        ("coupling", "dof", "residual", "models", "map_mode", "threshold", "f_max", "harmonic")
+        + VEHICLE,
+        scoped(main.suggested_result, vehicle.suggested_result),
+        slow=lambda s: None if s.vehicle else main.residual_work(s),
+        problem=True,
+        vehicle_only=("harmonic",),
+        doc="Suggested modes (table 5.1), plain and with residuals; the car's from the maps "
+        "computed so far.",
+    ),
+    Row("eigen", ("n_modes", "models"), main.eigen_result, doc="Eigenfrequency vs N (fig. 5.8)."),
+    Row(
+        "tire_quality",
+        ("models",),
+        main.tire_quality_result,
+        doc="Leave-one-out interpolation error and speed coverage of the tire.",
+    ),
+    Row(
+        "uncoupled",
+        ("harmonic", "n_modes", "dof", "spindle_input", "models"),
+        main.uncoupled_result,
+        when=SHOWN_UNCOUPLED,
+        doc="Uncoupled tire and chassis (None until shown).",
+    ),
+    Row(
+        "band_curves",
+        ("band", "dof", "percentile", "single_round"),
+        main.band_result,
+        doc="The band's curves at the selected DOF.",
+    ),
+    Row(
+        "wheel_contributions",
+        (*CASE, *VEHICLE),
+        vehicle.wheels_result,
+        when=IN_VEHICLE,
+        doc="The contribution of each wheel's road to the car's response (vehicle scope).",
+    ),
+    Row(
+        "first_order",
+        ("band", "dof", "percentile"),
+        main.first_order_result,
+        when=SHOWN_FIRST_ORDER,
+        doc="The first-order band of the scatter band's settings (its overlay; None until shown).",
+    ),
+    Row(
+        "pinned",
+        ("pins", *CASE),
+        pins.pinned_result,
+        kind=tuple,
+        doc="Each pin against the current state (a tuple of Result; the report shows each).",
+    ),
+    Row(
+        "pick",
+        ("picked_speed", "picked_freq"),
+        analysis.pick_result,
+        doc="The picked speed and frequency.",
+    ),
+    Row(
+        "contributions",
+        (*CASE, "contrib_mode"),
+        analysis.contributions_result,
+        when=while_tab("contributions"),
+        doc="Contributions of the interface forces (eq. 4.1 term by term).",
+    ),
+    Row(
+        "phase",
+        (*PHASE, "phase_mode", "log_freq", "cursor1", "cursor2"),
+        analysis.phase_result,
+        when=while_tab("phase"),
+        doc="Bode or real/imaginary view with peaks and delta cursors.",
+    ),
+    Row(
+        "peak_modes",
+        PHASE,
+        analysis.peak_modes_result,
+        when=while_tab("phase"),
+        slow=analysis.peak_modes_work,
+        doc="The phase view's peak labels with the coupled modes nearby.",
+    ),
+    Row(
+        "speed_map",
+        ("harmonic", "n_modes", "dof", "coupling", "models"),
+        analysis.speed_map_result,
+        when=while_tab("speed"),
+        ahead=lambda old, new: (
+            None if old is None else analysis.speed_map_ahead(old, new, MODE_COUNTS)
+        ),
+        doc="Bushing level over speed and frequency.",
+    ),
+    Row(
+        "campbell",
+        ("harmonic", "models"),
+        analysis.campbell_result,
+        when=while_tab("speed"),
+        doc="Campbell diagram of the tire with the order lines (after the speed map: on a "
+        "change of harmonic only its thick line moves).",
+    ),
+    Row(
+        "compare",
+        (*CASE, "pins", "compare_to", "band", "percentile", "map_mode", *BAND[4:]),
+        pins.compare_result,
+        when=while_tab("compare"),
+        doc="The current state against the pins.",
+    ),
+    Row(
+        "participation",
+        MODES,
+        modes.participation_result,
+        when=while_tab("modes"),
+        ahead=modes.participation_ahead,
+        doc="Ranking of the tire modes in the bushing response (docs/modes.md, section 1).",
+    ),
+    Row(
+        "mode_shape",
+        (*MODES, "mode_pick", "mode_speed"),
+        modes.mode_shape_result,
+        when=while_tab("modes"),
+        doc="The picked tire mode (or the ranking's first) as the deformed belt.",
+    ),
+    Row(
+        "waves",
+        ("harmonic", "models", "waves_all"),
+        modes.waves_result,
+        when=while_tab("modes"),
+        slow=modes.waves_work,
+        doc="Campbell diagram of the belt waves (solved in the background the first time).",
+    ),
+    Row(
+        "selected_modes",
+        CRITERION,
+        modes.selected_modes_result,
+        when=while_tab("selection"),
+        doc="The modes the case needs chosen by importance, beside table 5.1's lowest N.",
+    ),
+    Row(
+        "chassis_truncation",
+        CRITERION,
+        modes.chassis_truncation_result,
+        when=while_tab("selection"),
+        doc="Eq. 5.1 truncation of the chassis side (the tire exact).",
+    ),
+    # last: its thread starts once the pass's other results are out (it publishes later)
+    Row("band", BAND, None, when=OWN_THREAD, kind=Band, doc="The latest scatter band."),
+)
+ROWS = {row.name: row for row in TABLE}
+#: The fields of the state (the rest of a snapshot's fields are published results).
+STATE_FIELDS = frozenset(FIELDS)
+
+
+def depends(name: str) -> frozenset[str]:
+    """The state fields result ``name`` depends on, through the results it is made of (and
+    the switch that shows it: a row shown while ``first_order`` is on depends on it)."""
+    out: set[str] = set()
+    todo, seen = [name], set()
+    while todo:
+        row = ROWS[todo.pop()]
+        seen.add(row.name)
+        flag = _SHOWN_BY.get(row.when)
+        for f in (*row.depends, flag) if flag else row.depends:
+            if f in STATE_FIELDS:
+                out.add(f)
+            elif f in ROWS and f not in seen:
+                todo.append(f)
+    return frozenset(out)
+
+
+def _affected(fields: Iterable[str]) -> frozenset[str]:
+    """The rows to look at when ``fields`` changed (and the rows made of those)."""
+    return _affected_by(frozenset(fields))
+
+
+@functools.lru_cache(maxsize=256)
+def _affected_by(fields: frozenset[str]) -> frozenset[str]:
+    out = {row.name for row in TABLE if fields & set(row.triggers)}
+    grew = True
+    while grew:
+        more = {row.name for row in TABLE if set(row.depends) & out} - out
+        grew = bool(more)
+        out |= more
+    return frozenset(out)
+
+
+def _order(names: frozenset[str], s: Snapshot) -> list[Row]:
+    """``names`` in the order of a pass: the shown tab's rows first, each after the rows
+    of the pass it is made of."""
+    first = sorted(
+        (ROWS[n] for n in names),
+        key=lambda r: (not (r.tab is not None and r.shown(s)), TABLE.index(r)),
+    )
+    out: list[Row] = []
+
+    def visit(row: Row) -> None:
+        if row in out:
+            return
+        for d in row.depends:  # (a band is published by its thread: not waited for)
+            if d in names and ROWS[d].when != OWN_THREAD:
+                visit(ROWS[d])
+        out.append(row)
+
+    for row in first:
+        visit(row)
+    return out
+
+
+def _done_status(band: Band) -> BandStatus:
+    return BandStatus(False, bands.done_text(band.result, band.seconds, band.settings.band_key()))
 
 
 class Results(param.Parameterized):
-    """The published results of one browser session (see the module docstring)."""
+    """The published results of one browser session (see the module docstring); one
+    parameter per row of :data:`TABLE`, added below the class."""
 
     state = param.ClassSelector(class_=DashboardState, instantiate=False, constant=True)
-
-    response = param.ClassSelector(class_=Result, doc="Coupled response v_e* (eq. 4.1).")
-    error_map = param.ClassSelector(class_=Result, doc="Truncation error map (eq. 5.1).")
-    suggested = param.ClassSelector(class_=Result, doc="Suggested modes (table 5.1).")
-    eigen = param.ClassSelector(class_=Result, doc="Eigenfrequency vs N (fig. 5.8).")
-    tire_quality = param.ClassSelector(
-        class_=Result, doc="Leave-one-out interpolation error and speed coverage of the tire."
-    )
-    uncoupled = param.ClassSelector(
-        class_=Result, allow_None=True, doc="Uncoupled tire and chassis (None until shown)."
-    )
-    band = param.ClassSelector(class_=Band, allow_None=True, doc="The latest scatter band.")
-    band_curves = param.ClassSelector(
-        class_=Result, allow_None=True, doc="The band's curves at the selected DOF."
-    )
     band_status = param.ClassSelector(class_=BandStatus, doc="Band computation status.")
-    pinned = param.Parameter(
-        default=(),
-        doc="The Analysis card's pinned baselines against the current state: a tuple of "
-        "Result, one per pin (app.analysis_store; the report shows each).",
+    message = param.String(default="", doc="The last pin action's or link's problem ('' if none).")
+    outside = param.Dict(
+        default={},
+        doc="Results of views that are no row of the table, as they show them now (the "
+        "campaign browser's case: they come from a file, not the session's state): name -> "
+        "Result; the report shows each as a section of its own.",
     )
     closed = param.Boolean(default=False, doc="The session has ended: nothing is drawn.")
     background = param.Boolean(
         default=None,
         allow_None=True,
-        doc="Compute bands on a thread of their own (None: when the page is served).",
+        doc="Longer work on threads of its own (None: when the page is served).",
     )
+
+    def __init__(self, state: DashboardState | None = None, **params):
+        self._lock = threading.RLock()
+        self._band_job: bands.Job | None = None
+        self._keys: dict[str, tuple] = {}  # the key of each published row
+        self._made: dict[str, Snapshot] = {}  # the snapshot of each published row
+        params["state"] = state if state is not None else DashboardState()
+        params.setdefault("band_status", BandStatus())
+        super().__init__(**params)
+        # the watchers, derived from the table: one per group of the state
+        watched = {f for row in TABLE for f in row.triggers if f in STATE_FIELDS}
+        by_group: dict[str, dict[str, str]] = {}
+        for f in watched:
+            group, name = FIELDS[f]
+            by_group.setdefault(group, {})[name] = f
+        for group, names in by_group.items():
+            getattr(self.state, group).param.watch(
+                lambda *events, names=names: self._changed({names[e.name] for e in events}),
+                list(names),
+            )
+        self._update(frozenset(row.name for row in TABLE if row.when != OWN_THREAD))
 
     @property
     def threaded(self) -> bool:
         """Whether longer work goes to threads of its own: ``background``, or when it is
         None, whether the page is served (no server: tests, exports compute in place)."""
-        return bands.served() if self.background is None else bool(self.background)
-
-    def __init__(self, state: DashboardState | None = None, **params):
-        self._lock = threading.RLock()
-        self._band_job: bands.Job | None = None
-        self._pending: set = set()  # residual tables being computed (see _residual_table)
-        params["state"] = state if state is not None else DashboardState()
-        params.setdefault("band_status", BandStatus())
-        #: Publishers that run first on a change of the case, before this store's own (the
-        #: Analysis card registers the one of the view it shows: what the user looks at is
-        #: computed and drawn first; ``app.analysis_store``).
-        self.first_publishers: list[Callable[[], None]] = []
-        super().__init__(**params)
-
-    # -- publishing ------------------------------------------------------------------------
-    def _publish(self, name: str, make: Callable[[Snapshot], Any]) -> None:
-        """Compute ``make(snapshot)`` from the current state and publish it as ``name``,
-        all under the session's lock (the newest state lands last)."""
-        with self._lock:
-            if self.closed:
-                return
-            setattr(self, name, make(Snapshot.of(self.state)))
+        return served() if self.background is None else bool(self.background)
 
     @property
     def lock(self) -> threading.RLock:
-        """The session's lock (publishers of other results of the session share it)."""
+        """The session's lock."""
         return self._lock
 
     def snapshot(self) -> Snapshot:
-        """The current state as plain values."""
-        return Snapshot.of(self.state)
+        """The current state as plain values, with the published band and pins."""
+        return Snapshot.of(self.state, self.band, self.pins)
 
-    # -- the results, each next to what it depends on -----------------------------------------
-    # (param calls a class's watchers in the order of their definition: this one first)
-    @param.depends(
-        "state.case.harmonic",
-        "state.case.n_modes",
-        "state.case.dof",
-        "state.case.coupling",
-        "state.case.spindle_input",
-        "state.case.models",
-        watch=True,
-    )
-    def _first(self):
-        for publish in list(self.first_publishers):
-            publish()
+    # -- publishing ------------------------------------------------------------------------
+    def _changed(self, fields: set[str]) -> None:
+        self._update(_affected(fields))
 
-    @param.depends(
-        "state.case.harmonic",
-        "state.case.n_modes",
-        "state.case.dof",
-        "state.case.coupling",
-        "state.case.models",
-        "state.case.residual",
-        watch=True,
-        on_init=True,
-    )
-    def _response(self):
-        self._publish("response", response_result)
-
-    @param.depends(
-        "state.case.harmonic",
-        "state.case.n_modes",
-        "state.case.dof",
-        "state.case.coupling",
-        "state.case.models",
-        "state.truncation.map_mode",
-        "state.truncation.threshold",
-        "state.truncation.f_max",
-        "state.case.residual",
-        watch=True,
-        on_init=True,
-    )
-    def _error_map(self):
-        self._publish("error_map", error_map_result)
-
-    @param.depends(
-        "state.case.coupling",
-        "state.case.dof",
-        "state.case.models",
-        "state.truncation.map_mode",
-        "state.truncation.threshold",
-        "state.truncation.f_max",
-        "state.case.residual",
-        watch=True,
-        on_init=True,
-    )
-    def _suggested(self):
-        self._publish("suggested", lambda s: suggested_result(s, self._residual_table(s)))
-
-    def _residual_table(self, s: Snapshot) -> dict | None:
-        """The suggestion with residual compensation beside the plain one, or None while
-        it is computed on a thread of its own (served pages: its seven residual maps must
-        not delay the first page); the table is published again when it is ready."""
-        args = (s.threshold, s.f_max, s.coupling, s.map_dof, s.models, True)
-        later = self.threaded
-        if s.residual or not later or compute.suggested_table_ready(*args):
-            return compute.suggested_table(*args)
+    def _update(self, names: frozenset[str]) -> None:
+        """One pass: the rows ``names`` from one snapshot, under the session's lock."""
         with self._lock:
-            if args in self._pending:
-                return None
-            self._pending.add(args)
+            if self.closed:
+                return
+            s = self.snapshot()
+            for row in _order(names, s):
+                if row.when == OWN_THREAD:
+                    if self._current(row, s):
+                        self._start_band(s)
+                        s = s.replace(band=self.band)  # published meanwhile without a server
+                    continue
+                s = self._publish(row, s)
 
-        def work():
-            try:
-                compute.suggested_table(*args)
-            finally:
-                with self._lock:
-                    self._pending.discard(args)
-            self._suggested()  # publish again (with the column if the state still wants it)
+    def _current(self, row: Row, s: Snapshot) -> bool:
+        """False when a field of ``row`` changed again since ``s`` was read: the pass of
+        that newer change (waiting for the lock) publishes it."""
+        state = self.state
+        for f in row.depends:
+            where = FIELDS.get(f)
+            if where is None:
+                continue
+            now = getattr(getattr(state, where[0]), where[1])
+            if (tuple(now) if isinstance(now, list) else now) != getattr(s, f):  # (a list: a tuple)
+                return False
+        return True
 
-        def start():  # at a lower priority: the page's own updates win the cores
-            background.start(work, "residual-table")
+    def _publish(self, row: Row, s: Snapshot, force: bool = False) -> Snapshot:
+        """Publish ``row`` made of ``s`` (when shown, current and not published for the same
+        key already); the snapshot with the new value when it is an input of other rows."""
+        if not row.shown(s) or not self._current(row, s):
+            return s
+        key = row.key(s)
+        if not force and self._keys.get(row.name, None) == key and row.name in self._made:
+            return s
+        assert row.make is not None
+        work = row.slow(s) if row.slow is not None else None
+        if work is not None and not self.threaded:  # no server: all of it now
+            _drain(work())
+            work = None
+        try:
+            value = row.make(s)
+        except FBSError as e:
+            if not row.problem:
+                raise
+            self.message = str(e)
+            return s
+        if isinstance(value, Result):
+            made = s.settings()
+            if made.vehicle and "scope" not in row.triggers:
+                made = made.replace(scope="corner")  # a corner's result (the Analysis card)
+            value = dataclasses.replace(value, key=key, snapshot=value.snapshot or made)
+        before = self._made.get(row.name)
+        self._keys[row.name], self._made[row.name] = key, s.settings()
+        setattr(self, row.name, value)
+        if work is not None:
+            self._later(row, key, work)
+        if row.ahead is not None and self.threaded:
+            ahead = row.ahead(before, s)
+            if ahead is not None:
+                self._ahead(row, key, ahead)
+        return s.replace(**{row.name: value}) if row.name in ("pins", "band") else s
 
-        if bands.served():  # after the page is sent (its first build stays as fast)
-            import panel as pn
+    def _stale(self, row: Row, key: tuple) -> bool:
+        return self.closed or self._keys.get(row.name) != key
 
-            pn.state.onload(start)
+    def _later(self, row: Row, key: tuple, work: Callable[[], Any]) -> None:
+        """``work`` on the background worker (a step at a time, dropped once the row moved
+        on), then ``row`` published again with what it computed."""
+
+        def task() -> Iterator[None]:
+            steps = work()
+            for _ in steps if isinstance(steps, Iterator) else ():
+                if self._stale(row, key):
+                    return
+                yield
+            with self._lock:
+                if not self._stale(row, key):
+                    self._publish(row, self.snapshot(), force=True)
+
+        def submit() -> None:
+            background.BACKGROUND.submit((self, row.name), task)
+
+        if served() and not pn.state.loaded:  # after the page is sent: its build stays as fast
+            pn.state.onload(submit)
         else:
-            start()
-        return None
+            submit()
 
-    @param.depends("state.case.models", watch=True, on_init=True)
-    def _tire_quality(self):
-        self._publish("tire_quality", tire_quality_result)
+    def _ahead(self, row: Row, key: tuple, work: Callable[[], Any]) -> None:
+        """``work`` computed ahead (nothing once the row moved on)."""
+        background.AHEAD.submit((self, row.name), lambda: None if self._stale(row, key) else work())
 
-    @param.depends("state.case.models", "state.case.n_modes", watch=True, on_init=True)
-    def _eigen(self):
-        self._publish("eigen", eigen_result)
+    def current(self, looked_at: bool = False) -> tuple[Snapshot, dict[str, Any]]:
+        """The snapshot and the published results that are of it (shown and made of its
+        values): what the page shows.
 
-    @param.depends(
-        "state.case.show_uncoupled",
-        "state.case.harmonic",
-        "state.case.n_modes",
-        "state.case.dof",
-        "state.case.spindle_input",
-        "state.case.models",
-        watch=True,
-        on_init=True,
-    )
-    def _uncoupled(self):
-        self._publish(
-            "uncoupled",
-            lambda s: uncoupled_result(s) if s.show_uncoupled or self.uncoupled else None,
-        )
+        ``looked_at``: also the results of Analysis tabs not shown now that the session
+        computed for these very values (a tab the user looked at, then closed or left for
+        another): what the report holds.
+        """
+        with self._lock:
+            s = self.snapshot()
+            out = {}
+            for row in TABLE:
+                value = getattr(self, row.name)
+                shown = row.shown(s) or (looked_at and row.tab is not None)
+                if row.make is None or value is None or value == () or not shown:
+                    continue
+                if self._keys.get(row.name) == row.key(s):
+                    out[row.name] = value
+            return s, out
 
-    @param.depends(
-        "band",
-        "state.case.dof",
-        "state.noise.percentile",
-        "state.noise.single_round",
-        watch=True,
-        on_init=True,
-    )
-    def _band_curves(self):
-        self._publish("band_curves", lambda s: band_result(self.band, s))
+    def show_outside(self, name: str, result: Result | None) -> None:
+        """Publish what a view outside the table shows now (None: it shows nothing)."""
+        with self._lock:
+            out = {k: v for k, v in self.outside.items() if k != name}
+            if result is not None:
+                out[name] = result
+            self.outside = out
 
     # -- the scatter band: long, off the session's threads --------------------------------
-    @param.depends(
-        "state.case.harmonic",
-        "state.case.n_modes",
-        "state.case.coupling",
-        "state.case.models",
-        "state.noise.noise",
-        "state.noise.target",
-        "state.noise.frequency_dependent",
-        "state.noise.rounds",
-        "state.noise.seed",
-        watch=True,
-    )
     def request_band(self, *, wait: bool | None = None) -> None:
         """Compute the band of the current settings (cancelling one still running).
 
@@ -402,25 +653,27 @@ class Results(param.Parameterized):
         with self._lock:
             if self.closed:
                 return
-            s = self.snapshot()
-            key = s.band_key()
-            running = self._band_job
-            if running is not None and running.key == key:
-                return  # already on its way
-            if running is not None:
-                running.cancel()
-                self._band_job = None
-            if self.band is not None and self.band.settings.band_key() == key:
-                self.band_status = _done_status(self.band)  # back to the shown band
-                return
-            job = self._band_job = bands.Job(key, owner=self, on_progress=self._band_progress)
-            self.band_status = progress_status(s.rounds, 0, 0, None)
+            self._start_band(self.snapshot(), wait)
+
+    def _start_band(self, s: Snapshot, wait: bool | None = None) -> None:
+        key = s.band_key()
+        running = self._band_job
+        if running is not None and running.key == key:
+            return  # already on its way
+        if running is not None:
+            running.cancel()
+            self._band_job = None
+        if self.band is not None and self.band.settings.band_key() == key:
+            self.band_status = _done_status(self.band)  # back to the shown band
+            return
+        job = self._band_job = bands.Job(key, owner=self, on_progress=self._band_progress)
+        self.band_status = progress_status(s.rounds, 0, 0, None)
         if wait is None:
             wait = not self.threaded
         if wait:
-            bands.run(job, self._band_done, s)
+            bands.run(job, self._band_done, s.settings())
         else:
-            bands.start(job, self._band_done, s)
+            bands.start(job, self._band_done, s.settings())
 
     #: Shortest interval between two progress updates of the page (s).
     PROGRESS_INTERVAL = 0.4
@@ -464,6 +717,7 @@ class Results(param.Parameterized):
                 self.band_status = BandStatus(False, f"Scatter band failed: {error}")
                 return
             self.band = Band(res, settings, seconds)
+            self._update(_affected({"band"}))  # the results made of it, then its status
             self.band_status = _done_status(self.band)
 
     def band_now(self) -> Band | None:
@@ -480,327 +734,95 @@ class Results(param.Parameterized):
             band.result, float(freq), self.state.case.dof, "max"
         )
 
+    # -- pins ----------------------------------------------------------------------------------
+    def pin(self, name: str) -> None:
+        """Pin the current state as ``name`` (up to four; a taken name is refused)."""
+        with self._lock:
+            try:
+                name = check_pin_name(name)
+                ps = pins.pin_settings(name, self.snapshot())
+                add_pin(self.pins, pin_state(name, {}))  # the core's rules: unique, at most 4
+            except FBSError as e:
+                self.message = str(e)
+                return
+            self.message = ""
+            self.state.analysis.pins = encode_pins([p.settings for p in self.pins] + [ps])
+
+    def unpin(self, name: str) -> None:
+        """Remove the pin named ``name``."""
+        with self._lock:
+            try:
+                remove_pin([p.data or pin_state(p.name, {}) for p in self.pins], name)
+            except FBSError as e:
+                self.message = str(e)
+                return
+            self.message = ""
+            a = self.state.analysis
+            a.pins = encode_pins([p.settings for p in self.pins if p.name != name])
+            if a.compare_to == name:
+                a.compare_to = ""
+
+    # -- picking ---------------------------------------------------------------------------------
+    def pick_point(self, speed_kmh: float | None, freq: float | None) -> None:
+        """Pick a speed (km/h) and a frequency (Hz) for the other views (None: unchanged)."""
+        upd = {}
+        if speed_kmh is not None and np.isfinite(speed_kmh):
+            upd["picked_speed"] = float(np.clip(round(speed_kmh, 2), 0.0, 300.0))
+        if freq is not None and np.isfinite(freq):
+            upd["picked_freq"] = float(np.clip(round(freq, 2), 0.0, 1000.0))
+        if upd:
+            self.state.analysis.param.update(**upd)
+
+    def pick_campbell(self, speed_kmh: float, freq: float, tol: float = 0.03) -> None:
+        """A click in the Campbell diagram: pick the point; if it lies on the order line of
+        a harmonic case inside that case's speed range (within ``tol`` relative frequency),
+        also choose that harmonic (its bushing response is the other views' subject)."""
+        self.pick_point(speed_kmh, freq)
+        r = self.campbell
+        if r is None:
+            return
+        d = r.draw
+        k = analysis.nearest_order_line(d["wavelength"], d["speed_range"], speed_kmh, freq, tol)
+        if k is not None:
+            self.state.case.harmonic = k
+
+    def pick_mode_bar(self, x: float) -> None:
+        """A click on the participation ranking at ``x``: draw that bar's mode, at the speed
+        where the harmonic line meets it (``mode`` / ``mv`` in the URL)."""
+        r = self.participation
+        if r is None or not r.draw.get("ready"):
+            return
+        i = modes.nearest_bar(r.draw, x)
+        if i is not None:
+            speed = round(float(r.draw["speed"][i]), 1)
+            self.state.analysis.param.update(mode_pick=int(r.draw["mode"][i]), mode_speed=speed)
+
+    def pick_wave(self, speed_kmh: float, freq: float) -> None:
+        """A click in the Campbell diagram of the waves: draw the mode that carries the
+        branch nearest ``(speed_kmh, freq)`` at that speed (nothing when no branch is near)."""
+        r = self.waves
+        if r is None or not r.draw.get("ready"):
+            return
+        hit = modes.nearest_branch(r.draw, speed_kmh, freq)
+        if hit is not None:
+            self.state.analysis.param.update(mode_pick=hit[0], mode_speed=round(hit[1], 1))
+
     def close(self) -> None:
-        """The session ended: cancel its band and publish nothing more."""
+        """The session ended: cancel its band and its waiting work, publish nothing more."""
         with self._lock:
             self.closed = True
             if self._band_job is not None:
                 self._band_job.cancel()
                 self._band_job = None
+        background.BACKGROUND.cancel(self)
+        background.AHEAD.cancel(self)
 
 
-def _done_status(band: Band) -> BandStatus:
-    conv = compute.convergence_db(band.result)
-    return BandStatus(
-        False,
-        f"{band.result.rounds:,} rounds in {band.seconds:.2f} s &middot; largest edge change "
-        f"in the last half of the rounds: {conv:.1f} dB",
-    )
+for _row in TABLE:  # one parameter per row of the table
+    Results.param.add_parameter(_row.name, _row.parameter())
 
 
-# -- what each result holds -----------------------------------------------------------------
-def residual_meta(on: bool) -> str:
-    """The CSV header's word on residual compensation."""
-    if on:
-        return (
-            "on: the tire modes left out of N enter with their quasi-static part "
-            "(upper residual flexibility, docs/tire-model.md)"
-        )
-    return "off: plain truncation to N modes"
-
-
-def tire_meta(s: Snapshot, harmonics=None) -> dict:
-    """The tire's interpolation quality and speed coverage for a CSV header (issue 13)."""
-    q = compute.tire_quality(s.models)
-    ks = [s.harmonic] if harmonics is None else list(harmonics)
-    idx = [list(q["harmonic"]).index(k) for k in ks]
-    loo = "; ".join(
-        f"h{k}: " + ("n/a" if not np.isfinite(q["loo_db"][i]) else f"{q['loo_db'][i]:.2f} dB")
-        for k, i in zip(ks, idx, strict=True)
-    )
-    warn = [w for k, w in zip(q["harmonic"], _band_warnings(q), strict=True) if k in ks and w]
-    return {
-        "tire interpolation error (leave-one-out, worst)": loo,
-        "tire speed range": (
-            " | ".join(warn)
-            if warn
-            else f"covered: {q['speeds'][0]:g}-{q['speeds'][1]:g} km/h, "
-            f"{q['n_points']} operating points"
-        ),
-    }
-
-
-def _band_warnings(q: dict) -> list[str]:
-    """One warning text (or "") per harmonic of ``compute.tire_quality``'s table."""
-    texts = iter(q["warnings"])
-    return [("" if ok else next(texts, "outside the stored speeds")) for ok in q["covered"]]
-
-
-def tire_quality_result(s: Snapshot) -> Result:
-    q = compute.tire_quality(s.models)
-    warn = _band_warnings(q)
-    return Result(
-        columns={
-            "harmonic": np.asarray(q["harmonic"]),
-            "loo_error_dB": np.asarray(q["loo_db"]),
-            "speeds_covered": np.asarray(q["covered"], float),
-        },
-        meta={
-            "view": "tire interpolation quality (leave-one-out) and speed coverage",
-            "method": q["method"],
-            "operating points": f"{q['n_points']}, {q['speeds'][0]:g}-{q['speeds'][1]:g} km/h",
-            "speed range warnings": " | ".join(w for w in warn if w) or "none",
-            "models": s.models.describe(),
-        },
-        filename="tire_interpolation_quality.csv",
-        caption=(
-            f"Tire between its {q['n_points']} operating points "
-            f"({q['speeds'][0]:g}-{q['speeds'][1]:g} km/h): leave-one-out error per "
-            "harmonic band"
-        ),
-        draw={"quality": q, "warnings": warn, "harmonic": s.harmonic},
-    )
-
-
-def response_result(s: Snapshot) -> Result:
-    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models, s.residual)
-    res = " + residual" if s.residual else ""
-    return Result(
-        columns={
-            "freq_Hz": d["freq"],
-            "reference_dB": d["reference_db"],
-            "truncated_dB": d["truncated_db"],
-            "reference": d["reference"],
-            "truncated": d["truncated"],
-        },
-        meta={
-            "view": "coupled bushing response v_e* (thesis eq. 4.1)",
-            "harmonic": s.harmonic,
-            "N (retained tire modes)": s.n_modes,
-            "reference": "all tire modes",
-            "residual compensation": residual_meta(s.residual),
-            "response DOF": f"bushing:{s.dof}",
-            "coupling": s.coupling,
-            "unit": compute.level_unit(s.dof),
-            "models": s.models.describe(),
-            **tire_meta(s),
-        },
-        filename=(
-            f"bushing_response_h{s.harmonic}_N{s.n_modes}{'_res' if s.residual else ''}"
-            f"_{s.dof}_{s.coupling}.csv"
-        ),
-        caption=(
-            f"**Harmonic {s.harmonic}** &middot; bushing:{s.dof} &middot; N = {s.n_modes}"
-            f"{res} &middot; {s.coupling} coupling"
-        ),
-        draw={
-            "dof": s.dof,
-            "truncated_label": f"N retained modes{' + residual' if s.residual else ''}",
-        },
-    )
-
-
-def _suggested_n(s: Snapshot) -> int:
-    tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models, s.residual)
-    return int(tab["n_modes"][list(tab["harmonic"]).index(s.harmonic)])
-
-
-def error_map_result(s: Snapshot) -> Result:
-    d = compute.error_map_data(s.harmonic, s.coupling, s.map_dof, s.models, s.residual)
-    what = f"bushing:{s.dof}" if s.map_dof else "max over 6 DOFs"
-    if s.residual:
-        what += ", with residuals"
-    nn, ff = np.meshgrid(d["n_modes"], d["centre_freq"], indexing="ij")
-    return Result(
-        columns={
-            "n_modes": nn.ravel(),
-            "centre_freq_Hz": ff.ravel(),
-            "error_pct": d["error_pct"].ravel(),
-        },
-        meta={
-            "view": "truncation error map (thesis eq. 5.1, figs. 5.3/5.6/5.7)",
-            "harmonic": s.harmonic,
-            "coupling": s.coupling,
-            "response DOF": what,
-            "reference": "all tire modes",
-            "residual compensation": residual_meta(s.residual),
-            "layout": "long: one row per (N, centre freq)",
-            "models": s.models.describe(),
-            **tire_meta(s),
-        },
-        filename=(
-            f"truncation_map_h{s.harmonic}_{s.map_dof or 'maxdof'}"
-            f"{'_res' if s.residual else ''}.csv"
-        ),
-        draw={
-            "map": d,
-            "title": f"Harmonic {s.harmonic}, {what}",
-            "threshold": s.threshold,
-            "f_max": s.f_max,
-            "n_modes": s.n_modes,
-            "suggested_n": _suggested_n(s),
-            "freq": compute.frequencies(s.harmonic),
-        },
-    )
-
-
-def suggested_result(s: Snapshot, tab_r: dict | None = None) -> Result:
-    """The suggested N for every harmonic, plain and (``tab_r``) with residuals; without
-    ``tab_r`` (still being computed) that column is NaN and the caption says so."""
-    tab = compute.suggested_table(s.threshold, s.f_max, s.coupling, s.map_dof, s.models)
-    pending = tab_r is None
-    if tab_r is None:
-        nan = np.full(len(tab["harmonic"]), np.nan)
-        tab_r = {**tab, "n_modes": nan, "eigenfrequency": nan}
-    where = f"bushing:{s.dof}" if s.map_dof else s.map_mode
-    shown = "with residuals" if s.residual else "plain"
-    return Result(
-        columns={
-            "harmonic": tab["harmonic"],
-            "f_low_Hz": tab["f_low"],
-            "f_high_Hz": tab["f_high"],
-            "n_modes": tab["n_modes"],
-            "n_modes_residual": tab_r["n_modes"],
-            "eigenfrequency_Hz": tab["eigenfrequency"],
-            "eigenfrequency_residual_Hz": tab_r["eigenfrequency"],
-        },
-        meta={
-            "view": "suggested number of modes (thesis table 5.1)",
-            "threshold_pct": s.threshold,
-            "f_max_Hz": s.f_max,
-            "coupling": s.coupling,
-            "response DOF": f"bushing:{s.dof}" if s.map_dof else "max over 6 DOFs",
-            "eigenfrequency": "highest retained eigenfrequency at 80 km/h",
-            "n_modes": "plain truncation to N modes",
-            "n_modes_residual": "N modes + quasi-static part of the modes left out "
-            "(residual compensation)",
-            "shown in the error map": shown,
-            "with residuals": "being computed (NaN)" if pending else "computed",
-            "models": s.models.describe(),
-            **tire_meta(s, harmonics=tab["harmonic"]),
-        },
-        filename=f"suggested_modes_thr{s.threshold:g}_fmax{s.f_max:g}.csv",
-        caption=(
-            f"Smallest N from which the error stays below **{s.threshold:g} %** up "
-            f"to **{s.f_max:g} Hz** ({where}), plain and with residual compensation "
-            f"(the error map and its dashed line: **{shown}**), and the highest "
-            "eigenfrequency among those modes at 80 km/h."
-            + (" The column with residuals is being computed ..." if pending else "")
-        ),
-        draw={"table": tab, "table_residual": tab_r, "residual": s.residual},
-    )
-
-
-def eigen_result(s: Snapshot) -> Result:
-    d = compute.eigen_curves(s.models)
-    return Result(
-        columns={
-            "n_modes": d["n_modes"],
-            **{f"f_{v:g}kmh_Hz": d[f"f_{int(v)}"] for v in EIGEN_SPEEDS},
-        },
-        meta={
-            "view": "highest retained eigenfrequency vs N (thesis fig. 5.8)",
-            "models": s.models.describe(),
-        },
-        filename="eigenfrequency_vs_modes.csv",
-        draw={"curves": d, "n_modes": s.n_modes},
-    )
-
-
-def chassis_label(dof: str, spindle_input: str) -> str:
-    """Axis label of the chassis mobility from a spindle input to a bushing DOF."""
-    out, inp = output_kind(f"bushing:{dof}"), input_kind(f"spindle:{spindle_input}")
-    return f"Mobility (dB re 1 {frf_unit(out, inp, 'mobility')})"
-
-
-def uncoupled_result(s: Snapshot) -> Result:
-    d = compute.uncoupled_data(s.harmonic, s.n_modes, s.dof, s.spindle_input, s.models)
-    # column name -> key of the computed data (units in the names, as every export)
-    keys = {
-        "freq_Hz": "freq",
-        "tire_reference_dB": "tire_reference_db",
-        "tire_truncated_dB": "tire_truncated_db",
-        "chassis_dB": "chassis_db",
-        "tire_reference": "tire_reference",
-        "tire_truncated": "tire_truncated",
-        "chassis": "chassis",
-    }
-    chassis_unit = frf_unit(
-        output_kind(f"bushing:{s.dof}"), input_kind(f"spindle:{s.spindle_input}"), "mobility"
-    )
-    tire_unit = frf_unit(output_kind(f"hub:{s.dof}"), "road", "mobility")
-    return Result(
-        columns={name: d[k] for name, k in keys.items()},
-        meta={
-            "view": "uncoupled subsystems",
-            "harmonic": s.harmonic,
-            "N (retained tire modes)": s.n_modes,
-            "tire output": f"hub:{s.dof}",
-            "chassis": f"spindle:{s.spindle_input} -> bushing:{s.dof}",
-            "unit": (
-                f"tire_*: {tire_unit} (free hub velocity per metre of road amplitude), "
-                f"tire_*_dB: dB re 1 {tire_unit}; chassis: {chassis_unit}, chassis_dB: "
-                f"dB re 1 {chassis_unit}"
-            ),
-            "models": s.models.describe(),
-        },
-        filename=f"uncoupled_h{s.harmonic}_N{s.n_modes}_{s.dof}_in{s.spindle_input}.csv",
-        draw={
-            "dof": s.dof,
-            "tire_title": f"Tire: free hub velocity hub:{s.dof} (figs. 4.6-4.7)",
-            "chassis_title": f"Chassis: spindle:{s.spindle_input} -> bushing:{s.dof} "
-            "(figs. 4.2-4.3)",
-            "chassis_label": chassis_label(s.dof, s.spindle_input),
-        },
-    )
-
-
-def band_result(band: Band | None, s: Snapshot) -> Result | None:
-    """The band's curves at the selected DOF, percentile band and round.
-
-    The header describes the band as it was computed (``band.settings``), whatever the
-    controls say now: a band still computing for new settings never relabels old data.
-    """
-    if band is None:
-        return None
-    b = band.settings
-    res = band.result
-    d = compute.band_data(res, s.dof, s.percentile)
-    k = min(s.single_round, res.rounds - 1)  # the round must exist in this band
-    r = compute.single_round_data(res, k, s.dof)
-    lo = (100 - s.percentile) / 2
-    fd = "fdep" if b.frequency_dependent else "findep"
-    return Result(
-        columns={
-            "freq_Hz": d["freq"],
-            "reference_dB": d["reference_db"],
-            "minimum_dB": d["minimum_db"],
-            "maximum_dB": d["maximum_db"],
-            "pct_low_dB": d["pct_low_db"],
-            "pct_high_dB": d["pct_high_db"],
-            f"round_{k}_dB": r["round_db"],
-        },
-        meta={
-            "view": "Monte-Carlo scatter band (thesis 5.2)",
-            "harmonic": b.harmonic,
-            "N (retained tire modes)": b.n_modes,
-            "response DOF": f"bushing:{s.dof}",
-            "coupling": b.coupling,
-            "noise_pct": b.noise,
-            "noise target": b.target,
-            "frequency dependent": b.frequency_dependent,
-            "rounds": b.rounds,
-            "seed": b.seed,
-            "single round": k,
-            "percentiles": f"{lo:g}-{100 - lo:g}",
-            "unit": compute.level_unit(s.dof),
-            "minimum/maximum": "min/max of |v_e| over the rounds",
-            "pct_low/pct_high": "percentiles of |v_e| over the rounds (numpy 'linear')",
-            "models": b.models.describe(),
-        },
-        filename=(
-            f"scatter_band_h{b.harmonic}_{s.dof}_p{b.noise:g}_{b.target}_{fd}"
-            f"_R{b.rounds}_seed{b.seed}.csv"
-        ),
-        draw={"band": d, "round": r, "dof": s.dof, "seconds": band.seconds},
-    )
+def _drain(steps: Any) -> None:
+    """Run background work to its end here (a generator: all of its steps)."""
+    for _ in steps if isinstance(steps, Iterator) else ():
+        pass

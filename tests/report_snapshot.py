@@ -7,7 +7,7 @@ import datetime as dt
 import numpy as np
 
 import fbs_core
-from app.report import DataFile, Provenance, Snapshot
+from app.report import DataFile, Provenance, ReportData
 from fbs_core import studies
 
 K, N = 1, 20
@@ -44,12 +44,12 @@ def results() -> dict:
     )
 
 
-def snapshot(results: dict) -> Snapshot:
+def snapshot(results: dict) -> ReportData:
     prov = Provenance(
         chassis=DataFile("chassis", "rear corner <v2>.uff", "0123abcd4567"),
         notes=("chassis: accelerance converted to mobility",),
     )
-    return Snapshot(
+    return ReportData(
         settings=SETTINGS,
         provenance=prov,
         url=URL,

@@ -42,12 +42,18 @@ def wait_for(condition, timeout_s: float, interval_s: float = 0.05, what: str = 
 
 
 class Server:
-    """The entrypoint serving ``app_text`` as ``/<name>`` on 127.0.0.1, log in ``folder``."""
+    """The entrypoint serving ``app_text`` as ``/<name>`` on 127.0.0.1, log in ``folder``
+    (``app_text`` None: the dashboard itself, ``app/main.py`` as ``/main``)."""
 
-    def __init__(self, folder: Path, app_text: str, env: dict[str, str], name: str = "fbsapp"):
+    def __init__(
+        self, folder: Path, app_text: str | None, env: dict[str, str], name: str = "fbsapp"
+    ):
         self.folder = Path(folder)
-        self.app = self.folder / f"{name}.py"
-        self.app.write_text(app_text)
+        if app_text is None:
+            self.app, name = ROOT / "app" / "main.py", "main"
+        else:
+            self.app = self.folder / f"{name}.py"
+            self.app.write_text(app_text)
         self.name = name
         self.port = free_port()
         self.base = f"http://127.0.0.1:{self.port}"
@@ -72,20 +78,35 @@ class Server:
     def log(self) -> str:
         return self.log_path.read_text()
 
-    def started(self, timeout_s: float = 60) -> Server:
-        """Wait until ``/liveness`` answers; raises with the log if the server ends first."""
+    def alive(self) -> bool:
+        return self.proc.poll() is None
 
-        def up():
-            if self.proc.poll() is not None:
-                raise RuntimeError(f"the server exited ({self.proc.returncode}):\n{self.log()}")
-            try:
-                with urllib.request.urlopen(self.base + "/liveness", timeout=2) as r:
-                    return r.status == 200
-            except OSError:
-                return False
-
-        wait_for(up, timeout_s, 0.1, "server start")
+    def listening(self, timeout_s: float = 60) -> Server:
+        """Wait until ``/liveness`` answers (the port is open: the app's proof may still
+        run); raises with the log if the server ends first."""
+        wait_for(lambda: self._answers("/liveness"), timeout_s, 0.1, "server listening")
         return self
+
+    def started(self, timeout_s: float = 120) -> Server:
+        """Wait until ``/liveness?endpoint=/<name>`` answers: the app built its page (the
+        server's proof, which runs once the port is open); raises with the log if the
+        server ends first."""
+        wait_for(
+            lambda: self._answers(f"/liveness?endpoint=/{self.name}"),
+            timeout_s,
+            0.1,
+            "server start",
+        )
+        return self
+
+    def _answers(self, path: str) -> bool:
+        if self.proc.poll() is not None:
+            raise RuntimeError(f"the server exited ({self.proc.returncode}):\n{self.log()}")
+        try:
+            with urllib.request.urlopen(self.base + path, timeout=2) as r:
+                return r.status == 200
+        except OSError:
+            return False
 
     def stop(self) -> None:
         if self.proc.poll() is None:

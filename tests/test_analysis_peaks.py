@@ -59,6 +59,33 @@ def test_sdof_mobility_peak_interpolated_between_lines(offset):
     assert lv[idx[0]] <= ld[0] <= exact_db + 1e-9
 
 
+def _worst_sdof_error(fn, method="inverse_power"):
+    """Worst peak error over 101 offsets of a 1 Hz grid, SDOF mobility, 1.5 Hz bandwidth."""
+    zeta = 0.75 / fn
+    m, k = 2.0, 2.0 * (2 * np.pi * fn) ** 2
+    c = 2 * zeta * np.sqrt(k * m)
+    worst = np.zeros(2)
+    for off in np.linspace(0.0, 1.0, 101):
+        f = np.arange(fn - 15.0, fn + 15.0, 1.0) + off
+        w = 2 * np.pi * f
+        lv = 20 * np.log10(np.abs(1j * w / (k - m * w**2 + 1j * w * c)))
+        fp, lp, _, _ = find_peaks_db(f, lv, method=method)
+        worst = np.maximum(worst, [abs(fp[0] - fn), abs(lp[0] - 20 * np.log10(1 / c))])
+    return worst
+
+
+def test_sdof_peak_accuracy_grows_with_the_relative_bandwidth():
+    """The figures of docs/analysis.md: the parabola through -1/|H|^2 is exact in the
+    limit of a narrow peak; its error grows with bandwidth / frequency."""
+    e25, e37, e100 = (_worst_sdof_error(fn) for fn in (25.0, 37.3, 100.0))
+    assert e37[0] < 0.014 and e37[1] < 0.085
+    assert e25[0] < 0.021 and e25[1] < 0.13
+    assert e100[0] < 0.0051 and e100[1] < 0.031
+    assert np.all(e25 > e37) and np.all(e37 > e100)
+    e_db = _worst_sdof_error(37.3, "db")
+    assert 0.08 < e_db[0] < 0.09 and 0.9 < e_db[1] < 0.95
+
+
 def test_sdof_receptance_peak_and_phase():
     f = np.arange(20.0, 60.0, 0.5)
     H = sdof(f, "receptance")

@@ -5,16 +5,18 @@ closed-form order lines), lazy computation, picking, CSV provenance."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 import fbs_core
-from app.analysis_store import AnalysisResults
 from app.export import read_csv, to_csv
 from app.store import Results
 from app.views.analysis_contrib import ContributionsView
 from app.views.analysis_phase import PhaseView
 from app.views.analysis_speed import CampbellView, SpeedMapView
+from fbs_core.vocabulary import magnitude_db
 
 DIRS = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -23,7 +25,7 @@ DIRS = ("x", "y", "z", "rx", "ry", "rz")
 def store():
     r = Results()
     r.state.case.param.update(harmonic=2, n_modes=60)
-    return r, AnalysisResults(store=r)
+    return r
 
 
 def _terms_by_hand(harmonic, n_modes, coupling):
@@ -47,10 +49,10 @@ def _terms_by_hand(harmonic, n_modes, coupling):
 
 @pytest.mark.parametrize("coupling", ["6dof", "5dof"])
 def test_contributions_view_equals_the_terms_solved_by_hand(store, coupling):
-    r, a = store
+    r = store
     r.state.case.coupling = coupling
     r.state.analysis.tab = "contributions"
-    view = ContributionsView(store=r, analysis=a)
+    view = ContributionsView(store=r)
     view.__panel__()
     f, terms, kept = _terms_by_hand(2, 60, coupling)
     z = DIRS.index("z")
@@ -69,7 +71,7 @@ def test_contributions_view_equals_the_terms_solved_by_hand(store, coupling):
     assert view._stack_fig.visible and not view._lines_fig.visible
     np.testing.assert_allclose(view._stack.data["c6"], 100.0, atol=1e-8)
     # CSV: the columns and the provenance of the same state
-    res = a.contributions
+    res = r.contributions
     meta, cols = read_csv(to_csv(res.columns, res.meta, "contributions"))
     assert meta["coupling"] == coupling and meta["harmonic"] == "2"
     np.testing.assert_allclose(
@@ -78,11 +80,11 @@ def test_contributions_view_equals_the_terms_solved_by_hand(store, coupling):
 
 
 def test_phase_view_bode_real_imag_and_cursors(store):
-    r, a = store
+    r = store
     # case 3: the loaded reference tire's case-2 bushing z has no peak to label (issue 14)
     r.state.case.harmonic = 3
     r.state.analysis.tab = "phase"
-    view = PhaseView(store=r, analysis=a)
+    view = PhaseView(store=r)
     view.__panel__()
     want = fbs_core.bushing_response(3, n_modes=60).sel(outputs="bushing:z").data[:, 0, 0]
     ref = fbs_core.bushing_response(3).sel(outputs="bushing:z").data[:, 0, 0]
@@ -98,15 +100,15 @@ def test_phase_view_bode_real_imag_and_cursors(store):
     np.testing.assert_allclose(
         view._cursors.data["level"], 20 * np.log10(abs(want[[3, 10]])), atol=1e-9
     )
-    assert "df = " in a.phase.caption and "cursors" in a.phase.meta
+    assert "df = " in r.phase.caption and "cursors" in r.phase.meta
     # the coupled modes near each peak (computed after the labels): near the peak
-    pm = a.peak_modes
-    assert pm is not None and pm[0] is a.phase
+    pm = r.peak_modes
+    assert pm is not None and pm.draw["waiting"] == 0
     assert all("modes" in t for t in view._peaks.data["text"])
     # labels arriving later change the labels only: the curves are not sent again
     curves = view._src["b"].data
-    new = tuple(f"label {k}" for k in range(len(pm[1])))
-    a.peak_modes = (a.phase, new)
+    new = tuple(f"label {k}" for k in range(len(pm.draw["labels"])))
+    r.peak_modes = dataclasses.replace(pm, draw={**pm.draw, "labels": new})
     assert view._src["b"].data is curves and list(view._peaks.data["text"]) == list(new)
     # real / imaginary parts
     r.state.analysis.phase_mode = "real/imag"
@@ -126,9 +128,9 @@ def test_phase_view_bode_real_imag_and_cursors(store):
 
 
 def test_campbell_and_speed_map_views_and_picking(store):
-    r, a = store
+    r = store
     r.state.analysis.tab = "speed"
-    cv, sv = CampbellView(store=r, analysis=a), SpeedMapView(store=r, analysis=a)
+    cv, sv = CampbellView(store=r), SpeedMapView(store=r)
     cv.__panel__(), sv.__panel__()
     tire = fbs_core.reference_tire()
     eig = tire.eigenfrequencies(80.0)
@@ -152,28 +154,28 @@ def test_campbell_and_speed_map_views_and_picking(store):
         img[:, row], 20 * np.log10(abs(want.sel(outputs="bushing:z").data[:, 0, 0])), atol=1e-8
     )
     # picking: a point in the map; on an order line in the Campbell: that harmonic
-    a.pick_point(70.0, 45.0)
+    r.pick_point(70.0, 45.0)
     assert [s.visible for s in sv._spans] == [True, True]
     assert [s.location for s in sv._spans] == [70.0, 45.0]
     assert r.state.case.harmonic == 2
-    a.pick_campbell(50.0, 5.0)  # below every order line: the harmonic stays
+    r.pick_campbell(50.0, 5.0)  # below every order line: the harmonic stays
     assert r.state.case.harmonic == 2
     lam5 = fbs_core.harmonic(5).wavelength
-    a.pick_campbell(90.0, 90.0 / 3.6 / lam5 * 1.01)
+    r.pick_campbell(90.0, 90.0 / 3.6 / lam5 * 1.01)
     assert r.state.case.harmonic == 5
     assert r.state.analysis.picked_speed == 90.0
 
 
 def test_nothing_is_computed_while_the_card_is_collapsed_or_another_tab_is_shown(store):
-    r, a = store
+    r = store
     r.state.case.n_modes = 80
-    assert a.contributions is None and a.phase is None and a.speed_map is None
+    assert r.contributions is None and r.phase is None and r.speed_map is None
     r.state.analysis.tab = "speed"
-    first = a.speed_map
-    assert first is not None and a.contributions is None
+    first = r.speed_map
+    assert first is not None and r.contributions is None
     r.state.analysis.tab = "phase"
     r.state.case.n_modes = 90  # not shown: the speed map stays as it was
-    assert a.speed_map is first and a.phase.meta["N (retained tire modes)"] == 90
+    assert r.speed_map is first and r.phase.meta["N (retained tire modes)"] == 90
 
 
 # -- compare: pinned baselines ----------------------------------------------------------------
@@ -185,15 +187,15 @@ def _db_direct(harmonic, n_modes, dof="z", coupling="6dof"):
 def test_compare_pins_overlay_difference_band_and_map(store):
     from app.views.analysis_compare import CompareView
 
-    r, a = store
+    r = store
     r.state.noise.param.update(rounds=200, seed=4, noise=5.0)
     r.request_band(wait=True)
-    a.pin("base")
-    assert a.message == "" and [p.name for p in a.pins] == ["base"]
-    assert a.pins[0].data.sources["models"] == "reference"
+    r.pin("base")
+    assert r.message == "" and [p.name for p in r.pins] == ["base"]
+    assert r.pins[0].data.sources["models"] == "reference"
     r.state.case.n_modes = 100
     r.state.analysis.tab = "compare"
-    view = CompareView(store=r, analysis=a)
+    view = CompareView(store=r)
     view.__panel__()
     # overlay and difference: current (N = 100) minus the pin (N = 60), from the core directly
     np.testing.assert_allclose(view._curves[0][0].data["level"], _db_direct(2, 100), atol=1e-9)
@@ -211,7 +213,7 @@ def test_compare_pins_overlay_difference_band_and_map(store):
     )
     # the error map as a difference map: the current map minus the pinned state's map
     r.state.case.coupling = "5dof"
-    a.pin("five")
+    r.pin("five")
     r.state.case.coupling = "6dof"
     r.state.analysis.compare_to = "five"
     from app import compute
@@ -224,7 +226,7 @@ def test_compare_pins_overlay_difference_band_and_map(store):
     # another harmonic: no difference on another grid, said so in the CSV header
     r.state.case.harmonic = 3
     assert np.isnan(view._diffs[0][0].data["diff"]).all()
-    res = a.compare
+    res = r.compare
     meta, cols = read_csv(to_csv(res.columns, res.meta, "compare"))
     assert "different frequency grids" in meta["curve 1 difference"]
     assert "pin 'base'" in meta["curve 1"] and "seed 4" in meta["curve 1"]
@@ -233,44 +235,42 @@ def test_compare_pins_overlay_difference_band_and_map(store):
 
 
 def test_pins_in_the_url_are_rebuilt_in_a_new_session_and_names_are_checked(store):
-    r, a = store
-    a.pin("base")
+    r = store
+    r.pin("base")
     r.state.case.n_modes = 120
-    a.pin("n120")
+    r.pin("n120")
     link = r.state.analysis.pins
     assert link.count("|") == 1
     # a new session restoring the link: the same pins, the same data
     r2 = Results()
     r2.state.analysis.pins = link
-    a2 = AnalysisResults(store=r2)
-    assert [p.name for p in a2.pins] == ["base", "n120"]
-    for p, q in zip(a.pins, a2.pins, strict=True):
+    assert [p.name for p in r2.pins] == ["base", "n120"]
+    for p, q in zip(r.pins, r2.pins, strict=True):
         np.testing.assert_array_equal(p.data.frfs["response"].data, q.data.frfs["response"].data)
     # names: taken, malformed, too many
-    a.pin("base")
-    assert "already named" in a.message
-    a.pin("bad|name")
-    assert "pin name" in a.message
-    a.pin("c")
-    a.pin("d")
-    a.pin("e")
-    assert "at most 4" in a.message and len(a.pins) == 4
-    a.unpin("c")
-    assert [p.name for p in a.pins] == ["base", "n120", "d"]
+    r.pin("base")
+    assert "already named" in r.message
+    r.pin("bad|name")
+    assert "pin name" in r.message
+    r.pin("c")
+    r.pin("d")
+    r.pin("e")
+    assert "at most 4" in r.message and len(r.pins) == 4
+    r.unpin("c")
+    assert [p.name for p in r.pins] == ["base", "n120", "d"]
     # a malformed link is refused with a message, the pins stay
     r.state.analysis.pins = "x~h9"
-    assert "malformed pin" in a.message and len(a.pins) == 3
+    assert "malformed pin" in r.message and len(r.pins) == 3
     # a pin of an upload that is not loaded here: listed, without data
     r3 = Results()
     r3.state.analysis.pins = link.replace("mreference", "mdeadbeef")
-    a3 = AnalysisResults(store=r3)
-    assert all(p.data is None and "not loaded" in p.note for p in a3.pins)
+    assert all(p.data is None and "not loaded" in p.note for p in r3.pins)
 
 
 def test_each_pin_is_published_in_the_store_against_the_current_state(store):
-    r, a = store
+    r = store
     assert r.pinned == ()
-    a.pin("base")  # N = 60
+    r.pin("base")  # N = 60
     r.state.case.n_modes = 90  # whatever tab is shown (here: none)
     (res,) = r.pinned
     np.testing.assert_allclose(res.columns["pin_base_dB"], _db_direct(2, 60), atol=1e-9)
@@ -281,7 +281,7 @@ def test_each_pin_is_published_in_the_store_against_the_current_state(store):
     r.state.case.harmonic = 4  # another grid: the pin alone, the reason in its header
     (res,) = r.pinned
     assert "current_dB" not in res.columns and "different frequency grids" in res.meta["difference"]
-    a.unpin("base")
+    r.unpin("base")
     assert r.pinned == ()
 
 
@@ -315,19 +315,18 @@ def test_peak_modes_are_the_nearest_coupled_modes_and_nearby_peaks_share_a_solve
 def test_the_shown_analysis_view_is_published_before_the_main_views(store, tab, name):
     """The view the user looks at is computed (and so drawn) first on a change of the case,
     and once: its own watcher, which comes later, finds it current."""
-    r, a = store
+    r = store
     r.state.analysis.tab = tab
     order = []
-    a.param.watch(lambda e: order.append(e.name), [name])
-    r.param.watch(lambda e: order.append(e.name), ["response", "error_map", "suggested"])
+    r.param.watch(lambda e: order.append(e.name), [name, "response", "error_map", "suggested"])
     r.state.case.dof = "x"
     assert order[0] == name and order.count(name) == 1, order
     assert "response" in order
     # the published result is that of the new state
-    meta = getattr(a, name).meta
+    meta = getattr(r, name).meta
     if name == "compare":
         assert " bushing:x " in meta["curve 0"]
-        cur = getattr(a, name).draw["curves"][0]["level"]
+        cur = getattr(r, name).draw["curves"][0]["level"]
         ref = fbs_core.vocabulary.magnitude_db(
             fbs_core.bushing_response(2, n_modes=60).sel(outputs="bushing:x").data[:, 0, 0]
         )
@@ -344,35 +343,46 @@ def test_the_compare_result_shown_first_follows_its_pins_and_the_band(store):
     """Compare, published ahead of the main views, is published again when anything else
     it is made of changes (a new pin, the compared pin, the band arriving), and not again
     by its own watcher for the same state."""
-    r, a = store
-    r.state.noise.seed = 90417  # bands of a seed no other test computed (the cache is shared)
+    import time
+
+    r = store
+    r.state.noise.param.update(seed=90417, rounds=500)  # bands no other test computed
+    r.request_band(wait=True)
+    r.background = True  # as served: bands on a thread of their own
     r.state.analysis.tab = "compare"
     seen = []
-    a.param.watch(lambda e: seen.append(e.new), ["compare"])
-    a.pin("one")
+    r.param.watch(lambda e: seen.append(e.new), ["compare"])
+    r.pin("one")
     assert len(seen) == 1 and len(seen[-1].draw["curves"]) == 2  # current + the new pin
     # a new N: published for the new state ahead of the main views (no band of it yet),
-    # then again when its band arrives (without a server computed in the store's watcher)
-    r.state.case.n_modes = 80
+    # then again when its band arrives
+    r.state.case.n_modes = 80  # the band starts on its thread, waiting for the lock
+    t0 = time.monotonic()
+    while len(seen) < 3 and time.monotonic() - t0 < 300:
+        time.sleep(0.01)
     assert len(seen) == 3
     assert seen[1].draw["curves"][0]["band"] is None
     assert seen[2].draw["curves"][0]["band"] is not None
     assert "N=80" in seen[1].meta["curve 0"] and "N=80" in seen[2].meta["curve 0"]
-    a.pin("two")
+    r.pin("two")
     assert len(seen) == 4 and len(seen[-1].draw["curves"]) == 3
-    a.state.analysis.compare_to = "two"
+    r.state.analysis.compare_to = "two"
     assert len(seen) == 5 and "'two'" in seen[-1].meta["difference map"]
-    a.state.analysis.cursor1 = 30.0  # not something the comparison is made of
+    r.state.analysis.cursor1 = 30.0  # not something the comparison is made of
     assert len(seen) == 5
 
 
-def test_a_step_of_the_n_slider_on_the_speed_tab_computes_the_next_step_ahead(store):
+def test_a_step_of_the_n_slider_on_the_speed_tab_computes_the_next_step_ahead(store, monkeypatch):
     """Served, a step of N on the speed tab computes the speed map of the next count in the
-    same direction on a thread of its own: the next step is a cache hit. A change of
-    harmonic computes nothing ahead."""
+    same direction on the process' worker for work ahead: the next step is a cache hit. A
+    change of harmonic computes nothing ahead."""
     from app import analysis_compute as ac
+    from app.runtime.background import AHEAD
 
-    r, a = store
+    r = store
+    asked = []
+    submit = AHEAD.submit
+    monkeypatch.setattr(AHEAD, "submit", lambda key, work: (asked.append(key), submit(key, work)))
     r.background = True  # as in a served page
     models = r.state.case.models
 
@@ -385,19 +395,59 @@ def test_a_step_of_the_n_slider_on_the_speed_tab_computes_the_next_step_ahead(st
     ac._speed_map.cache_clear()  # a hit below is this test's own computation
     try:
         r.state.analysis.tab = "speed"  # N = 60
-        assert a.prefetch_thread is None  # the first map: no step yet
+        assert asked == []  # the first map: no step yet
         r.state.case.n_modes = 70  # up: 80 ahead
-        a.prefetch_thread.join(timeout=300)
-        assert not a.prefetch_thread.is_alive() and hit(80)
+        assert asked == [(r, "speed_map")] and AHEAD.idle(300) and hit(80)
         r.state.case.n_modes = 60  # down: 50 ahead
-        a.prefetch_thread.join(timeout=300)
-        assert hit(50)
-        a.prefetch_thread = None
+        assert AHEAD.idle(300) and hit(50)
+        asked.clear()
         r.state.case.harmonic = 3
-        assert a.prefetch_thread is None
+        assert asked == []
         # not served: nothing computed ahead
         r.background = False
         r.state.case.n_modes = 70
-        assert a.prefetch_thread is None
+        assert asked == []
     finally:
         r.close()
+
+
+def test_a_pin_keeps_its_residual_setting_and_compare_honours_the_current_one(store):
+    """Issue 27: with residual compensation on, Compare showed a flat 0 dB difference to a
+    pin taken with it off (its current curve ignored the setting). Truth: the core's
+    plain and residual responses of this N computed directly."""
+    r = store
+    r.state.case.param.update(harmonic=5, n_modes=50)
+    r.pin("plain")  # residual off
+    r.state.case.residual = True
+    r.pin("comp")  # residual on
+    r.state.analysis.tab = "compare"
+    try:
+        curves = r.compare.draw["curves"]
+        on = _db_direct_res(5, 50, True)
+        off = _db_direct_res(5, 50, False)
+        np.testing.assert_allclose(curves[0]["level"], on, atol=1e-9)  # current: compensated
+        np.testing.assert_allclose(curves[1]["diff"], on - off, atol=1e-9)
+        assert np.nanmax(np.abs(curves[1]["diff"])) > 1.0  # not flat
+        np.testing.assert_allclose(curves[2]["diff"], 0.0, atol=1e-9)  # the same state
+        assert "+ residual" in r.compare.meta["curve 0"]
+        assert "+ residual" not in r.compare.meta["curve 1"]
+        assert "+ residual" in r.compare.meta["curve 2"]
+        # the link keeps it: a new session rebuilds both pins with their own setting
+        r2 = Results()
+        r2.state.analysis.pins = r.state.analysis.pins
+        assert [p.settings.residual for p in r2.pins] == [False, True]
+        np.testing.assert_allclose(
+            magnitude_db(r2.pins[1].data.frfs["response"].data[:, 0, 0]), on, atol=1e-9
+        )
+        # a link made before pins kept the setting opens as plain truncation
+        old = r.state.analysis.pins.split("|")[0].replace("~r0", "")
+        r2.state.analysis.pins = old
+        assert r2.message == "" and [p.settings.residual for p in r2.pins] == [False]
+    finally:
+        r.state.case.param.update(residual=False, harmonic=2, n_modes=60)
+        r.state.analysis.tab = ""
+
+
+def _db_direct_res(harmonic, n_modes, residual, dof="z"):
+    v = fbs_core.bushing_response(harmonic, n_modes=n_modes, residual=residual)
+    return magnitude_db(v.sel(outputs=f"bushing:{dof}").data[:, 0, 0])

@@ -144,3 +144,129 @@ def test_without_a_directory_the_browser_says_how_to_configure_it(monkeypatch):
     monkeypatch.delenv("FBS_CAMPAIGN_DIR", raising=False)
     b = CampaignBrowser()
     assert b.file is None and "FBS_CAMPAIGN_DIR" in b.message
+
+
+#: a variants study (issue 32) of a cheap base tire (few orders, six speeds): a rebuild takes
+#: a fraction of a second
+VARIANTS_TOML = """
+[campaign]
+name = "corridor"
+seed = 7
+output = "{out}"
+[variants]
+name = "cheap"
+parameters = ["inflation_pressure", "knuckle_mass"]
+design = "saltelli"
+n = 2
+harmonics = [1, 4]
+percentiles = [10.0, 50.0, 90.0]
+speeds = [20.0, 40.0, 60.0, 80.0, 100.0, 120.0]
+[variants.tire]
+orders = [6, 3, 4, 3, -1, -1, -1, -1]
+slip_zones = 1
+"""
+
+
+@pytest.fixture(scope="module")
+def variants_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("variants")
+    camp = parse_campaign(VARIANTS_TOML.format(out=(d / "corridor.h5").as_posix()), d)
+    assert run_campaign(camp).status == "complete"
+    return d
+
+
+def test_a_variants_case_is_listed_with_readable_columns(variants_dir):
+    rows = case_rows(open_campaign(variants_dir / "corridor.h5"))
+    assert rows["case"] == ["variants_cheap"] and rows["kind"] == ["variants"]
+    assert rows["harmonic"] == ["1, 4"]
+    assert rows["tire"] == ["inflation_pressure; base changed"]  # [variants.tire] given
+    assert rows["chassis"] == ["knuckle_mass"]
+    assert rows["design"] == ["saltelli n=2 (8 variants)"]  # N (k + 2) = 2 x 4
+    assert rows["status"] == ["complete"]
+    b = CampaignBrowser(directory=variants_dir)
+    assert "variants" in b.param.kind.objects
+    b.kind = "variants"
+    assert b.param.case.objects == ["variants_cheap"]
+    b.harmonic = 4
+    assert b.param.case.objects == ["variants_cheap"]
+    b.harmonic = 7
+    assert b.case is None and "variants_cheap" not in b.param.case.objects
+
+
+def test_the_chosen_variants_case_draws_the_studys_corridor_and_ranking(variants_dir):
+    """Truth: the study read independently (open_campaign(...).variants), its corridor
+    recomputed from the stored responses with numpy (min, max, percentiles over the rows)."""
+    path = variants_dir / "corridor.h5"
+    b = CampaignBrowser(directory=variants_dir)
+    b.__panel__()
+    b.case = "variants_cheap"
+    b.dof = "x"
+    b.harmonic = 4
+    st = open_campaign(path).variants("variants_cheap")
+    mag = np.abs(st.responses[4][:, :, st.corridor(4).dof_index("bushing:x")])
+    cols = b.shown.columns
+    np.testing.assert_array_equal(cols["freq_Hz"], st.freq(4))
+    np.testing.assert_allclose(cols["minimum"], mag.min(axis=0), rtol=1e-12)
+    np.testing.assert_allclose(cols["maximum"], mag.max(axis=0), rtol=1e-12)
+    np.testing.assert_allclose(cols["p90"], np.percentile(mag, 90, axis=0), rtol=1e-12)
+    np.testing.assert_allclose(cols["p10"], np.percentile(mag, 10, axis=0), rtol=1e-12)
+    j = st.corridor(4).dof_index("bushing:x")
+    np.testing.assert_array_equal(cols["nominal"], np.abs(st.nominal[4][:, j]))
+    # what is drawn: the corridor's edges and outer percentiles in dB over the nominal
+    d = b._corridor_src.data
+    np.testing.assert_allclose(d["hi"], 20 * np.log10(mag.max(axis=0)), rtol=1e-12)
+    np.testing.assert_allclose(d["qlo"], 20 * np.log10(np.percentile(mag, 10, axis=0)))
+    np.testing.assert_allclose(d["nominal"], 20 * np.log10(np.abs(st.nominal[4][:, j])))
+    assert b._corridor_fig.visible and not b._band_fig.visible and not b._map_fig.visible
+    # the ranking beside it: the leaders of the study's own Sobol' indices
+    lead = st.sensitivity(4).leaders("bushing:x")
+    table = b._leaders.value
+    assert list(table["leading parameter"]) == [x["parameter"] for x in lead]
+    assert len(table) == len(lead) > 0 and b._leaders.visible
+    # title block and export: campaign file, case, parameters, percentiles
+    for word in ("corridor.h5", "variants_cheap", "harmonic 4", "inflation_pressure", "10, 50, 90"):
+        assert word in b.shown.caption
+    meta, back = read_csv(to_csv(cols, b.shown.meta, "campaign"))
+    assert meta["campaign file"] == "corridor.h5" and meta["case"] == "variants_cheap"
+    assert meta["parameters"] == "inflation_pressure, knuckle_mass"
+    assert meta["percentiles"] == "10, 50, 90" and meta["harmonic"] == "4"
+    assert lead[0]["parameter"] in meta["sensitivity leaders (total Sobol' index per band)"]
+    np.testing.assert_allclose(back["maximum"], mag.max(axis=0), rtol=1e-12)
+    assert b.shown.filename == "corridor_variants_cheap_h4_x.csv"
+    # the other harmonic of the case through the harmonic filter
+    b.harmonic = 1
+    np.testing.assert_array_equal(b.shown.columns["freq_Hz"], st.freq(1))
+
+
+def test_the_shown_variants_case_is_a_section_of_the_sessions_report(variants_dir, monkeypatch):
+    """The card's browser publishes its case to the session's store; the report shows it
+    (the corridor's curves and the ranking) as the page shows it."""
+    from types import SimpleNamespace
+
+    import panel as pn
+
+    from app.report.session import report_data
+    from app.store import Results
+    from app.views.campaign import campaign_card
+
+    monkeypatch.setenv("FBS_CAMPAIGN_DIR", str(variants_dir))
+    store = Results(background=False)
+    parts = SimpleNamespace(
+        results=store, card=lambda title, view, height, **kw: pn.Card(view, title=title, **kw)
+    )
+    card = campaign_card(parts)
+    assert "campaign" not in store.outside
+    card.collapsed = False  # the user opens the card: the file is read, its case shown
+    card.browser.param.update(case="variants_cheap", dof="y")
+    st = open_campaign(variants_dir / "corridor.h5").variants("variants_cheap")
+    c = st.corridor(1, percentiles=(10.0, 50.0, 90.0))
+    j = c.dof_index("bushing:y")
+    (sec,) = [x for x in report_data(store).extra if x.key == "campaign"]
+    np.testing.assert_allclose(sec.curves["maximum"], 20 * np.log10(c.maximum[:, j]))
+    np.testing.assert_allclose(sec.curves["p90"], 20 * np.log10(c.percentiles[2, :, j]))
+    rows = dict(sec.rows)
+    assert rows["campaign file"] == "corridor.h5" and rows["parameters"].startswith("inflation")
+    lead = st.sensitivity(1).leaders("bushing:y")[0]["parameter"]
+    assert lead in rows["sensitivity leaders (total Sobol' index per band)"]
+    card.browser.case = None  # nothing shown: no section
+    assert all(x.key != "campaign" for x in report_data(store).extra)

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 import fbs_core
-from app import compute, offload
+from app import compute
+from app.runtime import offload
 from app.state import DashboardState
 from app.store import Results
 from fbs_core.campaign import SCHEDULER_ENV

@@ -1,7 +1,10 @@
-"""The app uses only public mechanisms of Panel, Bokeh and BokehJS, except in one isolated
-module (``app/panel_private.py``), whose private use fails a test here when it disappears.
+"""The app and its server use only public mechanisms of Panel, Bokeh, BokehJS and Tornado,
+except in two isolated modules (``app/runtime/panel_private.py`` for the app,
+``docker/server_private.py`` for the server stage of the image), whose private uses fail a
+test here when they disappear.
 
-Scanned: every module of ``app``, the browser tests and the dashboard benchmarks. Flagged:
+Scanned: every module of ``app`` and of ``docker`` (the server: ``entrypoint.py``,
+``fbs_server.py``, ``fbs_auth.py``), the browser tests and the dashboard benchmarks. Flagged:
 an attribute ``x._name`` on anything but ``self``/``cls``, ``getattr(x, "_name")`` and
 friends, imports of private names or modules of Panel/Bokeh, and ``._name`` inside the
 JavaScript strings that run in the page.
@@ -18,13 +21,17 @@ import panel as pn
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-ISOLATED = ROOT / "app" / "panel_private.py"
+ISOLATED = ROOT / "app" / "runtime" / "panel_private.py"
+SERVER_ISOLATED = ROOT / "docker" / "server_private.py"
 SCANNED = sorted(
     [p for p in (ROOT / "app").rglob("*.py") if p != ISOLATED]
+    + [p for p in (ROOT / "docker").glob("*.py") if p != SERVER_ISOLATED]
     + list((ROOT / "tests" / "browser").glob("*.py"))
     + [ROOT / "bench" / n for n in ("bench_dashboard.py", "load_test.py", "load_clients.py")]
 )
 JS_PRIVATE = re.compile(r"\.\s*_[A-Za-z]\w*")
+#: Documented names of the standard library that start with an underscore.
+STDLIB_PUBLIC = {("os", "_exit")}
 
 
 def _private(name: str) -> bool:
@@ -55,8 +62,13 @@ def violations(path: Path) -> list[str]:
                 and node.value.func.id == "super"
             )
             own |= isinstance(node.value, ast.Name) and node.value.id in own_modules
+            own |= isinstance(node.value, ast.Name) and (node.value.id, node.attr) in STDLIB_PUBLIC
             if not own:
                 out.append(f"{where} attribute .{node.attr}")
+        elif isinstance(node, ast.Assign) and any(
+            isinstance(t, ast.Attribute) and t.attr == "__class__" for t in node.targets
+        ):
+            out.append(f"{where} assignment to __class__")
         elif isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
             if node.func.id in ("getattr", "setattr", "hasattr", "delattr") and len(node.args) > 1:
                 arg = node.args[1]
@@ -65,7 +77,7 @@ def violations(path: Path) -> list[str]:
                         out.append(f"{where} {node.func.id}(..., {arg.value!r})")
         elif isinstance(node, ast.ImportFrom) and node.module:
             parts = node.module.split(".")
-            if parts[0] in ("panel", "bokeh"):
+            if parts[0] in ("panel", "bokeh", "tornado"):
                 if any(_private(p) for p in parts) or parts[:2] == ["panel", "models"]:
                     out.append(f"{where} import from {node.module}")
                 out += [f"{where} import {a.name}" for a in node.names if _private(a.name)]
@@ -96,6 +108,7 @@ def test_the_scan_finds_what_it_must():
         "self_ok = self._mine\n"
         "from . import figures\n"
         "own_ok = figures._LOCK\n"
+        "provider.__class__ = Other\n"
     )
     try:
         found = violations(bad)
@@ -109,15 +122,16 @@ def test_the_scan_finds_what_it_must():
         "attribute ._unblocked",
         "getattr(..., '_pending_writes')",
         "JavaScript ._all_models",
+        "assignment to __class__",
     ):
         assert what in joined
     assert "_mine" not in joined and "_LOCK" not in joined
 
 
 def test_the_isolated_private_use_still_exists_in_panel():
-    """``app/panel_private.py`` sets ``Widget._debounce``: Panel must still have it and read
+    """``app/runtime/panel_private.py`` sets ``Widget._debounce``: Panel must still have it and read
     it where it schedules a browser change (else the setting silently does nothing)."""
-    from app.panel_private import DEBOUNCE_MS, respond_at_once
+    from app.runtime.panel_private import DEBOUNCE_MS, respond_at_once
 
     assert isinstance(pn.widgets.IntSlider._debounce, int)
     from panel.reactive import Syncable
@@ -126,3 +140,25 @@ def test_the_isolated_private_use_still_exists_in_panel():
     w = pn.widgets.EditableFloatSlider(start=0, end=1)
     respond_at_once(w)
     assert all(x._debounce == DEBOUNCE_MS for x in w.select(pn.widgets.Widget))
+
+
+def test_the_server_scan_covers_docker():
+    names = {p.name for p in SCANNED if p.parent.name == "docker"}
+    assert {"entrypoint.py", "fbs_server.py", "fbs_auth.py"} <= names
+    assert "server_private.py" not in names
+
+
+def test_the_servers_isolated_private_uses_still_exist():
+    """``docker/server_private.py``: each private name it uses is still there and used as
+    relied on (else the server would silently lose its shutdown, its start-up proof or the
+    client address of the login throttle)."""
+    import tornado.httpserver
+    from panel.io import document
+    from panel.io.state import state
+
+    assert callable(document._cleanup_doc)
+    assert "_thread_pool" in vars(type(state)) or hasattr(state, "_thread_pool")
+    src = inspect.getsource(tornado.httpserver._HTTPRequestContext.__init__)
+    assert "self.address = address" in src
+    src = inspect.getsource(tornado.httpserver.HTTPServer.handle_stream)
+    assert "HTTP1ServerConnection(stream, self.conn_params, context)" in src

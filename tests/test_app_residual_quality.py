@@ -19,8 +19,10 @@ import fbs_core
 from app import compute
 from app.datasource import Models
 from app.export import read_csv, to_csv
+from app.results import Snapshot
+from app.results.main import tire_meta
 from app.state import URL_KEYS, DashboardState
-from app.store import Results, Snapshot, tire_meta
+from app.store import Results
 from fbs_core import studies
 from fbs_core.tire import TireModel
 from fbs_core.tire.quality import interpolation_quality

@@ -124,10 +124,17 @@ def test_single_round_stays_inside_the_batch():
         ("noise.seed", 7, "noise", "seed"),
         ("noise.single_round", 42, "noise", "single_round"),
         ("noise.percentile", 50, "noise", "percentile"),
+        ("plot.overlay", ["x", "rz"], "plot", "overlay"),
+        ("plot.level_scale", "linear", "plot", "level_scale"),
+        ("plot.cursor1", 42.5, "plot", "cursor1"),
+        ("plot.cursor2", 61.0, "plot", "cursor2"),
+        ("plot.snap", True, "plot", "snap"),
     ],
 )
 def test_widgets_drive_the_state(controls, key, value, group, name):
-    controls.widgets()[key].value = value
+    w = controls.widgets()[key]
+    # a typed number's widget is a text field: the text a person types
+    w.value = f"{value:g}" if key in controls.fields else value
     assert getattr(getattr(controls.state, group), name) == value
 
 
@@ -164,7 +171,9 @@ def test_csv_round_trip_with_metadata_header():
     )
     assert text.startswith("# tire-fbs dashboard export (coupled)\n")
     meta, cols = read_csv(text)
+    units = meta.pop("Re/Im columns")  # complex columns state their parts and unit (issue 29)
     assert meta == {"harmonic": "1", "N": "50", "seed": "0"}
+    assert "v_re, v_im" in units and "unit" in units
     assert list(cols) == ["freq_Hz", "level_dB", "v_re", "v_im"]
     np.testing.assert_array_equal(cols["level_dB"], db)  # 17 digits: exact round trip
     np.testing.assert_array_equal(cols["v_re"] + 1j * cols["v_im"], v)

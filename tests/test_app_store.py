@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 import fbs_core
-from app import bands, compute
+from app import compute
 from app.export import read_csv, to_csv
+from app.runtime import bands
 from app.state import DashboardState
 from app.store import Results
 

@@ -9,8 +9,9 @@ from __future__ import annotations
 import pytest
 
 import fbs_core as fc
-from app import compute, store
+from app import compute
 from app.report import figures
+from app.results import main as store
 from fbs_core.vocabulary import DIRECTIONS
 
 

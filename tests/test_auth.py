@@ -134,6 +134,8 @@ def test_auth_without_secret_makes_a_random_one(app_file):
         ({"FBS_PORT": "-1"}, "FBS_PORT"),
         ({"FBS_LOG_LEVEL": "loud"}, "allowed values are debug, info"),
         ({"FBS_USE_XHEADERS": "maybe"}, "FBS_USE_XHEADERS='maybe': allowed values"),
+        ({"FBS_USE_XHEADERS": "true"}, "needs FBS_TRUSTED_PROXIES"),
+        ({"FBS_TRUSTED_PROXIES": "10.0.0.1,proxy.local"}, "'proxy.local' is not an IP address"),
         ({"FBS_WEBSOCKET_MAX_MESSAGE_MB": "0"}, "FBS_WEBSOCKET_MAX_MESSAGE_MB"),
         ({"FBS_BASIC_AUTH_FILE": "/nonexistent/users.json"}, "cannot be read"),
         ({"FBS_APP": "/nonexistent/main.py"}, "does not exist"),

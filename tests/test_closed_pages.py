@@ -8,7 +8,7 @@ import threading
 
 from tornado.websocket import WebSocketClosedError
 
-from app.closed_pages import quiet_closed_page_writes
+from app.runtime.closed_pages import quiet_closed_page_writes
 
 
 def test_only_closed_page_writes_are_quieted(caplog):

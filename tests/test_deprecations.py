@@ -156,3 +156,35 @@ def test_harmonic_case_keyword_is_harmonic(function, kwargs):
         function(**kwargs)
     with pytest.raises(TypeError, match="give 'harmonic' only"), pytest.warns(DeprecationWarning):
         function(1, harmonic_case=1, **kwargs)
+
+
+def test_tire_truncated_is_subset_of_the_first_stored_pairs():
+    """``TireModel.truncated(N)`` (issue 30: the name hid that it keeps the first N stored
+    modes, not the lowest of each operating point) warns, naming ``subset``, and gives the
+    first N stored modes plus the residual of the others, as ``subset(range(N // 2))``."""
+    tire = fbs_core.reference_tire()
+    with pytest.warns(DeprecationWarning, match=r"subset\(range\(N // 2\)\)"):
+        old = tire.truncated(40)
+    new = tire.subset(range(20))
+    _same_model(old, new)
+    np.testing.assert_array_equal(old.residual, new.residual)
+    np.testing.assert_array_equal(old.poles, tire.poles[:, :40])  # the stored order
+    # the residual is the static part of the modes left out, per operating point (psi
+    # chi^T and psi p over -lambda; no zero poles among the modes left out)
+    p = tire.poles[:, 40:]
+    R = np.einsum("smi,smj->smij", tire.psi[:, 40:], tire.chi[:, 40:]).reshape(*p.shape, 36)
+    np.testing.assert_allclose(old.residual[:, :36], -(R / p[..., None]).sum(axis=1), rtol=1e-9)
+
+
+def test_analysis_level_db_is_magnitude_db_without_a_floor():
+    from fbs_core.analysis import level_db
+    from fbs_core.vocabulary import magnitude_db
+
+    h = np.array([10.0, 0.1j, -2.0, 0.0])  # 20, -20, 20 log10 2, -inf (no floor)
+    want = [20.0, -20.0, 20 * np.log10(2.0), -np.inf]
+    with pytest.warns(DeprecationWarning, match="magnitude_db"):
+        old = level_db(h, ref=1.0)
+    np.testing.assert_allclose(old, want)
+    np.testing.assert_array_equal(old, magnitude_db(h, floor=None))
+    with pytest.warns(DeprecationWarning):
+        np.testing.assert_allclose(level_db(h[:2], ref=10.0), [0.0, -40.0])

@@ -1,4 +1,4 @@
-"""The session's draw queue (app.views.live.DrawQueue): draws in the order asked for, each
+"""The session's draw queue (app.runtime.draw.DrawQueue): draws in the order asked for, each
 one written before the next starts, a failing draw does not stop the others, and a page
 that ended keeps nothing alive through draws that never ran.
 
@@ -14,7 +14,7 @@ import gc
 import threading
 import weakref
 
-from app.views.live import DrawQueue, on_document
+from app.runtime.draw import DrawQueue, on_document
 
 
 class _Context:

@@ -56,6 +56,27 @@ def test_immutable():
     assert Z.data[0, 0, 0] == 1.0
 
 
+def test_pickle_round_trip_rebuilds_an_equal_immutable_frf():
+    """An FRF crosses to another process (a report's data to the report process) whole."""
+    import pickle
+
+    Y = FRF(
+        F,
+        np.arange(8.0).reshape(4, 2, 1) * (1 + 2j),
+        ["patch", "b:rz"],
+        ["a:x"],
+        quantity="receptance",
+        kinds={"patch": "road"},
+    )
+    Z = pickle.loads(pickle.dumps(Y))
+    np.testing.assert_array_equal(Z.data, Y.data)
+    np.testing.assert_array_equal(Z.freq, Y.freq)
+    assert (Z.outputs, Z.inputs, Z.quantity) == (Y.outputs, Y.inputs, Y.quantity)
+    assert (Z.units == Y.units).all()  # the kinds travel too
+    with pytest.raises(ValueError):
+        Z.data[0, 0, 0] = 1.0
+
+
 def test_crop_interpolate_transpose_db():
     Y = _frf()
     assert Y.crop(2.0, 5.0).freq.tolist() == [2.0, 5.0]

@@ -121,7 +121,8 @@ def test_uff_export_of_functions_of_frequency(tmp_path):
     np.testing.assert_allclose(sets[k]["data"], tm.response[1, :, 1], rtol=1e-10)
     np.testing.assert_allclose(sets[k]["x"], F)
     assert sets[k]["rsp_dir"] == 3
-    assert any("seed=1" in s["id4"] for s in sets)
+    assert any("seed=1" in s["id3"] + s["id4"] for s in sets)  # whole pairs, lines 3-4
+    assert all(s["id5"].startswith("nodes: ") and "=bushing" in s["id5"] for s in sets)
 
 
 def test_coupled_frf_result_round_trips_through_every_export():

@@ -13,19 +13,19 @@ import threading
 import time
 
 import numpy as np
-import param
 import pytest
 
 import fbs_core
-from app import bands
 from app.export import read_csv, to_csv
 from app.main import EXTRA_CARDS, PageParts, create_app
+from app.page.titles import short_query
 from app.report import build_html, build_pdf
-from app.report.live import short_query
-from app.report.session import session_snapshot, store_sections
-from app.report.snapshot import ExtraSection
+from app.report.data import ExtraSection
+from app.report.session import report_data
+from app.results import progress_status
+from app.runtime import bands
 from app.state import DashboardState
-from app.store import Result, Results, progress_status
+from app.store import Results
 from app.views.controls import Controls, harmonic_text
 from app.views.live import export_meta
 
@@ -49,15 +49,15 @@ def test_an_out_of_range_value_gets_a_message_and_the_field_shows_the_value_in_f
     w = controls.widgets()[key]
     group, name = key.split(".")
     before = getattr(getattr(state, group), name)
-    w.value = typed
+    w.value = f"{typed:g}"
     msg = controls.messages[key]
     assert msg.visible and words in msg.object
     assert f"still {before:,}" in msg.object or f"still {before:g}" in msg.object
     assert getattr(getattr(state, group), name) == before  # nothing changed
-    assert w.value == before  # the field no longer shows the refused value
+    assert w.value == f"{before:g}"  # the field no longer shows the refused value
     # a valid value is taken and clears the message
     good = 2 * before if before else 3
-    w.value = good
+    w.value = str(good)
     assert getattr(getattr(state, group), name) == good and not msg.visible
 
 
@@ -69,19 +69,24 @@ def test_the_bounds_of_the_messages_are_the_parameters_own():
         obj = getattr(state, group)
         lo, hi = obj.param[name].bounds
         w = controls.widgets()[key]
-        w.value = hi  # the largest allowed value is taken
+        w.value = str(hi)  # the largest allowed value is taken
         assert getattr(obj, name) == hi and not controls.messages[key].visible
         with pytest.raises(ValueError):  # and param itself refuses one step above
             obj.param.update(**{name: hi + 1})
-        w.value = hi + 1
+        w.value = str(hi + 1)
         assert controls.messages[key].visible and getattr(obj, name) == hi
 
 
 def test_a_link_or_another_control_moves_the_field():
     state = DashboardState()
-    w = Controls(state=state).widgets()["noise.rounds"]
+    controls = Controls(state=state)
+    w = controls.widgets()["noise.rounds"]
     state.noise.rounds = 5000
-    assert w.value == 5000
+    assert w.value == "5000"
+    # a typed value beyond the slider's end moves the field and the slider alike
+    state.truncation.threshold = 75.5
+    field = controls.fields["truncation.threshold"]
+    assert field.text.value == "75.5" and field.bar.value == 75.5
 
 
 @pytest.mark.parametrize("k", range(1, 8))
@@ -184,32 +189,35 @@ def test_the_short_link_keeps_only_values_that_differ_from_the_defaults():
 
 
 # -- sections other views contribute -----------------------------------------------------
-def test_a_result_published_by_another_view_becomes_a_report_section():
-    class WithPins(Results):
-        pins = param.Parameter(default=(), doc="Pinned curves (tuple of Result).")
-
-    res = WithPins()
+def test_a_published_result_becomes_a_report_section_while_it_is_current():
+    """Every current result beyond the report's own sections is a section of it: its
+    description as a table and its dB columns over frequency as curves (a pin against the
+    current state here); a result of a tab looked at is reported while it is of the
+    current values, and left out once they changed."""
+    res = Results()
     res.state.noise.rounds = 30
-    r = res.response
-    f = r.columns["freq_Hz"]
-    pin = Result(
-        columns={"freq_Hz": f, "pinned_dB": r.columns["truncated_dB"] + 6.0},
-        meta={"view": "pinned curve", "unit": "dB re 1 (m/s)/m", "note": "N = 50 + 6 dB"},
-        caption="**Pinned** curve",
-    )
-    res.pins = (pin,)
-    extra = store_sections(res)
+    res.pin("base")  # N = 50
+    res.state.case.n_modes = 80
+    extra = report_data(res).extra
     # the store's own tire-quality result is one too; uncoupled not shown: not reported
-    assert [e.key for e in extra] == ["tire_quality", "pins-1"]
-    pins = extra[1]
-    assert pins.heading == "Pinned curve" and pins.paragraphs == ("Pinned curve",)
-    np.testing.assert_array_equal(pins.curves["pinned"], pin.columns["pinned_dB"])
-    snap = session_snapshot(res.state, extra=extra)
+    assert [e.key for e in extra] == ["tire_quality", "pinned-1"]
+    pin = extra[1]
+    assert pin.heading == "Pinned state 'base' against the current state"
+    r = res.pinned[0]
+    np.testing.assert_array_equal(pin.curves["pin base"], r.columns["pin_base_dB"])
+    np.testing.assert_array_equal(pin.curves["current"], res.response.columns["truncated_dB"])
+    snap = report_data(res)
     name, html = build_html(snap)
-    assert 'id="pins-1"' in html and "N = 50 + 6 dB" in html
-    assert 'id="figure-pins-1"' in html  # its curve is drawn
+    assert 'id="pinned-1"' in html and "N=50 bushing:z" in html
+    assert 'id="figure-pinned-1"' in html  # its curves are drawn
     _, pdf = build_pdf(snap)
     assert pdf.startswith(b"%PDF")
+    res.state.analysis.tab = "phase"  # shown: its results are current, and reported
+    assert "phase" in [e.key for e in report_data(res).extra]
+    res.state.analysis.tab = ""  # looked at, and still of the current values: reported
+    assert "phase" in [e.key for e in report_data(res).extra]
+    res.state.case.n_modes = 90  # the phase view of N = 80 is left behind: not reported
+    assert "phase" not in [e.key for e in report_data(res).extra]
     res.close()
 
 
@@ -245,8 +253,8 @@ def test_every_plot_title_names_the_data_in_use(key):
     import dataclasses
 
     from app.datasource import Models
-    from app.report.live import view_title
-    from app.store import Snapshot
+    from app.page.titles import view_title
+    from app.results import Snapshot
 
     s = Snapshot.of(DashboardState())
     tb, stem = view_title(key, s, "http://localhost:5006/main?h=1")

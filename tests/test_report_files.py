@@ -16,7 +16,7 @@ import report_snapshot
 from pypdf import PdfReader
 from report_snapshot import SETTINGS, URL, K, N
 
-from app.report import ReportError, Snapshot, build_html, build_pdf
+from app.report import ReportData, ReportError, build_html, build_pdf
 from app.report.method import THESIS
 from app.report.titles import harmonic_description
 
@@ -197,7 +197,7 @@ def test_pdf_holds_the_same(pdf_report, snap):
 
 
 def test_reference_data_report_says_so(results):
-    s = Snapshot(settings=SETTINGS, url=URL, truncation=results["truncation"])
+    s = ReportData(settings=SETTINGS, url=URL, truncation=results["truncation"])
     name, text = build_html(s)
     assert "_upload" not in name
     assert "reproduces this page with the shipped reference models" in text
@@ -205,15 +205,15 @@ def test_reference_data_report_says_so(results):
 
 def test_snapshot_refuses_results_that_do_not_match(results):
     with pytest.raises(ReportError, match="the band was computed with"):
-        Snapshot(settings={**SETTINGS, "rounds": 400}, band=results["band"])
+        ReportData(settings={**SETTINGS, "rounds": 400}, band=results["band"])
     with pytest.raises(ReportError, match="not the 10 and 90 %"):
-        Snapshot(settings={**SETTINGS, "percentile": 80}, band=results["band"])
+        ReportData(settings={**SETTINGS, "percentile": 80}, band=results["band"])
     with pytest.raises(ReportError, match="harmonic 1, not 2"):
-        Snapshot(settings={**SETTINGS, "harmonic": 2}, truncation=results["truncation"])
+        ReportData(settings={**SETTINGS, "harmonic": 2}, truncation=results["truncation"])
     with pytest.raises(ReportError, match="suggested modes were read at threshold 20 %"):
-        Snapshot(settings={**SETTINGS, "threshold": 10.0}, suggested=results["suggested"])
+        ReportData(settings={**SETTINGS, "threshold": 10.0}, suggested=results["suggested"])
     with pytest.raises(ReportError, match="needs the setting"):
-        Snapshot(
+        ReportData(
             settings=dict(harmonic=1, n_modes=20, dof="z", coupling="6dof"), band=results["band"]
         )
 
@@ -221,10 +221,10 @@ def test_snapshot_refuses_results_that_do_not_match(results):
 def test_a_plot_of_a_missing_result_is_a_report_error(results):
     from app.report import figures
 
-    s = Snapshot(settings=SETTINGS, url=URL, truncation=results["truncation"])  # no band
-    with pytest.raises(ReportError, match="holds no scatter band"):
+    s = ReportData(settings=SETTINGS, url=URL, truncation=results["truncation"])  # no band
+    with pytest.raises(ReportError, match="hold no scatter band"):
         figures.draw_band(s)
-    with pytest.raises(ReportError, match="holds no eigenfrequencies"):
+    with pytest.raises(ReportError, match="hold no eigenfrequencies"):
         figures.draw_eigen(s)
 
 

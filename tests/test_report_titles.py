@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 import fbs_core
-from app.report import DataFile, Provenance, ReportError, Snapshot, file_stem, title_block
-from app.report.snapshot import normalise_settings
+from app.report import DataFile, Provenance, ReportData, ReportError, file_stem, title_block
+from app.report.data import normalise_settings
 from app.report.titles import VIEWS, harmonic_description
 
 DATE = dt.datetime(2026, 12, 1, 20, 15, tzinfo=dt.UTC)
@@ -32,10 +32,10 @@ SETTINGS = dict(
 )
 
 
-def snap(**kw) -> Snapshot:
+def snap(**kw) -> ReportData:
     kw.setdefault("settings", SETTINGS)
     kw.setdefault("created", DATE)
-    return Snapshot(**kw)
+    return ReportData(**kw)
 
 
 # wavelengths of thesis table 5.1 / fig. 4.4 and the band f = v / lambda at 30 and 120 km/h
@@ -140,7 +140,7 @@ def test_settings_validation(change, message):
 
 def test_snapshot_validation():
     with pytest.raises(ReportError, match="missing setting"):
-        Snapshot(settings={"harmonic": 1})
+        ReportData(settings={"harmonic": 1})
     with pytest.raises(ReportError, match="http"):
         snap(url="javascript:alert(1)")
     with pytest.raises(ReportError, match="quotes"):
@@ -154,7 +154,7 @@ def test_snapshot_validation():
 
 
 def test_help_page_names_the_thesis_equations_and_the_harmonics():
-    text = (Path(__file__).parents[1] / "app" / "report" / "help.md").read_text()
+    text = (Path(__file__).parents[1] / "app" / "page" / "help.md").read_text()
     flat = re.sub(r"\s*\n>?\s*", " ", text)
     assert (
         'J. Rosholm and M. Westers, "Assembly of a tire and a vehicle model to predict '
@@ -170,3 +170,23 @@ def test_help_page_names_the_thesis_equations_and_the_harmonics():
         assert float(lam) == h.wavelength
         assert float(lo) == round(30 / 3.6 / float(lam), 1)
         assert float(hi) == round(120 / 3.6 / float(lam), 1)
+
+
+def test_help_covers_the_analysis_card_residual_compensation_presentation_and_uploads():
+    """Issue 29: the help said nothing of these. Each has a section, and each tab of the
+    Analysis card (the state's own list) and each upload format is named in it."""
+    from app.analysis_state import ANALYSIS_TABS
+
+    text = (Path(__file__).parents[1] / "app" / "page" / "help.md").read_text()
+    heads = re.findall(r"^## (.+)$", text, flags=re.M)
+    for head in ("The Analysis card", "The presentation view", "Uploads"):
+        assert head in heads, head
+    assert "**Residual compensation**" in text
+    card = text.split("## The Analysis card")[1].split("\n## ")[0]
+    for tab in ANALYSIS_TABS:
+        if tab:
+            assert f"**{tab.capitalize()}.**" in card, tab
+    uploads = text.split("## Uploads")[1].split("\n## ")[0]
+    for fmt in ("UFF 58", "MATLAB", "CSV", "HDF5", "100 MiB"):
+        assert fmt in uploads, fmt
+    assert "?view=present" in text and "FBS_PUBLIC_URL" in text

@@ -39,14 +39,17 @@ from server_util import (
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "docker"))
+import fbs_auth  # noqa: E402
 import fbs_server  # noqa: E402
 
 USER, PASSWORD = "reviewer", "Tyre:Chassis-2026-pw"
+OTHER_USER, OTHER_PASSWORD = "colleague", "Second-user-pw-2026"
 SECRET = "cookie-" + "k" * 40
 MAX_FAILURES = 5
 
 # counts its page builds in COUNT_FILE and starts a child per page that lives as long as
-# its parent (reads its stdin until EOF), like the sandbox worker
+# its parent (reads its stdin until EOF), like the sandbox worker; a page asked for with
+# ?exit=1 raises SystemExit while it is built (what importing venv.__main__ did: issue 28)
 APP = """
 import os, subprocess, sys
 from pathlib import Path
@@ -54,6 +57,8 @@ import panel as pn
 
 count = Path(__file__).with_name("builds.txt")
 count.write_text(str(int(count.read_text() or 0) + 1) if count.exists() else "1")
+if pn.state.session_args.get("exit"):
+    raise SystemExit(2)
 subprocess.Popen([sys.executable, "-c", "import sys; sys.stdin.read()"], stdin=subprocess.PIPE)
 pn.Column("# confidential-model-marker", pn.widgets.IntSlider(name="k", value=2)).servable()
 """
@@ -70,11 +75,13 @@ def server(tmp_path_factory):
         tmp_path_factory.mktemp("secapp"),
         APP,
         {
-            "FBS_BASIC_AUTH": f"{USER}:{PASSWORD}",
+            "FBS_BASIC_AUTH": f"{USER}:{PASSWORD},{OTHER_USER}:{OTHER_PASSWORD}",
             "FBS_COOKIE_SECRET": SECRET,
             "FBS_LOGIN_MAX_FAILURES": str(MAX_FAILURES),
-            # clients told apart by X-Real-IP, as behind a reverse proxy
+            # clients told apart by X-Forwarded-For, as behind a reverse proxy: the tests
+            # connect from 127.0.0.1, the trusted proxy
             "FBS_USE_XHEADERS": "true",
+            "FBS_TRUSTED_PROXIES": "127.0.0.1",
         },
     )
     try:
@@ -97,6 +104,35 @@ def test_health_check_answers_without_login_and_builds_no_page(server):
     assert _builds(server) == 1
     status, _, body = get(opener, server.base + "/liveness?endpoint=/nothing%3Cb%3E")
     assert status == 400 and "<b>" not in body and json.loads(body)["endpoints"] == ["/fbsapp"]
+
+
+def test_the_port_opens_before_the_app_is_proved(tmp_path):
+    """Issue 33: the server listens within seconds; the app's proof (one page built, the
+    server's warm-up) runs after, and ``/liveness?endpoint=`` says so until it is done."""
+    gate = tmp_path / "gate"
+    app = (
+        "import pathlib, time\n"
+        f"gate = pathlib.Path({str(gate)!r})\n"
+        "t0 = time.monotonic()\n"
+        "while not gate.exists() and time.monotonic() - t0 < 300:\n"
+        "    time.sleep(0.05)\n"
+        "import panel as pn\n"
+        "pn.pane.Markdown('slow app').servable()\n"
+    )
+    srv = Server(tmp_path, app, {}, name="slowapp")
+    try:
+        srv.listening(120)  # with the proof held at its gate
+        opener = urllib.request.build_opener(NoRedirect)
+        status, _, body = get(opener, srv.base + "/liveness?endpoint=/slowapp")
+        assert status == 503 and json.loads(body) == {"/slowapp": False}
+        status, _, body = get(opener, srv.base + "/liveness?endpoint=/other")
+        assert status == 400 and json.loads(body)["endpoints"] == ["/slowapp"]
+        gate.write_text("open")
+        srv.started(120)
+        status, _, body = get(opener, srv.base + "/liveness?endpoint=/slowapp")
+        assert status == 200 and json.loads(body) == {"/slowapp": True}
+    finally:
+        srv.stop()
 
 
 def test_an_app_that_cannot_build_a_page_stops_the_server(tmp_path):
@@ -150,28 +186,36 @@ def _signed(secret: str, name: str, value: str) -> str:
     return create_signed_value(secret, name, value).decode()
 
 
+def _login_cookies(secret: str = SECRET, user: str = USER, password: str = PASSWORD) -> str:
+    """Both login cookies as the server sets them, made here with the secret."""
+    token = fbs_auth.login_token(secret, user, password)
+    return f"user={_signed(secret, 'user', user)}; fbs_login={_signed(secret, 'fbs_login', token)}"
+
+
 def _page_with_cookie(server, cookie: str):
     opener = urllib.request.build_opener(NoRedirect)
     return get(opener, server.base + "/fbsapp", headers={"Cookie": cookie})
 
 
 def test_a_cookie_signed_with_another_secret_gives_no_access(server):
-    # control: a cookie signed with the server's secret is accepted (the forging is right)
-    good = f"user={_signed(SECRET, 'user', USER)}"
+    # control: cookies signed with the server's secret are accepted (the forging is right)
+    good = _login_cookies()
     status, _, body = _page_with_cookie(server, good)
     assert status == 200 and "render_items" in body
     token = re.search(r'"token":\s*"([^"]+)"', body).group(1)
     first, document = run_async(websocket_session(server.port, "fbsapp", good, token))
     assert first == "ACK" and "confidential-model-marker" in document
 
-    wrong_secret = f"user={_signed('x' * 40, 'user', USER)}"
+    wrong_secret = _login_cookies("x" * 40)
     # a signature made for one user, the value of another
     b64 = base64.b64encode(USER.encode()).decode()
     other = base64.b64encode(b"admin").decode()
     tampered = good.replace(f"{len(b64)}:{b64}", f"{len(other)}:{other}")
     assert tampered != good
     unsigned = f"user={USER}"
-    for cookie in (wrong_secret, tampered, unsigned):
+    # Panel's user cookie alone (a cookie of before issue 28): not a login here
+    user_only = f"user={_signed(SECRET, 'user', USER)}"
+    for cookie in (wrong_secret, tampered, unsigned, user_only):
         status, headers, body = _page_with_cookie(server, cookie)
         assert status == 302 and "login" in headers["Location"], cookie
         assert "render_items" not in body and "confidential-model-marker" not in body
@@ -180,7 +224,7 @@ def test_a_cookie_signed_with_another_secret_gives_no_access(server):
 
 
 def test_a_websocket_from_another_origin_is_refused(server):
-    good = f"user={_signed(SECRET, 'user', USER)}"
+    good = _login_cookies()
     _, _, body = _page_with_cookie(server, good)
     token = re.search(r'"token":\s*"([^"]+)"', body).group(1)
     with pytest.raises(Exception, match="403"):
@@ -194,14 +238,12 @@ def test_a_websocket_from_another_origin_is_refused(server):
 # ---- login flooding ----------------------------------------------------------------------
 
 
-def _login(server, client_ip: str, username: str, password: str):
-    """(status, headers, seconds) of a login POST from ``client_ip``."""
+def _login(server, client_ip: str, username: str, password: str, header="X-Forwarded-For"):
+    """(status, headers, seconds) of a login POST from ``client_ip`` (as the proxy says)."""
     opener = urllib.request.build_opener(NoRedirect)
     data = urllib.parse.urlencode({"username": username, "password": password}).encode()
     t0 = time.monotonic()
-    status, headers, _ = get(
-        opener, server.base + "/login", data=data, headers={"X-Real-IP": client_ip}
-    )
+    status, headers, _ = get(opener, server.base + "/login", data=data, headers={header: client_ip})
     return status, headers, time.monotonic() - t0
 
 
@@ -214,17 +256,19 @@ def test_wrong_logins_are_logged_slowed_and_then_refused(server):
         held.append(seconds)
     # the 4th and later wrong answers are held (0.5 s, 1 s, ...): a lower bound, safe on a
     # busy machine
-    for k in range(fbs_server.LOGIN_FREE_FAILURES + 1, MAX_FAILURES + 1):
-        assert held[k - 1] >= fbs_server.LoginThrottle.delay(k) * 0.95, held
+    for k in range(fbs_auth.LOGIN_FREE_FAILURES + 1, MAX_FAILURES + 1):
+        assert held[k - 1] >= fbs_auth.LoginThrottle.delay(k) * 0.95, held
     # now refused, even with the right password (which is not checked)
     status, headers, _ = _login(server, attacker, USER, PASSWORD)
     assert status == 429 and int(headers["Retry-After"]) > 0
-    # another client is not locked out
+    # another client is not locked out, nor another user of the same address (a NAT)
     status, headers, _ = _login(server, other, USER, PASSWORD)
+    assert status == 302 and "error" not in headers["Location"]
+    status, headers, _ = _login(server, attacker, OTHER_USER, OTHER_PASSWORD)
     assert status == 302 and "error" not in headers["Location"]
     log = server.log()
     assert f"failed login: user {USER!r} from {attacker} ({MAX_FAILURES} failures" in log
-    assert f"login refused: client {attacker}" in log
+    assert f"login refused: client {attacker}, user {USER!r}" in log
     assert "guess-" not in log and PASSWORD not in log  # passwords are never logged
 
 
@@ -245,34 +289,90 @@ class _Clock:
         return self.t
 
 
-def test_throttle_window_and_clients():
+def test_throttle_window_pairs_and_clients():
     clock = _Clock()
-    throttle = fbs_server.LoginThrottle(max_failures=3, window_s=60.0, clock=clock)
-    assert throttle.failed("a") == 1  # t = 1000
+    throttle = fbs_auth.LoginThrottle(max_failures=3, window_s=60.0, clock=clock)
+    assert throttle.failed("a", "u") == 1  # t = 1000
     clock.t += 5
-    assert throttle.failed("a") == 2  # t = 1005
-    assert throttle.retry_after("a") == 0.0
+    assert throttle.failed("a", "u") == 2  # t = 1005
+    assert throttle.retry_after("a", "u") == 0.0
     clock.t += 5
-    assert throttle.failed("a") == 3  # t = 1010: locked until the first ages out (1060)
-    assert throttle.retry_after("a") == pytest.approx(50.0)
-    assert throttle.retry_after("b") == 0.0
+    assert throttle.failed("a", "u") == 3  # t = 1010: locked until the first ages out (1060)
+    assert throttle.retry_after("a", "u") == pytest.approx(50.0)
+    # neither another client nor another user of the same client is locked
+    assert throttle.retry_after("b", "u") == 0.0 and throttle.retry_after("a", "v") == 0.0
     clock.t += 50.0  # t = 1060: the first failure aged out
-    assert throttle.retry_after("a") == 0.0 and throttle.failed("a") == 3
-    throttle.succeeded("a")
-    assert throttle.failed("a") == 1
-    delays = [fbs_server.LoginThrottle.delay(k) for k in range(1, 10)]
+    assert throttle.retry_after("a", "u") == 0.0 and throttle.failed("a", "u") == 3
+    throttle.succeeded("a", "u")
+    assert throttle.failed("a", "u") == 1
+    delays = [fbs_auth.LoginThrottle.delay(k) for k in range(1, 10)]
     assert delays == [0, 0, 0, 0.5, 1, 2, 4, 8, 8]
     with pytest.raises(ValueError, match="max_failures"):
-        fbs_server.LoginThrottle(max_failures=0)
+        fbs_auth.LoginThrottle(max_failures=0)
+    with pytest.raises(ValueError, match="global_failures"):
+        fbs_auth.LoginThrottle(global_failures=0)
 
 
-def test_throttle_forgets_the_oldest_clients_beyond_its_size(monkeypatch):
-    monkeypatch.setattr(fbs_server, "LOGIN_MAX_CLIENTS", 3)
-    throttle = fbs_server.LoginThrottle(max_failures=1)
+def test_throttle_across_all_clients_refuses_only_clients_that_failed():
+    clock = _Clock()
+    throttle = fbs_auth.LoginThrottle(
+        max_failures=10, window_s=60.0, global_failures=20, clock=clock
+    )
+    # many addresses guessing, each below its own limit
+    for k in range(20):
+        for _ in range(fbs_auth.LOGIN_FREE_FAILURES):
+            throttle.failed(f"10.0.0.{k}", f"user{k}")
+    # a guessing address is refused at once, with any user name ...
+    assert throttle.retry_after("10.0.0.3", "someone-else") > 0
+    # ... a client without failures is not (a colleague behind the same NAT logs in)
+    assert throttle.retry_after("10.0.1.1", "user3") == 0.0
+    clock.t += 61  # the failures age out
+    assert throttle.retry_after("10.0.0.3", "someone-else") == 0.0
+
+
+def test_throttle_forgets_the_oldest_pairs_beyond_its_size(monkeypatch):
+    monkeypatch.setattr(fbs_auth, "LOGIN_MAX_CLIENTS", 3)
+    throttle = fbs_auth.LoginThrottle(max_failures=1)
     for client in "abcd":
-        throttle.failed(client)
-    assert throttle.retry_after("a") == 0.0  # dropped
-    assert all(throttle.retry_after(c) > 0 for c in "bcd")
+        throttle.failed(client, "u")
+    assert throttle.retry_after("a", "u") == 0.0  # dropped
+    assert all(throttle.retry_after(c, "u") > 0 for c in "bcd")
+
+
+class _Headers(dict):
+    def get_list(self, name):
+        v = self.get(name)
+        return [] if v is None else [v]
+
+
+@pytest.mark.parametrize(
+    ("peer", "headers", "client"),
+    [
+        # directly connected: the headers are the client's own claim, never believed
+        ("203.0.113.9", {"X-Forwarded-For": "10.1.1.1", "X-Real-Ip": "10.1.1.2"}, "203.0.113.9"),
+        # from the trusted proxy: the address it appended (the last hop)
+        ("127.0.0.1", {"X-Forwarded-For": "10.1.1.1"}, "10.1.1.1"),
+        # a client's own X-Forwarded-For before the proxy's entry is not believed
+        ("127.0.0.1", {"X-Forwarded-For": "6.6.6.6, 10.1.1.1"}, "10.1.1.1"),
+        # two trusted proxies in a row: the first untrusted hop from the right
+        ("127.0.0.1", {"X-Forwarded-For": "10.1.1.1, 172.18.0.5"}, "10.1.1.1"),
+        # no X-Forwarded-For: X-Real-IP of the proxy
+        ("127.0.0.1", {"X-Real-Ip": "10.1.1.3"}, "10.1.1.3"),
+        # garbage where the proxy writes: the proxy itself
+        ("127.0.0.1", {"X-Forwarded-For": "not-an-address"}, "127.0.0.1"),
+        ("127.0.0.1", {}, "127.0.0.1"),
+    ],
+)
+def test_client_address_believes_forwarding_headers_only_from_trusted_proxies(
+    peer, headers, client
+):
+    proxies = fbs_auth.parse_networks("127.0.0.1, 172.18.0.0/16")
+    assert fbs_auth.client_address(peer, _Headers(headers), proxies) == client
+
+
+def test_trusted_proxies_are_checked():
+    with pytest.raises(ValueError, match="'proxy.example'"):
+        fbs_auth.parse_networks("10.0.0.1, proxy.example")
 
 
 def test_check_password(tmp_path):
@@ -286,3 +386,99 @@ def test_check_password(tmp_path):
         assert not fbs_server.check_password(source, "alice", "")
         assert not fbs_server.check_password(source, "carol", "pw-1")
         assert not fbs_server.check_password(source, "carol", "\0pw-1")
+
+
+# ---- issue 28: what a request may not do ---------------------------------------------------
+
+
+def _form_login(base: str, user: str, password: str) -> str:
+    import http.cookiejar
+
+    jar = http.cookiejar.CookieJar()
+    opener = urllib.request.build_opener(NoRedirect, urllib.request.HTTPCookieProcessor(jar))
+    data = urllib.parse.urlencode({"username": user, "password": password}).encode()
+    assert get(opener, base + "/login", data=data)[0] == 302
+    return "; ".join(f"{c.name}={c.value}" for c in jar)
+
+
+def _logged_in(base: str, cookie: str) -> bool:
+    status, _, body = get(
+        urllib.request.build_opener(NoRedirect), base + "/fbsapp", headers={"Cookie": cookie}
+    )
+    return status == 200 and "render_items" in body
+
+
+def test_a_page_that_raises_system_exit_does_not_end_the_server(server):
+    cookie = _login_cookies()
+    req = urllib.request.Request(server.base + "/fbsapp?exit=1", headers={"Cookie": cookie})
+    log0 = len(server.log())
+    try:  # the request itself gets no page (its handler ended): cut it short
+        urllib.request.build_opener(NoRedirect).open(req, timeout=5).read()
+    except OSError:
+        pass
+    wait_for(lambda: "SystemExit escaped" in server.log()[log0:], 60, what="the log line")
+    assert server.alive(), server.log()[-2000:]
+    assert _logged_in(server.base, cookie)  # and it serves the next page
+
+
+def test_logout_revokes_the_login_cookie(server):
+    cookie = _form_login(server.base, OTHER_USER, OTHER_PASSWORD)
+    assert _logged_in(server.base, cookie)
+    opener = urllib.request.build_opener(NoRedirect)
+    assert get(opener, server.base + "/logout", headers={"Cookie": cookie})[0] == 200
+    # the same cookie, kept (stolen) after the logout, is no login any more
+    assert not _logged_in(server.base, cookie)
+    with pytest.raises(Exception, match="403"):
+        run_async(websocket_session(server.port, "fbsapp", cookie))
+    # a new login works
+    assert _logged_in(server.base, _form_login(server.base, OTHER_USER, OTHER_PASSWORD))
+
+
+@pytest.fixture(scope="module")
+def direct_server(tmp_path_factory):
+    """Behind a proxy that is not the tests' address: the tests connect directly, and the
+    login comes from a users file that the tests change."""
+    folder = tmp_path_factory.mktemp("direct")
+    users = folder / "users.json"
+    users.write_text(json.dumps({USER: PASSWORD, OTHER_USER: OTHER_PASSWORD}))
+    srv = Server(
+        folder,
+        "import panel as pn\npn.Column('# confidential-model-marker').servable()\n",
+        {
+            "FBS_BASIC_AUTH_FILE": str(users),
+            "FBS_COOKIE_SECRET": SECRET,
+            "FBS_LOGIN_MAX_FAILURES": str(MAX_FAILURES),
+            "FBS_USE_XHEADERS": "true",
+            "FBS_TRUSTED_PROXIES": "10.255.0.1",
+        },
+    )
+    srv.users = users
+    try:
+        yield srv.started()
+    finally:
+        srv.stop()
+
+
+def test_a_direct_client_cannot_pick_its_address_with_forwarding_headers(direct_server):
+    srv = direct_server
+    statuses = []
+    for k in range(MAX_FAILURES + 2):
+        header = "X-Forwarded-For" if k % 2 else "X-Real-IP"
+        statuses.append(_login(srv, f"10.77.0.{k}", USER, f"guess-{k}", header=header)[0])
+    # every guess counted against the real address: refused after MAX_FAILURES
+    assert statuses[:MAX_FAILURES] == [302] * MAX_FAILURES and statuses[-1] == 429, statuses
+    assert "from 127.0.0.1" in srv.log() and "from 10.77.0." not in srv.log()
+
+
+def test_removing_a_user_or_changing_the_password_revokes_the_cookies(direct_server):
+    srv = direct_server
+    a = _form_login(srv.base, OTHER_USER, OTHER_PASSWORD)
+    assert _logged_in(srv.base, a)
+    # the password changed in the users file: the old cookie is no login
+    srv.users.write_text(json.dumps({USER: PASSWORD, OTHER_USER: OTHER_PASSWORD + "-new"}))
+    assert not _logged_in(srv.base, a)
+    b = _form_login(srv.base, OTHER_USER, OTHER_PASSWORD + "-new")
+    assert _logged_in(srv.base, b)
+    # the user removed
+    srv.users.write_text(json.dumps({USER: PASSWORD}))
+    assert not _logged_in(srv.base, b)

@@ -73,3 +73,51 @@ def test_stop_signal_ends_a_busy_server_promptly(tmp_path, sig):
             import os
 
             os.kill(child, signal.SIGKILL)
+
+
+# a page starts a child in a process group of its own that forks a busy grandchild, as the
+# file-parser sandbox does for a parse (issue 28: SIGTERM during a parse left the parser
+# running for minutes, orphaned)
+GROUP_APP = """
+import subprocess, sys
+from pathlib import Path
+import panel as pn
+
+here = Path(__file__).parent
+CODE = '''
+import os, sys, time
+pid = os.fork()
+if pid == 0:
+    while True:
+        sum(range(10_000))
+open(sys.argv[1], "w").write(str(pid))
+time.sleep(600)
+'''
+ctx = pn.state.curdoc.session_context
+if ctx is not None and ctx.server_context is not None:  # a served page
+    subprocess.Popen(
+        [sys.executable, "-c", CODE, str(here / "grandchild.pid")], start_new_session=True
+    )
+pn.Column("# parsing page").servable()
+"""
+
+
+def test_stop_signal_ends_the_process_group_of_a_child(tmp_path):
+    import os
+
+    srv = Server(tmp_path, GROUP_APP, {}, name="group").started()
+    grandchild = None
+    try:
+        status, _, body = get(urllib.request.build_opener(), srv.base + "/group")
+        assert status == 200 and "render_items" in body
+        pid_file = tmp_path / "grandchild.pid"
+        wait_for(lambda: pid_file.exists() and pid_file.read_text(), 60, what="parser forked")
+        grandchild = int(pid_file.read_text())
+        assert running(grandchild)
+        srv.proc.send_signal(signal.SIGTERM)
+        srv.proc.wait(DOCKER_STOP_GRACE_S)
+        wait_for(lambda: not running(grandchild), 5, what="the forked grandchild ended")
+    finally:
+        srv.stop()
+        if grandchild is not None and running(grandchild):
+            os.kill(grandchild, signal.SIGKILL)

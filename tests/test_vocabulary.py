@@ -86,3 +86,69 @@ def test_old_couplings_mapping_warns():
     with pytest.warns(DeprecationWarning, match="COUPLED_DOFS"):
         old = prediction.COUPLINGS
     assert old is prediction.COUPLED_DOFS
+
+
+# -- the words are written once: a scan of fbs_core's code (not its docstrings) ------------
+def _code_of_fbs_core():
+    import ast
+    from pathlib import Path
+
+    root = Path(fbs_core.__file__).parent
+    for path in sorted(root.rglob("*.py")):
+        if path.name != "vocabulary.py":
+            yield path.relative_to(root.parent).as_posix(), ast.parse(path.read_text())
+
+
+def _strings(node):
+    import ast
+
+    if isinstance(node, ast.Tuple | ast.List | ast.Set):
+        return tuple(e.value for e in node.elts if isinstance(e, ast.Constant))
+    return ()
+
+
+def test_fbs_core_spells_the_vocabulary_only_in_vocabulary():
+    """Directions, couplings, the dB conversion and the read-only copy are written in
+    fbs_core/vocabulary.py and imported everywhere else in the core."""
+    import ast
+
+    found = []
+    for name, tree in _code_of_fbs_core():
+        for node in ast.walk(tree):
+            words = _strings(node)
+            if {"rx", "ry", "rz"} <= set(words) or set(words) == {"x", "y", "z"}:
+                found.append(f"{name}:{node.lineno} directions (vocabulary.DIRECTIONS)")
+            if {"6dof", "5dof"} <= set(words):
+                found.append(f"{name}:{node.lineno} couplings (vocabulary.COUPLINGS)")
+            if (
+                isinstance(node, ast.BinOp)
+                and isinstance(node.op, ast.Mult)
+                and any(
+                    isinstance(s, ast.Constant) and s.value == 20 for s in (node.left, node.right)
+                )
+                and "log10" in ast.unparse(node)
+            ):
+                found.append(f"{name}:{node.lineno} dB (vocabulary.magnitude_db)")
+            if isinstance(node, ast.FunctionDef):
+                body = ast.unparse(node)
+                if "setflags(write=False)" in body and "copy=True" in body:
+                    found.append(f"{name}:{node.lineno} read-only copy (vocabulary.readonly)")
+    assert found == []
+
+
+def test_couplings_and_directions_agree_everywhere():
+    from fbs_core.studies._models import coupled_directions
+    from fbs_core.units import input_kind, output_kind
+
+    assert vocabulary.COUPLINGS == tuple(vocabulary.COUPLED_DIRECTIONS) == ("6dof", "5dof")
+    for c, dirs in vocabulary.COUPLED_DIRECTIONS.items():
+        assert coupled_directions(c) == dirs
+        assert fbs_core.prediction.coupled_dofs(c) == tuple(f"hub:{d}" for d in dirs)
+    # the free-rolling wheel releases its spin about the axle (y, ISO 8855) only
+    assert set(vocabulary.DIRECTIONS) - set(vocabulary.COUPLED_DIRECTIONS["5dof"]) == {"ry"}
+    assert vocabulary.TRANSLATIONS + vocabulary.ROTATIONS == vocabulary.DIRECTIONS
+    for d in vocabulary.DIRECTIONS:
+        rot = d in vocabulary.ROTATIONS
+        assert output_kind(f"n:{d}") == ("rotation" if rot else "translation")
+        assert input_kind(f"n:{d}") == ("moment" if rot else "force")
+    assert fbs_core.dofs.DIRECTIONS is vocabulary.DIRECTIONS

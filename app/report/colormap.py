@@ -19,7 +19,7 @@ import contourpy
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .snapshot import ReportError
+from .data import ReportError
 
 if TYPE_CHECKING:
     from bokeh.models import LinearColorMapper

@@ -1,6 +1,6 @@
 """The content of a report, independent of its format (HTML and PDF render the same blocks).
 
-:func:`report_content` turns a :class:`~app.report.snapshot.Snapshot` into sections of
+:func:`report_content` turns a :class:`~app.report.data.ReportData` into sections of
 title blocks, figures and tables whose numbers are formatted once here, so the HTML file and
 the PDF hold the same text.
 """
@@ -16,12 +16,12 @@ from numpy.typing import ArrayLike
 
 import fbs_core
 from fbs_core.harmonics import Harmonic
-from fbs_core.vocabulary import fraction, percent
-from fbs_core.vocabulary import magnitude_db as level_db  # the dashboard's dB conversion
+from fbs_core.vocabulary import magnitude_db, percent
 
 from . import figures
+from .data import SETTING_KEYS, ExtraSection, ReportData, ReportError, present
 from .method import EQUATIONS, METHOD_PARAGRAPHS, THESIS, Equation
-from .snapshot import SETTING_KEYS, ExtraSection, ReportError, Snapshot, present
+from .summary import Summary, report_summary, suggested_n
 from .titles import (
     TitleBlock,
     coupling_description,
@@ -36,7 +36,6 @@ __all__ = [
     "Section",
     "Report",
     "report_content",
-    "level_db",
     "plot_file",
 ]
 
@@ -73,6 +72,8 @@ class Section:
     figure: FigureBlock | None
     tables: tuple[Table, ...]
     title: TitleBlock | None = None
+    #: Tables printed last, after every plot (a row per N, per speed, a view's settings).
+    long_tables: tuple[Table, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -84,6 +85,7 @@ class Report:
     title_block: TitleBlock
     url: str
     reproduce_note: str
+    summary: Summary
     provenance: Table
     settings: Table
     sections: tuple[Section, ...]
@@ -98,7 +100,7 @@ def _fixed(x: SupportsFloat, digits: int) -> str:
     return f"{v + 0.0:.{digits}f}"
 
 
-def _db(x: SupportsFloat) -> str:
+def _db_text(x: SupportsFloat) -> str:
     return f"{_fixed(x, 2)} dB"
 
 
@@ -120,14 +122,14 @@ def _setting_text(name: str, value: object) -> str:
     return str(value)
 
 
-def _settings_table(snap: Snapshot) -> Table:
+def _settings_table(snap: ReportData) -> Table:
     rows = tuple(
         (name, SETTING_KEYS[name][1], _setting_text(name, v)) for name, v in snap.settings.items()
     )
     return Table("Settings of the page", ("setting", "meaning", "value"), rows)
 
 
-def _provenance_table(snap: Snapshot) -> Table:
+def _provenance_table(snap: ReportData) -> Table:
     p = snap.provenance
     rows = []
     for d in (p.tire, p.chassis):
@@ -145,21 +147,22 @@ def _provenance_table(snap: Snapshot) -> Table:
 
 
 def _peak_row(label: str, freq: np.ndarray, v: ArrayLike, h: Harmonic) -> tuple[str, ...]:
-    lv = level_db(v)
+    lv = magnitude_db(v)
     i = int(np.argmax(lv))
-    return (label, _db(lv[i]), _hz(freq[i]), f"{h.speed_at(freq[i]):.1f} km/h")
+    return (label, _db_text(lv[i]), _hz(freq[i]), f"{h.speed_at(freq[i]):.1f} km/h")
 
 
-def _coupled_section(snap: Snapshot) -> Section:
+def _coupled_section(snap: ReportData) -> Section:
     dof = snap.response_dof
     s, h = snap.settings, snap.harmonic
     rows = []
-    ref = snap.reference.sel(outputs=dof, inputs="patch") if snap.reference else None
-    tr = snap.truncated.sel(outputs=dof, inputs="patch") if snap.truncated else None
+    ref = snap.reference.sel(outputs=dof) if snap.reference else None
+    tr = snap.truncated.sel(outputs=dof) if snap.truncated else None
     if ref is not None:
         rows.append(_peak_row("all tire modes", ref.freq, ref.data[:, 0, 0], h))
+    res = " + residual" if s.get("residual") else ""
     if tr is not None:
-        rows.append(_peak_row(f"N = {s['n_modes']} modes", tr.freq, tr.data[:, 0, 0], h))
+        rows.append(_peak_row(f"N = {s['n_modes']} modes{res}", tr.freq, tr.data[:, 0, 0], h))
     tables = [
         Table(
             f"Peak level at {dof} ({figures.level_unit(dof)})",
@@ -168,17 +171,17 @@ def _coupled_section(snap: Snapshot) -> Section:
         )
     ]
     if ref is not None and tr is not None and np.array_equal(ref.freq, tr.freq):
-        lr, lt = level_db(ref.data[:, 0, 0]), level_db(tr.data[:, 0, 0])
+        lr, lt = magnitude_db(ref.data[:, 0, 0]), magnitude_db(tr.data[:, 0, 0])
         i = int(np.argmax(lr))
         d = lt - lr
         j = int(np.argmax(np.abs(d)))
         tables.append(
             Table(
-                f"N = {s['n_modes']} against all modes",
+                f"N = {s['n_modes']}{res} against all modes",
                 ("quantity", "value", "at frequency"),
                 (
-                    ("level difference at the reference peak", _db(d[i]), _hz(ref.freq[i])),
-                    ("largest level difference", _db(d[j]), _hz(ref.freq[j])),
+                    ("level difference at the reference peak", _db_text(d[i]), _hz(ref.freq[i])),
+                    ("largest level difference", _db_text(d[j]), _hz(ref.freq[j])),
                 ),
             )
         )
@@ -188,20 +191,25 @@ def _coupled_section(snap: Snapshot) -> Section:
         figures.draw_coupled(snap),
         stem=file_stem(snap, "coupled-response"),
     )
+    comp = (
+        " and the quasi-static part of the modes left out (residual compensation)"
+        if s.get("residual")
+        else ""
+    )
     para = (
         f"Velocity v_e* at {dof} per metre of road amplitude along the harmonic's speed line "
         f"(eq. 4.1, {coupling_description(s['coupling'])}), with all tire modes and with the "
-        f"first {s['n_modes']} modes.",
+        f"first {s['n_modes']} modes{comp}.",
     )
     return Section("coupled-response", "Coupled response", para, fig, tuple(tables))
 
 
-def _truncation_section(snap: Snapshot) -> Section:
+def _truncation_section(snap: ReportData) -> Section:
     m, s = present(snap.truncation, "truncation map"), snap.settings
     dof = snap.map_dof
     err = percent(m.max_error if dof is None else m.dof_error(dof))
     thr, fmax = s["threshold"], s["f_max"]
-    n_sugg = int(m.suggest(fraction(thr), fmax, dof))
+    n_sugg = present(suggested_n(snap), "suggested N")
     sel = m.centres <= fmax + 1e-9
     rows = []
     for i, n in enumerate(m.n_modes):
@@ -216,9 +224,10 @@ def _truncation_section(snap: Snapshot) -> Section:
             (str(int(n)), _pct(worst), _hz(at), mark, ", ".join(notes)),
         )
     what = f"{dof}" if dof else "the maximum over the 6 bushing DOFs"
+    comp = " (with residual compensation)" if s.get("residual") else ""
     para = (
         f"Floating-band error of eq. 5.1 ({m.width:g} Hz band, {m.step:g} Hz steps) of "
-        f"{what} for N retained modes against all {m.n_modes_total} modes. Blue: below the "
+        f"{what} for N retained modes{comp} against all {m.n_modes_total} modes. Blue: below the "
         f"{thr:g} % threshold (darker is larger); red, hatched: at or above it; black line: "
         f"the {thr:g} % contour. Suggested N = {n_sugg}: the smallest N from which the error "
         f"stays below {thr:g} % at all centres up to {fmax:g} Hz (thesis table 5.1).",
@@ -235,10 +244,10 @@ def _truncation_section(snap: Snapshot) -> Section:
         aspect=0.62,
         stem=file_stem(snap, "truncation-map"),
     )
-    return Section("truncation-map", "Truncation error map", para, fig, (table,))
+    return Section("truncation-map", "Truncation error map", para, fig, (), long_tables=(table,))
 
 
-def _suggested_section(snap: Snapshot) -> Section:
+def _suggested_section(snap: ReportData) -> Section:
     sm = present(snap.suggested, "suggested modes")
     rows = []
     for k, n, ef, (lo, hi) in zip(
@@ -253,10 +262,11 @@ def _suggested_section(snap: Snapshot) -> Section:
             )
         )
     what = sm.dof or "maximum over the 6 bushing DOFs"
+    comp = ", N modes with residual compensation" if snap.settings.get("residual") else ""
     para = (
         f"Smallest N from which the eq. 5.1 error stays below {percent(sm.threshold):g} % at all "
-        f"centres up to {sm.f_max:g} Hz ({what}), and the highest eigenfrequency among those "
-        f"modes at {sm.speed:g} km/h (thesis table 5.1).",
+        f"centres up to {sm.f_max:g} Hz ({what}{comp}), and the highest eigenfrequency among "
+        f"those modes at {sm.speed:g} km/h (thesis table 5.1).",
     )
     table = Table(
         "Suggested number of modes",
@@ -267,33 +277,33 @@ def _suggested_section(snap: Snapshot) -> Section:
     return Section("suggested-modes", "Suggested number of modes", para, None, (table,), tb)
 
 
-def _band_section(snap: Snapshot) -> Section:
+def _band_section(snap: ReportData) -> Section:
     b, s = present(snap.band, "scatter band"), snap.settings
     dof = snap.response_dof
     j = b.dofs.index(dof)
     w = s["percentile"]
     q = [float(x) for x in b.q]
     lo, hi = (100 - w) / 2, (100 + w) / 2
-    ref = level_db(b.reference[:, j])
+    ref = magnitude_db(b.reference[:, j])
     i = int(np.argmax(ref))
-    rnd = level_db(b.round(s["single_round"])[:, j])
-    width = level_db(b.maximum[:, j]) - level_db(b.minimum[:, j])
+    rnd = magnitude_db(b.round(s["single_round"])[:, j])
+    width = magnitude_db(b.maximum[:, j]) - magnitude_db(b.minimum[:, j])
     k = int(np.argmax(width))
     conv = np.asarray(b.convergence.step_change_db, float)
     f_i = _hz(b.freq[i])
     rows = (
-        ("unpolluted reference", _db(ref[i])),
-        ("minimum over the rounds", _db(level_db(b.minimum[i, j]))),
-        ("maximum over the rounds", _db(level_db(b.maximum[i, j]))),
-        (f"{lo:g} % percentile", _db(level_db(b.percentiles[q.index(lo), i, j]))),
-        (f"{hi:g} % percentile", _db(level_db(b.percentiles[q.index(hi), i, j]))),
-        (f"round #{s['single_round']}", _db(rnd[i])),
+        ("unpolluted reference", _db_text(ref[i])),
+        ("minimum over the rounds", _db_text(magnitude_db(b.minimum[i, j]))),
+        ("maximum over the rounds", _db_text(magnitude_db(b.maximum[i, j]))),
+        (f"{lo:g} % percentile", _db_text(magnitude_db(b.percentiles[q.index(lo), i, j]))),
+        (f"{hi:g} % percentile", _db_text(magnitude_db(b.percentiles[q.index(hi), i, j]))),
+        (f"round #{s['single_round']}", _db_text(rnd[i])),
     )
     extra = (
-        ("widest corridor (max - min)", _db(width[k]), _hz(b.freq[k])),
+        ("widest corridor (max - min)", _db_text(width[k]), _hz(b.freq[k])),
         (
             "last change of a band edge",
-            _db(conv[-1]) if conv.size else "-",
+            _db_text(conv[-1]) if conv.size else "-",
             f"rounds {int(b.convergence.rounds[-2]):,} to {int(b.convergence.rounds[-1]):,}"
             if conv.size
             else "",
@@ -320,7 +330,7 @@ def _band_section(snap: Snapshot) -> Section:
     return Section("scatter-band", "Noise scatter band", para, fig, tables)
 
 
-def _eigen_section(snap: Snapshot) -> Section:
+def _eigen_section(snap: ReportData) -> Section:
     e, n = present(snap.eigen, "eigenfrequencies"), snap.settings["n_modes"]
     hit = np.flatnonzero(e.n_modes == n)
     rows = []
@@ -341,26 +351,45 @@ def _eigen_section(snap: Snapshot) -> Section:
     table = Table(
         f"Highest retained eigenfrequency at N = {n}", ("speed", "frequency"), tuple(rows)
     )
-    return Section("eigenfrequency", "Eigenfrequency vs number of modes", para, fig, (table,))
+    return Section(
+        "eigenfrequency", "Eigenfrequency vs number of modes", para, fig, (), long_tables=(table,)
+    )
 
 
-def _extra_section(snap: Snapshot, ex: ExtraSection) -> Section:
-    """A section contributed by another view (:class:`~app.report.snapshot.ExtraSection`)."""
+def _extra_section(snap: ReportData, ex: ExtraSection) -> Section:
+    """A section contributed by another view (:class:`~app.report.data.ExtraSection`)."""
     table = Table(f"{ex.heading}: settings and description", ("item", "value"), ex.rows)
     fig = None
+    draw = None
     if ex.curves and ex.freq is not None:  # curves always come with their frequencies
+        draw = figures.draw_curves(ex.freq, ex.curves, ex.y_label)
+    elif ex.plot is not None:
+        kind = ex.plot["kind"]
+        draw = figures.draw_lines(ex.plot) if kind == "lines" else figures.draw_image(ex.plot)
+    if draw is not None:
         base = title_block(snap, "report")
         tb = TitleBlock(ex.heading, base.lines)
         fig = FigureBlock(
             ex.key,
             tb,
-            figures.draw_curves(ex.freq, ex.curves, ex.y_label),
+            draw,
             stem=f"{file_stem(snap, 'report')}_{re.sub(r'[^A-Za-z0-9._-]', '-', ex.key)}",
         )
-    return Section(ex.key, ex.heading, ex.paragraphs, fig, (table,) if ex.rows else ())
+    if draw is None and ex.strip is not None:  # a mode shape: its frames side by side
+        base = title_block(snap, "report")
+        fig = FigureBlock(
+            ex.key,
+            TitleBlock(ex.heading, base.lines),
+            figures.draw_strip(ex.strip),
+            aspect=0.22,
+            stem=f"{file_stem(snap, 'report')}_{re.sub(r'[^A-Za-z0-9._-]', '-', ex.key)}",
+        )
+    return Section(
+        ex.key, ex.heading, ex.paragraphs, fig, (), long_tables=(table,) if ex.rows else ()
+    )
 
 
-def report_content(snap: Snapshot) -> Report:
+def report_content(snap: ReportData) -> Report:
     """The formatted content of the report of a snapshot (all results it holds)."""
     sections = []
     if snap.reference is not None or snap.truncated is not None:
@@ -385,7 +414,8 @@ def report_content(snap: Snapshot) -> Report:
         )
     title = (
         f"tire-fbs report: {harmonic_description(s['harmonic']).split(':')[0]}, "
-        f"{snap.response_dof}, N = {s['n_modes']}, {s['coupling']}"
+        f"{snap.response_dof}, N = {s['n_modes']}{' + residual' if s.get('residual') else ''}, "
+        f"{s['coupling']}"
     )
     return Report(
         title=title,
@@ -393,6 +423,7 @@ def report_content(snap: Snapshot) -> Report:
         title_block=title_block(snap, "report"),
         url=snap.url,
         reproduce_note=note,
+        summary=report_summary(snap),
         provenance=_provenance_table(snap),
         settings=_settings_table(snap),
         sections=tuple(sections),
@@ -402,7 +433,7 @@ def report_content(snap: Snapshot) -> Report:
     )
 
 
-def plot_file(snap: Snapshot, view: str, fmt: str = "png") -> tuple[str, bytes]:
+def plot_file(snap: ReportData, view: str, fmt: str = "png") -> tuple[str, bytes]:
     """``(file name, bytes)`` of one plot of the report with its title block on top.
 
     ``view`` is one of the report's plots (``coupled-response``, ``truncation-map``,

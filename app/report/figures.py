@@ -27,11 +27,10 @@ from matplotlib.patches import Patch
 from numpy.typing import ArrayLike
 
 from fbs_core.units import frf_unit, output_kind
-from fbs_core.vocabulary import magnitude_db as _db
-from fbs_core.vocabulary import percent
+from fbs_core.vocabulary import magnitude_db, percent
 
 from .colormap import LINE_STYLES, ErrorColorScale, threshold_contour
-from .snapshot import Snapshot, present
+from .data import ReportData, present
 from .titles import TitleBlock
 
 if TYPE_CHECKING:
@@ -50,6 +49,7 @@ __all__ = [
     "draw_band",
     "draw_eigen",
     "draw_curves",
+    "draw_strip",
     "draw_title_block",
     "standalone",
     "render",
@@ -117,7 +117,7 @@ def _labels(ax: Axes, x: str, y: str) -> None:
     ax.set_ylabel(y, fontsize=LABEL_PT)
 
 
-def draw_coupled(snap: Snapshot) -> Draw:
+def draw_coupled(snap: ReportData) -> Draw:
     """Coupled response v_e* (eq. 4.1) in dB: all modes and N modes."""
     dof, n = snap.response_dof, snap.settings["n_modes"]
 
@@ -130,9 +130,9 @@ def draw_coupled(snap: Snapshot) -> Draw:
         ):
             if frf is None:
                 continue
-            sel = frf.sel(outputs=dof, inputs="patch")
+            sel = frf.sel(outputs=dof)
             (ln,) = ax.plot(
-                sel.freq, _db(sel.data[:, 0, 0]), style, color=color, lw=1.6, label=label
+                sel.freq, magnitude_db(sel.data[:, 0, 0]), style, color=color, lw=1.6, label=label
             )
             handles.append(ln)
         _labels(ax, "Frequency (Hz)", f"Level at {dof} ({level_unit(dof)})")
@@ -147,7 +147,7 @@ def _halo_line(ax: Axes, draw: Callable[..., Any], style_key: str, **kw: Any) ->
     return draw(color=color, linestyle=_DASH[dash], linewidth=width, path_effects=effects, **kw)
 
 
-def draw_truncation(snap: Snapshot, n_suggested: int | None = None) -> Draw:
+def draw_truncation(snap: ReportData, n_suggested: int | None = None) -> Draw:
     """Error map (eq. 5.1) with the threshold scale, contour, chosen and suggested N."""
     m, s = present(snap.truncation, "truncation map"), snap.settings
     dof = snap.map_dof
@@ -214,7 +214,7 @@ def _legend_line(key: str, label: str) -> Line2D:
     )  # fmt: skip
 
 
-def draw_band(snap: Snapshot) -> Draw:
+def draw_band(snap: ReportData) -> Draw:
     """Scatter band: min-max corridor, central percentile band, reference, one round."""
     b, s = present(snap.band, "scatter band"), snap.settings
     dof = snap.response_dof
@@ -226,19 +226,30 @@ def draw_band(snap: Snapshot) -> Draw:
     def draw(fig: Figure, rect: Rect) -> None:
         ax = _axes(fig, rect, legend_rows=2)
         f = np.asarray(b.freq, float)
+        low, high = b.percentiles[q.index(lo), :, j], b.percentiles[q.index(hi), :, j]
         h = [
             ax.fill_between(
-                f, _db(b.minimum[:, j]), _db(b.maximum[:, j]), color=COLORS["band"], lw=0,
+                f,
+                magnitude_db(b.minimum[:, j]),
+                magnitude_db(b.maximum[:, j]),
+                color=COLORS["band"],
+                lw=0,
                 label=f"min-max over R = {s['rounds']:,} rounds",
             ),
             ax.fill_between(
-                f, _db(b.percentiles[q.index(lo), :, j]), _db(b.percentiles[q.index(hi), :, j]),
-                color=COLORS["percentile"], lw=0, label=f"{w} % central band ({lo:g}-{hi:g} %)",
+                f,
+                magnitude_db(low),
+                magnitude_db(high),
+                color=COLORS["percentile"],
+                lw=0,
+                label=f"{w} % central band ({lo:g}-{hi:g} %)",
             ),
-        ]  # fmt: skip
-        (r,) = ax.plot(f, _db(b.reference[:, j]), color=COLORS["reference"], lw=1.6)
+        ]
+        (r,) = ax.plot(f, magnitude_db(b.reference[:, j]), color=COLORS["reference"], lw=1.6)
         r.set_label("unpolluted reference")
-        (one,) = ax.plot(f, _db(b.round(s["single_round"])[:, j]), color=COLORS["round"], lw=0.9)
+        (one,) = ax.plot(
+            f, magnitude_db(b.round(s["single_round"])[:, j]), color=COLORS["round"], lw=0.9
+        )
         one.set_label(f"round #{s['single_round']}")
         _labels(ax, "Frequency (Hz)", f"Level at {dof} ({level_unit(dof)})")
         _legend_below(ax, [*h, r, one], rect, ncol=2)
@@ -246,7 +257,7 @@ def draw_band(snap: Snapshot) -> Draw:
     return draw
 
 
-def draw_eigen(snap: Snapshot) -> Draw:
+def draw_eigen(snap: ReportData) -> Draw:
     """Highest retained eigenfrequency versus N at the operating speeds (fig. 5.8)."""
     e, n = present(snap.eigen, "eigenfrequencies"), snap.settings["n_modes"]
 
@@ -280,6 +291,89 @@ def draw_curves(freq: ArrayLike, curves: Mapping[str, ArrayLike], y_label: str) 
             handles.append(ln)
         _labels(ax, "Frequency (Hz)", y_label)
         _legend_below(ax, handles, rect, ncol=min(3, max(1, len(handles))))
+
+    return draw
+
+
+def draw_lines(plot: Mapping[str, Any]) -> Draw:
+    """Groups of lines over one x axis, one colour per group (the Campbell diagram's
+    branches by direction and its order lines); the group ``plot["highlight"]`` thick and
+    red, the group ``plot["muted"]`` dashed grey."""
+    x = np.asarray(plot["x"], float)
+    groups = dict(plot["groups"])
+
+    def draw(fig: Figure, rect: Rect) -> None:
+        ax = _axes(fig, rect, legend_rows=1 + (len(groups) - 1) // 3)
+        handles: list[Any] = []
+        for i, (label, ys) in enumerate(groups.items()):
+            color, lw, style = _CURVE_COLORS[i % len(_CURVE_COLORS)], 0.9, "-"
+            if label == plot.get("highlight"):
+                color, lw = "#c92a2a", 2.6
+            elif label == plot.get("muted"):
+                color, style = "#495057", "--"
+            for k, y in enumerate(ys):
+                (ln,) = ax.plot(x, y, style, color=color, lw=lw, label=label if k == 0 else None)
+                if k == 0:
+                    handles.append(ln)
+        if plot.get("y_max") is not None:
+            ax.set_ylim(0.0, float(plot["y_max"]))
+        _labels(ax, str(plot.get("x_label", "")), str(plot.get("y_label", "")))
+        _legend_below(ax, handles, rect, ncol=min(3, max(1, len(handles))))
+
+    return draw
+
+
+def draw_image(plot: Mapping[str, Any]) -> Draw:
+    """A map ``z (n_x, n_y)`` over two axes with a colour bar (the speed map), and a line
+    over it (the harmonic's line f = v / lambda) when given."""
+    x, y = np.asarray(plot["x"], float), np.asarray(plot["y"], float)
+    z = np.asarray(plot["z"], float)
+
+    def draw(fig: Figure, rect: Rect) -> None:
+        ax = _axes(fig, rect, legend_rows=0, right=1.0)
+        mesh = ax.pcolormesh(x, y, z.T, shading="nearest", cmap="viridis", rasterized=True)
+        if plot.get("line") is not None:
+            lx, ly = plot["line"]
+            ax.plot(lx, ly, "--", color="white", lw=1.6)
+        ax.set_xlim(x.min(), x.max())
+        ax.set_ylim(y.min(), y.max())
+        _labels(ax, str(plot.get("x_label", "")), str(plot.get("y_label", "")))
+        pos, w_in = ax.get_position(), fig.get_figwidth()
+        cax = fig.add_axes((pos.x1 + 0.12 / w_in, pos.y0, 0.15 / w_in, pos.height))
+        bar = fig.colorbar(mesh, cax=cax)
+        bar.set_label(str(plot.get("z_label", "")), fontsize=TICK_PT)
+        bar.ax.tick_params(labelsize=TICK_PT)
+
+    return draw
+
+
+def draw_strip(strip: Mapping[str, Any]) -> Draw:
+    """A mode shape as a static strip: frames of one period side by side, each the
+    deformed centre line over the undeformed one, with one crest of the dominant order
+    (``strip``: ``frames`` as (x, z) pairs, ``rest`` (x, z), ``crest`` (x, z) per frame,
+    ``labels`` per frame)."""
+    frames = list(strip["frames"])
+    rx, rz = (np.asarray(a, float) for a in strip["rest"])
+
+    def draw(fig: Figure, rect: Rect) -> None:
+        left, bottom, width, height = rect
+        n = max(len(frames), 1)
+        w = width / n
+        lim = 1.25 * float(np.max(np.hypot(rx, rz))) if rx.size else 1.0
+        for k, (x, z) in enumerate(frames):
+            ax = fig.add_axes((left + k * w + 0.005, bottom + 0.08 * height, w - 0.01,
+                               0.84 * height))  # fmt: skip
+            ax.plot(np.r_[rx, rx[:1]], np.r_[rz, rz[:1]], "--", color="#adb5bd", lw=0.8)
+            x, z = np.asarray(x, float), np.asarray(z, float)
+            ax.plot(np.r_[x, x[:1]], np.r_[z, z[:1]], "-", color=_CURVE_COLORS[0], lw=1.4)
+            cx, cz = strip["crest"][k]
+            ax.plot([cx], [cz], "o", color="#c2255c", ms=5)
+            ax.set_xlim(-lim, lim)
+            ax.set_ylim(-lim, lim)
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            ax.set_title(str(strip["labels"][k]), fontsize=8)
 
     return draw
 

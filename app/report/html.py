@@ -15,8 +15,8 @@ from matplotlib.figure import Figure
 
 from . import figures
 from .content import Report, Table, report_content
+from .data import ReportData
 from .method import UNITS, Equation
-from .snapshot import Snapshot
 from .titles import TitleBlock
 
 __all__ = ["build_html", "render_html", "CSS"]
@@ -108,8 +108,12 @@ def render_html(rep: Report) -> str:
             f'<p>Reproduce this page: <a href="{_e(rep.url)}" id="reproduce">{_e(rep.url)}</a></p>'
         )
     out.append(f'<p class="note">{_e(rep.reproduce_note)}</p>')
-    out.append(f'<section id="data"><h2>Data in use</h2>{_table(rep.provenance)}</section>')
-    out.append(f'<section id="settings"><h2>Settings</h2>{_table(rep.settings)}</section>')
+    sm = rep.summary
+    out.append('<section id="summary"><h2>Summary</h2>')
+    out.append(_table(Table("The case in numbers", ("quantity", "value"), sm.rows)))
+    if sm.peak_rows:
+        out.append(_table(Table(sm.peak_caption, sm.peak_header, sm.peak_rows)))
+    out.append("</section>")
     for sec in rep.sections:
         out.append(f'<section id="{_e(sec.key)}"><h2>{_e(sec.heading)}</h2>')
         out += [f"<p>{_e(p)}</p>" for p in sec.paragraphs]
@@ -123,6 +127,15 @@ def render_html(rep: Report) -> str:
             )
         out += [_table(t) for t in sec.tables]
         out.append("</section>")
+    out.append('<section id="tables"><h2>Tables</h2>')
+    for sec in rep.sections:
+        if sec.long_tables:
+            out.append(f'<div id="tables-{_e(sec.key)}">')
+            out += [_table(t) for t in sec.long_tables]
+            out.append("</div>")
+    out.append("</section>")
+    out.append(f'<section id="data"><h2>Data in use</h2>{_table(rep.provenance)}</section>')
+    out.append(f'<section id="settings"><h2>Settings</h2>{_table(rep.settings)}</section>')
     out.append('<section id="method"><h2>Method</h2>')
     out += [f"<p>{_e(p)}</p>" for p in rep.method]
     out += [_equation(eq) for eq in rep.equations]
@@ -132,7 +145,7 @@ def render_html(rep: Report) -> str:
     return "\n".join(out)
 
 
-def build_html(snap: Snapshot) -> tuple[str, str]:
+def build_html(snap: ReportData) -> tuple[str, str]:
     """``(file name, HTML text)`` of the report of a snapshot."""
     rep = report_content(snap)
     return f"{rep.stem}.html", render_html(rep)

@@ -17,8 +17,8 @@ from matplotlib.figure import Figure
 
 from . import figures
 from .content import FigureBlock, Report, Table, report_content
+from .data import ReportData
 from .method import UNITS, Equation
-from .snapshot import Snapshot
 from .titles import TitleBlock
 
 __all__ = ["build_pdf", "render_pdf"]
@@ -84,15 +84,23 @@ class _Pages:
         self.text(s, size, weight="bold")
         self.y += 0.04
 
-    def table(self, t: Table, size: float = 8.0) -> None:
+    def table(self, t: Table, size: float = 8.0, wrap: bool = False) -> None:
+        """A table in a monospaced font; ``wrap``: the last column wrapped to the page."""
         cols = len(t.header)
         widths = [max(len(r[i]) for r in (t.header, *t.rows)) for i in range(cols)]
+        chars = int(self.width * 72 / (size * 0.6))  # DejaVu Sans Mono: 0.6 em a glyph
+        last = max(12, chars - sum(widths[:-1]) - 2 * (cols - 1))
+        if wrap:
+            widths[-1] = min(widths[-1], last)
         fmt = "  ".join(f"{{:<{w}}}" for w in widths)
         self.need(size * _LINE * min(4, len(t.rows) + 2))
         self.text(t.caption, size + 0.5, weight="bold")
         self.text(fmt.format(*t.header), size, family="DejaVu Sans Mono", weight="bold")
         for r in t.rows:
-            self.text(fmt.format(*r), size, family="DejaVu Sans Mono")
+            parts = textwrap.wrap(r[-1], widths[-1]) if wrap else [r[-1]]
+            for k, part in enumerate(parts or [""]):
+                cells = (*r[:-1], part) if k == 0 else ("",) * (cols - 1) + (part,)
+                self.text(fmt.format(*cells).rstrip(), size, family="DejaVu Sans Mono")
         self.y += 0.12
 
     def title_block(self, tb: TitleBlock) -> None:
@@ -136,10 +144,11 @@ def render_pdf(rep: Report) -> bytes:
         if rep.url:
             pages.para(f"Reproduce this page: {rep.url}", 8.5)
         pages.para(rep.reproduce_note, 8.5, color="#862e9c")
-        pages.heading("Data in use")
-        pages.table(rep.provenance)
-        pages.heading("Settings")
-        pages.table(rep.settings)
+        sm = rep.summary
+        pages.heading("Summary")
+        pages.table(Table("The case in numbers", ("quantity", "value"), sm.rows), wrap=True)
+        if sm.peak_rows:
+            pages.table(Table(sm.peak_caption, sm.peak_header, sm.peak_rows))
         for sec in rep.sections:
             if sec.figure is not None:
                 pages.page_break()  # a plot's section starts on a new page
@@ -152,6 +161,15 @@ def render_pdf(rep: Report) -> bytes:
                 pages.figure(sec.figure)
             for t in sec.tables:
                 pages.table(t)
+        pages.page_break()  # the long tables last
+        pages.heading("Tables")
+        for sec in rep.sections:
+            for t in sec.long_tables:
+                pages.table(t)
+        pages.heading("Data in use")
+        pages.table(rep.provenance)
+        pages.heading("Settings")
+        pages.table(rep.settings)
         pages.heading("Method")
         for p in rep.method:
             pages.para(p)
@@ -164,7 +182,7 @@ def render_pdf(rep: Report) -> bytes:
     return buf.getvalue()
 
 
-def build_pdf(snap: Snapshot) -> tuple[str, bytes]:
+def build_pdf(snap: ReportData) -> tuple[str, bytes]:
     """``(file name, PDF bytes)`` of the report of a snapshot."""
     rep = report_content(snap)
     return f"{rep.stem}.pdf", render_pdf(rep)

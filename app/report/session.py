@@ -1,67 +1,29 @@
-"""A report snapshot of a dashboard session: its settings, its data and its results.
+"""The report of a dashboard session: its published results, as they are on the page.
 
-Reads the session's :class:`~app.state.DashboardState` (plain values) and takes the results
-from the app's caches (:mod:`app.compute`): the same objects the views show, so the report
-holds what the page showed. The scatter band is passed in (the one on the page) and only kept
-when it was computed for the current settings.
+:func:`report_data` reads the session's store (:class:`app.store.Results`): the snapshot of
+its state and the results published for that very snapshot (the coupled response, the
+error map, the suggested modes, the eigenfrequencies, the scatter band when it is of the
+current settings, and every other result that is current: the tire's quality, the
+uncoupled subsystems while shown, the pins, the shown Analysis tab's results). Nothing is
+computed here: the report holds the numbers the page shows, under the page's settings,
+residual compensation included.
 """
 
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable
 from typing import Any
 
-import numpy as np
+from .data import SETTING_KEYS, DataFile, ExtraSection, Provenance, ReportData, ReportError
 
-import fbs_core
-from fbs_core import studies
-from fbs_core.vocabulary import fraction, percent
+__all__ = ["BUILTIN_RESULTS", "depends", "provenance_of", "report_data", "settings_of"]
 
-from .. import compute
-from .snapshot import DataFile, ExtraSection, Provenance, Snapshot
-
-__all__ = [
-    "settings_of",
-    "provenance_of",
-    "session_snapshot",
-    "band_matches",
-    "store_sections",
-    "BUILTIN_RESULTS",
-]
-
-_DIRS = ("x", "y", "z", "rx", "ry", "rz")
-
-
-def settings_of(state: Any, n_axis: str = "linear") -> dict[str, Any]:
-    """The settings of a ``DashboardState`` as the plain dict of a report snapshot.
-
-    Read through :meth:`app.store.Snapshot.of` (the one place that reads a state's values).
-    """
-    from ..store import Snapshot as StateSnapshot
-
-    return _settings(StateSnapshot.of(state), n_axis)
-
-
-def _settings(st: Any, n_axis: str) -> dict[str, Any]:
-    """The report's settings of an :class:`app.store.Snapshot` of the state."""
-    return dict(
-        harmonic=st.harmonic,
-        n_modes=st.n_modes,
-        dof=str(st.dof),
-        coupling=str(st.coupling),
-        threshold=st.threshold,
-        f_max=st.f_max,
-        map_mode=str(st.map_mode),
-        n_axis=n_axis,
-        noise=st.noise,
-        target=str(st.target),
-        frequency_dependent=st.frequency_dependent,
-        rounds=st.rounds,
-        seed=st.seed,
-        single_round=st.single_round,
-        percentile=st.percentile,
-    )
+#: Results of the store that the report's own sections show; every other current result
+#: (or tuple of them) of the store becomes a section of its own.
+BUILTIN_RESULTS = ("response", "error_map", "suggested", "eigen", "band_curves", "band")
+#: Results that are no section: the pins themselves (their comparison is, ``pinned``).
+NOT_SECTIONS = ("pins",)
 
 
 def _digests(key: str) -> dict[str, str]:
@@ -91,121 +53,115 @@ def provenance_of(models: Any, notes: Iterable[str] = ()) -> Provenance:
     return Provenance(tire=tire, chassis=chassis, notes=tuple(notes))
 
 
-def band_matches(band: Any, settings: Mapping[str, Any], models: Any = None) -> bool:
-    """True when ``band`` (a ScatterBand) was computed for these settings."""
-    if band is None:
-        return False
-    s = settings
-    return bool(
-        band.harmonic == s["harmonic"]
-        and abs(percent(band.noise) - s["noise"]) <= 1e-9 * max(1.0, s["noise"])
-        and band.target == s["target"]
-        and band.frequency_dependent == s["frequency_dependent"]
-        and band.rounds == s["rounds"]
-        and band.seed == s["seed"]
-    )
+def settings_of(s: Any, n_axis: str = "linear") -> dict[str, Any]:
+    """The report's settings of a session snapshot (:class:`app.results.Snapshot`, or any
+    object with its attribute names)."""
+    out = {k: getattr(s, k) for k in SETTING_KEYS if hasattr(s, k)}
+    out["n_axis"] = n_axis
+    if out.get("scope") != "vehicle":  # the car's settings only where they act
+        for k in ("wheels", "tracks", "coherence", "point"):
+            out.pop(k, None)
+    else:
+        out["wheels"] = " ".join(w.upper() for w in out.get("wheels", ())) or "none"
+        if out.get("tracks") != "coherence":
+            out.pop("coherence", None)
+    return out
 
 
-#: Results of the store that the report's own sections show; every other published
-#: ``Result`` (or tuple of them) of the store becomes a section of its own.
-BUILTIN_RESULTS = ("response", "error_map", "suggested", "eigen", "band_curves")
-
-
-def store_sections(store: Any) -> tuple[ExtraSection, ...]:
-    """The sections other views contribute: each published :class:`app.store.Result`
-    parameter of ``store`` beyond :data:`BUILTIN_RESULTS` (and the uncoupled subsystems only
-    while the page shows them), in the store's parameter order.
-
-    A view that wants its result in the report publishes it as a parameter of the store
-    (``param.ClassSelector(class_=Result)``, or a tuple of results, e.g. pinned curves);
-    nothing in :mod:`app.report` needs to change.
-    """
-    from ..store import Result
+def _sections(current: dict[str, Any]) -> tuple[ExtraSection, ...]:
+    """The sections of the current results beyond :data:`BUILTIN_RESULTS`, in the store's
+    table order (a picked point only when one is picked)."""
+    from ..results import Result
 
     out: list[ExtraSection] = []
-    for name in store.param:
-        if name in BUILTIN_RESULTS:
+    for name, value in current.items():
+        if name in BUILTIN_RESULTS or name in NOT_SECTIONS:
             continue
-        if name == "uncoupled" and not store.state.case.show_uncoupled:
+        if name == "pick" and value.draw.get("speed") is None and value.draw.get("freq") is None:
             continue
-        value = getattr(store, name, None)
+        if name == "response_plot" and not _plot_extras(value):
+            continue  # the coupled response as the report shows it already
         if isinstance(value, Result):
             out.append(ExtraSection.of_result(name, value))
-        elif isinstance(value, (tuple, list)) and value:
-            if all(isinstance(v, Result) for v in value):
-                out += [ExtraSection.of_result(f"{name}-{i + 1}", v) for i, v in enumerate(value)]
+        elif isinstance(value, tuple) and all(isinstance(v, Result) for v in value):
+            out += [ExtraSection.of_result(f"{name}-{i + 1}", v) for i, v in enumerate(value)]
     return tuple(out)
 
 
-def _frf(freq: Any, data: Any) -> fbs_core.FRF:
-    return fbs_core.FRF(
-        np.asarray(freq, float),
-        np.asarray(data)[:, :, None],
-        [f"bushing:{d}" for d in _DIRS],
-        ["patch"],
-    )
+def _plot_extras(r: Any) -> bool:
+    """Whether the response plot's result holds more than the coupled response: overlaid
+    DOFs, cursors or the linear level axis (then it is a section of the report)."""
+    d = r.draw
+    return len(d["curves"]) > 2 or bool(d["cursors"]) or d["scale"] != "dB"
 
 
-def session_snapshot(
-    state: Any,
+def depends(store: Any) -> frozenset[str]:
+    """The state fields the session's report depends on now: those its settings table
+    names and those of every result it holds."""
+    from ..store import depends as row_depends
+
+    _, current = store.current(looked_at=True)
+    out = set(SETTING_KEYS) | {"models"}
+    for name in current:
+        out |= row_depends(name)
+    return frozenset(out)
+
+
+def report_data(
+    store: Any,
     *,
     url: str = "",
-    band: Any = None,
-    band_n_modes: int | None = None,
     n_axis: str = "linear",
     notes: Iterable[str] = (),
     created: dt.datetime | None = None,
-    extra: Sequence[ExtraSection] = (),
-) -> Snapshot:
-    """The report snapshot of a session's current state.
+) -> ReportData:
+    """The report of a session's store: its current results, read under its lock.
 
     Parameters
     ----------
-    state : app.state.DashboardState
+    store : app.store.Results
     url : str
         The page URL that reproduces the state.
-    band : fbs_core.ScatterBand, optional
-        The band on the page; kept only if it matches the settings (and ``band_n_modes``,
-        the N it was computed with, equals the chosen N).
     n_axis : {"linear", "log"}
         Scale of the error map's N axis on the page.
     notes : sequence of str
         Import notes of the uploads.
-    extra : sequence of ExtraSection
-        Sections of other views (:func:`store_sections` of the page's store).
-    """
-    from ..store import Snapshot as StateSnapshot
+    created : datetime, optional
+        When the report is made (default now).
 
-    st = StateSnapshot.of(state)
-    s = _settings(st, n_axis)
-    models = st.models
-    k, coupling = s["harmonic"], s["coupling"]
-    m = compute.error_map(k, coupling, models)
-    ref = compute.coupled_response(k, None, coupling, models)
-    tr = compute.coupled_response(k, s["n_modes"], coupling, models)
-    map_dof = None if st.map_dof is None else f"bushing:{st.map_dof}"
-    sugg = studies.suggest_modes(
-        fraction(s["threshold"]),
-        s["f_max"],
-        maps=[compute.error_map(h, coupling, models) for h in range(1, 8)],
-        dof=map_dof,
-        tire=None if models is None else models.tire,
-    )
-    eigen = studies.mode_frequencies(
-        compute.EIGEN_SPEEDS, tire=None if models is None else models.tire
-    )
-    keep = band_matches(band, s, models) and band_n_modes in (None, s["n_modes"])
-    return Snapshot(
-        settings=s,
-        provenance=provenance_of(models, notes),
+    Raises
+    ------
+    ReportError
+        When a result of the page is missing (the session is closed).
+    """
+    s, current = store.current(looked_at=True)
+    outside = dict(getattr(store, "outside", {}))  # views outside the table (a campaign case)
+    # the car's map and suggested N need a coherent road (with a coherence: not reported)
+    needed = ("response", "eigen") if s.vehicle else ("response", "error_map", "suggested", "eigen")
+    missing = [n for n in needed if n not in current]
+    if missing:
+        raise ReportError(f"the page has no current {', '.join(missing)} to report")
+    response, error_map = current["response"], current.get("error_map")
+    suggested = current.get("suggested")
+    band = s.current_band()
+    return ReportData(
+        settings=settings_of(s, n_axis),
+        provenance=provenance_of(s.models, notes),
         url=url,
         created=created or dt.datetime.now(dt.UTC),
-        reference=_frf(m.freq, ref),
-        truncated=_frf(m.freq, tr),
-        truncation=m,
-        suggested=sugg,
-        band=band if keep else None,
-        eigen=eigen,
-        n_modes_total=m.n_modes_total,
-        extra=tuple(extra),
+        reference=response.core["reference"],
+        truncated=response.core["truncated"],
+        truncation=error_map.core["map"] if error_map is not None else None,
+        suggested=suggested.core.get("shown") if suggested is not None else None,
+        band=band.result if band is not None else None,
+        eigen=current["eigen"].core["eigen"],
+        suggested_n=int(error_map.draw["suggested_n"]) if error_map is not None else None,
+        peaks=tuple(response.core.get("peaks", ())),
+        contributions=(
+            current["contributions"].core.get("contributions")
+            # the Contributions tab is the corner's: a car's report has none of its own
+            if "contributions" in current and not s.vehicle
+            else None
+        ),
+        extra=_sections(current) + _sections(outside),
     )

@@ -16,7 +16,7 @@ from typing import Any
 
 import fbs_core
 
-from .snapshot import ReportError, Snapshot
+from .data import ReportData, ReportError
 
 __all__ = [
     "VIEWS",
@@ -44,7 +44,41 @@ VIEWS: dict[str, str] = {
     "phase": "Coupled response: magnitude and phase, peaks and the coupled modes near them",
     "campbell": "Campbell diagram: tire eigenfrequencies vs speed, harmonic order lines",
     "speed-map": "Bushing level over speed and frequency for the harmonic",
+    "wheel-contributions": "Contribution of each wheel's road to the car's response (eq. 4.1)",
+    "participation": "Participation of the tire modes in the bushing response (docs/modes.md)",
+    "mode-shape": "Tire mode shape: the deformed belt over one period",
+    "waves": "Campbell diagram of the belt waves, branches tracked by shape",
+    "selected-modes": "Selected tire modes beside the lowest N (table 5.1)",
+    "chassis-truncation": "Truncation of the chassis side (eq. 5.1, the tire exact)",
 }
+#: What a view shows in vehicle scope, where it differs (the whole car, issue 31).
+_VEHICLE_WHAT = {
+    "coupled-response": "Coupled response of the car v_e* (eq. 4.1, four tires): all tire "
+    "modes and N modes",
+    "scatter-band": "Noise scatter band of the car's v_e* (eqs. 5.2-5.4, noise per wheel and "
+    "on the body)",
+}
+#: Views of one harmonic's tire alone (the harmonic's line only, no case line).
+_TIRE_VIEWS = ("campbell", "mode-shape", "waves")
+#: Views judged by the truncation criterion (the map's DOF, the threshold, no chosen N).
+_CRITERION_VIEWS = ("truncation-map", "suggested-modes", "selected-modes", "chassis-truncation")
+#: Views that do not depend on the chosen N.
+_NO_N_VIEWS = ("suggested-modes", *_TIRE_VIEWS, "participation", "selected-modes",
+               "chassis-truncation")  # fmt: skip
+
+#: The views whose numbers residual compensation changes (their titles and names say it).
+RESIDUAL_VIEWS = (
+    "report",
+    "coupled-response",
+    "truncation-map",
+    "suggested-modes",
+    "compare",
+    "contributions",
+    "phase",
+    "wheel-contributions",
+    "selected-modes",
+    "chassis-truncation",
+)
 
 _NOISE_EQ = {"tire": "5.2", "chassis": "5.3", "both": "5.4"}
 _NOISE_WHERE = {"tire": "the tire", "chassis": "the chassis", "both": "tire and chassis"}
@@ -120,16 +154,41 @@ def noise_description(settings: Mapping[str, Any]) -> str:
     )
 
 
-def _dof_text(snap: Snapshot, view: str) -> str:
+def _dof_text(snap: ReportData, view: str) -> str:
     if view in ("truncation-map", "suggested-modes"):
         d = snap.map_dof
-        return f"DOF {d}" if d is not None else "DOF: maximum over the 6 bushing DOFs"
+        return f"DOF {d}" if d is not None else f"DOF: maximum over the 6 {_node(snap)} DOFs"
     if view == "uncoupled":
         return f"DOF hub:{snap.settings['dof']} (tire) and {snap.response_dof} (chassis)"
     return f"DOF {snap.response_dof}"
 
 
-def _date_text(snap: Snapshot) -> str:
+def _node(snap: ReportData) -> str:
+    """The response node: ``bushing``, or the car's point in vehicle scope."""
+    return str(snap.settings["point"]) if snap.vehicle else "bushing"
+
+
+def vehicle_line(snap: ReportData) -> str | None:
+    """The car's line of a title block in vehicle scope (None in corner scope)."""
+    if not snap.vehicle:
+        return None
+    s = snap.settings
+    tracks = f"coherence {s['coherence']:g}" if s["tracks"] == "coherence" else s["tracks"]
+    return f"Vehicle (reference car): wheels {s['wheels']} | tracks {tracks} | point {s['point']}"
+
+
+def _vehicle_part(snap: ReportData) -> list[str]:
+    """The car's part of a file name: ``car-wFLFRRLRR-inphase``."""
+    if not snap.vehicle:
+        return []
+    s = snap.settings
+    tracks = {"in phase": "inphase", "anti-phase": "antiphase"}.get(
+        s["tracks"], f"coh{_num(s.get('coherence', 0.0))}"
+    )
+    return [f"car-w{s['wheels'].replace(' ', '')}-{tracks}"]
+
+
+def _date_text(snap: ReportData) -> str:
     t = snap.created.astimezone(snap.created.tzinfo)
     return f"{t:%Y-%m-%d %H:%M} {t.tzname() or 'UTC'}"
 
@@ -139,14 +198,15 @@ _PARTS: dict[str, tuple[str, ...]] = {
     "report": ("harmonic", "dof", "modes", "threshold", "coupling", "noise"),
     "coupled-response": ("harmonic", "dof", "modes", "coupling"),
     "truncation-map": ("harmonic", "dof", "chosen", "threshold", "coupling"),
-    "suggested-modes": ("all-harmonics", "dof", "threshold", "coupling"),
+    "suggested-modes": ("all-harmonics", "dof", "threshold", "coupling", "residual"),
     "scatter-band": ("harmonic", "dof", "modes", "coupling", "noise"),
     "eigenfrequency": ("chosen",),
     "uncoupled": ("harmonic", "dof", "modes"),
+    "wheel-contributions": ("harmonic", "dof", "modes", "coupling"),
 }
 
 
-def _part(snap: Snapshot, view: str, part: str) -> str | None:
+def _part(snap: ReportData, view: str, part: str) -> str | None:
     s = snap.settings
     if part == "harmonic":
         return harmonic_description(s["harmonic"])
@@ -154,9 +214,13 @@ def _part(snap: Snapshot, view: str, part: str) -> str | None:
         return "All seven harmonics, 30-120 km/h"
     if part == "dof":
         return _dof_text(snap, view)
+    residual = bool(s.get("residual")) and view in RESIDUAL_VIEWS
     if part in ("modes", "chosen"):
         text = modes_description(s["n_modes"], snap.n_modes_total)
+        text += " + residual compensation" if residual else ""
         return "chosen " + text if part == "chosen" else text
+    if part == "residual":
+        return "with residual compensation" if residual else None
     if part == "coupling":
         return coupling_description(s["coupling"])
     need = ("threshold", "f_max") if part == "threshold" else ("noise", "target", "rounds")
@@ -170,7 +234,7 @@ def _part(snap: Snapshot, view: str, part: str) -> str | None:
     return noise_description(s)
 
 
-def title_block(snap: Snapshot, view: str) -> TitleBlock:
+def title_block(snap: ReportData, view: str) -> TitleBlock:
     """The title block of a view (key of :data:`VIEWS`) for a snapshot.
 
     Lines: the harmonic (wavelength, speeds, band); DOF, N, threshold and coupling in one
@@ -187,6 +251,9 @@ def title_block(snap: Snapshot, view: str) -> TitleBlock:
         raise ReportError(f"unknown view {view!r}; allowed: {', '.join(VIEWS)}")
     parts = {p: _part(snap, view, p) for p in _PARTS[view]}
     lines = [line for p in ("harmonic", "all-harmonics") if p in parts and (line := parts.pop(p))]
+    car = vehicle_line(snap)
+    if car:
+        lines.append(car)
     noise = parts.pop("noise", None)
     case = [v for v in parts.values() if v]
     if case:
@@ -197,9 +264,11 @@ def title_block(snap: Snapshot, view: str) -> TitleBlock:
     lines.append(f"{_date_text(snap)} | tire-fbs {fbs_core.__version__}")
     if snap.url:
         lines.append(snap.url)
-    what = VIEWS[view]
+    what = _VEHICLE_WHAT.get(view, VIEWS[view]) if snap.vehicle else VIEWS[view]
     if view == "truncation-map" and snap.map_dof is None:
-        what = "Truncation error (eq. 5.1), maximum over the 6 bushing DOFs (thesis fig. 5.6)"
+        what = (
+            f"Truncation error (eq. 5.1), maximum over the 6 {_node(snap)} DOFs (thesis fig. 5.6)"
+        )
     return TitleBlock(what, tuple(lines))
 
 
@@ -215,12 +284,18 @@ _SHORT_WHAT = {
     "phase": "Magnitude and phase, peaks",
     "campbell": "Campbell diagram",
     "speed-map": "Bushing level over speed",
+    "wheel-contributions": "Per-wheel contributions (eq. 4.1)",
+    "participation": "Which tire modes matter",
+    "mode-shape": "Tire mode shape",
+    "waves": "Campbell diagram of the belt waves",
+    "selected-modes": "Selected modes beside table 5.1",
+    "chassis-truncation": "Chassis-side truncation, eq. 5.1",
     "report": "tire-fbs",
 }
 _SHORT_COUPLING = {"6dof": "6-DOF hub (braked)", "5dof": "5-DOF hub (spin free)"}
 
 
-def compact_title(snap: Snapshot, view: str) -> TitleBlock:
+def compact_title(snap: ReportData, view: str) -> TitleBlock:
     """The title block of a live plot in short lines (a plot's title does not wrap).
 
     The harmonic (wavelength, speeds, band); DOF, N, threshold, coupling; the noise
@@ -230,28 +305,39 @@ def compact_title(snap: Snapshot, view: str) -> TitleBlock:
         raise ReportError(f"unknown view {view!r}; allowed: {', '.join(VIEWS)}")
     s = snap.settings
     lines = []
-    if view not in ("eigenfrequency", "suggested-modes"):
+    if view in _TIRE_VIEWS:  # the tire across speed: the chosen harmonic's line only
+        lines.append(harmonic_description(s["harmonic"]))
+    elif view not in ("eigenfrequency", "suggested-modes"):
         h = snap.harmonic
         lo, hi = h.freq_range
         lines.append(
             f"Harmonic {h.k}: wavelength {h.wavelength:g} m, {h.speed_range[0]:g}-"
             f"{h.speed_range[1]:g} km/h, {lo:.1f}-{hi:.1f} Hz"
         )
+    car = vehicle_line(snap)
+    if car and view not in ("eigenfrequency", "campbell"):
+        lines.append(car)
     case = []
-    if view != "eigenfrequency":
-        d = snap.map_dof if view in ("truncation-map", "suggested-modes") else snap.response_dof
+    if view not in ("eigenfrequency", *_TIRE_VIEWS):
+        d = snap.map_dof if view in _CRITERION_VIEWS else snap.response_dof
         case.append(d or "max over 6 DOFs")
     total = snap.n_modes_total
     n = f"N = {s['n_modes']}" + (f" of {total}" if total else "")
+    residual = bool(s.get("residual")) and view in RESIDUAL_VIEWS
     if view in ("truncation-map", "eigenfrequency"):
         n = "chosen " + n
-    if view != "suggested-modes":
-        case.append(n)
-    if view in ("truncation-map", "suggested-modes") and "threshold" in s:
+    if view not in _NO_N_VIEWS:
+        case.append(n + (" + residual" if residual else ""))
+    if view in _CRITERION_VIEWS and "threshold" in s:
         case.append(f"threshold {s['threshold']:g} % to {s['f_max']:g} Hz")
-    if view not in ("eigenfrequency", "uncoupled"):
+    if view == "participation" and "f_max" in s:
+        case.append(f"band up to {s['f_max']:g} Hz")
+    if view in ("suggested-modes", "selected-modes", "chassis-truncation") and residual:
+        case.append("with residuals")
+    if view not in ("eigenfrequency", "uncoupled", "campbell", "mode-shape", "waves"):
         case.append(_SHORT_COUPLING[s["coupling"]])
-    lines.append(" | ".join(case))
+    if case:
+        lines.append(" | ".join(case))
     if view == "scatter-band" and "noise" in s:
         how = "every line" if s["frequency_dependent"] else "per round"
         lines.append(
@@ -267,7 +353,10 @@ def compact_title(snap: Snapshot, view: str) -> TitleBlock:
     lines.append(f"Data: {data} | {_date_text(snap)}")
     if snap.url:
         lines.append(snap.url)
-    return TitleBlock(_SHORT_WHAT[view], tuple(lines))
+    what = _SHORT_WHAT[view]
+    if snap.vehicle and view in _VEHICLE_WHAT:
+        what = what.replace("bushing response", "response of the car").replace("v_e*", "car's v_e*")
+    return TitleBlock(what, tuple(lines))
 
 
 def _num(x: float) -> str:
@@ -278,10 +367,11 @@ def _safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9.-]+", "-", text).strip("-.")
 
 
-def file_stem(snap: Snapshot, view: str = "report") -> str:
+def file_stem(snap: ReportData, view: str = "report") -> str:
     """File name without extension that says what a view shows.
 
-    ``tire-fbs_h4_bushing-z_N60_6dof_2026-12-01`` for the report,
+    ``tire-fbs_h4_bushing-z_N60_6dof_2026-12-01`` for the report (``_N60_res_`` with
+    residual compensation),
     ``tire-fbs_scatter-band_h4_bushing-z_N60_6dof_p10-both_R10000_2026-12-01`` for the band;
     ``_upload`` before the date when uploaded data are in use. Only ``[A-Za-z0-9._-]``.
 
@@ -293,8 +383,8 @@ def file_stem(snap: Snapshot, view: str = "report") -> str:
     if view not in VIEWS:
         raise ReportError(f"unknown view {view!r}; allowed: {', '.join(VIEWS)}")
     s = snap.settings
-    dof = snap.map_dof if view in ("truncation-map", "suggested-modes") else snap.response_dof
-    dof_part = dof.replace(":", "-") if dof else "bushing-max6"
+    dof = snap.map_dof if view in _CRITERION_VIEWS else snap.response_dof
+    dof_part = dof.replace(":", "-") if dof else f"{_node(snap)}-max6"
     parts = ["tire-fbs"] if view == "report" else ["tire-fbs", view]
     if view == "suggested-modes":
         parts += [f"thr{_num(s['threshold'])}", f"fmax{_num(s['f_max'])}", dof_part]
@@ -304,10 +394,20 @@ def file_stem(snap: Snapshot, view: str = "report") -> str:
         parts += [f"h{s['harmonic']}", dof_part, f"thr{_num(s['threshold'])}"]
     elif view == "uncoupled":
         parts += [f"h{s['harmonic']}", f"hub-{s['dof']}", f"N{s['n_modes']}"]
+    elif view in _TIRE_VIEWS:
+        parts += [f"h{s['harmonic']}"]
+    elif view in ("selected-modes", "chassis-truncation"):
+        parts += [f"h{s['harmonic']}", dof_part, f"thr{_num(s['threshold'])}"]
+        parts += [f"fmax{_num(s['f_max'])}"]
+    elif view == "participation":
+        parts += [f"h{s['harmonic']}", dof_part, f"fmax{_num(s['f_max'])}"]
     else:
         parts += [f"h{s['harmonic']}", dof_part, f"N{s['n_modes']}"]
-    if view not in ("eigenfrequency", "uncoupled"):
+    if s.get("residual") and view in RESIDUAL_VIEWS:
+        parts.append("res")
+    if view not in ("eigenfrequency", "uncoupled", *_TIRE_VIEWS):
         parts.append(s["coupling"])
+        parts += _vehicle_part(snap)
     if view == "scatter-band":
         parts += [f"p{_num(s['noise'])}-{s['target']}", f"R{s['rounds']}"]
         if s["frequency_dependent"]:

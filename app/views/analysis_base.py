@@ -1,10 +1,10 @@
 """Shared base of the Analysis card's views (issue 18) and the card itself.
 
 An :class:`AnalysisView` is a :class:`~app.views.live.LiveView` that draws a result of the
-session's :class:`~app.analysis_store.AnalysisResults` and shows the picked speed /
-frequency (``AnalysisResults.pick``) as markers. :func:`analysis_card` builds the card with
-one tab per view; the tab shown is ``state.analysis.tab`` (in the URL as ``atab``), and
-only the shown tab's results are computed.
+session's store (:mod:`app.store`: the rows computed while their tab is shown) and shows
+the picked speed / frequency (the ``pick`` result) as markers. :func:`analysis_card`
+builds the card with one tab per view; the tab shown is ``state.analysis.tab`` (in the URL
+as ``atab``), and only the shown tab's results are computed.
 """
 
 from __future__ import annotations
@@ -13,39 +13,29 @@ import panel as pn
 import param
 
 from ..analysis_state import ANALYSIS_TABS
-from ..analysis_store import AnalysisResults
 from .common import FREQ_LABEL
 from .live import LiveView
 from .plots import frequency_range, new_figure
 
 __all__ = ["AnalysisView", "analysis_card"]
 
-#: Colours of the six interface DOFs' terms (and of pins).
-TERM_COLORS = ("#1971c2", "#2b8a3e", "#e03131", "#f08c00", "#7048e8", "#0c8599")
+#: Colours of the six interface DOFs' terms hub:x ... hub:rz (and of pins): the Okabe-Ito
+#: palette without its yellow, distinct also for colour-blind readers (the earlier
+#: palette's hub:x and hub:rz were two blues; tests/test_app_palette.py measures it).
+TERM_COLORS = ("#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00")
 PICK_COLOR = "#c2255c"
-#: Height of the opened Analysis card (px).
-CARD_HEIGHT = 760
 
 
 class AnalysisView(LiveView):
     """A view of an analysis result; redrawn when its result or the pick changes."""
 
-    analysis = param.ClassSelector(class_=AnalysisResults, doc="The card's results.")
     x_range = param.Parameter(default=None, doc="Shared frequency range (linked zoom).")
-    #: Name of the result in AnalysisResults.
-    result_name = ""
-
-    def __init__(self, **params):
-        super().__init__(**params)
-        self.analysis.param.watch(lambda _e: self.redraw(), [self.result_name, "pick"])
-
-    def result(self):
-        return getattr(self.analysis, self.result_name)
+    also = ("pick",)
 
     def _apply(self):
         super()._apply()
         if not self.store.closed and self.result() is not None:
-            self._draw_pick(self.analysis.pick.draw)
+            self._draw_pick(self.store.pick.draw)
 
     def _draw_pick(self, pick: dict) -> None:
         """Show the picked speed / frequency (``None``: not picked)."""
@@ -71,39 +61,82 @@ def _tab_names() -> dict[str, str]:
         "phase": "Phase and peaks",
         "speed": "Across speed",
         "contributions": "Contributions",
+        "modes": "Modes",
+        "selection": "Selected modes",
     }
 
 
-def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
+def _building() -> pn.Row:
+    """What the opened card shows while its views are built the first time (several
+    seconds): it is in the page from the start, so the browser shows it as soon as the card
+    is opened, before the server has answered."""
+    return pn.Row(
+        pn.indicators.LoadingSpinner(value=True, size=36, margin=(10, 10)),
+        pn.pane.HTML(
+            "<p>Preparing the analysis views (the first time takes a few seconds) ...</p>",
+            margin=(10, 0),
+        ),
+        css_classes=["analysis-building"],
+        sizing_mode="stretch_width",
+    )
+
+
+#: Stylesheet of the card's tabs: a tab not shown takes no room. (Bokeh stacks the tabs'
+#: contents in one grid cell and hides the others with ``visibility``: the card was as tall
+#: as its tallest tab, with an empty space under a shorter one.)
+TABS_CSS = 'div[style*="visibility: hidden"] { display: none !important; }'
+
+
+def analysis_card(results, x_range=None, tabs: dict | None = None, page=None) -> pn.Card:
     """The "Analysis" card: one tab per analysis view, computed only while shown.
 
     ``tabs`` maps tab keys (:data:`~app.analysis_state.ANALYSIS_TABS`) to a function
-    ``(analysis_results, x_range) -> viewable``; default all views of the card.
+    ``(results, x_range) -> viewable``; default all views of the card. ``page``
+    (the page's layout state): the default views follow its view (type sizes of the normal
+    or the presentation view).
     """
     from .analysis_compare import CompareView
     from .analysis_contrib import ContributionsView
+    from .analysis_modes import modes_tab, selection_tab
     from .analysis_phase import PhaseView
     from .analysis_speed import speed_tab
 
-    analysis = AnalysisResults(store=results)
-    results.analysis = analysis  # for the report, tests and benchmarks
     state = results.state.analysis
+    views: list = []  # the default views built so far: they follow the page's view
+
+    def mode() -> str:
+        return page.view if page is not None else "normal"
+
+    def made(view):
+        views.append(view)
+        return view
+
     if tabs is None:
         tabs = {
-            "phase": lambda a, x: PhaseView(store=results, analysis=a, x_range=x),
-            "speed": lambda a, x: speed_tab(results, a),
-            "contributions": lambda a, x: ContributionsView(store=results, analysis=a, x_range=x),
+            "compare": lambda r, x: made(CompareView(store=r, x_range=x, mode=mode())),
+            "phase": lambda r, x: made(PhaseView(store=r, x_range=x, mode=mode())),
+            "speed": lambda r, x: speed_tab(r, mode(), views),
+            "contributions": lambda r, x: made(ContributionsView(store=r, x_range=x, mode=mode())),
+            "modes": lambda r, x: modes_tab(r),
+            "selection": lambda r, x: selection_tab(r),
         }
-        tabs = {
-            "compare": lambda a, x: CompareView(store=results, analysis=a, x_range=x),
-            **tabs,
-        }
+    if page is not None:
+
+        def restyle(e):
+            for v in views:
+                v.mode = e.new
+
+        page.param.watch(restyle, "view")
     keys = [k for k in ANALYSIS_TABS if k in tabs]
     names = _tab_names()
-    body = pn.Column(sizing_mode="stretch_both", css_classes=["analysis-body"])
+    # each view has the height of its plots (app/views/layout.py: the window's height within
+    # limits); the card and its tabs state their sizing, so it is never inferred from their
+    # content (a card of no height given a stretch_both sizing got no height at all in the
+    # page column: issue 29)
+    body = pn.Column(_building(), sizing_mode="stretch_width", css_classes=["analysis-body"])
     card = pn.Card(
         body,
-        title="Analysis: compare states, phase and peaks, across speed, contributions",
+        title="Analysis: compare states, phase and peaks, across speed, contributions, modes",
         collapsible=True,
         collapsed=True,
         sizing_mode="stretch_width",
@@ -116,25 +149,24 @@ def analysis_card(results, x_range=None, tabs: dict | None = None) -> pn.Card:
     def build() -> pn.Tabs:
         if not panes:
             tabs_ = pn.Tabs(
-                *[(names[k], tabs[k](analysis, x_range)) for k in keys],
+                *[(names[k], tabs[k](results, x_range)) for k in keys],
                 dynamic=True,
-                sizing_mode="stretch_both",
+                sizing_mode="stretch_width",
+                stylesheets=[TABS_CSS],
                 css_classes=["analysis-tabs"],
             )
             if state.tab in keys:
                 tabs_.active = keys.index(state.tab)
             tabs_.param.watch(shown, "active")
             panes.append(tabs_)
-            body.append(tabs_)
+            body.objects = [tabs_]  # in place of the indicator
         return panes[0]
 
     def shown(*_):
         if not card.collapsed:
             tabs_ = build()
-            card.height = CARD_HEIGHT
             tab = keys[tabs_.active]
         else:
-            card.height = None
             tab = ""
         if state.tab != tab:
             state.tab = tab

@@ -14,15 +14,23 @@ from bokeh.models import ColumnDataSource, HoverTool
 from bokeh.palettes import RdBu11
 
 from fbs_core.analysis import MAX_PINS
+from fbs_core.vocabulary import magnitude_db
 
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .analysis_speed import _pick_spans
 from .common import COLORS, level_label
+from .layout import plot_rows, weight
 from .plots import add_image, set_data
 
 __all__ = ["CompareView"]
 
-CURVE_COLORS = (COLORS["truncated"],) + TERM_COLORS[:MAX_PINS]
+#: The current state, then the pins (not the orange next to the current state's colour).
+CURVE_COLORS = (COLORS["truncated"],) + tuple(
+    c for i, c in enumerate(TERM_COLORS) if i not in (1, 5)
+)[:MAX_PINS]
+#: A difference map whose largest value is below this (percentage points) is zero: the two
+#: maps are the same (eq. 5.1 does not depend on N, the pinned state may differ in N only).
+SAME_MAP_PP = 1e-9
 
 
 class CompareView(AnalysisView):
@@ -30,34 +38,50 @@ class CompareView(AnalysisView):
 
     key = "compare"
     result_name = "compare"
-    min_height = 560
+    css_height = plot_rows(1.8)
 
     def __init__(self, **params):
         super().__init__(**params)
         self._unpin: pn.widgets.Select | None = None  # the header's widgets, once built
-        self.analysis.param.watch(lambda _e: self._sync_widgets(), ["pins", "message"])
+        self.store.param.watch(lambda _e: self._sync_widgets(), ["pins", "message"])
 
     def _controls(self):
         a = self.store.state.analysis
         self._name = pn.widgets.TextInput(
-            placeholder="name of the pin", width=150, css_classes=["ctl-analysis-pin_name"]
+            label="Name of the pin",
+            placeholder="e.g. baseline",
+            width=160,
+            css_classes=["ctl-analysis-pin_name"],
         )
         self._pin_btn = pn.widgets.Button(
-            label="Pin current state", width=140, css_classes=["ctl-analysis-pin"]
+            label="Pin current state", width=150, css_classes=["ctl-analysis-pin"], align="end"
         )
-        self._unpin = pn.widgets.Select(options=[], width=120, css_classes=["ctl-analysis-unpin"])
+        self._unpin = pn.widgets.Select(
+            label="Pinned", options=[], width=130, css_classes=["ctl-analysis-unpin"]
+        )
         self._unpin_btn = pn.widgets.Button(
-            label="Unpin", width=70, css_classes=["ctl-analysis-unpin_btn"]
+            label="Unpin", width=80, css_classes=["ctl-analysis-unpin_btn"], align="end"
         )
         self._against = pn.widgets.Select(
-            options=[], width=140, css_classes=["ctl-analysis-compare_to"]
+            label="Error map against",
+            options=[],
+            width=150,
+            css_classes=["ctl-analysis-compare_to"],
         )
         self._msg = pn.pane.HTML(
-            "", styles={"color": "#c92a2a"}, width=220, css_classes=["analysis-pin-message"]
+            "",
+            styles={"color": "#c92a2a"},
+            sizing_mode="stretch_width",
+            min_width=200,
+            css_classes=["analysis-pin-message"],
         )
-        self._pin_btn.on_click(lambda _e: self.analysis.pin(self._name.value or ""))
+        # the name as typed so far: the field's value arrives with its blur, which the click
+        # on the button causes, and the two may be handled on two threads in either order
+        self._pin_btn.on_click(
+            lambda _e: self.store.pin(self._name.value_input or self._name.value or "")
+        )
         self._unpin_btn.on_click(
-            lambda _e: self._unpin.value and self.analysis.unpin(self._unpin.value)
+            lambda _e: self._unpin.value and self.store.unpin(self._unpin.value)
         )
 
         def chosen(e):
@@ -71,7 +95,7 @@ class CompareView(AnalysisView):
     def _sync_widgets(self):
         if self._unpin is None:
             return
-        names = [p.name for p in self.analysis.pins]
+        names = [p.name for p in self.store.pins]
 
         def update():
             self._unpin.options = names
@@ -79,7 +103,7 @@ class CompareView(AnalysisView):
             want = self.store.state.analysis.compare_to
             if names:
                 self._against.value = want if want in names else names[0]
-            self._msg.object = self.analysis.message
+            self._msg.object = self.store.message
 
         doc = self._doc
         if doc is None:
@@ -177,12 +201,14 @@ class CompareView(AnalysisView):
             colorbar_title="pp",
         )
         self._mapper.palette = tuple(reversed(RdBu11))
+        self._map_glyph = mp.renderers[-1]
         self._spans = [
             _pick_spans(f, f"compare.{k}")[0]
             for k, f in (("levels", lv), ("diff", df), ("band", bd))
         ]
         for s in self._spans:
             s.line_color = PICK_COLOR
+        weight(lv, 1.6)  # it carries the title block
         return [
             row(
                 column(lv, df, sizing_mode="stretch_both"),
@@ -217,12 +243,14 @@ class CompareView(AnalysisView):
             if c is not None and c["band"] is not None:
                 src.data = {
                     "freq": c["freq"],
-                    "low": 20 * np.log10(c["band"][0]),
-                    "high": 20 * np.log10(c["band"][1]),
+                    "low": magnitude_db(c["band"][0]),
+                    "high": magnitude_db(c["band"][1]),
                 }
             else:
                 set_data(src, {"freq": np.zeros(0), "low": np.zeros(0), "high": np.zeros(0)})
             item.visible = c is not None and c["band"] is not None
+            if c is not None:
+                item.label = {"value": c["name"]}
         m = d["map"]
         if m is not None:
             e = m["diff_pct"]
@@ -236,10 +264,14 @@ class CompareView(AnalysisView):
                 "dw": [float(c[-1] - c[0] + dc)],
                 "dh": [float(n[-1] - n[0] + dn)],
             }
-            lim = float(np.nanmax(np.abs(e))) if np.isfinite(e).any() else 1.0
-            lim = max(lim, 1e-6)
+            lim = float(np.nanmax(np.abs(e))) if np.isfinite(e).any() else 0.0
+            title = f"Error map: current minus pin {m['pin']!r} ({m['what']})"
+            if lim < SAME_MAP_PP:  # a colour scale of +-1e-6 pp drew a grey box: say it
+                lim = 1.0
+                title = f"Error map: no difference to pin {m['pin']!r} (identical maps)"
             self._mapper.update(low=-lim, high=lim)
-            self._mp.title.text = f"Error map: current minus pin {m['pin']!r} ({m['what']})"
+            self._mp.title.text = title
+            self._map_glyph.visible = self._bar.visible = True
         else:
             self._img.data = {
                 "image": [np.zeros((1, 1))],
@@ -249,6 +281,7 @@ class CompareView(AnalysisView):
                 "dh": [1.0],
             }
             self._mp.title.text = "Error map: no difference map (pin a state of this harmonic)"
+            self._map_glyph.visible = self._bar.visible = False
         self._lv.yaxis.axis_label = level_label(d["dof"])
         self._fit(self.x_range, curves[0]["freq"])
 

@@ -10,17 +10,43 @@ from __future__ import annotations
 
 import numpy as np
 import panel as pn
-from bokeh.models import ColumnDataSource, HoverTool, Span
+from bokeh.models import ColumnDataSource, HoverTool, Range1d, Span
 
-from fbs_core.vocabulary import percent
+from fbs_core.vocabulary import DIRECTIONS, percent
 
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .common import COLORS, level_label, level_tooltips
+from .layout import plot_rows
 from .plots import add_line
 
 __all__ = ["ContributionsView"]
 
-DOFS = ("x", "y", "z", "rx", "ry", "rz")
+#: Near an antiresonance the total is small and the terms' shares of it reach +-1000 % and
+#: more over a few lines, which flattened the rest: the axis then spans the central part of
+#: the stacked edges (these percentiles over the lines) and 0-100 %.
+CLIP_PERCENTILES = (2.0, 98.0)
+#: ... when the values reach beyond that central part by more than this share of its span.
+CLIP_BEYOND = 0.5
+
+
+def share_range(edges: np.ndarray) -> tuple[float, float, bool]:
+    """The y range of the stacked shares ``edges`` (%, any shape): ``(low, high, cut)``.
+
+    All values and 0-100 %, padded by 8 %, unless they reach beyond the central
+    :data:`CLIP_PERCENTILES` (and 0-100 %) by more than :data:`CLIP_BEYOND` of its span:
+    then that central part, padded, and ``cut`` is True.
+    """
+    finite = edges[np.isfinite(edges)]
+    if finite.size == 0:
+        return -10.0, 110.0, False
+    lo, hi = np.percentile(finite, CLIP_PERCENTILES)
+    lo, hi = min(float(lo), 0.0), max(float(hi), 100.0)
+    reach = CLIP_BEYOND * (hi - lo)
+    cut = bool(finite.min() < lo - reach or finite.max() > hi + reach)
+    if not cut:
+        lo, hi = min(lo, float(finite.min())), max(hi, float(finite.max()))
+    pad = 0.08 * (hi - lo)
+    return lo - pad, hi + pad, cut
 
 
 class ContributionsView(AnalysisView):
@@ -28,7 +54,7 @@ class ContributionsView(AnalysisView):
 
     key = "contributions"
     result_name = "contributions"
-    min_height = 420
+    css_height = plot_rows(1)
 
     def _controls(self):
         return [
@@ -42,14 +68,18 @@ class ContributionsView(AnalysisView):
 
     def _build(self):
         self._lines_fig = fig = self._frequency_figure(
-            "contributions.figure", level_label("z"), 400
+            "contributions.figure", level_label("z"), 300
         )
         # one source for the six terms and the total: one patch per change
         self._lines = ColumnDataSource(
-            {"freq": np.zeros(0), **{f"hub_{d}": np.zeros(0) for d in DOFS}, "total": np.zeros(0)},
+            {
+                "freq": np.zeros(0),
+                **{f"hub_{d}": np.zeros(0) for d in DIRECTIONS},
+                "total": np.zeros(0),
+            },
             name="contributions.lines",
         )
-        for d, color in zip(DOFS, TERM_COLORS, strict=True):
+        for d, color in zip(DIRECTIONS, TERM_COLORS, strict=True):
             add_line(
                 fig,
                 "",
@@ -74,13 +104,17 @@ class ContributionsView(AnalysisView):
         )
         # stacked shares: one source, a varea per term between cumulative columns
         self._stack = ColumnDataSource(
-            {"freq": np.zeros(0), **{f"c{k}": np.zeros(0) for k in range(len(DOFS) + 1)}},
+            {"freq": np.zeros(0), **{f"c{k}": np.zeros(0) for k in range(len(DIRECTIONS) + 1)}},
             name="contributions.stacked",
         )
+        self._stack_range = Range1d(-10.0, 110.0, name="contributions.share_range")
         self._stack_fig = sf = self._frequency_figure(
-            "contributions.stacked_figure", "Share of the total (%)", 400
+            "contributions.stacked_figure",
+            "Share of the total (%)",
+            300,
+            y_range=self._stack_range,
         )
-        for k, (d, color) in enumerate(zip(DOFS, TERM_COLORS, strict=True)):
+        for k, (d, color) in enumerate(zip(DIRECTIONS, TERM_COLORS, strict=True)):
             sf.varea(
                 "freq",
                 f"c{k}",
@@ -93,7 +127,7 @@ class ContributionsView(AnalysisView):
         sf.add_tools(
             HoverTool(
                 tooltips=[("Frequency", "@freq{0.0} Hz")]
-                + [(f"hub:{d}", f"@s{k}{{0.0}} %") for k, d in enumerate(DOFS)],
+                + [(f"hub:{d}", f"@s{k}{{0.0}} %") for k, d in enumerate(DIRECTIONS)],
                 mode="vline",
             )
         )
@@ -114,9 +148,8 @@ class ContributionsView(AnalysisView):
         fig.add_layout(self._picks[0])
         sf.add_layout(self._picks[1])
         sf.visible = False
-        from bokeh.layouts import column
-
-        return [column(fig, sf, sizing_mode="stretch_both")]
+        # two figures, one shown at a time, each with its own title block
+        return [fig, sf]
 
     def _draw(self, r):
         c, d = r.columns, r.draw
@@ -128,18 +161,27 @@ class ContributionsView(AnalysisView):
             empty = np.full(f.size, np.nan)
             self._lines.data = {
                 "freq": f,
-                **{f"hub_{d}": c[f"hub_{d}_dB"] if d in interface else empty for d in DOFS},
+                **{f"hub_{d}": c[f"hub_{d}_dB"] if d in interface else empty for d in DIRECTIONS},
                 "total": c["total_dB"],
             }
         else:
             cum = np.zeros(f.size)
             stack = {"freq": f, "c0": cum.copy()}
-            for k, dof in enumerate(DOFS):
+            for k, dof in enumerate(DIRECTIONS):
                 share = percent(c[f"hub_{dof}_share"]) if dof in interface else np.zeros(f.size)
                 stack[f"s{k}"] = share
                 cum = cum + share
                 stack[f"c{k + 1}"] = cum.copy()
             self._stack.data = stack
+            edges = np.stack([stack[f"c{k + 1}"] for k in range(len(DIRECTIONS))])
+            lo, hi, cut = share_range(edges)
+            self._stack_range.update(start=lo, end=hi, reset_start=lo, reset_end=hi)
+            self._stack_fig.title.text = (
+                f"Axis cut at {lo:.0f}..{hi:.0f} %: shares reach {np.nanmin(edges):.0f}.."
+                f"{np.nanmax(edges):.0f} % near antiresonances"
+                if cut
+                else ""
+            )
         self._stack_fig.visible = stacked
         self._lines_fig.visible = not stacked
         self._lines_fig.yaxis.axis_label = level_label(d["dof"])

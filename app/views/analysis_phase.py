@@ -15,6 +15,7 @@ from bokeh.events import Tap
 from bokeh.layouts import column
 from bokeh.models import (
     ColumnDataSource,
+    DataRange1d,
     HoverTool,
     LabelSet,
     LinearAxis,
@@ -26,11 +27,15 @@ from bokeh.models import (
 
 from .analysis_base import PICK_COLOR, AnalysisView
 from .common import COLORS, FREQ_LABEL
+from .layout import plot_rows, weight
 from .plots import frequency_range, new_figure, set_data
+from .typed import NumberField
 
 __all__ = ["PhaseView"]
 
 CURSOR_COLOR = "#5f3dc4"
+#: Type of the peak labels in the normal and the presentation view.
+LABEL_SIZES = {"normal": "11px", "present": "16px"}
 
 
 class PhaseView(AnalysisView):
@@ -38,13 +43,26 @@ class PhaseView(AnalysisView):
 
     key = "phase"
     result_name = "phase"
-    min_height = 520
+    css_height = plot_rows(1.45)
 
     def __init__(self, **params):
         super().__init__(**params)
         self._next_cursor = 1
+        a = self.store.state.analysis
+        # typed cursors (Hz; 0: off), read as a person means them (app/views/typed.py)
+        self._cursor_fields = [
+            NumberField(
+                obj=a,
+                parameter=f"cursor{k}",
+                label=f"Cursor {k} (Hz, 0: off)",
+                css_class=f"ctl-analysis-cursor{k}",
+                width=80,
+                compact=True,
+            )
+            for k in (1, 2)
+        ]
         # the modes near the peaks arrive later: only the labels change (not the curves)
-        self.analysis.param.watch(lambda _e: self._on_document(self._apply_labels), ["peak_modes"])
+        self.store.param.watch(lambda _e: self._on_document(self._apply_labels), ["peak_modes"])
 
     def _controls(self):
         a = self.store.state.analysis
@@ -57,13 +75,11 @@ class PhaseView(AnalysisView):
             W.Checkbox.from_param(
                 a.param.log_freq, name="log f", width=70, css_classes=["ctl-analysis-log_freq"]
             ),
-            W.FloatInput.from_param(
-                a.param.cursor1, name="", width=80, step=0.5, css_classes=["ctl-analysis-cursor1"]
-            ),
-            W.FloatInput.from_param(
-                a.param.cursor2, name="", width=80, step=0.5, css_classes=["ctl-analysis-cursor2"]
-            ),
+            *self._cursor_fields,
         ]
+
+    def _messages(self):
+        return [f.message for f in self._cursor_fields]
 
     def _build(self):
         if self.x_range is None:
@@ -72,6 +88,7 @@ class PhaseView(AnalysisView):
             x_label=FREQ_LABEL,
             y_label="Level (dB)",
             x_range=self.x_range,
+            y_range=DataRange1d(range_padding=0.08, only_visible=True),
             name="phase.top",
             min_height=260,
         )
@@ -118,7 +135,9 @@ class PhaseView(AnalysisView):
             fig.legend.location = "bottom_left"
             fig.legend.click_policy = "hide"
             fig.legend.label_text_font_size = "9pt"
-        self._peaks = ColumnDataSource({"freq": [], "level": [], "text": []}, name="phase.peaks")
+        self._peaks = ColumnDataSource(
+            {"freq": [], "level": [], "text": [], "align": [], "dx": []}, name="phase.peaks"
+        )
         top.scatter(
             "freq",
             "level",
@@ -132,8 +151,12 @@ class PhaseView(AnalysisView):
             y="level",
             text="text",
             source=self._peaks,
-            x_offset=6,
-            y_offset=4,
+            # below the marker, towards the middle of the plot: a label above the highest
+            # peak was cut at the top of the plot, one at the right end at its right edge
+            x_offset="dx",
+            y_offset=-10,
+            text_align="align",
+            text_baseline="top",
             text_font_size="8pt",
             background_fill_color="white",
             background_fill_alpha=0.7,
@@ -171,6 +194,8 @@ class PhaseView(AnalysisView):
             )
             fig.add_layout(s)
             self._pick_spans.append(s)
+        weight(top, 1.7)  # it carries the title block and the peak labels
+        bottom.yaxis.ticker.desired_num_ticks = 4  # a short plot: ticks apart
         top.on_event(Tap, self._tapped)
         bottom.on_event(Tap, self._tapped)
         self._log = False
@@ -187,6 +212,10 @@ class PhaseView(AnalysisView):
         else:
             a.cursor2 = f
             self._next_cursor = 1
+
+    def _restyle_now(self) -> None:
+        super()._restyle_now()
+        self._labels.text_font_size = LABEL_SIZES[self.mode]
 
     def _set_log(self, log: bool) -> None:
         if log == self._log:
@@ -220,7 +249,7 @@ class PhaseView(AnalysisView):
             }
         unit = d["y_label"]
         self._top.yaxis.axis_label = unit if bode else "Real part"
-        self._bottom.yaxis.axis_label = "Phase (deg, unwrapped)" if bode else "Imaginary part"
+        self._bottom.yaxis.axis_label = "Phase (deg)" if bode else "Imaginary part"
         self._peaks.data = self._peak_data(r)
         cur = d["cursors"]
         for spans in self._cursor_spans:
@@ -241,14 +270,22 @@ class PhaseView(AnalysisView):
         d = r.draw
         bode = d["mode"] == "bode"
         labels = list(d["labels"])
-        pm = self.analysis.peak_modes
-        if pm is not None and pm[0] is r:
-            labels = list(pm[1])
-        peaks = d["peaks"]
+        pm = self.store.peak_modes
+        if pm is not None and np.array_equal(
+            pm.columns["freq_Hz_of_peak"], [p["freq"] for p in d["peaks"]]
+        ):  # the labels of these peaks, with the coupled modes known so far
+            labels = list(pm.draw["labels"])
+        peaks = d["peaks"] if bode else []
+        f = d["freq"]
+        lo, hi = (float(f[0]), float(f[-1])) if len(f) else (0.0, 0.0)
+        mid = float(np.sqrt(lo * hi)) if d["log"] and lo > 0 else 0.5 * (lo + hi)
+        right = [p["freq"] > mid for p in peaks]
         return {
-            "freq": [p["freq"] for p in peaks] if bode else [],
-            "level": [p["level"] for p in peaks] if bode else [],
+            "freq": [p["freq"] for p in peaks],
+            "level": [p["level"] for p in peaks],
             "text": labels if bode else [],
+            "align": ["right" if r else "left" for r in right],
+            "dx": [-8 if r else 8 for r in right],
         }
 
     def _apply_labels(self) -> None:

@@ -25,7 +25,8 @@ from bokeh.models import ColumnDataSource, HoverTool, Span
 from bokeh.palettes import Viridis256
 
 from .analysis_base import PICK_COLOR, AnalysisView
-from .plots import add_image, new_figure
+from .layout import plot_rows
+from .plots import add_image, new_figure, set_data
 
 __all__ = ["CampbellView", "SpeedMapView", "speed_tab"]
 
@@ -64,7 +65,7 @@ class CampbellView(AnalysisView):
 
     key = "campbell"
     result_name = "campbell"
-    min_height = 460
+    css_height = plot_rows(1)
 
     def _build(self):
         self._fig = fig = new_figure(
@@ -108,13 +109,13 @@ class CampbellView(AnalysisView):
 
     def _tapped(self, event):
         if event.x is not None and event.y is not None:
-            self.analysis.pick_campbell(float(event.x), float(event.y))
+            self.store.pick_campbell(float(event.x), float(event.y))
 
     def _draw(self, r):
         d = r.draw
-        for k, src in self._branches.items():
+        for k, src in self._branches.items():  # the same tire: nothing sent again
             b = d["branches"][k]
-            src.data = {"xs": b["xs"], "ys": b["ys"], "branch": b["branch"]}
+            set_data(src, {"xs": b["xs"], "ys": b["ys"], "branch": b["branch"]})
         v = d["speeds"]
         xs, ys, hs, ws, out_x, out_y = [], [], [], [], [], []
         for j, h in enumerate(d["harmonic"]):
@@ -126,7 +127,7 @@ class CampbellView(AnalysisView):
             out_x.append(v)
             out_y.append(d["lines"][:, j])
         self._orders.data = {"xs": xs, "ys": ys, "harmonic": hs, "width": ws}
-        self._order_out.data = {"xs": out_x, "ys": out_y}
+        set_data(self._order_out, {"xs": out_x, "ys": out_y})
         self._fig.y_range.end = 460  # branches up to 450 Hz: the seven lines' band
 
     def _draw_pick(self, pick):
@@ -138,7 +139,7 @@ class SpeedMapView(AnalysisView):
 
     key = "speedmap"
     result_name = "speed_map"
-    min_height = 460
+    css_height = plot_rows(1)
 
     def _build(self):
         self._fig = fig = new_figure(
@@ -165,7 +166,7 @@ class SpeedMapView(AnalysisView):
 
     def _tapped(self, event):
         if event.x is not None and event.y is not None:
-            self.analysis.pick_point(float(event.x), float(event.y))
+            self.store.pick_point(float(event.x), float(event.y))
 
     def _draw(self, r):
         d = r.draw
@@ -192,10 +193,13 @@ class SpeedMapView(AnalysisView):
         _show_pick(self._spans, pick)
 
 
-def speed_tab(results, analysis) -> pn.Row:
-    """The "Across speed" tab: the Campbell diagram beside the speed map."""
-    return pn.Row(
-        CampbellView(store=results, analysis=analysis),
-        SpeedMapView(store=results, analysis=analysis),
-        sizing_mode="stretch_both",
-    )
+def speed_tab(results, mode: str = "normal", views: list | None = None) -> pn.Row:
+    """The "Across speed" tab: the Campbell diagram beside the speed map (in the type sizes
+    of ``mode``; both views are appended to ``views``)."""
+    pair = [
+        CampbellView(store=results, mode=mode),
+        SpeedMapView(store=results, mode=mode),
+    ]
+    if views is not None:
+        views.extend(pair)
+    return pn.Row(*pair, sizing_mode="stretch_width")

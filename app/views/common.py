@@ -14,6 +14,7 @@ COLORS = {
     "percentile": "#1864ab",
     "round": "#e8590c",
     "suggested": "#0ca678",
+    "first_order": "#ae3ec9",
 }
 
 FREQ_LABEL = "Frequency (Hz)"

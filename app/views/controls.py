@@ -1,8 +1,10 @@
 """The control panel: widgets generated from the state parameters.
 
-Typed numbers are checked against their parameter's bounds: a value outside them is not
-silently ignored but answered with a message under the field (and a notification), and the
-field goes back to the value in force.
+Typed numbers are plain text fields read by :func:`app.views.typed.parse_number` (``1e5``,
+``1.5``, ``5,5``): a text that is not a number of the field's kind, or a value outside the
+parameter's bounds, is answered with a message under the field (and a notification) that
+names the field and what it takes, and the field (and its slider) go back to the value in
+force.
 """
 
 from __future__ import annotations
@@ -15,46 +17,27 @@ from panel.viewable import Viewer
 
 import fbs_core
 
-from ..bands import served
-from ..panel_private import respond_at_once
-from ..state import DashboardState
+from ..runtime.panel_private import respond_at_once
+from ..state import VEHICLE_ROUNDS, DashboardState
+from .layout import font
+from .typed import NumberField, refusal
 
-#: Typed numeric controls: key -> (widget class, label, extra widget arguments).
+#: Typed numeric controls: key -> (label, with a slider).
 _TYPED = {
-    "truncation.threshold": ("slider", "Error threshold (%)", {"format": "0.0"}),
-    "truncation.f_max": ("slider", "Upper frequency for suggestion (Hz)", {"format": "0"}),
-    "noise.noise": ("slider", "Noise level p (%)", {"format": "0.0"}),
-    "noise.rounds": ("int", "Rounds R", {"step": 1000}),
-    "noise.seed": ("int", "Seed", {}),
-    "noise.single_round": ("int", "Single round #", {}),
+    "truncation.threshold": ("Error threshold (%)", True),
+    "truncation.f_max": ("Upper frequency for suggestion (Hz)", True),
+    "noise.noise": ("Noise level p (%)", True),
+    "noise.rounds": ("Rounds R", False),
+    "noise.seed": ("Seed", False),
+    "noise.single_round": ("Single round #", False),
+    "plot.cursor1": ("Cursor 1 (Hz, 0: off)", False),
+    "plot.cursor2": ("Cursor 2 (Hz, 0: off)", False),
 }
-
-
-def _fmt(x) -> str:
-    if isinstance(x, int) or float(x).is_integer():
-        return f"{int(x):,}"
-    return f"{x:g}"
 
 
 def out_of_bounds(obj: param.Parameterized, name: str, value, label: str = "") -> str:
     """The message for ``value`` typed for ``obj.name`` ("" when the parameter takes it)."""
-    p = obj.param[name]
-    label = label or p.label or name
-    if value is None:
-        return f"{label}: type a number; still {_fmt(getattr(obj, name))}."
-    lo, hi = p.bounds if p.bounds is not None else (None, None)
-    if isinstance(p, param.Integer) and not float(value).is_integer():
-        return f"{label}: a whole number please (typed {value:g}); still {getattr(obj, name)}."
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        return (
-            f"{label}: {_fmt(value)} is outside the allowed range {_fmt(lo)} to {_fmt(hi)}; "
-            f"still {_fmt(getattr(obj, name))} in use."
-        )
-    return ""
-
-
-def _put_back(w: pn.widgets.Widget, obj: param.Parameterized, name: str) -> None:
-    w.value = getattr(obj, name)
+    return refusal(obj, name, str(value), label)
 
 
 def _harmonic_html(k: int) -> str:
@@ -79,72 +62,57 @@ class Controls(Viewer):
     def __init__(self, **params):
         super().__init__(**params)
         self._widgets: dict[str, pn.widgets.Widget] | None = None
-        self.messages: dict[str, pn.pane.HTML] = {}
+        self._fields: dict[str, NumberField] = {}
+        self._messages: dict[str, pn.pane.HTML] = {}
 
-    def _typed(self, key: str) -> pn.widgets.Widget:
-        """A numeric field whose value is checked here, not refused silently by the widget."""
+    @property
+    def fields(self) -> dict[str, NumberField]:
+        """The typed numbers by ``"<group>.<parameter>"`` (text field, slider, message)."""
+        self.widgets()
+        return self._fields
+
+    @property
+    def messages(self) -> dict[str, pn.pane.HTML]:
+        """The message under each typed number."""
+        self.widgets()
+        return self._messages
+
+    def _typed(self, key: str) -> NumberField:
+        """A typed number of the state (a text field read here, and maybe a slider)."""
         group, name = key.split(".")
-        obj = getattr(self.state, group)
-        kind, label, kw = _TYPED[key]
-        p = obj.param[name]
-        w: pn.widgets.Widget
-        if kind == "slider":
-            lo, hi = p.softbounds or p.bounds
-            w = pn.widgets.EditableFloatSlider(
-                label=label,
-                value=getattr(obj, name),
-                start=lo,
-                end=hi,
-                step=p.step or 0.1,
-                fixed_start=None,
-                fixed_end=None,
-                **kw,
-            )
-        else:
-            w = pn.widgets.IntInput(label=label, value=getattr(obj, name), **kw)
-        msg = self.messages[key] = pn.pane.HTML(
-            "",
-            visible=False,
-            css_classes=["ctl-message", f"ctl-message-{group}-{name}"],
-            styles={"color": "#b02a37", "font-size": "0.9em", "font-weight": "bold"},
-            margin=(0, 12),
-            sizing_mode="stretch_width",
+        label, slider = _TYPED[key]
+        field = NumberField(
+            obj=getattr(self.state, group),
+            parameter=name,
+            label=label,
+            slider=slider,
+            css_class="ctl-" + key.replace(".", "-"),
         )
-
-        def typed(event):
-            if event.new == getattr(obj, name):
-                return  # the value in force (also the field put back after a message)
-            text = out_of_bounds(obj, name, event.new, label)
-            if text:
-                msg.param.update(object=html.escape(text), visible=True)
-                # the field shows the value in force again; when served, after Panel has
-                # handled the browser's change (a change of the same property while it is
-                # handled is not sent back)
-                if served():
-                    pn.state.execute(lambda: _put_back(w, obj, name), schedule=True)
-                else:
-                    _put_back(w, obj, name)
-                if pn.state.notifications is not None:
-                    pn.state.notifications.error(text, duration=8000)
-                return
-            if msg.visible:
-                msg.param.update(object="", visible=False)
-            setattr(obj, name, event.new)
-
-        def follow(event):  # a link or another control changed the parameter
-            if w.value != event.new:
-                w.value = event.new
-
-        w.param.watch(typed, "value")
-        obj.param.watch(follow, name)
-        return w
+        self._fields[key] = field
+        self._messages[key] = field.message
+        return field
 
     def widgets(self) -> dict[str, pn.widgets.Widget]:
-        """The widgets by ``"<group>.<parameter>"`` (built once, reused by the layout)."""
+        """The widgets by ``"<group>.<parameter>"`` (built once, reused by the layout); a
+        typed number's widget is its text field (its slider: ``fields[key].bar``)."""
         if self._widgets is None:
             c, n, t = self.state.case, self.state.noise, self.state.truncation
+            p = self.state.plot
             W = pn.widgets
             self._widgets = {
+                "case.scope": W.RadioButtonGroup.from_param(
+                    c.param.scope, name="Scope", options={"Corner": "corner", "Vehicle": "vehicle"}
+                ),
+                "case.wheels": W.CheckButtonGroup.from_param(
+                    c.param.wheels,
+                    name="Road input on the wheels",
+                    options={"FL": "fl", "FR": "fr", "RL": "rl", "RR": "rr"},
+                ),
+                "case.tracks": W.RadioButtonGroup.from_param(c.param.tracks, name="Tracks"),
+                "case.coherence": W.FloatSlider.from_param(
+                    c.param.coherence, name="Coherence of the tracks", start=-1.0, end=1.0
+                ),
+                "case.point": W.Select.from_param(c.param.point, name="Response point"),
                 "case.harmonic": W.IntSlider.from_param(
                     c.param.harmonic, name="Harmonic case", start=1, end=7, step=1
                 ),
@@ -164,42 +132,88 @@ class Controls(Viewer):
                     c.param.residual,
                     name="Residual compensation (modes left out: quasi-static part)",
                 ),
-                "truncation.threshold": self._typed("truncation.threshold"),
-                "truncation.f_max": self._typed("truncation.f_max"),
+                "plot.overlay": W.CheckButtonGroup.from_param(
+                    p.param.overlay, name="Overlay bushing DOFs"
+                ),
+                "plot.level_scale": W.RadioButtonGroup.from_param(
+                    p.param.level_scale, name="Level axis"
+                ),
+                "plot.cursor1": self._typed("plot.cursor1").text,
+                "plot.cursor2": self._typed("plot.cursor2").text,
+                "plot.snap": W.Checkbox.from_param(
+                    p.param.snap, name="Cursors snap to the nearest peak"
+                ),
+                "truncation.threshold": self._typed("truncation.threshold").text,
+                "truncation.f_max": self._typed("truncation.f_max").text,
                 "truncation.map_mode": W.RadioButtonGroup.from_param(
                     t.param.map_mode, name="Error map of"
                 ),
-                "noise.noise": self._typed("noise.noise"),
+                "noise.noise": self._typed("noise.noise").text,
                 "noise.target": W.RadioButtonGroup.from_param(n.param.target, name="Noise in"),
                 "noise.frequency_dependent": W.Checkbox.from_param(
                     n.param.frequency_dependent,
                     name="Frequency-dependent noise (new S at every line)",
                 ),
-                "noise.rounds": self._typed("noise.rounds"),
-                "noise.seed": self._typed("noise.seed"),
-                "noise.single_round": self._typed("noise.single_round"),
+                "noise.rounds": self._typed("noise.rounds").text,
+                "noise.seed": self._typed("noise.seed").text,
+                "noise.single_round": self._typed("noise.single_round").text,
                 "noise.percentile": W.Select.from_param(
                     n.param.percentile, name="Central percentile band (%)"
                 ),
+                "noise.first_order": W.Checkbox.from_param(
+                    n.param.first_order,
+                    name="First-order band overlay (linearised, docs/corridor.md)",
+                ),
             }
             for key, w in self._widgets.items():
+                if key in self._fields:  # classed and quickened by its NumberField
+                    continue
                 w.css_classes = [*w.css_classes, "ctl-" + key.replace(".", "-")]
                 respond_at_once(w)
         return self._widgets
 
     def __panel__(self):
-        w = self.widgets()
-        m = self.messages
+        w: dict[str, object] = {**self.widgets(), **self.fields}
         label = pn.pane.Markdown
         case = self.state.case
         info = pn.pane.HTML(
             pn.bind(_harmonic_html, case.param.harmonic),
             css_classes=["ctl-harmonic-info"],
-            styles={"font-size": "0.9em", "color": "#343a40"},
+            styles={"font-size": font("0.9em"), "color": "#343a40"},
             margin=(0, 12),
             sizing_mode="stretch_width",
         )
+        vehicle = case.param.scope.rx.pipe(lambda v: v == "vehicle")
+        car = pn.Column(
+            label(
+                "The reference car, the tire on all four wheels; the rear wheels meet the "
+                "road a wheelbase after the front ones",
+                margin=(0, 10),
+                styles={"font-size": "0.85em"},
+            ),
+            label("Road input on the wheels", margin=(0, 10)),
+            w["case.wheels"],
+            label("Right track against the left", margin=(0, 10)),
+            w["case.tracks"],
+            pn.Column(w["case.coherence"], visible=case.param.tracks.rx() == "coherence"),
+            w["case.point"],
+            visible=vehicle,
+            css_classes=["ctl-vehicle"],
+            sizing_mode="stretch_width",
+        )
+        rounds_note = label(
+            f"Vehicle scope: the band starts at {VEHICLE_ROUNDS:,} rounds (a car's round "
+            "solves the 24-DOF interface of four wheels: about 33x a corner's); the map and "
+            "the band need tracks in phase or in anti-phase",
+            margin=(0, 10),
+            styles={"font-size": "0.85em"},
+            visible=vehicle,
+            css_classes=["ctl-vehicle-rounds"],
+        )
         return pn.Column(
+            label("#### Scope", margin=(0, 5)),
+            w["case.scope"],
+            car,
             label("#### Case", margin=(0, 5)),
             w["case.harmonic"],
             info,
@@ -210,26 +224,32 @@ class Controls(Viewer):
             w["case.coupling"],
             w["case.show_uncoupled"],
             pn.layout.Divider(),
+            label("#### Response plot", margin=(0, 5)),
+            label("Overlay bushing DOFs (with N modes)", margin=(0, 10)),
+            w["plot.overlay"],
+            label("Level axis", margin=(0, 10)),
+            w["plot.level_scale"],
+            label("Cursors: type a frequency or click the plot", margin=(0, 10)),
+            pn.Row(w["plot.cursor1"], w["plot.cursor2"], sizing_mode="stretch_width"),
+            w["plot.snap"],
+            pn.layout.Divider(),
             label("#### Truncation study", margin=(0, 5)),
             w["truncation.threshold"],
-            m["truncation.threshold"],
             w["truncation.f_max"],
-            m["truncation.f_max"],
             label("Error map of", margin=(0, 10)),
             w["truncation.map_mode"],
             w["case.residual"],
             pn.layout.Divider(),
             label("#### Noise study", margin=(0, 5)),
             w["noise.noise"],
-            m["noise.noise"],
             label("Noise in", margin=(0, 10)),
             w["noise.target"],
             w["noise.frequency_dependent"],
-            pn.Row(w["noise.rounds"], w["noise.seed"]),
-            m["noise.rounds"],
-            m["noise.seed"],
-            pn.Row(w["noise.single_round"]),
-            m["noise.single_round"],
+            rounds_note,
+            w["noise.rounds"],
+            w["noise.seed"],
+            w["noise.single_round"],
             w["noise.percentile"],
+            w["noise.first_order"],
             sizing_mode="stretch_width",
         )

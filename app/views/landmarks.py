@@ -19,6 +19,8 @@ import panel as pn
 from fbs_core.tire.landmarks import FINDING, NOTES
 from fbs_core.tire.storage import DATA_FILE
 
+from .layout import font
+
 __all__ = ["LANDMARKS_FILE", "load_landmarks", "landmarks_markdown", "landmarks_card"]
 
 #: The precomputed table (written by ``scripts/print_landmarks.py --json``).
@@ -89,7 +91,7 @@ def landmarks_card(parts: object = None) -> pn.Card:
     except (OSError, ValueError, KeyError) as exc:  # a missing or old file: say so
         text = f"The landmark table is not available ({exc})."
     return pn.Card(
-        pn.pane.Markdown(text, sizing_mode="stretch_width", styles={"font-size": "0.85em"}),
+        pn.pane.Markdown(text, sizing_mode="stretch_width", styles={"font-size": font("0.85em")}),
         title="The thesis' landmarks next to the reference tire (issue 14)",
         collapsible=True,
         collapsed=True,

@@ -1,17 +1,11 @@
 """The skeleton every view shares: a figure built once, redrawn from a published result.
 
-A view is a :class:`LiveView` subclass that says which result of the session's
+A view is a :class:`LiveView` subclass that says which published result of the session's
 :class:`~app.store.Results` it shows and how to draw it::
 
     class EigenView(LiveView):
         key = "eigen"                                   # CSV name, css class
-
-        def result(self):
-            return self.store.eigen
-
-        @param.depends("store.eigen", watch=True)
-        def _changed(self):
-            self.redraw()
+        result_name = "eigen"                           # the row of app.store.TABLE
 
         def _build(self):                              # Bokeh figures, once per session
             ...
@@ -19,7 +13,12 @@ A view is a :class:`LiveView` subclass that says which result of the session's
         def _draw(self, r):                            # assign sources from ``r``
             ...
 
-Drawing goes through the session's :class:`DrawQueue`: from any thread, the draws run one
+The view is redrawn when its result is published; its title block and its file names are
+those of the result's own snapshot. It computes nothing: the numbers, the CSV and the
+description are the result's.
+
+Drawing goes through the session's :class:`~app.runtime.draw.DrawQueue`: from any thread,
+the draws run one
 after the other on the session's event loop under its document lock (Bokeh's
 ``with_locked_document``), each one's patches written to the page before the next draw, in
 the order they were asked for. A redraw draws the result published *when it runs*, so
@@ -35,52 +34,51 @@ import io
 import logging
 import re
 import threading
-import weakref
-from collections import deque
-from functools import partial
 
 import panel as pn
 import param
-from bokeh.document import without_document_lock
-from panel.io.state import set_curdoc
 from panel.viewable import Viewer
 
 from .. import compute
-from ..export import to_csv
-from ..panel_private import html_model, html_text
-from ..report.bokeh import TitleBlockModels, style_figure
-from ..report.live import page_url, view_title
-from ..store import Result, Results
+from ..export import dated, export_columns, to_csv, to_uff
+from ..page.bokeh import TitleBlockModels, style_figure
+from ..page.titles import page_url, view_title
+from ..results import Result
+from ..runtime.draw import on_document, served_document
+from ..runtime.panel_private import html_model, html_text
+from ..store import Results
+from .layout import CAPTION_ROW_CSS, font, sized
 from .plots import fit_range
 
 
 def _plots_in(obj) -> list:
-    """The Bokeh plots of ``obj``: itself if it is one, else those of its layout in order."""
+    """The Bokeh plots of ``obj``: itself if it is one, else those of its layout in the
+    layout's order (``select`` walks the model graph in no set order: the phase view's
+    title block once landed on its lower plot)."""
     from bokeh.models import Plot
 
     if isinstance(obj, Plot):
         return [obj]
-    return list(obj.select({"type": Plot})) if hasattr(obj, "select") else []
+    children = getattr(obj, "children", None)
+    if children is None:
+        return list(obj.select({"type": Plot})) if hasattr(obj, "select") else []
+    out = []
+    for child in children:  # a grid's children are (model, row, column)
+        out += _plots_in(child[0] if isinstance(child, tuple) else child)
+    return out
 
 
 log = logging.getLogger(__name__)
 
 __all__ = [
-    "DrawQueue",
     "LiveText",
     "LiveView",
     "download_button",
+    "downloads",
+    "uff_button",
     "export_meta",
     "inline_html",
-    "on_document",
-    "served_document",
 ]
-
-
-def served_document():
-    """The Bokeh document of the current served session (None: no server)."""
-    doc = pn.state.curdoc
-    return doc if doc is not None and doc.session_context is not None else None
 
 
 def inline_html(text: str) -> str:
@@ -105,20 +103,26 @@ def export_meta(meta, url: str | None = None, now: dt.datetime | None = None) ->
     }
 
 
+#: Views whose data are functions of frequency: a UFF download beside the CSV one.
+UFF_VIEWS = ("mobility", "scatter", "uncoupled", "contributions", "phase")
+
+
 def download_button(key: str, result) -> pn.widgets.FileDownload:
-    """A CSV download of ``result()``: its columns under its own header and file name."""
+    """A CSV download of ``result()``: its columns under its own header, a file name with
+    the date (:func:`app.export.dated`)."""
 
     def callback():
         r = result()
         if r is None:
             return io.StringIO("")
-        btn.filename = r.filename
-        return io.StringIO(to_csv(r.columns, export_meta(r.meta), key))
+        btn.filename = dated(r.filename)
+        cols, meta = export_columns(r)
+        return io.StringIO(to_csv(cols, export_meta(meta), key))
 
     first = result()
     btn = pn.widgets.FileDownload(
         callback=callback,
-        filename=first.filename if first is not None else f"{key}.csv",
+        filename=dated(first.filename) if first is not None else f"{key}.csv",
         label="CSV",
         button_type="light",
         width=90,
@@ -128,100 +132,40 @@ def download_button(key: str, result) -> pn.widgets.FileDownload:
     return btn
 
 
-def on_document(doc, fn) -> None:
-    """Run ``fn`` (changes of Bokeh models) where it may change the served document
-    ``doc``: on the session's event loop under its lock, whichever thread asks (``doc``
-    None: no server, at once), after the changes asked for before it (:class:`DrawQueue`)."""
-    if doc is None or doc.session_context is None:
-        fn()  # no server: tests, notebooks, exports
-    else:
-        DrawQueue.of(doc).add(fn)
+def uff_button(key: str, result) -> pn.widgets.FileDownload:
+    """A UFF (dataset 58) download of ``result()`` beside its CSV download: its FRFs and
+    complex curves over frequency, the case of its snapshot in the ID lines, the node map
+    in ID line 5 (:func:`app.export.to_uff`)."""
+
+    def callback():
+        r = result()
+        if r is None:
+            return io.BytesIO(b"")
+        btn.filename = dated(r.filename.rsplit(".", 1)[0] + ".uff")
+        meta = export_meta({})
+        return io.BytesIO(to_uff(r, {k: meta[k] for k in ("exported", "fbs_core version")}))
+
+    first = result()
+    btn = pn.widgets.FileDownload(
+        callback=callback,
+        filename=dated(first.filename.rsplit(".", 1)[0] + ".uff")
+        if first is not None
+        else f"{key}.uff",
+        label="UFF",
+        button_type="light",
+        width=90,
+        embed=False,
+        css_classes=[f"download-uff-{key}"],
+    )
+    return btn
 
 
-class DrawQueue:
-    """A served session's draws, run one after the other on its event loop.
-
-    Each draw runs under the document lock (Bokeh's ``with_locked_document``) and its
-    patches are written to the socket before the next draw starts. Scheduled as separate
-    next-tick callbacks instead, every socket write of a draw (a data patch is seven
-    websocket frames) waited for one turn of the event loop, in which the session's other
-    waiting draws ran in full: the view drawn first (the Analysis card's shown view)
-    reached the page only after the main views' draws (10-40 ms each). One queue per
-    document, in the order the draws were asked for; a failing draw is logged and the
-    next one runs.
-    """
-
-    _queues: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-    _queues_lock = threading.Lock()
-
-    def __init__(self, doc) -> None:
-        self._doc = weakref.ref(doc)
-        self._fns: deque = deque()
-        self._lock = threading.Lock()
-        self._running = False
-
-    @classmethod
-    def of(cls, doc) -> DrawQueue:
-        """The queue of document ``doc`` (made on first use)."""
-        with cls._queues_lock:
-            q = cls._queues.get(doc)
-            if q is None:
-                q = cls._queues[doc] = cls(doc)
-            return q
-
-    @classmethod
-    def discard(cls, doc) -> None:
-        """Drop the draws still waiting for ``doc`` (its session ended: a next-tick callback
-        of a destroyed session may never run, and a waiting draw keeps its page alive)."""
-        if doc is None:
-            return
-        with cls._queues_lock:
-            q = cls._queues.pop(doc, None)
-        if q is not None:
-            q.clear()
-
-    def clear(self) -> None:
-        """Drop the draws waiting in this queue."""
-        with self._lock:
-            self._fns.clear()
-
-    def add(self, fn) -> None:
-        """Run ``fn`` after the draws already waiting (from any thread)."""
-        with self._lock:
-            self._fns.append(fn)
-            if self._running:
-                return
-            self._running = True
-        doc = self._doc()
-        try:
-            if doc is None:
-                raise RuntimeError("document gone")
-            doc.add_next_tick_callback(self._drain)  # thread-safe in Bokeh
-        except Exception:
-            with self._lock:  # the session is gone: nothing will draw
-                self._fns.clear()
-                self._running = False
-
-    @without_document_lock
-    async def _drain(self) -> None:
-        while True:
-            with self._lock:
-                if not self._fns:
-                    self._running = False
-                    return
-                fn = self._fns.popleft()
-            doc = self._doc()
-            if doc is None or doc.session_context is None:
-                continue
-            try:  # returns once the draw's patches are written (or the session ended)
-                await doc.session_context.with_locked_document(partial(_run_on, fn))
-            except Exception:
-                log.exception("drawing on the page failed")
-
-
-def _run_on(fn, doc) -> None:
-    with set_curdoc(doc):  # Panel components changed by ``fn`` find their document
-        fn()
+def downloads(key: str, result) -> list[pn.widgets.FileDownload]:
+    """The downloads of a view: CSV, and UFF for the views over frequency."""
+    out = [download_button(key, result)]
+    if key in UFF_VIEWS:
+        out.append(uff_button(key, result))
+    return out
 
 
 class LiveText:
@@ -274,10 +218,15 @@ class LiveView(Viewer):
 
     #: Short name: CSV view key and download css class.
     key = "view"
+    #: The published result shown (a row of :data:`app.store.TABLE`).
+    result_name = ""
+    #: Other published values whose change redraws the view.
+    also: tuple[str, ...] = ()
     #: Text beside the download button when the view has no caption of its own.
     note = ""
-    #: Smallest height of the plot row (px).
-    min_height = 340
+    #: CSS height of the view (None: it fills the card it is put in; see
+    #: app/views/layout.py).
+    css_height: str | None = None
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -289,11 +238,13 @@ class LiveView(Viewer):
         self._figures: list = []
         self._titles: list[TitleBlockModels] = []
         self._fits: list[tuple] = []  # ranges to fit after a draw's data (_fit)
+        if self.result_name:
+            self.store.param.watch(lambda _e: self.redraw(), [self.result_name, *self.also])
 
     # -- what a subclass provides ----------------------------------------------------------
     def result(self) -> Result | None:
         """The published result this view shows."""
-        raise NotImplementedError
+        return getattr(self.store, self.result_name)
 
     def _build(self) -> list:
         """The view's Bokeh figures (called once)."""
@@ -305,6 +256,10 @@ class LiveView(Viewer):
 
     def _controls(self) -> list:
         """Widgets shown in the view's header row."""
+        return []
+
+    def _messages(self) -> list:
+        """Messages of the header's controls, under them (e.g. of a typed number)."""
         return []
 
     # -- machinery ---------------------------------------------------------------------------
@@ -343,7 +298,7 @@ class LiveView(Viewer):
         self._draw(r)
         for rng, values in self._fits:  # after the data: the page renders linked plots once
             fit_range(rng, values)
-        self._draw_title()
+        self._draw_title(r)
 
     def _fit(self, rng, values) -> None:
         """Fit the range ``rng`` to ``values`` once the draw has set its data (ranges are
@@ -352,14 +307,12 @@ class LiveView(Viewer):
         self._fits.append((rng, values))
 
     # -- title block: what the plot shows, on the plot and in its saved PNG -----------------
-    def _title_state(self):
-        """The state snapshot the title describes (the band view: the band's own)."""
-        return self.store.snapshot()
-
-    def _draw_title(self) -> None:
-        if not self._titles:
+    def _draw_title(self, r: Result) -> None:
+        """The title block of ``r``'s own snapshot (the band's: the settings it was
+        computed for)."""
+        if not self._titles or r.snapshot is None:
             return
-        tb, stem = view_title(self.key, self._title_state(), page_url())
+        tb, stem = view_title(self.key, r.snapshot, page_url())
         for t in self._titles:
             t.update(tb, stem)
 
@@ -375,18 +328,34 @@ class LiveView(Viewer):
         for t in self._titles:
             t.style(self.mode)
 
-    def _header(self) -> pn.Row:
+    def _header(self) -> pn.viewable.Viewable:
         first: pn.pane.HTML | LiveText
         if self.note:
             first = pn.pane.HTML(
                 f"<p>{inline_html(self.note)}</p>",
                 margin=(0, 10),
-                styles={"color": "#495057", "font-size": "0.9em"},
+                styles={"color": "#495057", "font-size": font("0.9em")},
                 sizing_mode="stretch_width",
             )
         else:
             first = self._caption = LiveText()
-        return pn.Row(*self._controls(), first, download_button(self.key, self.result))
+        controls = self._controls()
+        download = downloads(self.key, self.result)
+        if controls:  # the controls on lines of their own (wrapped), the caption below them
+            return pn.Column(
+                pn.FlexBox(
+                    *controls,
+                    *download,
+                    flex_wrap="wrap",
+                    align_items="flex-end",
+                    sizing_mode="stretch_width",
+                ),
+                *self._messages(),
+                first,
+                sizing_mode="stretch_width",
+            )
+        # a caption and a CSV button only repeat the title block: not on the projector
+        return pn.Row(first, *download, stylesheets=[CAPTION_ROW_CSS])
 
     def __panel__(self):
         if self._layout is None:
@@ -399,12 +368,13 @@ class LiveView(Viewer):
             self._titles = [TitleBlockModels(plots[0]) for plots in per_object if plots]
             self._restyle_now()
             header = self._header()
-            plots = [
-                pn.pane.Bokeh(f, sizing_mode="stretch_both", min_height=self.min_height)
-                for f in figures
-            ]
+            plots = [pn.pane.Bokeh(f, sizing_mode="stretch_both") for f in figures]
             body = plots[0] if len(plots) == 1 else pn.Row(*plots, sizing_mode="stretch_both")
-            self._layout = pn.Column(header, *self._extra(), body, sizing_mode="stretch_both")
+            parts = (header, *self._extra(), body)
+            if self.css_height is None:  # the card around it gives the height
+                self._layout = pn.Column(*parts, sizing_mode="stretch_both")
+            else:
+                self._layout = sized(*parts, height=self.css_height)
             self._apply()
         return self._layout
 

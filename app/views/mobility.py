@@ -6,30 +6,52 @@ chassis' spindle-to-bushing mobility (figs. 4.2-4.3).
 
 from __future__ import annotations
 
+import html
+
+import numpy as np
 import panel as pn
 import param
 from bokeh.core.property.vectorization import value
+from bokeh.events import Tap
+from bokeh.models import ColumnDataSource, HoverTool, Label, Span
 
+from fbs_core.vocabulary import DIRECTIONS
+
+from .analysis_base import TERM_COLORS
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
-from .live import LiveView
+from .layout import font
+from .live import LiveText, LiveView
 from .plots import add_line, frequency_range, new_figure
+
+#: The cursors' colour (the phase view's) and line styles.
+CURSOR_COLOR = "#5f3dc4"
+CURSOR_DASH = ("solid", "dashed")
+#: Height (px) of a line of the cursors' readout in the normal and the presentation view.
+READOUT_LINE_PX = {"normal": 24, "present": 30}
+#: Type of the cursors' labels in the normal and the presentation view.
+CURSOR_LABEL_SIZES = {"normal": "12px", "present": "16px"}
 
 
 class MobilityView(LiveView):
-    """Coupled bushing response v_e* in dB versus frequency (thesis eq. 4.1)."""
+    """Coupled bushing response v_e* versus frequency (thesis eq. 4.1), as a test lab's FRF
+    display: further DOFs overlaid, a dB or linear level axis and two labelled cursors
+    with a readout (the published ``response_plot``, :mod:`app.results.response_plot`)."""
 
     key = "mobility"
+    result_name = "response"
+    also = ("response_plot",)
     x_range = param.Parameter(
         default=None,
         doc="Frequency range shared with other views (linked zoom and pan); a new one if None.",
     )
 
-    def result(self):
-        return self.store.response
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._next_cursor = 1
+        self._readout = LiveText(css_classes=["mobility-readout"])
 
-    @param.depends("store.response", watch=True)
-    def _changed(self):
-        self.redraw()
+    def _extra(self):
+        return [self._readout]
 
     def _build(self):
         if self.x_range is None:
@@ -55,33 +77,170 @@ class MobilityView(LiveView):
             dash="dashed",
             tooltips=level_tooltips("N retained modes"),
         )
+        # one line per DOF that may be overlaid (hidden while not), Okabe-Ito colours
+        self._over = {}
+        for d, color in zip(DIRECTIONS, TERM_COLORS, strict=True):
+            src = add_line(
+                fig,
+                f"mobility.overlay_{d}",
+                color=color,
+                legend=f"bushing:{d}",
+                tooltips=level_tooltips(f"bushing:{d}"),
+            )
+            self._over[d] = src
+        self._set_overlays(())
+        self._cursor_spans = [
+            Span(
+                location=0,
+                dimension="height",
+                line_color=CURSOR_COLOR,
+                line_width=1.5,
+                line_dash=dash,
+                visible=False,
+                name=f"mobility.cursor{k + 1}",
+            )
+            for k, dash in enumerate(CURSOR_DASH)
+        ]
+        self._cursor_labels = [
+            Label(
+                x=0,
+                y=4,
+                y_units="screen",
+                x_offset=4,
+                text=f"f{k + 1}",
+                text_color=CURSOR_COLOR,
+                text_font_size=CURSOR_LABEL_SIZES["normal"],
+                text_font_style="bold",
+                background_fill_color="white",
+                background_fill_alpha=0.8,
+                visible=False,
+                name=f"mobility.cursor_label{k + 1}",
+            )
+            for k in range(2)
+        ]
+        for m in (*self._cursor_spans, *self._cursor_labels):
+            fig.add_layout(m)
+        self._cursor_points = ColumnDataSource({"freq": [], "level": []}, name="mobility.cursors")
+        fig.scatter("freq", "level", source=self._cursor_points, size=9, color=CURSOR_COLOR)
+        fig.on_event(Tap, self._tapped)
+        self._scale = "dB"
         return [fig]
+
+    def _tapped(self, event):
+        """A click on the plot places cursor 1, the next one cursor 2, and so on."""
+        if event.x is None:
+            return
+        p = self.store.state.plot
+        f = float(np.clip(round(event.x, 2), 0.01, 1000.0))
+        if self._next_cursor == 1:
+            p.cursor1 = f
+            self._next_cursor = 2
+        else:
+            p.cursor2 = f
+            self._next_cursor = 1
+
+    def _restyle_now(self) -> None:
+        super()._restyle_now()
+        for lb in self._cursor_labels:
+            lb.text_font_size = CURSOR_LABEL_SIZES[self.mode]
+        self._readout.model.styles = {"font-size": font("0.9em")}
+
+    def _legend_items(self):
+        return self._fig.legend[0].items if self._fig.legend else []
+
+    def _set_overlays(self, shown) -> None:
+        for item in self._legend_items():
+            for src_dof, src in self._over.items():
+                if item.renderers and item.renderers[0].data_source is src:
+                    item.visible = src_dof in shown
+                    item.renderers[0].visible = src_dof in shown
+
+    def _set_scale(self, scale: str) -> None:
+        """Hover lines in the level scale's unit (dB, or the magnitude's)."""
+        if scale == self._scale:
+            return
+        self._scale = scale
+        fmt = "{0.0} dB" if scale == "dB" else "{0.000}"
+        for tool in self._fig.select({"type": HoverTool}):
+            tool.tooltips = [(a, "@level" + fmt if a == "Level" else b) for a, b in tool.tooltips]
 
     def _draw(self, r):
         c = r.columns
-        self._ref.data = {"freq": c["freq_Hz"], "level": c["reference_dB"]}
-        self._tr.data = {"freq": c["freq_Hz"], "level": c["truncated_dB"]}
-        self._fig.yaxis.axis_label = level_label(r.draw["dof"])
+        f = c["freq_Hz"]
+        p = self.store.response_plot
+        # the plot's extras only when made of the same case (they are published just after)
+        extras = p if p is not None and p.key[: len(r.key)] == r.key else None
+        if extras is None:
+            self._ref.data = {"freq": f, "level": c["reference_dB"]}
+            self._tr.data = {"freq": f, "level": c["truncated_dB"]}
+            self._fig.yaxis.axis_label = level_label(r.draw["dof"])
+        else:
+            self._draw_extras(extras.draw)
         label = r.draw.get("truncated_label")
-        for item in self._fig.legend[0].items if label and self._fig.legend else ():
+        for item in self._legend_items() if label else ():
             if item.renderers and item.renderers[0].data_source is self._tr:
                 item.label = value(label)  # "N retained modes" or "... + residual"
-        self._fit(self.x_range, c["freq_Hz"])
+        self._fit(self.x_range, f)
+
+    def _draw_extras(self, d) -> None:
+        f = d["freq"]
+        curves = d["curves"]
+        self._set_scale(d["scale"])
+        self._ref.data = {"freq": f, "level": curves[0]["y"]}
+        self._tr.data = {"freq": f, "level": curves[1]["y"]}
+        shown = []
+        for cv in curves[2:]:
+            self._over[cv["dof"]].data = {"freq": f, "level": cv["y"]}
+            shown.append(cv["dof"])
+        for item in self._legend_items():
+            for dof, src in self._over.items():
+                if dof in shown and item.renderers and item.renderers[0].data_source is src:
+                    item.label = value(next(cv["label"] for cv in curves if cv["dof"] == dof))
+        self._set_overlays(shown)
+        self._fig.yaxis.axis_label = d["y_label"]
+        on = {cur["k"]: cur for cur in d["cursors"]}
+        for k, (span, lb) in enumerate(zip(self._cursor_spans, self._cursor_labels, strict=True)):
+            cur = on.get(k + 1)
+            span.visible = lb.visible = cur is not None
+            if cur is not None:
+                span.location = lb.x = cur["f"]
+        pts = [cur for cur in d["cursors"] if cur["y"] is not None]
+        self._cursor_points.data = {
+            "freq": [cur["f"] for cur in pts],
+            "level": [cur["y"] for cur in pts],
+        }
+        errors = [cur["error"] for cur in d["cursors"]]
+        self._readout.text = readout_html(d["readout"], errors)
+        # its height stated: a text set in place keeps the height of its first layout (the
+        # table lay over the plot's title block)
+        lines = len(d["readout"]["rows"]) + 1 + sum(1 for x in errors if x)
+        line = READOUT_LINE_PX[self.mode]
+        self._readout.model.height = lines * line + 6 if d["readout"]["rows"] else 0
+
+
+def readout_html(readout: dict, errors: list[str]) -> str:
+    """The cursors' readout as an HTML table (escaped: DOF labels may come from uploads)."""
+    if not readout["rows"]:
+        return ""
+    e = html.escape
+    head = "".join(f'<th style="padding:0 8px">{e(h)}</th>' for h in readout["header"])
+    body = "".join(
+        "<tr>" + "".join(f'<td style="padding:0 8px">{e(str(x))}</td>' for x in row) + "</tr>"
+        for row in readout["rows"]
+    )
+    notes = "".join(f"<div>{e(x)}</div>" for x in errors if x)
+    return (
+        '<table class="cursor-readout" style="border-collapse:collapse;text-align:right">'
+        f"<tr>{head}</tr>{body}</table>{notes}"
+    )
 
 
 class UncoupledView(LiveView):
     """Uncoupled tire hub response and chassis spindle-to-bushing mobility."""
 
     key = "uncoupled"
+    result_name = "uncoupled"
     x_range = param.Parameter(default=None, doc="Shared frequency range; a new one if None.")
-    min_height = 300
-
-    def result(self):
-        return self.store.uncoupled
-
-    @param.depends("store.uncoupled", watch=True)
-    def _changed(self):
-        self.redraw()
 
     def _controls(self):
         return [

@@ -17,6 +17,7 @@ import param
 from panel.viewable import Viewer
 
 from ..store import Results
+from .layout import font
 from .live import download_button, inline_html
 
 #: Badge colours (background, text) by the worst leave-one-out error: < 1 dB, < 3 dB, more.
@@ -56,7 +57,7 @@ def quality_html(r) -> str:
         f'padding:1px 8px;border-radius:10px;font-weight:600">'
         f"interpolation {worst_txt}</span> "
         f"<span>{inline_html(r.caption)} (dB); {cover}</span>"
-        f'<table class="tire-quality-table" style="font-size:0.85em;margin-top:2px">'
+        f'<table class="tire-quality-table" style="font-size:{font("0.85em")};margin-top:2px">'
         f"<tr><th></th>{head}</tr><tr><th>dB</th>{cells}</tr></table>"
         f"{warn_html}</div>"
     )
@@ -70,8 +71,8 @@ class TireQualityView(Viewer):
     def __init__(self, **params):
         super().__init__(**params)
         self._layout = None
+        self.store.param.watch(lambda _e: self._changed(), ["tire_quality"])
 
-    @param.depends("store.tire_quality", watch=True)
     def _changed(self):
         if self._layout is None or self.store.closed:
             return

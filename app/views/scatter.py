@@ -1,43 +1,50 @@
 """Monte-Carlo noise scatter band (thesis section 5.2, figs. 5.9-5.11).
 
 The band is computed by the session's :class:`~app.store.Results` off the session's threads
-(:mod:`app.bands`); this view draws the published band and its status line, and a click on
-the plot picks the round with the highest level at that frequency.
+(:mod:`app.runtime.bands`); this view draws the published band and its status line, and a click on
+the plot picks the round with the highest level at that frequency. With the state's
+``noise.first_order`` on it overlays the first-order band of the same noise (the store's
+``first_order`` row, computed only while shown; docs/corridor.md section 6).
 """
 
 from __future__ import annotations
 
-import dataclasses
-
+import numpy as np
 import panel as pn
 import param
 from bokeh.core.properties import value
 from bokeh.events import Tap
+from bokeh.models import ColumnDataSource
 
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
-from .live import LiveText, LiveView, download_button, inline_html
-from .plots import add_band, add_line, frequency_range, new_figure
+from .layout import font
+from .live import LiveText, LiveView, downloads, inline_html
+from .plots import add_band, add_line, frequency_range, new_figure, set_data
 
-#: Styles of the progress bar: hidden when idle (its box kept: no new layout of the page).
-IDLE = {"visibility": "hidden"}
-BUSY = {"visibility": "visible"}
+#: The overlay's legend (its band's quantile said once drawn).
+FIRST_ORDER_LEGEND = "first-order band (linearised)"
+#: The progress bar is hidden when idle (its box kept: no new layout of the page). The rule
+#: follows the bar's own ``active`` class: the bar's ``styles`` are copied onto the inner
+#: ``<progress>`` element once, when it is drawn, so a bar drawn idle stayed hidden for
+#: good (issue 29: no bar on a page whose first band was ready when it loaded).
+IDLE_CSS = "progress:not(.active) { visibility: hidden; }"
 
 
 class ScatterBandView(LiveView):
     """Min/max corridor, percentile band, unpolluted reference and one single round."""
 
     key = "scatter"
+    result_name = "band_curves"
+    also = ("band_status", "first_order")
     x_range = param.Parameter(
         default=None,
         doc="Frequency range shared with other views (linked zoom and pan); a new one if None.",
     )
 
-    def result(self):
-        return self.store.band_curves
-
-    @param.depends("store.band_curves", "store.band_status", watch=True)
-    def _changed(self):
-        self.redraw()
+    def __init__(self, **params):
+        super().__init__(**params)
+        # switched off, the overlay is hidden (the row is not published again for that)
+        self.store.state.noise.param.watch(lambda _e: self.redraw(), "first_order")
 
     def _header(self):
         # The indicator and the status line keep their place and size: changing their
@@ -53,7 +60,7 @@ class ScatterBandView(LiveView):
             height=14,
             css_classes=["scatter-progress"],
             margin=(12, 10),
-            styles=IDLE,
+            stylesheets=[IDLE_CSS],
         )
         self._cancel = pn.widgets.Button(
             label="Cancel band",
@@ -68,7 +75,7 @@ class ScatterBandView(LiveView):
             self._progress,
             self._cancel,
             pn.layout.HSpacer(),
-            download_button(self.key, self.result),
+            *downloads(self.key, self.result),
         )
 
     def _extra(self):
@@ -76,7 +83,7 @@ class ScatterBandView(LiveView):
         self._status = LiveText(
             height=40,
             css_classes=["scatter-status"],
-            styles={"font-size": "0.85em", "line-height": "1.3"},
+            styles={"font-size": font("0.85em"), "line-height": "1.3"},
         )
         return [self._status]
 
@@ -114,23 +121,45 @@ class ScatterBandView(LiveView):
             legend="single round",
             tooltips=level_tooltips("single round"),
         )
+        self._first = ColumnDataSource(
+            {"freq": np.zeros(0), "low": np.zeros(0), "high": np.zeros(0)},
+            name="scatter.first_order",
+        )
+        for edge in ("low", "high"):
+            add_line(
+                fig,
+                f"scatter.first_order.{edge}",
+                color=COLORS["first_order"],
+                legend=FIRST_ORDER_LEGEND,
+                tooltips=level_tooltips(f"first-order {edge} edge", column=edge),
+                y=edge,
+                dash="dashed",
+                width=1.5,
+                source=self._first,
+            )
+        for leg in fig.legend:  # hidden until the overlay is drawn
+            for item in leg.items:
+                if getattr(item.label, "value", None) == FIRST_ORDER_LEGEND:
+                    item.visible = False
         fig.on_event(Tap, self._tapped)
         return [fig]
 
-    def _title_state(self):
-        """The band's own settings (it may be older than the controls), the shown DOF,
-        percentile band and round."""
-        s = self.store.snapshot()
-        band = self.store.band
-        if band is None:
-            return s
-        k = min(s.single_round, band.result.rounds - 1)
-        return dataclasses.replace(
-            band.settings, dof=s.dof, percentile=s.percentile, single_round=k
+    def _overlay(self, r):
+        """The published first-order result when it is shown and of the drawn band, DOF and
+        percentile band (else None: the overlay is empty)."""
+        fo = self.store.first_order
+        if not self.store.state.noise.first_order or fo is None:
+            return None
+        same = fo.core["band"] is r.core["band"] and (fo.draw["dof"], fo.draw["percentile"]) == (
+            r.draw["dof"],
+            r.snapshot.percentile if r.snapshot is not None else None,
         )
+        return fo if same else None
 
-    def _draw_title(self):
-        super()._draw_title()
+    def _draw_title(self, r):
+        """The band's own settings (it may be older than the controls: the heading says
+        so), the shown DOF, percentile band and round."""
+        super()._draw_title(r)
         st, band = self.store.band_status, self.store.band
         stale = band is not None and band.settings.band_key() != self.store.snapshot().band_key()
         for t in self._titles:
@@ -154,9 +183,7 @@ class ScatterBandView(LiveView):
         self._status.text = f"<p>{inline_html(st.text)}</p>" if st.text else ""
         value = (st.percent if st.total else -1) if st.busy else 0
         if self._progress.active != st.busy or self._progress.value != value:
-            self._progress.param.update(
-                active=st.busy, value=value, styles=BUSY if st.busy else IDLE
-            )
+            self._progress.param.update(active=st.busy, value=value)
         if self._cancel.disabled == st.busy:
             self._cancel.disabled = not st.busy
 
@@ -167,15 +194,36 @@ class ScatterBandView(LiveView):
         self._pct.data = {"freq": f, "lower": d["pct_low_db"], "upper": d["pct_high_db"]}
         self._ref.data = {"freq": f, "level": d["reference_db"]}
         self._round.data = {"freq": f, "level": single["round_db"]}
+        fo = self._overlay(r)
+        if fo is None:
+            set_data(self._first, {"freq": [], "low": [], "high": []})
+        else:
+            c = fo.columns
+            set_data(
+                self._first,
+                {
+                    "freq": c["freq_Hz"],
+                    "low": c["first_order_low_dB"],
+                    "high": c["first_order_high_dB"],
+                },
+            )
         self._fig.yaxis.axis_label = level_label(r.draw["dof"], "Band level")
         labels = [
             f"min-max over {r.meta['rounds']:,} rounds",
             f"central band, percentiles {r.meta['percentiles']} %",
             "unpolluted",
             f"round #{r.meta['single round']} (click: highest round there)",
+            FIRST_ORDER_LEGEND
+            if fo is None
+            else f"first order: |v| \u00b1 {fo.draw['k']:.3f} std (linearised, Gaussian "
+            f"{r.meta['percentiles']} %)",
         ]
         for leg in self._fig.legend:
             for item, text in zip(leg.items, labels, strict=False):
                 if getattr(item.label, "value", None) != text:
                     item.label = value(text)
+            if len(leg.items) > len(labels) - 1:
+                item = leg.items[len(labels) - 1]
+                if item.visible != (fo is not None):
+                    item.visible = fo is not None
         self._fit(self.x_range, f)

@@ -7,13 +7,15 @@ import numpy as np
 import panel as pn
 import param
 from bokeh.core.properties import value
+from bokeh.models import FixedTicker
 from panel.viewable import Viewer
 
-from ..report.bokeh import ErrorMapLayers
+from ..page.bokeh import ErrorMapLayers
 from ..report.colormap import LINE_STYLES, log_rows
+from ..runtime.draw import on_document, served_document
 from ..store import Results
 from .common import COLORS, MODES_LABEL
-from .live import LiveText, LiveView, download_button, inline_html, on_document, served_document
+from .live import LiveText, LiveView, download_button, inline_html
 from .plots import (
     add_image,
     add_line,
@@ -23,6 +25,9 @@ from .plots import (
     new_figure,
     set_data,
 )
+
+#: Ticks of a logarithmic N axis (1-2-5, and the reference tire's 400).
+LOG_N_TICKS = (10, 20, 50, 100, 200, 400, 1000, 2000)
 
 #: Eigenfrequency curves of fig. 5.8: column -> (legend, colour).
 EIGEN_STYLES = {
@@ -50,6 +55,7 @@ class TruncationView(LiveView):
     """Error over centre frequency and retained modes, colour capped at the threshold."""
 
     key = "truncation"
+    result_name = "error_map"
     note = (
         "Error vs all modes, 12 Hz floating band; blue below the threshold (darker: larger), "
         "red at or above it, black line: the threshold contour."
@@ -68,13 +74,6 @@ class TruncationView(LiveView):
         doc="Scale of the N axis (log: the detail below N = 100 spreads out); set at build.",
     )
 
-    def result(self):
-        return self.store.error_map
-
-    @param.depends("store.error_map", watch=True)
-    def _changed(self):
-        self.redraw()
-
     def _build(self):
         if self.x_range is None:
             self.x_range = frequency_range()
@@ -90,6 +89,8 @@ class TruncationView(LiveView):
         )
         fig.grid.visible = False
         fig.title.visible = False  # the title block above says what the map shows
+        if self.n_axis == "log":  # Bokeh's log ticks ran into each other from 150 to 400
+            fig.yaxis.ticker = FixedTicker(ticks=list(LOG_N_TICKS))
         self._src, self._mapper, self._bar = add_image(
             fig,
             "truncation.map",
@@ -179,6 +180,15 @@ class TruncationView(LiveView):
         self._fit(self.x_range, d["freq"])
 
 
+#: Headings of the suggested-modes table (its columns keep their full names in the data).
+TABLE_TITLES = {
+    "Harmonic": "Case",
+    "Suggested N": "N",
+    "N with residuals": "N, residual",
+    "Highest eigenfreq. (Hz)": "Highest eig. (Hz)",
+}
+
+
 class SuggestedModesView(Viewer):
     """Suggested number of modes for all seven harmonics (thesis table 5.1)."""
 
@@ -188,6 +198,7 @@ class SuggestedModesView(Viewer):
         super().__init__(**params)
         self._layout = None
         self._doc = None
+        self.store.param.watch(lambda _e: self._changed(), ["suggested"])
 
     @staticmethod
     def frame(r):
@@ -210,7 +221,6 @@ class SuggestedModesView(Viewer):
         cols["Highest eigenfreq. (Hz)"] = shown["eigenfrequency"].round(1)
         return pd.DataFrame(cols)
 
-    @param.depends("store.suggested", watch=True)
     def _changed(self):
         if self._layout is None or self.store.closed:
             return
@@ -237,6 +247,8 @@ class SuggestedModesView(Viewer):
                 sizing_mode="stretch_width",
                 css_classes=["suggested-table"],
                 layout="fit_data_stretch",
+                # short headings: the table fits half the width of a 1280 px window
+                titles=TABLE_TITLES,
                 theme="bootstrap5",
             )
             self._caption = LiveText(
@@ -253,26 +265,18 @@ class EigenView(LiveView):
     """Highest retained eigenfrequency versus number of modes at 20/80/120 km/h (fig. 5.8)."""
 
     key = "eigen"
+    result_name = "eigen"
     note = "Highest eigenfrequency among N retained modes (N/2 +/- pairs, lowest first)."
-    min_height = 300
     n_range = param.Parameter(
         default=None,
         doc="Retained-modes range shared with the "
         "truncation map's N axis (linked zoom); own if None.",
     )
 
-    def result(self):
-        return self.store.eigen
-
-    @param.depends("store.eigen", watch=True)
-    def _changed(self):
-        self.redraw()
-
     def _build(self):
         fig = new_figure(
             x_label=MODES_LABEL,
             y_label="Highest retained eigenfrequency (Hz)",
-            title="Eigenfrequency vs mode number",
             min_height=300,
             name="eigen.figure",
             x_range=self.n_range,

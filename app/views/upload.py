@@ -4,6 +4,11 @@ The files go to the session's :class:`~app.datasource.DataSource` (read with
 :mod:`fbs_core.io`, checked, never written anywhere); the page shows what was read
 (quantity, DOFs, frequency range, operating points) or why the file was refused. A refused
 file changes nothing; "Use reference data" goes back to the shipped models.
+
+The reading runs on the upload queue's threads (:mod:`app.runtime.uploads`), never on the Panel
+worker thread that received the file: a slow file holds no thread the other sessions'
+controls need, a session has one reading per kind of file waiting, and a closed tab stops
+its reading.
 """
 
 from __future__ import annotations
@@ -15,6 +20,8 @@ import param
 from panel.viewable import Viewer
 
 from ..datasource import CHASSIS_ACCEPT, TIRE_ACCEPT, DataSource
+from ..runtime.bands import served
+from ..runtime.uploads import UPLOADS
 
 HELP = (
     "Chassis FRF: UFF 58 (.uff/.unv), MATLAB (.mat), CSV or HDF5 (.h5), layouts in "
@@ -104,23 +111,41 @@ class UploadView(Viewer):
         )
         self.chassis_file.param.watch(self._on_chassis, "value")
         self.tire_file.param.watch(self._on_tire, "value")
-        self.reread.on_click(lambda _: self._run(ds.load_chassis))
+        self.reread.on_click(lambda _: self._run("chassis", ds.load_chassis))
         # a new node name or the interpolation choice re-reads the chassis file at once;
         # this also settles a click on "Read chassis again" that overtook the change
         # (Panel hands both to its worker threads, in either order)
         ds.param.watch(
-            lambda *_: self._run(ds.reread_if_changed),
+            lambda *_: self._run("chassis", ds.reread_if_changed),
             ["spindle", "bushing", "interpolate", "quantity"],
         )
-        self.reset.on_click(lambda _: ds.reset())
+        self.reset.on_click(lambda _: self._reset())
+        doc = pn.state.curdoc
+        if doc is not None and doc.session_context is not None:  # served: a tab to close
+            doc.on_session_destroyed(lambda _ctx, owner=ds: UPLOADS.cancel(owner))
 
     # -- actions (each a call into the data source; errors land in ``data.error``) --------
-    def _run(self, fn, *args):
+    def _run(self, slot: str, fn, *args):
+        """Read on the upload queue (see the module); ``slot``: "chassis" or "tire"."""
+
+        def job():
+            try:
+                fn(*args)
+            finally:
+                self._busy(False)
+
         self._busy(True)
-        try:
-            fn(*args)
-        finally:
+        if not served():  # a notebook or a test: no other sessions, read here
+            job()
+        elif UPLOADS.submit(self.data, slot, job, self._refused) is None:
             self._busy(False)
+
+    def _refused(self, message: str) -> None:
+        self.data.error = message
+
+    def _reset(self):
+        UPLOADS.cancel(self.data)
+        self.data.reset()
 
     def _busy(self, on: bool):
         for w in (self.chassis_file, self.tire_file, self.reread, self.reset):
@@ -129,11 +154,11 @@ class UploadView(Viewer):
     # an empty file (b"") is read too: the page says it is empty instead of ignoring it
     def _on_chassis(self, event):
         if event.new is not None:
-            self._run(self.data.load_chassis, event.new, self.chassis_file.filename)
+            self._run("chassis", self.data.load_chassis, event.new, self.chassis_file.filename)
 
     def _on_tire(self, event):
         if event.new is not None:
-            self._run(self.data.load_tire, event.new, self.tire_file.filename)
+            self._run("tire", self.data.load_tire, event.new, self.tire_file.filename)
 
     # -- display -----------------------------------------------------------------------
     @param.depends("data.models", "data.tire_summary", "data.chassis_summary")

@@ -39,15 +39,32 @@ class PageState(param.Parameterized):
     data = param.String(
         default="", doc="The uploads the page's results need (empty: the reference models)."
     )
+    sidebar: param.Selector[str] = param.Selector(
+        default="auto",
+        objects=["auto", "open", "closed"],
+        doc="The controls' sidebar: auto (open in the normal view, collapsed in the "
+        "presentation view), or as the user left it.",
+    )
+
+    @property
+    def sidebar_collapsed(self) -> bool:
+        """Whether the sidebar is collapsed."""
+        return bool(self.sidebar == "closed" or (self.sidebar == "auto" and self.view == "present"))
 
 
 #: URL query keys of the page state.
-PAGE_URL_KEYS = {"view": "view", "data_card": "card", "n_axis": "naxis", "data": "data"}
+PAGE_URL_KEYS = {
+    "view": "view",
+    "data_card": "card",
+    "n_axis": "naxis",
+    "data": "data",
+    "sidebar": "sidebar",
+}
 
 #: Larger type of the controls and cards in the presentation view: the page's font size
 #: and Bokeh's font-size variable, which the widgets and cards inside their shadow roots
 #: inherit (a document-level selector such as ``.card-title`` does not reach them).
-PRESENT_RULE = "font-size: 17px; --bokeh-font-size: 16px;"
+PRESENT_RULE = "font-size: 17px; --bokeh-font-size: 17px;"
 #: Classes of ``<body>`` set by the page's view switch in the browser (no reload needed).
 PRESENT_CLASS, NORMAL_CLASS = "fbs-present", "fbs-normal"
 

@@ -34,7 +34,6 @@ rounds a page draws and the band's reference run on the calling thread without t
 from __future__ import annotations
 
 import os
-import sys
 import threading
 import time
 from collections import deque
@@ -44,7 +43,11 @@ import panel as pn
 
 from fbs_core.errors import FBSError, StudyCancelled
 
-from . import compute, offload
+from .. import compute
+from . import offload
+from .draw import served
+from .priority import BACKGROUND_NICE
+from .priority import lower_priority as _lower
 
 __all__ = [
     "BAND_NICE",
@@ -54,6 +57,7 @@ __all__ = [
     "Turnstile",
     "TURNSTILE",
     "band_nice",
+    "done_text",
     "lower_priority",
     "run",
     "served",
@@ -62,7 +66,7 @@ __all__ = [
 
 #: How much a band's thread raises its nice value (lowers its CPU priority), unless
 #: ``FBS_BAND_NICE`` says otherwise (0: bands run at the server's priority).
-BAND_NICE = 10
+BAND_NICE = BACKGROUND_NICE
 BAND_NICE_ENV = "FBS_BAND_NICE"
 
 
@@ -75,29 +79,9 @@ def band_nice() -> int:
 
 
 def lower_priority(by: int | None = None) -> int | None:
-    """Raise the calling thread's nice value by ``by`` (default :func:`band_nice`, at most
-    to 19); its new value.
-
-    Linux only (``setpriority`` with the thread's id acts on that thread alone, and threads
-    it starts later inherit it); elsewhere, or when refused, nothing changes and None is
-    returned. Relative, so a server started with ``nice`` keeps the difference.
-    """
-    by = band_nice() if by is None else by
-    if not sys.platform.startswith("linux"):  # elsewhere the id would name a process
-        return None
-    tid = threading.get_native_id()
-    try:
-        now = os.getpriority(os.PRIO_PROCESS, tid)
-        os.setpriority(os.PRIO_PROCESS, tid, min(19, now + by))
-        return os.getpriority(os.PRIO_PROCESS, tid)
-    except OSError:  # refused (e.g. a sandbox without the right to renice)
-        return None
-
-
-def served() -> bool:
-    """True inside a served browser session (else: tests, notebooks, the warm-up)."""
-    doc = pn.state.curdoc
-    return doc is not None and doc.session_context is not None
+    """Raise the calling thread's nice value by ``by`` (default :func:`band_nice`), see
+    :func:`app.runtime.priority.lower_priority`; its new value (None: unchanged)."""
+    return _lower(band_nice() if by is None else by)
 
 
 class Job:
@@ -345,3 +329,25 @@ def start(
     t = threading.Thread(target=work, name="scatter-band", daemon=True)
     t.start()
     return t
+
+
+def done_text(result, seconds: float, key: tuple, now: float | None = None) -> str:
+    """The status line of a finished band ``result`` of settings ``key``, ``seconds``
+    after it was asked for: its rounds, how long it took (or that it was computed before,
+    and how long it took then), and how well the rounds fix its central 5-95 % band
+    (:func:`app.compute.percentile_confidence_db`: to halve it, four times the rounds)."""
+    rec = compute.band_computed(key)
+    now = time.monotonic() if now is None else now
+    if rec is not None and rec.ready < now - seconds - 0.05:  # ready before it was asked
+        took = "" if rec.seconds is None else f", in {rec.seconds:.2f} s"
+        when = f"computed before{took}"
+    else:
+        when = f"in {seconds:.2f} s"
+    conf = compute.percentile_confidence_db(result)
+    edges = (
+        f"5-95 % band edges within ±{conf:.2f} dB (95 % confidence, lines within "
+        f"{compute.CONVERGENCE_WITHIN_DB:g} dB of the peak; four times the rounds halve it)"
+        if conf == conf
+        else "no line within the peak's range to judge the band by"
+    )
+    return f"{result.rounds:,} rounds {when} &middot; {edges}"

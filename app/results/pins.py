@@ -1,20 +1,23 @@
 """Pinned baselines of the Compare tab (issue 18): what a pin holds and the comparison.
 
-A pin is the session's state at one moment, named (up to four,
-:data:`fbs_core.analysis.MAX_PINS`): its settings (:class:`~app.analysis_state.PinSettings`,
-in the URL as ``pins=``) and its data as a :class:`fbs_core.analysis.PinnedState` (the coupled
-response with N and all modes at its DOF, the scatter band's edges when its band was
-computed, its provenance: models, fbs_core version, time). The data are recomputed from the
-settings through the same caches as the live views (:mod:`app.compute`), so a pin made by a
-click and one restored from a link are the same; a pin of uploaded data can only be
-restored where the same upload is loaded (its models key is a digest of the bytes).
+A pin is the session's snapshot at one moment, named (up to four,
+:data:`fbs_core.analysis.MAX_PINS`). In the URL (``pins=``) it travels as the settings that
+change its numbers (:class:`~app.analysis_state.PinSettings`: the case, residual
+compensation included, the noise study, the models); in the session it keeps its whole
+:class:`~app.results.base.Snapshot` and its data as a :class:`fbs_core.analysis.PinnedState`
+(the coupled response with N and all modes at its DOF, made by the coupled-response view's
+own :func:`~app.results.main.response_result`; the scatter band's edges when its band was
+computed; its provenance: models, fbs_core version, time). A pin made by a click and one
+restored from a link are the same; a pin of uploaded data can only be restored where the
+same upload is loaded (its models key is a digest of the bytes).
 
-The comparison (:func:`compare_result`) overlays the current coupled response and the
-pins', gives their difference in dB (:func:`fbs_core.analysis.db_difference`, current minus
-pin, only on the same frequency grid: another harmonic has no difference curve), the band
-edges of each, and the error map of the current state minus the chosen pin's
-(:func:`fbs_core.analysis.truncation_map_difference`, same harmonic only) at the current
-map DOF.
+The comparison (:func:`compare_result`) overlays the current coupled response (the
+coupled-response view's) and the pins', gives their difference in dB
+(:func:`fbs_core.analysis.db_difference`, current minus pin, only on the same frequency grid:
+another harmonic has no difference curve), the band edges of each, and the error map of
+the current state minus the chosen pin's (:func:`fbs_core.analysis.
+truncation_map_difference`, same harmonic only; each map with its own residual setting) at
+the current map DOF.
 """
 
 from __future__ import annotations
@@ -30,19 +33,22 @@ from fbs_core.analysis import PinnedState, db_difference, pin_state, truncation_
 from fbs_core.errors import FBSError
 from fbs_core.vocabulary import magnitude_db, percent
 
-from . import compute
-from .analysis_state import PinSettings
-from .datasource import REFERENCE
-from .store import Result, Snapshot
+from .. import compute
+from ..analysis_state import PinSettings, decode_pins
+from ..datasource import REFERENCE
+from .base import Band, Result, Snapshot, csv_name
+from .main import res_part, response_result
 
-__all__ = ["Pin", "build_pin", "compare_result", "pin_result", "pin_settings"]
+__all__ = ["Pin", "build_pins", "compare_result", "pin_settings", "pinned_result"]
 
 
 @dataclass(frozen=True, eq=False)
 class Pin:
-    """A pinned baseline: its settings, its data (None if its models are not loaded here)."""
+    """A pinned baseline: its settings (as in the URL), the whole snapshot it describes and
+    its data (None, with the reason in ``note``, if its models are not loaded here)."""
 
     settings: PinSettings
+    snapshot: Snapshot | None
     data: PinnedState | None
     note: str = ""
 
@@ -52,13 +58,14 @@ class Pin:
 
 
 def pin_settings(name: str, s: Snapshot) -> PinSettings:
-    """The settings of a pin of snapshot ``s``."""
+    """The settings of a pin of snapshot ``s`` (what the URL keeps of it)."""
     return PinSettings(
         name=name,
         harmonic=s.harmonic,
         n_modes=s.n_modes,
         dof=s.dof,
         coupling=s.coupling,
+        residual=s.residual,
         noise=s.noise,
         target=s.target,
         frequency_dependent=s.frequency_dependent,
@@ -77,12 +84,12 @@ def _snapshot_of(ps: PinSettings, current: Snapshot) -> Snapshot | None:
         models = REFERENCE
     else:
         return None
-    return dataclasses.replace(
-        current,
+    return current.settings().replace(
         harmonic=ps.harmonic,
         n_modes=ps.n_modes,
         dof=ps.dof,
         coupling=ps.coupling,
+        residual=ps.residual,
         noise=ps.noise,
         target=ps.target,
         frequency_dependent=ps.frequency_dependent,
@@ -90,20 +97,21 @@ def _snapshot_of(ps: PinSettings, current: Snapshot) -> Snapshot | None:
         seed=ps.seed,
         percentile=ps.percentile,
         models=models,
+        scope="corner",  # a pin is of the corner (the thesis' case), whatever the scope
     )
 
 
 def build_pin(ps: PinSettings, current: Snapshot) -> Pin:
-    """The pin of settings ``ps`` with its data, computed through the app's caches."""
+    """The pin of settings ``ps`` with its data (its response: the coupled-response view's
+    result of its snapshot; a problem with its settings is its note)."""
     s = _snapshot_of(ps, current)
     if s is None:
-        return Pin(ps, None, "its uploaded data are not loaded in this session")
-    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models)
-    out = [f"bushing:{s.dof}"]
-    result: dict[str, Any] = {
-        "response": FRF(d["freq"], d["truncated"][:, None, None], out, ["patch"]),
-        "reference": FRF(d["freq"], d["reference"][:, None, None], out, ["patch"]),
-    }
+        return Pin(ps, None, None, "its uploaded data are not loaded in this session")
+    try:
+        core = response_result(s).core
+    except (FBSError, ValueError) as e:  # settings the models cannot have (a crafted link)
+        return Pin(ps, s, None, f"not computed: {e}")
+    result: dict[str, Any] = {"response": core["truncated"], "reference": core["reference"]}
     band = compute.cached_band(s.band_key())
     note = ""
     if band is not None:
@@ -124,15 +132,33 @@ def build_pin(ps: PinSettings, current: Snapshot) -> Pin:
         settings=settings,
         sources={"models": s.models.key, "fbs_core": compute.version()},
     )
-    return Pin(ps, data, note)
+    return Pin(ps, s, data, note)
+
+
+def build_pins(s: Snapshot) -> tuple[Pin, ...]:
+    """The pins the URL lists (``s.pin_text``), keeping those already built (``s.pins``).
+
+    Raises
+    ------
+    FBSError
+        For a malformed link (the pins stay as they were).
+    """
+    wanted = decode_pins(s.pin_text)
+    have = {p.settings: p for p in s.pins}
+    return tuple(have.get(ps) or build_pin(ps, s) for ps in wanted)
+
+
+def _describe_settings(s: Snapshot | PinSettings) -> str:
+    res = " + residual" if s.residual else ""
+    return (
+        f"h{s.harmonic} N={s.n_modes}{res} bushing:{s.dof} {s.coupling} noise {s.noise:g} % "
+        f"on the {s.target}{' (every line)' if s.frequency_dependent else ''} R={s.rounds} "
+        f"seed {s.seed}"
+    )
 
 
 def _describe(p: Pin) -> str:
-    s = p.settings
-    txt = (
-        f"h{s.harmonic} N={s.n_modes} bushing:{s.dof} {s.coupling} noise {s.noise:g} % "
-        f"{s.target} R={s.rounds} seed {s.seed}"
-    )
+    txt = _describe_settings(p.settings)
     if p.data is not None:
         txt += f"; {p.data.settings.get('models', '')}; pinned {p.data.created}"
     return txt + (f" ({p.note})" if p.note else "")
@@ -144,20 +170,29 @@ def _band_edges(data: PinnedState | None) -> tuple[np.ndarray, np.ndarray] | Non
     return data.arrays["band_pct_low"][1], data.arrays["band_pct_high"][1]
 
 
-def compare_result(s: Snapshot, pins: tuple[Pin, ...], compare_to: str) -> Result:
+def _relabel(resp: FRF, like: FRF) -> FRF:
+    """``resp`` with the labels of ``like`` (a pin of another DOF compares level to level)."""
+    return FRF(resp.freq, resp.data, like.outputs, like.inputs, resp.quantity)
+
+
+def compare_result(s: Snapshot) -> Result:
     """The Compare tab's result: curves, differences, band edges, difference map."""
-    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models)
-    cur = FRF(d["freq"], d["truncated"][:, None, None], [f"bushing:{s.dof}"], ["patch"])
-    band = compute.cached_band(s.band_key())
+    pins, compare_to = s.pins, s.compare_to
+    current = response_result(s)
+    cur = current.core["truncated"]
+    # the corner's band (in vehicle scope the published band is the car's)
+    band = s.current_band() if not s.vehicle else None
+    corner = compute.cached_band(s.replace(scope="corner").band_key()) if s.vehicle else None
     cur_band = None
-    if band is not None:
-        b = compute.band_data(band, s.dof, s.percentile)
+    if band is not None or corner is not None:
+        band = band or Band(corner, s.settings().replace(scope="corner"), 0.0)
+        b = compute.band_data(band.result, s.dof, s.percentile)
         cur_band = (b["pct_low"], b["pct_high"])
     curves = [
         {
             "name": "current",
             "freq": np.asarray(cur.freq, float),
-            "level": magnitude_db(cur.data[:, 0, 0]),
+            "level": current.columns["truncated_dB"],
             "diff": np.full(cur.freq.size, np.nan),
             "band": cur_band,
             "note": "",
@@ -165,11 +200,12 @@ def compare_result(s: Snapshot, pins: tuple[Pin, ...], compare_to: str) -> Resul
     ]
     meta: dict[str, Any] = {
         "view": "comparison of pinned states: coupled bushing response v_e* (eq. 4.1)",
-        "curve 0": f"current: h{s.harmonic} N={s.n_modes} bushing:{s.dof} {s.coupling} "
-        f"noise {s.noise:g} % {s.target} R={s.rounds} seed {s.seed}; {s.models.describe()}",
+        "curve 0": f"current: {_describe_settings(s)}; {s.models.describe()}",
         "diff_dB": "20 log10 |current| - 20 log10 |pin| on the same frequency grid "
         "(fbs_core.analysis.db_difference); NaN: another grid (another harmonic)",
-        "band": f"central percentile band edges of |v_e| ({s.percentile} % for the current)",
+        "band": f"central percentile band edges of |v_e| ({s.percentile} % for the current"
+        + ("" if band is not None else ", not computed yet")
+        + ")",
     }
     for i, p in enumerate(pins, start=1):
         meta[f"curve {i}"] = f"pin {p.name!r}: {_describe(p)}"
@@ -197,12 +233,12 @@ def compare_result(s: Snapshot, pins: tuple[Pin, ...], compare_to: str) -> Resul
     # the difference map: current minus the chosen pin, at the current map DOF
     target = next((p for p in pins if p.name == compare_to), pins[0] if pins else None)
     dmap, map_note = None, ""
-    if target is not None and target.data is not None:
-        ps = _snapshot_of(target.settings, s)
+    if target is not None and target.data is not None and target.snapshot is not None:
+        ps = target.snapshot
         try:
             md = truncation_map_difference(
-                compute.error_map(s.harmonic, s.coupling, s.models),
-                compute.error_map(ps.harmonic, ps.coupling, ps.models),
+                compute.error_map(s.harmonic, s.coupling, s.models, s.residual),
+                compute.error_map(ps.harmonic, ps.coupling, ps.models, ps.residual),
             )
             what = s.map_dof
             err = md.max_diff if what is None else md.diff[:, :, md.dofs.index(f"bushing:{what}")]
@@ -223,57 +259,75 @@ def compare_result(s: Snapshot, pins: tuple[Pin, ...], compare_to: str) -> Resul
     elif map_note:
         meta["difference map"] = map_note
     meta["models"] = s.models.describe()
-    cols = _long_columns(curves)
+    res = " + residual" if s.residual else ""
     return Result(
-        columns=cols,
+        columns=_long_columns(curves),
         meta=meta,
-        filename=f"compare_h{s.harmonic}_N{s.n_modes}_{s.dof}_{len(pins)}pins.csv",
+        filename=csv_name(
+            s,
+            "compare",
+            f"h{s.harmonic}",
+            f"N{s.n_modes}",
+            res_part(s),
+            s.dof,
+            s.coupling,
+            f"{len(pins)}pins",
+        ),
         caption=(
-            f"**{len(pins)} pinned** &middot; current: harmonic {s.harmonic}, N = {s.n_modes}, "
-            f"bushing:{s.dof}, {s.coupling}" + (f" &middot; {map_note}" if map_note else "")
+            f"**{len(pins)} pinned** &middot; current: harmonic {s.harmonic}, N = {s.n_modes}"
+            f"{res}, bushing:{s.dof}, {s.coupling}" + (f" &middot; {map_note}" if map_note else "")
         ),
         draw={"curves": curves, "map": dmap, "dof": s.dof, "pins": [p.name for p in pins]},
     )
 
 
-def pin_result(s: Snapshot, p: Pin) -> Result | None:
-    """One pin against the current state, for the report and the CSV of a pin: its level,
-    the current level and their difference (the current one and the difference only on
-    the same frequency grid). None for a pin without data."""
-    if p.data is None:
-        return None
+def pinned_result(s: Snapshot) -> tuple[Result, ...]:
+    """Each pin against the current state (for the report and the CSV of a pin): its
+    level, the current level (the coupled-response view's) and their difference (the
+    current one and the difference only on the same frequency grid); pins without data
+    are left out."""
+    if not any(p.data is not None for p in s.pins):
+        return ()
+    current = response_result(s)
+    return tuple(_pinned(s, p, current) for p in s.pins if p.data is not None)
+
+
+def _pinned(s: Snapshot, p: Pin, current: Result) -> Result:
+    assert p.data is not None
     resp = p.data.frfs["response"]
+    label = p.name.replace(" ", "_")
     cols: dict[str, np.ndarray] = {
         "freq_Hz": np.asarray(resp.freq, float),
-        f"pin_{p.name.replace(' ', '_')}_dB": magnitude_db(resp.data[:, 0, 0]),
+        f"pin_{label}_dB": magnitude_db(resp.data[:, 0, 0]),
     }
-    d = compute.mobility_data(s.harmonic, s.n_modes, s.dof, s.coupling, s.models)
-    cur = FRF(d["freq"], d["truncated"][:, None, None], [f"bushing:{s.dof}"], ["patch"])
+    cur = current.core["truncated"]
     meta: dict[str, Any] = {
         "view": f"pinned state {p.name!r} against the current state",
         "pin": _describe(p),
         "pin sources": ", ".join(f"{k}={v}" for k, v in p.data.sources.items()),
-        "current": f"h{s.harmonic} N={s.n_modes} bushing:{s.dof} {s.coupling}; "
-        f"{s.models.describe()}",
+        "current": f"{_describe_settings(s)}; {s.models.describe()}",
         "unit": compute.level_unit(p.settings.dof),
     }
     try:
         diff = db_difference(cur, _relabel(resp, cur))
-        cols["current_dB"] = magnitude_db(cur.data[:, 0, 0])
+        cols["current_dB"] = current.columns["truncated_dB"]
         cols["current_minus_pin_dB"] = np.asarray(diff.db[:, 0, 0], float)
     except FBSError as e:
         meta["difference"] = f"none: {e}"
     return Result(
         columns=cols,
         meta=meta,
-        filename=f"pin_{p.name.replace(' ', '_')}.csv",
+        filename=csv_name(
+            s,
+            f"pin_{label}_vs",
+            f"h{s.harmonic}",
+            f"N{s.n_modes}",
+            res_part(s),
+            s.dof,
+            s.coupling,
+        ),
         caption=f"Pin **{p.name}**: {_describe(p)}",
     )
-
-
-def _relabel(resp: FRF, like: FRF) -> FRF:
-    """``resp`` with the labels of ``like`` (a pin of another DOF compares level to level)."""
-    return FRF(resp.freq, resp.data, like.outputs, like.inputs, resp.quantity)
 
 
 def _long_columns(curves: list[dict]) -> dict[str, np.ndarray]:

@@ -1,8 +1,8 @@
-"""Title blocks of the live views, from the store's plain state snapshot.
+"""Title blocks of the live views and the page's link, from the snapshot a result was made of.
 
-The views draw their title block (:class:`app.report.bokeh.TitleBlockModels`) from the
-settings a result was computed for: :func:`view_title` takes the store's snapshot (any
-object with the state's attribute names), the page URL and the N-axis scale.
+The views draw their title block (:class:`app.page.bokeh.TitleBlockModels`) from the
+settings a result was computed for: :func:`view_title` takes the result's snapshot
+(:class:`app.results.Snapshot`), the page URL and the N-axis scale.
 """
 
 from __future__ import annotations
@@ -13,11 +13,12 @@ from typing import Any
 
 import fbs_core
 
-from .session import provenance_of
-from .snapshot import SETTING_KEYS, Snapshot
-from .titles import TitleBlock, compact_title, file_stem
+from ..public_url import public_link
+from ..report.data import ReportData
+from ..report.session import provenance_of, settings_of
+from ..report.titles import TitleBlock, compact_title, file_stem
 
-__all__ = ["VIEW_OF_KEY", "title_snapshot", "view_title", "page_url", "short_query"]
+__all__ = ["VIEW_OF_KEY", "title_snapshot", "view_title", "link_of", "page_url", "short_query"]
 
 #: LiveView key -> title-block view.
 VIEW_OF_KEY = {
@@ -32,6 +33,12 @@ VIEW_OF_KEY = {
     "phase": "phase",
     "campbell": "campbell",
     "speedmap": "speed-map",
+    "wheels": "wheel-contributions",
+    "participation": "participation",
+    "modeshape": "mode-shape",
+    "waves": "waves",
+    "selected": "selected-modes",
+    "chassistrunc": "chassis-truncation",
 }
 
 
@@ -45,13 +52,11 @@ def _n_total(models: Any) -> int | None:
 
 def title_snapshot(
     s: Any, url: str = "", n_axis: str = "linear", created: dt.datetime | None = None
-) -> Snapshot:
-    """A results-free report snapshot of a state snapshot ``s`` (for titles and names)."""
-    settings = {k: getattr(s, k) for k in SETTING_KEYS if hasattr(s, k)}
-    settings["n_axis"] = n_axis
+) -> ReportData:
+    """Results-free report data of a session snapshot ``s`` (for titles and names)."""
     models = getattr(s, "models", None)
-    return Snapshot(
-        settings=settings,
+    return ReportData(
+        settings=settings_of(s, n_axis),
         provenance=provenance_of(models),
         url=url if url.startswith(("http://", "https://")) else "",
         created=created or dt.datetime.now(dt.UTC),
@@ -60,7 +65,7 @@ def title_snapshot(
 
 
 def view_title(key: str, s: Any, url: str = "", n_axis: str = "linear") -> tuple[TitleBlock, str]:
-    """``(title block, file stem)`` of the live view ``key`` for the state snapshot ``s``."""
+    """``(title block, file stem)`` of the live view ``key`` for the session snapshot ``s``."""
     snap = title_snapshot(s, url, n_axis)
     view = VIEW_OF_KEY[key]
     return compact_title(snap, view), file_stem(snap, view)
@@ -69,7 +74,7 @@ def view_title(key: str, s: Any, url: str = "", n_axis: str = "linear") -> tuple
 def _url_defaults() -> dict[str, object]:
     """Default value of every URL query key of the page (state and layout)."""
     from ..state import URL_KEYS, DashboardState
-    from .page import PAGE_URL_KEYS, PageState
+    from .layout import PAGE_URL_KEYS, PageState
 
     out: dict[str, object] = {}
     for group, keys in URL_KEYS.items():
@@ -101,14 +106,27 @@ def short_query(query: Mapping[str, Any]) -> dict[str, Any]:
 
 def page_url() -> str:
     """The served page's URL that reproduces its state: the address and the query values
-    that differ from the defaults (``""`` when not served)."""
-    import urllib.parse
+    that differ from the defaults (``""`` when not served).
 
+    With ``FBS_PUBLIC_URL`` set (:mod:`app.public_url`), the address starts with it instead
+    of the one in the browser's location bar, so the link opens for its recipient.
+    """
     import panel as pn
 
     loc = pn.state.location
     if loc is None or not loc.href:
         return ""
-    href = loc.href.split("?")[0]
-    query = short_query(loc.query_params)
+    return link_of(loc.href, loc.query_params)
+
+
+def link_of(href: str, query: Mapping[str, Any]) -> str:
+    """The link of a page at ``href`` with the ``query`` values: the public base URL in
+    front (when set), the query values that differ from the defaults."""
+    import urllib.parse
+
+    # the address without its query and fragment, every character a report would refuse
+    # (quotes, angle brackets, spaces: a crafted link's path or #fragment) percent-encoded
+    href = urllib.parse.quote(href.split("#")[0].split("?")[0], safe=":/%@-._~!$&()*+,;=")
+    href = public_link(href)
+    query = short_query(query)
     return href + ("?" + urllib.parse.urlencode(query) if query else "")

@@ -1,12 +1,12 @@
-"""A plain snapshot of one dashboard state: what a report, a title block or a file name shows.
+"""What a report, a title block or a file name shows, as plain data (:class:`ReportData`).
 
-The snapshot holds no Panel or param objects: the settings as a plain dict, where the data
-came from (the shipped reference models or uploaded files with their digests), the computed
-results as the core library's immutable objects (:class:`fbs_core.FRF`,
-:class:`fbs_core.TruncationMap`, :class:`fbs_core.SuggestedModes`,
-:class:`fbs_core.ScatterBand`, :class:`fbs_core.ModeFrequencies`), the page URL that
-reproduces the state and the time it was taken. Everything in :mod:`app.report` is a pure
-function of it.
+It holds no Panel or param objects: the settings as a plain dict, where the data came from
+(the shipped reference models or uploaded files with their digests), the results as the
+core library's immutable objects (:class:`fbs_core.FRF`, :class:`fbs_core.TruncationMap`,
+:class:`fbs_core.SuggestedModes`, :class:`fbs_core.ScatterBand`,
+:class:`fbs_core.ModeFrequencies`: those the session's store published, see
+:mod:`app.report.session`), the page URL that reproduces the state and the time it was
+taken. Everything in :mod:`app.report` is a pure function of it.
 """
 
 from __future__ import annotations
@@ -20,8 +20,9 @@ from typing import Any, TypeVar
 from numpy.typing import ArrayLike
 
 import fbs_core
+from fbs_core.analysis import Contributions, Peak
 from fbs_core.errors import FBSError
-from fbs_core.vocabulary import percent
+from fbs_core.vocabulary import COUPLINGS, DIRECTIONS, percent
 
 __all__ = [
     "present",
@@ -29,7 +30,7 @@ __all__ = [
     "ReportError",
     "DataFile",
     "Provenance",
-    "Snapshot",
+    "ReportData",
     "SETTING_KEYS",
     "DIRECTIONS",
     "COUPLINGS",
@@ -38,20 +39,21 @@ __all__ = [
     "N_AXES",
 ]
 
-#: Bushing DOF directions, hub couplings, noise targets, map modes and N-axis scales
-#: accepted in the settings (the dashboard's choices).
-DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
-COUPLINGS = ("6dof", "5dof")
+#: Noise targets, map modes and N-axis scales accepted in the settings (the dashboard's
+#: choices; the DOF directions and couplings are the core's vocabulary).
 NOISE_TARGETS = ("both", "tire", "chassis")
 MAP_MODES = ("selected DOF", "max over 6 DOFs")
 N_AXES = ("linear", "log")
 
-#: Settings a snapshot may hold: name -> (type, meaning). The first four are required.
+#: Settings a report may hold: name -> (type, meaning). The first four are required.
 SETTING_KEYS: dict[str, tuple[type, str]] = {
     "harmonic": (int, "harmonic case 1-7"),
     "n_modes": (int, "retained tire modes N"),
     "dof": (str, "response DOF direction at the bushing"),
     "coupling": (str, "hub coupling"),
+    "residual": (bool, "residual compensation of the tire modes left out of N"),
+    "spindle_input": (str, "spindle input of the uncoupled chassis mobility"),
+    "show_uncoupled": (bool, "uncoupled subsystems shown"),
     "threshold": (float, "error threshold in %"),
     "f_max": (float, "upper frequency of the suggested N in Hz"),
     "map_mode": (str, "error map of the selected DOF or the maximum over 6 DOFs"),
@@ -63,14 +65,23 @@ SETTING_KEYS: dict[str, tuple[type, str]] = {
     "seed": (int, "random seed"),
     "single_round": (int, "index of the single round drawn"),
     "percentile": (int, "width of the central percentile band in %"),
+    "scope": (str, "corner (the thesis' tire on the rear corner) or vehicle (the whole car)"),
+    "wheels": (str, "vehicle scope: the wheels whose road input is on"),
+    "tracks": (str, "vehicle scope: the right track's road against the left's"),
+    "coherence": (float, "vehicle scope: coherency of the two tracks"),
+    "point": (str, "vehicle scope: the car's response point"),
+    "first_order": (bool, "first-order band overlaid on the scatter band"),
 }
 _REQUIRED = ("harmonic", "n_modes", "dof", "coupling")
 _CHOICES = {
     "dof": DIRECTIONS,
+    "spindle_input": DIRECTIONS,
     "coupling": COUPLINGS,
     "target": NOISE_TARGETS,
     "map_mode": MAP_MODES,
     "n_axis": N_AXES,
+    "scope": ("corner", "vehicle"),
+    "tracks": ("in phase", "anti-phase", "coherence"),
 }
 #: Settings each result needs to be described.
 _NEEDS = {
@@ -89,7 +100,7 @@ _NEEDS = {
 
 
 class ReportError(FBSError):
-    """A snapshot that cannot be reported: missing or invalid settings, mismatched results."""
+    """Report data that cannot be reported: missing or invalid settings, mismatched results."""
 
 
 _T = TypeVar("_T")
@@ -98,13 +109,13 @@ _T = TypeVar("_T")
 def present(value: _T | None, what: str) -> _T:
     """``value``, which a report part needs: a :class:`ReportError` naming ``what`` if None."""
     if value is None:
-        raise ReportError(f"the snapshot holds no {what}")
+        raise ReportError(f"the report data hold no {what}")
     return value
 
 
 @dataclass(frozen=True)
 class DataFile:
-    """One model of the snapshot: the shipped reference (``name=None``) or an uploaded file.
+    """One model of the report: the shipped reference (``name=None``) or an uploaded file.
 
     Attributes
     ----------
@@ -139,7 +150,7 @@ class DataFile:
 
 @dataclass(frozen=True)
 class Provenance:
-    """Where the models of a snapshot came from.
+    """Where the models of a report came from.
 
     Attributes
     ----------
@@ -230,6 +241,31 @@ def normalise_settings(settings: Mapping[str, Any]) -> Mapping[str, Any]:
     return MappingProxyType(out)
 
 
+def _check_plot(key: str, plot: Mapping[str, Any]) -> None:
+    """A section's plot description (:attr:`ExtraSection.plot`) of consistent shapes."""
+    import numpy as np
+
+    kind = plot.get("kind")
+    if kind not in ("lines", "image"):
+        raise ReportError(f"section {key!r}: plot kind {kind!r}; allowed: lines, image")
+    x = np.asarray(plot.get("x", ()), float)
+    if kind == "lines":
+        for label, ys in dict(plot.get("groups", {})).items():
+            for y in ys:
+                if np.shape(y) != x.shape:
+                    raise ReportError(
+                        f"section {key!r}: a line of {label!r} has shape {np.shape(y)}, "
+                        f"its x {x.shape}"
+                    )
+    else:
+        y = np.asarray(plot.get("y", ()), float)
+        z_shape = np.asarray(plot.get("z", ()), float).shape
+        if z_shape != (x.size, y.size):
+            raise ReportError(
+                f"section {key!r}: the image has shape {z_shape}, its axes ({x.size}, {y.size})"
+            )
+
+
 @dataclass(frozen=True, eq=False)
 class ExtraSection:
     """A section another view contributes to the report (an analysis, a pinned curve).
@@ -251,6 +287,15 @@ class ExtraSection:
     curves : mapping of str to ndarray
         Levels in dB on ``freq``, by label.
     y_label : str
+    plot : mapping, optional
+        A plot that is no set of curves over frequency, as the view describes it in its
+        result's ``draw["report_plot"]``: ``{"kind": "lines", "x", "groups": {label:
+        [y, ...]}, "x_label", "y_label"}`` (e.g. the Campbell diagram: branches and order
+        lines over speed) or ``{"kind": "image", "x", "y", "z" (n_x, n_y), "x_label",
+        "y_label", "z_label", "line": (x, y) optional}`` (e.g. the speed map).
+    strip : mapping or None
+        A mode shape's frames drawn side by side (``figures.draw_strip``): the result's
+        ``draw["strip"]``.
     """
 
     key: str
@@ -260,6 +305,8 @@ class ExtraSection:
     freq: ArrayLike | None = None
     curves: Mapping[str, Any] = field(default_factory=dict)
     y_label: str = "Level (dB)"
+    plot: Mapping[str, Any] | None = None
+    strip: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         import numpy as np
@@ -276,6 +323,8 @@ class ExtraSection:
                         f"section {self.key!r}: curve {label!r} has shape {np.shape(c)}, "
                         f"the frequencies {f.shape}"
                     )
+        if self.plot is not None:
+            _check_plot(self.key, self.plot)
 
     @classmethod
     def of_result(cls, key: str, result: Any) -> ExtraSection:
@@ -291,13 +340,15 @@ class ExtraSection:
         cols = result.columns
         freq = cols.get("freq_Hz")
         curves = {}
-        if freq is not None:
+        # curves over a frequency axis (a long layout, one row per (curve, line), is a table)
+        if freq is not None and np.all(np.diff(np.asarray(freq, float)) > 0):
             curves = {
                 k[: -len("_dB")].replace("_", " "): np.asarray(v, float)
                 for k, v in cols.items()
                 if k.endswith("_dB") and np.shape(v) == np.shape(freq)
             }
         unit = meta.get("unit")
+        plot = result.draw.get("report_plot") if not curves else None
         return cls(
             key=key,
             heading=heading[:1].upper() + heading[1:],
@@ -306,11 +357,13 @@ class ExtraSection:
             freq=None if not curves else np.asarray(freq, float),
             curves=curves,
             y_label=f"Level ({unit})" if unit else "Level (dB)",
+            plot=plot,
+            strip=result.draw.get("strip"),
         )
 
 
 @dataclass(frozen=True, eq=False)
-class Snapshot:
+class ReportData:
     """Everything one report shows, as plain data.
 
     Attributes
@@ -323,10 +376,11 @@ class Snapshot:
     url : str
         The page URL that reproduces the state (``""`` if unknown).
     created : datetime.datetime
-        When the snapshot was taken (timezone-aware; naive is taken as UTC).
+        When the data were taken (timezone-aware; naive is taken as UTC).
     reference, truncated : fbs_core.FRF, optional
-        Coupled bushing response (eq. 4.1) with all tire modes and with ``n_modes`` modes:
-        outputs ``bushing:x`` ... ``bushing:rz``, input ``patch``.
+        Coupled bushing response (eq. 4.1) with all tire modes and with ``n_modes`` modes
+        (with residual compensation when the settings say so): outputs ``bushing:<dof>``
+        (and possibly the other bushing DOFs), input ``patch``.
     truncation : fbs_core.TruncationMap, optional
         Error map of the harmonic (eq. 5.1).
     suggested : fbs_core.SuggestedModes, optional
@@ -337,6 +391,13 @@ class Snapshot:
         Highest retained eigenfrequency versus N (thesis fig. 5.8).
     n_modes_total : int, optional
         Modes of the tire (default from the truncation map).
+    suggested_n : int, optional
+        The N the error map suggests (marked on the page's map; default read from the map).
+    peaks : tuple of fbs_core.analysis.Peak
+        The peaks of the N-mode response the page labels (the summary's peak table).
+    contributions : fbs_core.analysis.Contributions, optional
+        The contributions of the interface forces, when the page computed them for these
+        settings (the summary's largest contributions).
     extra : tuple of ExtraSection
         Sections contributed by other views (after the built-in ones).
     """
@@ -352,6 +413,9 @@ class Snapshot:
     band: fbs_core.ScatterBand | None = None
     eigen: fbs_core.ModeFrequencies | None = None
     n_modes_total: int | None = None
+    suggested_n: int | None = None
+    peaks: tuple[Any, ...] = ()
+    contributions: Any = None
     extra: tuple[ExtraSection, ...] = ()
 
     def __post_init__(self) -> None:
@@ -387,6 +451,19 @@ class Snapshot:
                     raise ReportError(
                         f"the {name} result needs the setting(s) {', '.join(missing)}"
                     )
+        object.__setattr__(self, "peaks", tuple(self.peaks))
+        for p in self.peaks:
+            if not isinstance(p, Peak):
+                raise ReportError(f"peaks must be fbs_core.analysis.Peak, got {type(p).__name__}")
+        c = self.contributions
+        if c is not None:
+            if not isinstance(c, Contributions):
+                raise ReportError(f"contributions must be a Contributions, got {type(c).__name__}")
+            if self.response_dof not in c.outputs:
+                raise ReportError(
+                    f"the contributions have no output {self.response_dof!r}; "
+                    f"outputs: {', '.join(c.outputs)}"
+                )
         object.__setattr__(self, "extra", tuple(self.extra))
         for ex in self.extra:
             if not isinstance(ex, ExtraSection):
@@ -396,7 +473,9 @@ class Snapshot:
             object.__setattr__(self, "n_modes_total", self.truncation.n_modes_total)
 
     def _check_results(self, s: Mapping[str, Any]) -> None:
-        dof = f"bushing:{s['dof']}"
+        if s.get("scope") == "vehicle" and "point" not in s:
+            raise ReportError("a report in vehicle scope needs the setting 'point'")
+        dof = self.response_dof
         for name in ("reference", "truncated"):
             frf = getattr(self, name)
             if frf is not None and dof not in frf.outputs:
@@ -452,8 +531,15 @@ class Snapshot:
         return fbs_core.harmonic(self.settings["harmonic"])
 
     @property
+    def vehicle(self) -> bool:
+        """Whether the report is of the whole car (vehicle scope, issue 31)."""
+        return self.settings.get("scope") == "vehicle"
+
+    @property
     def response_dof(self) -> str:
-        """``"bushing:z"`` etc."""
+        """``"bushing:z"`` etc.; in vehicle scope the car's point, ``"seat_fl:z"``."""
+        if self.vehicle:
+            return f"{self.settings['point']}:{self.settings['dof']}"
         return f"bushing:{self.settings['dof']}"
 
     @property

@@ -15,13 +15,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from bokeh.models import ColumnDataSource, Legend, LegendItem, SaveTool, Title
+from bokeh.models import ColorBar, ColumnDataSource, Legend, LegendItem, SaveTool, Title
 from numpy.typing import ArrayLike
 
-from .colormap import LINE_STYLES, ErrorColorScale, contour_columns, threshold_contour
-from .titles import TitleBlock
+from ..report.colormap import LINE_STYLES, ErrorColorScale, contour_columns, threshold_contour
+from ..report.titles import TitleBlock
 
-__all__ = ["STYLES", "TitleBlockModels", "style_figure", "ErrorMapLayers"]
+__all__ = ["STYLES", "TitleBlockModels", "style_figure", "wrap_line", "ErrorMapLayers"]
 
 #: Type sizes of the normal and the presentation view (the projector needs tick labels of
 #: at least 14 px and legends of at least 12 pt).
@@ -37,12 +37,47 @@ STYLES: dict[str, dict[str, str]] = {
         "tick": "16px",
         "axis": "17px",
         "title": "18px",
-        "detail": "13px",
+        "detail": "16px",
         "legend": "13pt",
     },
 }
-#: Lines of a live plot's title block (heading + case, noise, data and date, link).
-TITLE_LINES = 6
+#: Lines of a live plot's title block (heading + case, noise, data and date, link; long
+#: lines wrapped at their separators, :func:`wrap_line`).
+TITLE_LINES = 9
+#: Characters per title-block line before it wraps: 10 px type in a half-width plot of a
+#: 1280 px window, 16 px type in a half-width plot without the sidebar (issue 29: the
+#: presentation view's lines were cut at the plot's right edge).
+WRAP = {"normal": 72, "present": 62}
+#: Columns of a legend below a plot (the same widths).
+LEGEND_COLUMNS = {"normal": 3, "present": 2}
+
+
+def wrap_line(text: str, width: int) -> list[str]:
+    """``text`` as lines of at most ``width`` characters, broken after its ``" | "``
+    separators, then after the ``&`` of a link's query, then between words, then after
+    the ``~`` between a pin's fields (a piece longer than ``width`` is cut)."""
+    if len(text) <= width:
+        return [text]
+    for sep in (" | ", "&", " ", "~"):
+        parts = text.split(sep)
+        if len(parts) > 1:
+            break
+    else:
+        return [text[i : i + width] for i in range(0, len(text), width)]
+    keep = sep.rstrip()  # the separator stays at the line's end
+    lines: list[str] = []
+    cur = parts[0]
+    for part in parts[1:]:
+        if len(cur) + len(sep) + len(part) <= width:
+            cur = cur + sep + part
+        else:
+            lines.append(cur + keep)
+            cur = part
+    lines.append(cur)
+    out: list[str] = []
+    for line in lines:
+        out.extend(wrap_line(line, width) if len(line) > width else [line])
+    return out
 
 
 class TitleBlockModels:
@@ -69,13 +104,17 @@ class TitleBlockModels:
             fig.add_layout(t, "above")
         self.heading = Title(text="", text_font_size="13px", text_font_style="bold", standoff=2)
         fig.add_layout(self.heading, "above")
+        self.mode = "normal"
+        self._shown: tuple[TitleBlock | None, str | None] = (None, None)
         # the figure's save tools, found once (figure.select walks the whole model graph:
         # it was the largest cost of a control change)
         self.save_tools = [t for t in fig.toolbar.tools if isinstance(t, SaveTool)]
 
     def update(self, tb: TitleBlock, stem: str | None = None) -> None:
-        """Show ``tb`` (lines beyond the models' count are joined into the last one)."""
-        lines = list(tb.lines)
+        """Show ``tb``: its lines wrapped for the view's type size (:data:`WRAP`); lines
+        beyond the models' count are joined into the last one."""
+        self._shown = (tb, stem)
+        lines = [w for line in tb.lines for w in wrap_line(line, WRAP[self.mode])]
         n = len(self.titles)
         if len(lines) > n:
             lines = lines[: n - 1] + [" | ".join(lines[n - 1 :])]
@@ -98,6 +137,11 @@ class TitleBlockModels:
         self.heading.text_font_size = s["title"]
         for t in self.titles:
             t.text_font_size = s["detail"]
+        if mode != self.mode:
+            self.mode = mode
+            tb, stem = self._shown
+            if tb is not None:  # wrapped again for the new type size
+                self.update(tb, stem)
 
 
 def style_figure(fig: Any, mode: str = "normal", legend_side: str = "right") -> None:
@@ -113,10 +157,17 @@ def style_figure(fig: Any, mode: str = "normal", legend_side: str = "right") -> 
     if legend_side not in ("right", "below", "left", "above"):
         raise ValueError(f"unknown legend side {legend_side!r}; allowed: right, below")
     s = STYLES[mode]
+    # on the projector the toolbar goes beside the plot: the height is the scarce direction
+    toolbar = "right" if mode == "present" else "above"
+    if fig.toolbar_location is not None and fig.toolbar_location != toolbar:
+        fig.toolbar_location = toolbar
     for ax in (*fig.xaxis, *fig.yaxis):
         ax.major_label_text_font_size = s["tick"]
         ax.axis_label_text_font_size = s["axis"]
     fig.title.text_font_size = s["title"]
+    for bar in (r for r in (*fig.right, *fig.left, *fig.below) if isinstance(r, ColorBar)):
+        bar.major_label_text_font_size = s["tick"]
+        bar.title_text_font_size = s["axis"]
     for leg in list(fig.legend):
         leg.label_text_font_size = s["legend"]
         if leg in fig.center:
@@ -124,8 +175,12 @@ def style_figure(fig: Any, mode: str = "normal", legend_side: str = "right") -> 
             leg.location = "top_left" if legend_side in ("right", "left") else "center"
             if legend_side in ("below", "above"):
                 leg.orientation = "horizontal"
-                leg.nrows = 2 if len(leg.items) > 2 else 1
             fig.add_layout(leg, legend_side)
+        if leg.orientation == "horizontal" and (leg in fig.below or leg in fig.above):
+            # as many columns as fit a half-width plot in the view's type
+            cols = max(1, min(len(leg.items), LEGEND_COLUMNS[mode]))
+            if (leg.ncols, leg.nrows) != (cols, "auto"):
+                leg.update(ncols=cols, nrows="auto")
 
 
 class ErrorMapLayers:
@@ -169,7 +224,7 @@ class ErrorMapLayers:
         leg = Legend(
             items=[LegendItem(label=lab, renderers=[r]) for lab, r in items],
             orientation="horizontal",
-            nrows=2,
+            ncols=3,
             location="center",
             name="truncation.legend",
         )
