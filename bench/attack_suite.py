@@ -69,7 +69,19 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from load_clients import BokehSession  # noqa: E402
 
-SECTIONS = ("endpoints", "cookies", "origin", "url", "files", "flood", "logins", "sigterm")
+SECTIONS = (
+    "endpoints",
+    "cookies",
+    "origin",
+    "url",
+    "files",
+    "flood",
+    "uploads",
+    "reports",
+    "bodies",
+    "logins",
+    "sigterm",
+)
 
 
 # ---- reporting -----------------------------------------------------------------------------
@@ -101,7 +113,7 @@ def free_port() -> int:
 class LocalServer:
     """The container's entrypoint on a loopback port, basic auth with random credentials."""
 
-    def __init__(self, threads: int):
+    def __init__(self, threads: int, campaign_dir: str | None = None):
         self.port = free_port()
         self.user = "attack-suite"
         self.password = secrets.token_urlsafe(12)
@@ -114,7 +126,9 @@ class LocalServer:
             "FBS_NUM_THREADS": str(threads),
             "FBS_BASIC_AUTH": f"{self.user}:{self.password}",
             "FBS_COOKIE_SECRET": self.secret,
-            "FBS_USE_XHEADERS": "true",  # the login flood comes from a made-up address
+            "FBS_USE_XHEADERS": "true",  # the login flood comes from a made-up address,
+            "FBS_TRUSTED_PROXIES": "127.0.0.1",  # as a reverse proxy on this machine says
+            **({"FBS_CAMPAIGN_DIR": campaign_dir} if campaign_dir else {}),
             "BOKEH_ALLOW_WS_ORIGIN": f"127.0.0.1:{self.port}",
         }
         self.proc = subprocess.Popen(
@@ -405,10 +419,24 @@ def attack_origin(rep: Report, base: str, app: str, cookie: str) -> None:
 
 MARKUP = "<script>alert(1)</script>"
 
+#: The sidebar controls' titles (the campaign card has a "Harmonic" and a "Noise (%)"
+#: filter, which a match by part of the title picked when FBS_CAMPAIGN_DIR is set).
+CONTROL_TITLES = {
+    "Harmonic": "Harmonic case",
+    "Rounds": "Rounds R",
+    "Seed": "Seed",
+    "Noise": "Noise level p (%)",
+}
+
+
+def _is(m, title: str) -> bool:
+    """Whether model ``m`` is the control called ``title`` (a key of CONTROL_TITLES)."""
+    return str(m.title) == CONTROL_TITLES.get(title, title)
+
 
 def _value(sess: BokehSession, title: str):
     for m in sess.doc.models:
-        if "title" in m.properties() and "value" in m.properties() and title in str(m.title):
+        if "title" in m.properties() and "value" in m.properties() and _is(m, title):
             try:
                 return m.value
             except Exception:
@@ -681,7 +709,7 @@ async def _set(sess: BokehSession, title: str, value) -> bool:
     from bokeh.document.events import ModelChangedEvent
 
     for m in sess.doc.models:
-        if "title" in m.properties() and "value" in m.properties() and title in str(m.title):
+        if "title" in m.properties() and "value" in m.properties() and _is(m, title):
             events = []
             for attr in ("value", "value_throttled"):
                 if attr in m.properties():
@@ -698,7 +726,7 @@ def _pct(values: list[float], q: float) -> float:
 
 def _model(sess: BokehSession, title: str):
     for m in sess.doc.models:
-        if "title" in m.properties() and "value" in m.properties() and title in str(m.title):
+        if "title" in m.properties() and "value" in m.properties() and _is(m, title):
             return m
     raise LookupError(f"no control titled {title!r} in the page")
 
@@ -712,9 +740,14 @@ def _n_slider(sess: BokehSession):
 
 
 def _dof_buttons(sess: BokehSession):
-    """The "Response DOF at the bushing" buttons (``active`` is the index of the DOF)."""
+    """The "Response DOF at the bushing" buttons of the controls (``active`` is the index of
+    the DOF); not the campaign card's, which have the same labels."""
     for m in sess.doc.models:
-        if type(m).__name__ == "RadioButtonGroup" and list(m.labels) == DOF_LABELS:
+        if (
+            type(m).__name__ == "RadioButtonGroup"
+            and list(m.labels) == DOF_LABELS
+            and "ctl-case-dof" in (getattr(m, "css_classes", None) or [])
+        ):
             return m
     raise LookupError("no response DOF buttons in the page")
 
@@ -861,6 +894,305 @@ def attack_flood(rep: Report, base: str, app: str, cookie: str, args) -> None:
         rep.line("session errors during the flood", str(errors[:3]), False)
 
 
+# ---- 6b. starvation: slow uploads, report floods, body floods -----------------------------
+
+
+def _stats(v: list[float]) -> str:
+    return f"p50 {_pct(v, 50):.0f} / p95 {_pct(v, 95):.0f} / max {max(v):.0f} ms"
+
+
+def _attack_process(name: str, base: str, app: str, cookie: str, args, stop_flag, out) -> None:
+    """Run the attack ``name`` in this (spawned) process until ``stop_flag`` is set; put its
+    one-line description into ``out``. A process of its own: the hostile clients' work
+    (encoding megabytes of uploads, decoding reports) must not delay the victim's client,
+    whose timings are the measurement."""
+
+    async def main():
+        stop = asyncio.Event()
+
+        async def watch():
+            while not stop_flag.is_set():
+                await asyncio.sleep(0.1)
+            stop.set()
+
+        watcher = asyncio.ensure_future(watch())
+        try:
+            return await ATTACKS[name](base, app, cookie, args, stop)
+        finally:
+            watcher.cancel()
+
+    try:
+        out.put(asyncio.run(main()))
+    except Exception as exc:  # noqa: BLE001 (said in the report)
+        out.put(f"the attack failed: {type(exc).__name__}: {exc}")
+
+
+def _cpu_s(pid: int) -> float:
+    """CPU seconds (user + system) of process ``pid`` and its children that ended."""
+    try:
+        f = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return float("nan")
+    return sum(int(x) for x in f[11:15]) / os.sysconf("SC_CLK_TCK")
+
+
+def side_by_side(
+    rep: Report, base: str, app: str, cookie: str, args, title: str, name: str, server=None
+):
+    """The victim's control changes alone, then while the attack ``name`` (of
+    :data:`ATTACKS`) runs in a process of its own (one run). With the suite's own server,
+    also the server's CPU time in each phase (its share of the wall time)."""
+    import multiprocessing
+
+    rep.section(title)
+    ctx = multiprocessing.get_context("spawn")
+    stop_flag, out = ctx.Event(), ctx.Queue()
+
+    async def main():
+        victim = await _open(base, f"{app}?rounds={args.victim_rounds}", cookie)
+        await victim.settle(120, 1.0)
+        for h in range(2, 9):  # every harmonic once: its truncation map is cached
+            await _timed_change(victim, {"Harmonic": (h - 1) % 7 + 1}, 120)
+        c0, w0 = _cpu(), time.perf_counter()
+        alone = await _timed_changes(victim, args.flood_changes, args.flood_timeout, 30_000)
+        cpu_alone = (_cpu() - c0) / (time.perf_counter() - w0)
+        proc = ctx.Process(
+            target=_attack_process, args=(name, base, app, cookie, args, stop_flag, out)
+        )
+        proc.start()
+        await asyncio.sleep(args.attack_warmup)  # the attack under way before the victim moves
+        t0, c0 = time.perf_counter(), _cpu()
+        under = await _timed_changes(victim, args.flood_changes, args.flood_timeout, 40_000)
+        secs = time.perf_counter() - t0
+        cpu_under = (_cpu() - c0) / secs
+        stop_flag.set()
+        what = await asyncio.to_thread(out.get, True, 300)
+        await asyncio.to_thread(proc.join, 60)
+        errors = list(victim.errors)
+        await victim.close()
+        return alone, under, secs, what, errors, cpu_alone, cpu_under
+
+    def _cpu() -> float:
+        if server is None:
+            return float("nan")
+        return sum(_cpu_s(p) for p in _tree(server.proc.pid))
+
+    (kinds, a1, a2), (_, u1, u2), secs, what, errors, cpu_a, cpu_u = run(main())
+    if server is not None:
+        rep.line(
+            "server CPU (with its parser and report processes), share of one core",
+            f"victim alone {100 * cpu_a:.0f} %, under attack {100 * cpu_u:.0f} %",
+            None,
+        )
+    rep.line(
+        "victim alone: change -> first plot update; -> settled plots",
+        f"{_stats(a1)}; {_stats(a2)}",
+        None,
+    )
+    rep.line(
+        f"victim under attack ({what}; {secs:.0f} s): first update", _stats(u1), _pct(u1, 95) < 1000
+    )
+    by_kind = "; ".join(
+        f"{k} " + " ".join(f"{x:.0f}" for x, kk in zip(u1, kinds, strict=True) if kk == k)
+        for k in KINDS
+    )
+    rep.line("  first update by kind of change (ms)", by_kind, None)
+    rep.line("victim under attack: settled plots (its own band included)", _stats(u2), None)
+    if errors:
+        rep.line("victim session errors", str(errors[:3]), False)
+
+
+RECORD_58 = """    -1
+    58
+mobility {o}:z / {i}:z
+tire-fbs attack suite
+03-Dec-26 10:50:18
+NONE
+NONE
+    4         0    0         0 {o:>10s}         1   3 {i:>10s}         2   3
+         6         3         1  1.00000e+00  1.00000e+00  0.00000e+00
+        18    0    0    0 NONE                 Hz
+        11    1    0    0 NONE                 m/s
+        13    0    1    0 NONE                 N
+         0    0    0    0 NONE                 NONE
+   1.00000000000e-03   0.00000000000e+00   1.00000000000e-03   0.00000000000e+00
+   1.00000000000e-03   0.00000000000e+00
+    -1
+"""
+
+
+def slow_uff(n: int) -> bytes:
+    """A valid UFF of ``n`` datasets 58: the parser needs seconds per 10,000 (the issue's
+    slow file was an HDF5 file of 3,000 nested groups, now refused in seconds)."""
+    return "".join(RECORD_58.format(o=f"n{k % 100}", i=f"m{k // 100}") for k in range(n)).encode()
+
+
+def nested_h5(depth: int) -> bytes:
+    """A valid HDF5 file of ``depth`` nested groups (the issue's slow file: h5py's visit took
+    minutes; now refused in seconds, naming the nesting limit)."""
+    import h5py
+
+    b = io.BytesIO()
+    with h5py.File(b, "w") as h:
+        g = h
+        for k in range(depth):
+            g = g.create_group(f"g{k}")
+        h.create_dataset("freq", data=np.arange(1.0, 4.0))
+    return b.getvalue()
+
+
+def _upload_file(args) -> tuple[bytes, str, str]:
+    if args.upload_file == "nested":
+        return nested_h5(3000), "slow{}.h5", "an HDF5 file of 3,000 nested groups"
+    what = f"a valid UFF of {args.upload_records:,} datasets 58"
+    return slow_uff(args.upload_records), "slow{}.uff", what
+
+
+async def _uploads_attack(base, app, cookie, args, stop) -> str:
+    content, name, _ = _upload_file(args)
+    tabs = [await _open(base, app, cookie) for _ in range(args.attack_tabs)]
+    sent = 0
+    try:
+        while not stop.is_set():
+            for sess in tabs:
+                widget = _upload_widgets(sess).get("chassis")
+                await _upload(sess, widget, name.format(sent), content)
+                sent += 1
+            try:
+                await asyncio.wait_for(stop.wait(), args.upload_every)
+            except TimeoutError:
+                pass
+    finally:
+        for sess in tabs:
+            await sess.close()  # closed tabs: their readings are cancelled
+    return f"{args.attack_tabs} tabs sent {sent} uploads of {len(content) / 2**20:.1f} MB"
+
+
+def attack_uploads(rep: Report, base: str, app: str, cookie: str, args, server=None) -> None:
+    what = _upload_file(args)[2]
+    side_by_side(
+        rep,
+        base,
+        app,
+        cookie,
+        args,
+        f"6b. {args.attack_tabs} tabs upload {what} every {args.upload_every:.0f} s while "
+        "another session changes N, harmonic, DOF",
+        "uploads",
+        server,
+    )
+
+
+def _report_button(sess, kind: str = "pdf"):
+    for m in sess.doc.models:
+        if (
+            f"report-{kind}" in (getattr(m, "css_classes", None) or [])
+            and "clicks" in m.properties()
+        ):
+            return m
+    raise LookupError(f"no report-{kind} download in the page")
+
+
+async def _reports_attack(base, app, cookie, args, stop) -> str:
+    from bokeh.document.events import ModelChangedEvent
+
+    tabs = [await _open(base, app, cookie) for _ in range(args.attack_tabs)]
+    done = 0
+
+    async def loop(sess):
+        nonlocal done
+        btn = _report_button(sess)
+        while not stop.is_set():
+            data0 = btn.data
+            clicks = int(btn.clicks or 0) + 1
+            btn.set_from_json("clicks", clicks, setter=sess)
+            await sess.send([ModelChangedEvent(sess.doc, btn, "clicks", clicks)])
+            t0 = time.perf_counter()
+            while btn.data == data0 and time.perf_counter() - t0 < 120 and not stop.is_set():
+                await asyncio.sleep(0.1)
+            done += btn.data != data0
+
+    try:
+        await asyncio.gather(*(loop(sess) for sess in tabs))
+    finally:
+        for sess in tabs:
+            await sess.close()
+    return f"{args.attack_tabs} tabs asked for PDF reports in a loop, {done} delivered"
+
+
+def attack_reports(rep: Report, base: str, app: str, cookie: str, args, server=None) -> None:
+    side_by_side(
+        rep,
+        base,
+        app,
+        cookie,
+        args,
+        f"6c. {args.attack_tabs} tabs ask for PDF reports in a loop while another session "
+        "changes N, harmonic, DOF",
+        "reports",
+        server,
+    )
+
+
+async def _bodies_attack(base, app, cookie, args, stop) -> str:
+    port = int(urllib.parse.urlparse(base).port or 80)
+    size = args.body_mb << 20
+
+    def one_body(stop: threading.Event) -> str:
+        chunk = b"x" * (1 << 20)
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=30) as s:
+                s.sendall(
+                    b"POST /login HTTP/1.1\r\nHost: x\r\n"
+                    b"Content-Type: application/x-www-form-urlencoded\r\n"
+                    + f"Content-Length: {size}\r\n\r\n".encode()
+                )
+                sent = 0
+                while sent < size and not stop.is_set():
+                    s.sendall(chunk)
+                    sent += len(chunk)
+                return s.recv(64).split(b"\r\n")[0].decode("latin-1")
+        except OSError as exc:  # the server closed the connection: the body was refused
+            return f"closed ({type(exc).__name__})"
+
+    flag = threading.Event()
+    answers: Counter = Counter()
+
+    def flood():
+        while not flag.is_set():
+            answers[one_body(flag)] += 1
+
+    threads = [threading.Thread(target=flood, daemon=True) for _ in range(args.body_connections)]
+    for t in threads:
+        t.start()
+    await stop.wait()
+    flag.set()
+    for t in threads:
+        await asyncio.to_thread(t.join, 30)
+    return (
+        f"{args.body_connections} unauthenticated connections posting {args.body_mb} MB "
+        f"bodies in a loop: {dict(answers.most_common(3))}"
+    )
+
+
+def attack_bodies(rep: Report, base: str, app: str, cookie: str, args, server=None) -> None:
+    side_by_side(
+        rep,
+        base,
+        app,
+        cookie,
+        args,
+        f"6d. unauthenticated body flood ({args.body_connections} connections, "
+        f"{args.body_mb} MB bodies) while a logged-in session changes N, harmonic, DOF",
+        "bodies",
+        server,
+    )
+
+
+#: The starvation attacks, each run in a process of its own by :func:`side_by_side`.
+ATTACKS = {"uploads": _uploads_attack, "reports": _reports_attack, "bodies": _bodies_attack}
+
+
 # ---- 7. login flood ----------------------------------------------------------------------------
 
 
@@ -930,6 +1262,9 @@ def attack_sigterm(rep: Report, server) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    import faulthandler
+
+    faulthandler.register(signal.SIGUSR1, all_threads=True)  # kill -USR1: where it waits
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--url", help="attack a running server instead of starting one")
     ap.add_argument("--user", default=None)
@@ -948,6 +1283,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--flood-changes", type=int, default=10)
     ap.add_argument("--victim-rounds", type=int, default=1_000, help="rounds of the victim's band")
     ap.add_argument("--flood-timeout", type=float, default=30.0, help="s per victim change")
+    ap.add_argument("--campaign-dir", help="FBS_CAMPAIGN_DIR of its own server")
+    ap.add_argument("--attack-tabs", type=int, default=4, help="hostile tabs (uploads, reports)")
+    ap.add_argument("--attack-warmup", type=float, default=6.0, help="s of attack before timing")
+    ap.add_argument("--upload-file", choices=("nested", "uff"), default="nested")
+    ap.add_argument("--upload-records", type=int, default=40_000, help="datasets of the slow UFF")
+    ap.add_argument("--upload-every", type=float, default=2.0, help="s between a tab's uploads")
+    ap.add_argument("--body-mb", type=int, default=90)
+    ap.add_argument("--body-connections", type=int, default=2)
     args = ap.parse_args(argv)
     sections = set(args.only or SECTIONS)
     rep = Report()
@@ -956,7 +1299,7 @@ def main(argv: list[str] | None = None) -> int:
         base, user, password, secret = args.url.rstrip("/"), args.user, args.password, None
     else:
         print("starting the server (docker/entrypoint.py, basic auth, random credentials) ...")
-        server = LocalServer(args.threads)
+        server = LocalServer(args.threads, args.campaign_dir)
         base, user = server.base, server.user
         password, secret = server.password, server.secret
         print(f"server up in {server.start_s:.1f} s at {base} (pid {server.proc.pid})")
@@ -976,6 +1319,12 @@ def main(argv: list[str] | None = None) -> int:
             attack_files(rep, base, app, cookie, server, args.big)
         if "flood" in sections:
             attack_flood(rep, base, app, cookie, args)
+        if "uploads" in sections:
+            attack_uploads(rep, base, app, cookie, args, server)
+        if "reports" in sections:
+            attack_reports(rep, base, app, cookie, args, server)
+        if "bodies" in sections:
+            attack_bodies(rep, base, app, cookie, args, server)
         if "logins" in sections:
             attack_logins(rep, base, user or "admin", password, server)
         if server is not None and "sigterm" in sections:

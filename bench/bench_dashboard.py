@@ -8,6 +8,12 @@ document (the named ColumnDataSource of the view):
 - retained modes N, harmonic and response DOF: median and 95th percentile;
 - the scatter band with R rounds (default 10,000): a new seed until the band's data change;
 - server start: process launch to "app running", and to the first rendered plot;
+- with ``--vehicle``: vehicle scope (issue 31), the page opened with ``?scope=vehicle``: a
+  wheel toggled (front-left on/off), the track relation (in phase / anti-phase), the
+  response point, N and the harmonic, each until the car's response view changes
+  (``mobility.truncated``), and a wheel toggle until the per-wheel view and the car's
+  truncation map change (``wheels.lines``, ``truncation.map``); the band at the car's
+  default rounds (``--vehicle-rounds``);
 - with ``--analysis``: the Analysis card's views (issue 18), each in a fresh page opened on
   its tab (``?atab=...``): N, harmonic and DOF changes until the view's own source changes
   (phase: ``phase.b``; contributions: ``contributions.lines``; across speed:
@@ -20,10 +26,15 @@ Usage::
     .venv/bin/python bench/bench_dashboard.py --tree /path/to/old/checkout --tree .
     .venv/bin/python bench/bench_dashboard.py --only-analysis --samples 14
     .venv/bin/python bench/bench_dashboard.py --only-analysis --tabs phase,compare
+    .venv/bin/python bench/bench_dashboard.py --only-vehicle --samples 12
 
 With several ``--tree`` (source checkouts of the project), one server per tree runs at the
 same time and the samples alternate between them: a before/after comparison under the same
-machine load.
+machine load. The trees' first pages are opened one after the other, each after the
+previous tree's band, so "server start -> ..." of a later tree includes the earlier trees'
+first pages (its "page request -> plot" does not: it is timed from its own request; until
+issue 33 it was timed from the server's start line and so included them too). First pages
+side by side, alternated: ``bench/bench_first_page.py``.
 """
 
 from __future__ import annotations
@@ -68,6 +79,10 @@ async ([kind, cls, value, name, timeout]) => {
     const w = models().filter(m => m.css_classes && m.css_classes.includes(cls)
                               && 'value' in m && m.type === 'Slider')[0];
     w.value = value;
+  } else if (kind === 'select') {
+    const w = models().filter(m => m.css_classes && m.css_classes.includes(cls)
+                              && 'value' in m && 'options' in m)[0];
+    w.value = value;
   } else {
     const w = models().filter(m => m.css_classes && m.css_classes.includes(cls)
                               && 'active' in m)[0];
@@ -93,7 +108,8 @@ async ([seed]) => {
                            && 'value' in m)[0];
   const src = ms.filter(m => m.name === 'scatter.minmax')[0];
   const before = src.data.upper[3];
-  const t0 = performance.now(); w.value = seed;
+  // a typed number's field holds text (issue 29), an older numeric field a number
+  const t0 = performance.now(); w.value = typeof w.value === 'string' ? String(seed) : seed;
   return await new Promise(r => { const c = () => {
     if (src.data.upper[3] !== before) r(performance.now() - t0);
     else setTimeout(c, 5); }; c(); });
@@ -254,6 +270,53 @@ def analysis_bench(servers, measure, modes, n, rounds, only=None):
             print(f"[{tree.name}] open tab {title!r:34s} {ms:7.0f} ms (first view of the tab)")
 
 
+def vehicle_bench(servers, measure, n, rounds):
+    """Page changes in vehicle scope (issue 31), printed like the others."""
+    for _tree, page, _proc, port, *_ in servers:
+        page.goto(
+            f"http://127.0.0.1:{port}/main?scope=vehicle&rounds={rounds}",
+            timeout=300_000,
+            wait_until="commit",
+        )
+        page.wait_for_function(JS_READY, arg="wheels.lines", timeout=600_000)
+        page.wait_for_function(JS_READY, arg="truncation.map", timeout=600_000)
+        wait_band_idle(page, timeout=900_000)
+    wheels = [[1, 2, 3] if k % 2 == 0 else [0, 1, 2, 3] for k in range(n)]  # FL off / on
+    points = [str(p) for p in np.resize(["seat_fl", "bushing_rr", "strut_fl", "bushing_rl"], n)]
+    steps = {
+        "vehicle: wheel FL (mobility.truncated)": lambda: measure(
+            "active", "ctl-case-wheels", wheels, "mobility.truncated"
+        ),
+        "vehicle: wheel FL (wheels.lines)": lambda: measure(
+            "active", "ctl-case-wheels", wheels, "wheels.lines"
+        ),
+        "vehicle: wheel FL (truncation.map)": lambda: measure(
+            "active", "ctl-case-wheels", wheels, "truncation.map"
+        ),
+        "vehicle: tracks (mobility.truncated)": lambda: measure(
+            "active", "ctl-case-tracks", [k % 2 for k in range(1, n + 1)], "mobility.truncated"
+        ),
+        "vehicle: point (mobility.truncated)": lambda: measure(
+            "select", "ctl-case-point", points, "mobility.truncated"
+        ),
+        "vehicle: modes N (mobility.truncated)": lambda: measure(
+            "value",
+            "ctl-case-n_modes",
+            [int(i) for i in np.resize(np.arange(1, 20), n)],
+            "mobility.truncated",
+        ),
+        "vehicle: harmonic (mobility.truncated)": lambda: measure(
+            "value",
+            "ctl-case-harmonic",
+            [int(h) for h in np.resize([2, 3, 4, 5, 6, 7, 1], n)],
+            "mobility.truncated",
+        ),
+    }
+    for k, step in steps.items():  # printed as measured
+        for tree, ms in step().items():
+            print(f"[{tree.name}] {k:46s} {stats(ms)}  (load {os.getloadavg()[0]:.1f})", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=10_000)
@@ -262,6 +325,14 @@ def main():
     ap.add_argument("--no-warm", action="store_true")
     ap.add_argument("--analysis", action="store_true", help="also the Analysis card's views")
     ap.add_argument("--only-analysis", action="store_true", help="only the Analysis card")
+    ap.add_argument("--vehicle", action="store_true", help="also vehicle scope (issue 31)")
+    ap.add_argument("--only-vehicle", action="store_true", help="only vehicle scope")
+    ap.add_argument(
+        "--vehicle-rounds",
+        type=int,
+        default=1_000,
+        help="rounds of the car's band (vehicle scope's default: 1,000)",
+    )
     ap.add_argument(
         "--tabs",
         default="",
@@ -299,6 +370,7 @@ def main():
                 t_ready = ready.get(timeout=900)
                 if t_ready is None:
                     raise RuntimeError(f"server of {tree} did not start")
+                t_req = time.perf_counter()
                 page.goto(
                     f"http://127.0.0.1:{port}/main?rounds={args.rounds}",
                     timeout=300_000,
@@ -311,7 +383,7 @@ def main():
                 print(f"[{tree.name}] server start -> app running:          {t_ready - t0:6.1f} s")
                 print(
                     f"[{tree.name}] server start -> first rendered plot:  {t_plot - t0:6.1f} s "
-                    f"(page request -> plot {t_plot - t_ready:.1f} s)"
+                    f"(page request -> plot {t_plot - t_req:.1f} s)"
                 )
                 print(f"[{tree.name}] server start -> scatter band shown:   {t_band - t0:6.1f} s")
                 wait_band_idle(page)
@@ -329,7 +401,9 @@ def main():
             if args.analysis or args.only_analysis:
                 only = {t.strip() for t in args.tabs.split(",") if t.strip()}
                 analysis_bench(servers, measure, modes, n, args.rounds, only)
-            if args.only_analysis:
+            if args.vehicle or args.only_vehicle:
+                vehicle_bench(servers, measure, n, args.vehicle_rounds)
+            if args.only_analysis or args.only_vehicle:
                 return
             res = {
                 "modes N (mobility.truncated)": measure(

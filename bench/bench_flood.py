@@ -13,7 +13,7 @@ Issue 20, finding "one session flooding the compute". Two sessions' stores
   time until its own band of the new settings is published.
 
 The same changes run first without the flood. Also printed: how long threads waited for
-the band kernels' process-wide lock (``fbs_core.studies.scatter._LOCK``), and how late a
+the band kernels' process-wide lock (``fbs_core.studies.band_kernel.LOCK``), and how late a
 thread that sleeps 5 ms wakes up (the interpreter lock and the cores: what Bokeh's event
 loop would feel). No server, no websocket, no drawing: the compute side of the page.
 
@@ -35,7 +35,7 @@ import numpy as np
 
 from app.state import DashboardState
 from app.store import Results
-from fbs_core.studies import scatter as _scatter
+from fbs_core.studies import band_kernel
 
 RESULTS = ("response", "error_map", "suggested", "eigen", "uncoupled", "band_curves")
 
@@ -146,8 +146,8 @@ def _report(label: str, r: dict[str, list]) -> None:
 
 
 def flood(args) -> None:
-    lock = TimedLock(_scatter._LOCK)
-    _scatter._LOCK = lock
+    lock = TimedLock(band_kernel.LOCK)
+    band_kernel.LOCK = lock  # read by band_kernel.band_lines at every call
     victim = _store(rounds=args.victim_rounds)
     print("warming up (every harmonic once, its maps and band cached) ...", flush=True)
     for h in list(range(2, 8)) + [1]:

@@ -304,6 +304,10 @@ class BokehSession:
     async def _send(self, events) -> None:
         await self._protocol.create("PATCH-DOC", events).send(self._sock)
 
+    async def send(self, events) -> None:
+        """Send document events (e.g. ``ModelChangedEvent``) as one patch, as BokehJS does."""
+        await self._send(events)
+
     async def _read(self) -> None:
         while True:
             msg = await self._pop()

@@ -37,10 +37,20 @@ Variables (all optional; the table with examples is in docs/deployment.md):
     as well.
 ``PANEL_OAUTH_PROVIDER``, ``PANEL_OAUTH_KEY``, ``PANEL_OAUTH_SECRET``, ...
     Read by Panel itself: OAuth login instead of basic authentication.
+``FBS_PUBLIC_URL``
+    The address at which recipients reach the server's root (with ``FBS_PREFIX``: the
+    prefix), e.g. ``https://nvh.example.com/tire-fbs``: the links in reports, CSV headers
+    and title blocks start with it instead of the browser's address. An absolute http(s)
+    address without query or fragment; anything else stops the start with a message.
 ``FBS_PREFIX``
     URL prefix when served behind a reverse proxy under a sub-path (``--prefix``).
 ``FBS_USE_XHEADERS``
-    ``true`` behind a TLS-terminating reverse proxy (``--use-xheaders``).
+    ``true`` behind a TLS-terminating reverse proxy (``--use-xheaders``); needs
+    ``FBS_TRUSTED_PROXIES``.
+``FBS_TRUSTED_PROXIES``
+    Addresses or networks (comma-separated) of the reverse proxies whose ``X-Forwarded-For``
+    / ``X-Real-IP`` headers name the client (login throttling, logs); from anyone else
+    these headers are ignored.
 ``FBS_WEBSOCKET_MAX_MESSAGE_MB``
     Largest websocket message (file uploads travel in one, base64-encoded), default 200.
 ``FBS_LOG_LEVEL``
@@ -122,6 +132,23 @@ def _positive_int(env: dict[str, str], name: str, default: int | None) -> int | 
     return value
 
 
+def _networks(env: dict[str, str], name: str) -> str:
+    """Comma-separated IP addresses or networks, checked; "" when unset."""
+    import ipaddress
+
+    raw = env.get(name, "").strip()
+    for entry in raw.replace(" ", ",").split(","):
+        if entry.strip():
+            try:
+                ipaddress.ip_network(entry.strip(), strict=False)
+            except ValueError:
+                raise SettingError(
+                    f"{name}: {entry.strip()!r} is not an IP address or network "
+                    "(e.g. 172.18.0.2 or 10.0.0.0/8)"
+                ) from None
+    return raw
+
+
 def parse_users(text: str, name: str = "FBS_BASIC_AUTH") -> dict[str, str]:
     """Parse ``user:password`` entries separated by commas or newlines.
 
@@ -192,6 +219,20 @@ def default_app() -> str:
     return str(Path(next(iter(spec.submodule_search_locations))) / "main.py")
 
 
+def _check_public_url(env: dict[str, str]) -> None:
+    """``FBS_PUBLIC_URL`` checked by the app's own rule (:mod:`app.public_url`)."""
+    if not env.get("FBS_PUBLIC_URL", "").strip():
+        return
+    try:
+        from app.public_url import PublicURLError, check_public_url
+    except ImportError:
+        raise SettingError("FBS_PUBLIC_URL needs the package 'app' (not installed)") from None
+    try:
+        check_public_url(env["FBS_PUBLIC_URL"])
+    except PublicURLError as exc:
+        raise SettingError(str(exc)) from None
+
+
 def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
     """Arguments of ``panel serve``, private settings and warnings, from the environment.
 
@@ -234,6 +275,7 @@ def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
         )
     options = {
         "login_max_failures": _positive_int(env, "FBS_LOGIN_MAX_FAILURES", 10),
+        "trusted_proxies": _networks(env, "FBS_TRUSTED_PROXIES"),
     }
 
     secret = _cookie_secret(env)
@@ -249,10 +291,17 @@ def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
     if secret:
         private["cookie_secret"] = secret
 
+    _check_public_url(env)
     prefix = env.get("FBS_PREFIX", "").strip("/")
     if prefix:
         args += [f"--prefix={prefix}"]
     if _flag(env, "FBS_USE_XHEADERS"):
+        if not options["trusted_proxies"]:
+            raise SettingError(
+                "FBS_USE_XHEADERS=true needs FBS_TRUSTED_PROXIES: the address(es) or "
+                "network(s) of the reverse proxy, e.g. 172.18.0.2 or 10.0.0.0/8 (forwarding "
+                "headers from anyone else must not name the client)"
+            )
         args += ["--use-xheaders"]
     # an uploaded file travels base64-encoded in one message: 200 MB carries files up to
     # 150 MB, so a file above fbs_core's 100 MiB limit gets its clear refusal instead of a

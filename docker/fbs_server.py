@@ -1,7 +1,7 @@
 """``panel serve`` of the dashboard, hardened for deployment (run by ``docker/entrypoint.py``).
 
 The container's entrypoint validates the settings and then runs :func:`serve` in the server
-process (PID 1 in the container). It is Panel's own ``panel serve`` command, with four
+process (PID 1 in the container). It is Panel's own ``panel serve`` command, with the
 changes that ``panel serve`` offers no option for:
 
 Secrets stay off the command line
@@ -12,17 +12,33 @@ Secrets stay off the command line
     sandbox) do not inherit them.
 A cheap health check
     ``/liveness`` answers from memory, without login: ``{"/liveness": true}``, and with
-    ``?endpoint=/main`` whether that app built a page. The app is proved *once*, at start,
-    before the server listens: one page is built and cleaned up, and a script that fails
-    stops the server with the error (the container exits; a restart policy retries). No
-    request, authenticated or not, makes the health check build a page (Panel's own
-    ``--liveness`` built one on the event loop for every request; finding 2 of issue 20).
-Throttled logins
-    Wrong basic-auth logins are logged (client address, user name) and slowed per client:
-    from the 4th failure within :data:`LOGIN_WINDOW_S` each answer is delayed (0.5 s,
-    doubling, at most 8 s) without blocking the server, and from the ``max_failures``-th
-    on the client gets ``429 Too Many Requests`` until its failures age out, without its
-    password being checked. Passwords are compared in constant time.
+    ``?endpoint=/main`` whether that app built a page (503 ``{"/main": false}`` while the
+    proof still runs). The app is proved *once*, right after the port is open, on a thread
+    of its own: one page is built and cleaned up (which also warms the server: reference
+    models loaded, kernels compiled, the first page's results cached), and a script that
+    fails stops the server with the error (the container exits; a restart policy retries).
+    The port opens within seconds of the start (issue 33: 23.6 s when a warm-up and the
+    proof ran before listening); a page requested meanwhile is served, computing what it
+    needs beside the proof. No request, authenticated or not, makes the health check build
+    a page (Panel's own ``--liveness`` built one on the event loop for every request;
+    finding 2 of issue 20).
+Throttled logins, revocable cookies
+    Wrong basic-auth logins are logged and slowed, then refused, per (client address, user
+    name); a login cookie stops working on logout, when its user is removed or the
+    password changed (``docker/fbs_auth.py``).
+Only the app's own routes are open to code paths of the request
+    Panel's component-resource route (``/components/<module>/...``) imported the module the
+    URL named before any check, without login (``venv.__main__`` ended the process: issue
+    28, finding 1). Here it is behind the login and serves only modules of Panel that are
+    already loaded (:func:`allowed_component_module`), so a URL never imports anything. An
+    exception that escapes any request handler or callback (even ``SystemExit``) is logged
+    and the server goes on (:class:`Supervised`).
+Small HTTP bodies, large websocket messages
+    Every HTTP request body is limited to :data:`HTTP_MAX_BODY_BYTES` (the login form is the
+    only body the app takes; uploads travel over the websocket), so no request can make the
+    event loop read and parse megabytes (finding 8); the read buffer of a connection is
+    as large as the largest websocket message, so a file upload up to that size reaches the
+    app and gets its refusal instead of a closed connection (finding 9).
 Prompt shutdown
     On SIGTERM or SIGINT the server stops listening and exits within seconds, whatever
     computations are running or queued: queued work is cancelled, worker threads are not
@@ -35,200 +51,75 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import collections
-import hmac
-import json
 import logging
 import os
+import re
 import signal
 import sys
 import threading
 import time
 
+from fbs_auth import (  # noqa: F401  (re-exported: the server's login in one import)
+    LOGIN_FREE_FAILURES,
+    LOGIN_MAX_FAILURES,
+    GuardedBasicAuth,
+    LoginThrottle,
+    check_password,
+    parse_networks,
+)
+from server_private import cancel_queued_panel_work, cleanup_document
+
 log = logging.getLogger("tire_fbs.server")
 
-#: Failures (per client) before wrong logins are slowed down.
-LOGIN_FREE_FAILURES = 3
-#: Delay of the first slowed answer in seconds; doubles per failure up to LOGIN_MAX_DELAY_S.
-LOGIN_BASE_DELAY_S = 0.5
-LOGIN_MAX_DELAY_S = 8.0
-#: Seconds a failed login counts against its client.
-LOGIN_WINDOW_S = 300.0
-#: Default failures within the window after which a client is refused (429).
-LOGIN_MAX_FAILURES = 10
-#: Clients remembered at most (older entries are dropped first).
-LOGIN_MAX_CLIENTS = 10_000
 #: Seconds after SIGTERM after which the process ends, orderly or not.
 SHUTDOWN_DEADLINE_S = 6.0
 #: Seconds child processes get to end after SIGTERM before they are killed.
 CHILD_GRACE_S = 1.0
+#: Largest body of an HTTP request (the login form: a user name and a password).
+HTTP_MAX_BODY_BYTES = 16 * 1024
+#: Room in a connection's read buffer beyond the largest websocket message (frame headers).
+READ_BUFFER_SLACK = 1 << 20
+#: Packages whose loaded modules Panel's component-resource route may serve files of.
+COMPONENT_PACKAGES = ("panel",)
 
 
-# ---- login throttle ----------------------------------------------------------------------
+# ---- component resources -------------------------------------------------------------------
 
 
-class LoginThrottle:
-    """Failed logins per client in a sliding window.
-
-    Parameters
-    ----------
-    max_failures : int
-        Failures within ``window_s`` after which the client is refused.
-    window_s : float
-        Seconds a failure counts.
-    clock : callable
-        Monotonic clock (seconds); replaceable in tests.
-    """
-
-    def __init__(
-        self,
-        max_failures: int = LOGIN_MAX_FAILURES,
-        window_s: float = LOGIN_WINDOW_S,
-        clock=time.monotonic,
-    ) -> None:
-        if max_failures < 1:
-            raise ValueError(f"max_failures={max_failures}: must be >= 1")
-        self.max_failures = max_failures
-        self.window_s = window_s
-        self.clock = clock
-        self._failures: collections.OrderedDict[str, collections.deque] = collections.OrderedDict()
-        self._lock = threading.Lock()
-
-    def _recent(self, client: str, now: float) -> collections.deque:
-        times = self._failures.get(client)
-        if times is None:
-            return collections.deque()
-        while times and now - times[0] >= self.window_s:
-            times.popleft()
-        if not times:
-            del self._failures[client]
-        return times
-
-    def retry_after(self, client: str) -> float:
-        """Seconds until ``client`` may try again; 0 if it may now."""
-        with self._lock:
-            now = self.clock()
-            times = self._recent(client, now)
-            if len(times) < self.max_failures:
-                return 0.0
-            return max(times[-self.max_failures] + self.window_s - now, 0.0)
-
-    def failed(self, client: str) -> int:
-        """Count a failure of ``client``; the number of its failures in the window."""
-        with self._lock:
-            now = self.clock()
-            times = self._recent(client, now)
-            self._failures[client] = times
-            self._failures.move_to_end(client)
-            times.append(now)
-            while len(self._failures) > LOGIN_MAX_CLIENTS:
-                self._failures.popitem(last=False)
-            return len(times)
-
-    def succeeded(self, client: str) -> None:
-        with self._lock:
-            self._failures.pop(client, None)
-
-    @staticmethod
-    def delay(failures: int) -> float:
-        """Seconds to hold the answer to the ``failures``-th failure."""
-        if failures <= LOGIN_FREE_FAILURES:
-            return 0.0
-        delay = LOGIN_BASE_DELAY_S * 2.0 ** (failures - LOGIN_FREE_FAILURES - 1)
-        return min(delay, LOGIN_MAX_DELAY_S)
+def allowed_component_module(name: str) -> bool:
+    """Whether Panel's component-resource route may serve files of module ``name``: a module
+    of :data:`COMPONENT_PACKAGES` that is loaded already (the route then imports nothing)."""
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*", name):
+        return False
+    return name.split(".")[0] in COMPONENT_PACKAGES and name in sys.modules
 
 
-def _printable(text: str, limit: int = 64) -> str:
-    """A user-supplied string made safe for one log line."""
-    return repr(text[:limit] + ("..." if len(text) > limit else ""))
+def _component_handler_class():
+    from panel.io.server import AuthenticatedStaticFileHandler, ComponentResourceHandler
+    from tornado.web import HTTPError
+
+    class GuardedComponentHandler(AuthenticatedStaticFileHandler, ComponentResourceHandler):
+        """Panel's ``/components/<module>/<class>/<attribute>/<file>`` behind the login, for
+        loaded modules of Panel only (checked before the route would import the module)."""
+
+        def parse_url_path(self, path: str) -> str:
+            module = path.split("/", 1)[0]
+            if not allowed_component_module(module):
+                raise HTTPError(404, "Module not found")
+            return super().parse_url_path(path)
+
+    return ComponentResourceHandler, GuardedComponentHandler
 
 
-def check_password(users, username: str, password: str) -> bool:
-    """Constant-time check of ``username``/``password`` against ``users``.
-
-    ``users`` is a mapping user -> password or the path of a JSON file holding one.
-    """
-    if isinstance(users, str):
-        with open(users, encoding="utf-8") as f:
-            users = json.load(f)
-    expected = users.get(username) if isinstance(users, dict) else None
-    # compare against something of the same kind also for an unknown user
-    ok = hmac.compare_digest(
-        (expected if isinstance(expected, str) else "\0" + password).encode("utf-8"),
-        password.encode("utf-8"),
-    )
-    return ok and isinstance(expected, str)
-
-
-def _login_handler_class(throttle: LoginThrottle):
-    import tornado.escape
-    from panel.auth import BasicLoginHandler
-    from panel.config import config
-
-    class ThrottledLoginHandler(BasicLoginHandler):
-        """Panel's login form with per-client throttling and logging of failures."""
-
-        def _validate(self, username, password):
-            return check_password(config.basic_auth, username, password)
-
-        async def post(self):
-            client = self.request.remote_ip or "unknown"
-            wait = throttle.retry_after(client)
-            if wait > 0:
-                log.warning(
-                    "login refused: client %s has %d failed logins within %.0f s "
-                    "(may try again in %.0f s)",
-                    client,
-                    throttle.max_failures,
-                    throttle.window_s,
-                    wait,
-                )
-                self.set_status(429)
-                self.set_header("Retry-After", str(int(wait) + 1))
-                self.finish("Too many failed logins: try again later.")
-                return
-            username = self.get_argument("username", "")
-            if self._validate(username, self.get_argument("password", "")):
-                throttle.succeeded(client)
-                log.info("login: user %s from %s", _printable(username), client)
-                self.set_current_user(username)
-                self.redirect(self._next_url())
-                return
-            failures = throttle.failed(client)
-            pause = throttle.delay(failures)
-            log.warning(
-                "failed login: user %s from %s (%d failures within %.0f s%s)",
-                _printable(username),
-                client,
-                failures,
-                throttle.window_s,
-                f"; answer held {pause:.1f} s" if pause else "",
-            )
-            if pause:
-                await asyncio.sleep(pause)  # holds this answer only, not the server
-            error = "?error=" + tornado.escape.url_escape("Invalid username or password!")
-            self.redirect(self.request.path + error)
-
-        def _next_url(self):
-            from panel.auth import _validate_next_url
-            from panel.io.state import state
-
-            return _validate_next_url(self.get_cookie("next_url", state.base_url))
-
-    return ThrottledLoginHandler
-
-
-def _throttled_provider_class(handler_class):
-    from panel.auth import BasicAuthProvider
-
-    class ThrottledBasicAuthProvider(BasicAuthProvider):
-        @property
-        def login_handler(self):
-            handler_class._login_endpoint = self._login_endpoint
-            handler_class._login_template = self._login_template
-            return handler_class
-
-    return ThrottledBasicAuthProvider
+def guard_component_route(patterns: list) -> int:
+    """Replace Panel's component-resource route in ``patterns``; the number replaced."""
+    original, guarded = _component_handler_class()
+    n = 0
+    for i, pattern in enumerate(patterns):
+        if isinstance(pattern, tuple) and len(pattern) >= 2 and pattern[1] is original:
+            patterns[i] = (pattern[0], guarded, *pattern[2:])
+            n += 1
+    return n
 
 
 # ---- health check ------------------------------------------------------------------------
@@ -240,8 +131,9 @@ def _health_handler_class():
     class HealthHandler(web.RequestHandler):
         """``/liveness``: answered from memory, never builds a page."""
 
-        def initialize(self, proved: dict[str, float]):
-            self.proved = proved
+        def initialize(self, proved: dict[str, float], paths: list[str]):
+            self.proved = proved  # filled by the proof's thread
+            self.paths = paths
 
         def get(self):
             self.set_header("Content-Type", "application/json")
@@ -251,29 +143,37 @@ def _health_handler_class():
                 self.write({self.request.path: True})
             elif endpoint in self.proved:
                 self.write({endpoint: True})
+            elif endpoint in self.paths:  # its proof still runs
+                self.set_status(503)
+                self.write({endpoint: False})
             else:
                 self.set_status(400)
-                self.write({"error": "unknown endpoint", "endpoints": sorted(self.proved)})
+                self.write({"error": "unknown endpoint", "endpoints": sorted(self.paths)})
 
         head = get
 
     return HealthHandler
 
 
-def prove_applications(files: list[str], args: list[str]) -> dict[str, float]:
-    """Build and clean up one page of each app; seconds per app path (e.g. ``/main``).
+def applications(files: list[str], args: list[str]) -> dict:
+    """The apps of ``panel serve FILES`` by path (e.g. ``/main``); no script is run."""
+    from panel.command import serve as panel_serve
+
+    return panel_serve.build_single_handler_applications(files, {f: args for f in files})
+
+
+def prove_applications(apps: dict, proved: dict[str, float] | None = None) -> dict[str, float]:
+    """Build and clean up one page of each app of :func:`applications`; seconds per app
+    path, entered in ``proved`` (a new dict by default) as each app is proved.
 
     Raises
     ------
     RuntimeError
         If an app script fails or builds an empty page (the message names the error).
     """
-    from panel.command import serve as panel_serve
-    from panel.io.document import _cleanup_doc
     from panel.io.session import generate_session
 
-    apps = panel_serve.build_single_handler_applications(files, {f: args for f in files})
-    proved = {}
+    proved = {} if proved is None else proved
     for path, app in apps.items():
         t0 = time.perf_counter()
         # a session context as in a served session: .servable() adds the page's roots
@@ -288,10 +188,27 @@ def prove_applications(files: list[str], args: list[str]) -> dict[str, float]:
             if not doc.roots:
                 raise RuntimeError(f"the app {path} built an empty page")
         finally:
-            _cleanup_doc(doc)
+            cleanup_document(doc)
         proved[path] = time.perf_counter() - t0
         log.info("app %s builds a page (%.1f s); /liveness reports it", path, proved[path])
     return proved
+
+
+def prove_in_background(apps: dict, proved: dict[str, float]) -> threading.Thread:
+    """:func:`prove_applications` on a thread of its own, once the server listens; an app
+    that cannot build a page stops the server (as a failed start would)."""
+
+    def work() -> None:
+        try:
+            prove_applications(apps, proved)
+        except Exception as exc:  # noqa: BLE001 (any failure of the app: stop with it)
+            log.error("the server stopped: %s", exc)
+            print(f"tire-fbs: the server stopped: {exc}", file=sys.stderr, flush=True)
+            exit_now(1)
+
+    t = threading.Thread(target=work, name="fbs-prove-apps", daemon=True)
+    t.start()
+    return t
 
 
 # ---- shutdown ----------------------------------------------------------------------------
@@ -321,25 +238,36 @@ def _alive(pid: int) -> bool:
     return done == 0
 
 
+def _signal_tree(pid: int, sig: int) -> None:
+    """``sig`` to child ``pid``, and to its whole process group when it leads one (the
+    file-parser sandbox does: its forked parsers end with it)."""
+    try:
+        if os.getpgid(pid) == pid:
+            os.killpg(pid, sig)
+        else:
+            os.kill(pid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
 def stop_children(grace_s: float = CHILD_GRACE_S) -> int:
-    """SIGTERM every child process, SIGKILL those alive after ``grace_s``; their number."""
+    """SIGTERM every child process (and the process group it leads), SIGKILL those alive
+    after ``grace_s``; their number."""
     pids = child_pids()
     for pid in pids:
-        try:
-            os.kill(pid, signal.SIGTERM)
-        except ProcessLookupError:
-            pass
+        _signal_tree(pid, signal.SIGTERM)
     deadline = time.monotonic() + grace_s
     alive = list(pids)
     while alive and time.monotonic() < deadline:
         alive = [p for p in alive if _alive(p)]
         if alive:
             time.sleep(0.02)
+    for pid in pids:  # the groups of those that ended too: a grandchild may linger
+        _signal_tree(pid, signal.SIGKILL)
     for pid in alive:
         try:
-            os.kill(pid, signal.SIGKILL)
             os.waitpid(pid, 0)
-        except (ProcessLookupError, ChildProcessError):
+        except ChildProcessError:
             pass
     return len(pids)
 
@@ -361,13 +289,8 @@ def exit_now(status: int) -> None:
     os._exit(status)
 
 
-def _cancel_queued_work() -> None:
-    """Cancel work queued on Panel's thread pool (running work is abandoned at exit)."""
-    from panel.io.state import state
-
-    pool = getattr(state, "_thread_pool", None)
-    if pool is not None:
-        pool.shutdown(wait=False, cancel_futures=True)
+#: Set by the stop signal: the event loop's end is then the server's.
+STOPPING = threading.Event()
 
 
 def _on_stop_signal(signum: int, deadline_s: float) -> None:
@@ -381,7 +304,8 @@ def _on_stop_signal(signum: int, deadline_s: float) -> None:
         exit_now(1)
 
     threading.Thread(target=watchdog, name="shutdown-watchdog", daemon=True).start()
-    _cancel_queued_work()
+    STOPPING.set()
+    cancel_queued_panel_work()
     IOLoop.current().stop()
 
 
@@ -395,15 +319,54 @@ def _install_stop_signals(deadline_s: float) -> None:
 # ---- the command -------------------------------------------------------------------------
 
 
+class Supervised:
+    """Runs the Bokeh server's event loop until the stop signal, whatever a request raises.
+
+    An exception that escapes a request handler or a callback ends Tornado's event loop
+    when it is not an ``Exception`` (``SystemExit``, ``KeyboardInterrupt``): asyncio re-raises
+    those out of the loop, and ``panel serve`` would then end. Here it is logged and the
+    loop started again; only the stop signal (:func:`_on_stop_signal`) ends the server.
+    What ``customize_server`` returns to ``bokeh serve``: it only calls
+    :meth:`run_until_shutdown`.
+    """
+
+    def __init__(self, server) -> None:
+        self.server = server
+        self.escaped = 0
+
+    def run_until_shutdown(self) -> None:
+        self.server.start()
+        loop = self.server.io_loop
+        while not STOPPING.is_set():
+            try:
+                loop.start()
+            except BaseException as exc:  # noqa: BLE001 (the point: nothing ends the server)
+                if STOPPING.is_set():
+                    break
+                self.escaped += 1
+                log.error(
+                    "%s escaped a request handler and would have ended the server; it goes on",
+                    type(exc).__name__,
+                    exc_info=exc,
+                )
+                continue
+            break
+        self.server.stop()
+
+
 def _serve_class():
     from panel.auth import BasicAuthProvider
     from panel.command.serve import Serve
+    from panel.config import config
 
     class HardenedServe(Serve):
         """Panel's ``serve`` command with the changes listed in the module docstring."""
 
         login_max_failures = LOGIN_MAX_FAILURES
         shutdown_deadline_s = SHUTDOWN_DEADLINE_S
+        trusted_proxies = ""
+        http_max_body_bytes = HTTP_MAX_BODY_BYTES
+        users: dict | str | None = None  # the basic-auth users (set by serve)
 
         def customize_kwargs(self, args, server_kwargs):
             # the level panel serve gave Bokeh's loggers (--log-level)
@@ -413,18 +376,43 @@ def _serve_class():
                 args.liveness = False
             kwargs = super().customize_kwargs(args, server_kwargs)
             provider = kwargs.get("auth_provider")
-            if type(provider) is BasicAuthProvider:
-                throttle = LoginThrottle(self.login_max_failures)
-                handler = _login_handler_class(throttle)
-                provider.__class__ = _throttled_provider_class(handler)
-            proved = prove_applications(args.files, args.args or [])
+            proxies = parse_networks(self.trusted_proxies)
+            if type(provider) is BasicAuthProvider and self.users:
+                login = GuardedBasicAuth(
+                    provider,
+                    self.users,
+                    config.cookie_secret,
+                    LoginThrottle(self.login_max_failures),
+                    proxies,
+                    config.oauth_expiry,
+                )
+                kwargs["auth_provider"] = login.provider()
+            if guard_component_route(kwargs["extra_patterns"]) != 1:
+                raise RuntimeError("Panel's component-resource route was not found to guard")
+            ws_max = getattr(args, "websocket_max_message_size", None) or 20 * 1024 * 1024
+            kwargs["http_server_kwargs"] = {
+                **(kwargs.get("http_server_kwargs") or {}),
+                "max_body_size": int(self.http_max_body_bytes),
+                "max_buffer_size": int(ws_max) + READ_BUFFER_SLACK,
+            }
+            apps = applications(args.files, args.args or [])
+            proved: dict[str, float] = {}
             kwargs["extra_patterns"].append(
-                (f"/{args.liveness_endpoint}", _health_handler_class(), {"proved": proved})
+                (
+                    f"/{args.liveness_endpoint}",
+                    _health_handler_class(),
+                    {"proved": proved, "paths": sorted(apps)},
+                )
             )
             from tornado.ioloop import IOLoop
 
             IOLoop.current().add_callback(_install_stop_signals, self.shutdown_deadline_s)
+            # once the loop runs (the port is open): the proof, which warms the server
+            IOLoop.current().add_callback(prove_in_background, apps, proved)
             return kwargs
+
+        def customize_server(self, server):
+            return Supervised(super().customize_server(server))
 
     return HardenedServe
 
@@ -440,7 +428,9 @@ def serve(argv: list[str], private: dict, options: dict | None = None) -> int:
         ``cookie_secret`` (str) and ``basic_auth`` (dict user -> password, or the path of
         a JSON file), each optional.
     options : dict, optional
-        ``login_max_failures`` (int), ``shutdown_deadline_s`` (float).
+        ``login_max_failures`` (int), ``shutdown_deadline_s`` (float), ``trusted_proxies``
+        (str: addresses or networks, :func:`fbs_auth.parse_networks`),
+        ``http_max_body_bytes`` (int).
     """
     from panel.config import config
 
@@ -449,6 +439,7 @@ def serve(argv: list[str], private: dict, options: dict | None = None) -> int:
     if private.get("basic_auth"):
         config.basic_auth = private["basic_auth"]
     cls = _serve_class()
+    cls.users = private.get("basic_auth")
     for key, value in (options or {}).items():
         setattr(cls, key, value)
     parser = argparse.ArgumentParser(prog="panel serve")

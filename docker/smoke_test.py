@@ -128,7 +128,10 @@ def run(
                 raise AssertionError("no slider on the page to change")
             before = wait_stable(page, timeout_s)
             values = page.evaluate(SLIDER_VALUES_JS)
-            handle = page.locator(".noUi-handle").first
+            # the harmonic's slider: it changes every view (a slider of the vehicle scope,
+            # e.g. the tracks' coherence, changes nothing in the corner scope a page opens in)
+            harmonic = page.locator(".ctl-case-harmonic .noUi-handle")
+            handle = harmonic.first if harmonic.count() else page.locator(".noUi-handle").first
             handle.focus()
             t1 = time.monotonic()
             handle.press("ArrowRight")

@@ -15,6 +15,9 @@
 #     campaign of one scatter case in 8 blocks on the cluster, checks that every block was
 #     computed on a worker and that the band equals fbs_core.scatter_band with the case's
 #     seed to 1e-12; runs campaigns/example.toml (mounted read-only) and lists its cases;
+#     runs a corridor study (a [variants] table of 8 variants of a small tire: one task per
+#     rebuilt tire) on the cluster and checks that every task ran on a worker and that its
+#     responses equal fbs_core.variants.run_variants of the case's seed in the container;
 #  6. `down` of the project and stops dockerd if it started it, also on failure or
 #     interruption, and prints the timings.
 #
@@ -216,6 +219,52 @@ example_campaign() {
     [[ "$summary" == *"16 of 16 cases complete"* ]] || fail "example campaign incomplete"
 }
 
+variants_campaign() {  # a corridor study on the cluster == the same study in-process
+    dc exec -T dashboard sh -c 'cat > /tmp/variants.toml' <<'TOML'
+[campaign]
+name = "compose-variants"
+seed = 32
+output = "/tmp/variants.h5"
+[variants]
+name = "smoke"
+parameters = ["inflation_pressure", "tread_mass", "body_bushing_stiffness"]
+design = "sobol"
+n = 8
+harmonics = [4]
+speeds = [20.0, 40.0, 60.0, 80.0, 100.0, 120.0]
+[variants.tire]
+orders = [6, 3, 4, 3, -1, -1, -1, -1]
+slip_zones = 1
+TOML
+    dc exec -T dashboard python -m fbs_core.campaign run /tmp/variants.toml --quiet \
+        | sed 's/^/    /'
+    dc exec -T dashboard python - <<'PY'
+import os
+import h5py, numpy as np
+import fbs_core.variants as fv
+from distributed import Client
+from fbs_core.campaign import load_campaign, open_campaign
+(case,) = load_campaign("/tmp/variants.toml").variants_cases
+res = open_campaign("/tmp/variants.h5")
+study = res.variants(case.name)
+c = Client(os.environ["FBS_DASK_SCHEDULER"], timeout="60s")
+workers = set(c.scheduler_info()["workers"])
+c.close()
+with h5py.File("/tmp/variants.h5") as h:
+    g = h["cases"][case.name]
+    units = [g["nominal"], *g["tires"].values()]
+    used = [str(u.attrs["worker"]) for u in units]
+    assert g.attrs["seed"] == str(case.seed)
+assert len(used) == 9 and set(used) <= workers, (used, workers)
+ref = fv.run_variants(case.sample(), case.variant_settings())
+a, b = study.responses[4], ref.responses[4]
+np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-9 * np.abs(b).max())
+print(f"    9 tasks (8 tires + nominal) on {len(set(used))} of {len(workers)} workers; "
+      f"responses == run_variants (1e-6); corridor width up to "
+      f"{study.corridor(4).width_db.max():.1f} dB")
+PY
+}
+
 timed "install tools (apt-get when missing)" install_tools
 timed "Docker daemon" start_dockerd
 timed "image $image" ensure_image
@@ -225,4 +274,5 @@ timed "scheduler sees 2 workers" wait_cluster
 timed "dashboard healthy + app document" wait_dashboard
 timed "campaign in 8 blocks on the cluster == scatter_band" smoke_campaign
 timed "campaigns/example.toml on the cluster" example_campaign
+timed "corridor study ([variants]) on the cluster == in-process" variants_campaign
 log "all checks passed"

@@ -28,9 +28,14 @@ from fbs_core.tire.ring import belt_labels  # noqa: E402
 THESIS_TABLE_5_1 = {10: 20, 20: 90, 40: 144, 70: 236, 130: 347, 270: 511, 340: 573}
 
 
-def peaks(f, a):
-    i = np.flatnonzero((a[1:-1] > a[:-2]) & (a[1:-1] > a[2:])) + 1
-    return f[i]
+def peaks(f, a, prominence_db=1.0):
+    """Maxima of the level that stand out by ``prominence_db`` (and the lesser bumps)."""
+    from scipy.signal import find_peaks
+
+    i, p = find_peaks(20 * np.log10(a), prominence=0.0)
+    prom = p["prominences"]
+    bumps = [(f[k], x) for k, x in zip(i, prom, strict=True) if x < prominence_db]
+    return f[i[prom >= prominence_db]], bumps
 
 
 def main():
@@ -71,7 +76,13 @@ def main():
     v = np.abs(tire.patch_response(f, 1).data[:, :, 0])
     for dof in ("hub:z", "hub:x", "hub:ry"):
         a = v[:, HUB_DOFS.index(dof)]
-        print(f"   {dof:6s} peaks at " + ", ".join(f"{x:.2f}" for x in peaks(f, a)) + " Hz")
+        pk, bumps = peaks(f, a)
+        line = f"   {dof:6s} peaks (>= 1 dB prominence) at " + (
+            ", ".join(f"{x:.2f}" for x in pk) + " Hz" if pk.size else "none"
+        )
+        if bumps:
+            line += "; bumps " + ", ".join(f"{x:.2f} Hz ({p:.2f} dB)" for x, p in bumps)
+        print(line)
 
     print("\n5. Modes (positive eigenfrequencies)          target: 200, ~150+ below 800 Hz")
     print("   speed   n   <160 Hz  <800 Hz  highest   damping ratio")

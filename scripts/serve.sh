@@ -32,19 +32,34 @@ fi
 
 HOST=$ADDRESS
 if [ "$HOST" = "0.0.0.0" ]; then HOST=localhost; fi
-echo "== dashboard: http://${HOST}:${PORT}/main   (Ctrl-C stops it)"
 
 SHOW_ARG=()
 if [ "${SHOW:-0}" = 1 ] && { [ -n "${DISPLAY:-}" ] || [ "$(uname)" = Darwin ]; }; then
   SHOW_ARG=(--show)
 fi
-# --warm runs the page once at start-up: the reference models are loaded, the compiled
-# kernels and the truncation maps cached, so the first visitor sees plots within seconds.
-echo "== warming up (reference models, truncation maps, default scatter band) ..."
+# The server listens within seconds; right after, it builds one page on a thread of its own
+# (docker/fbs_server.py: the app's proof, which loads the reference models, compiles the
+# kernels and caches the first page's results), so the first visitor need not wait for a
+# warm-up before the port opens (issue 33; Panel's --warm ran it before listening: 23.6 s).
 # uploads travel base64-encoded in one websocket message: 200 MB carries files up to
 # 150 MB, so a file above fbs_core's 100 MiB limit is refused with a message (Bokeh's
 # default of 20 MB would close the connection on files above 15 MB)
 WS_MAX_MB=${WS_MAX_MB:-200}
 FBS_APP=app/main.py FBS_PORT=$PORT FBS_ADDRESS=$ADDRESS FBS_NUM_THREADS=$NUM_THREADS \
   FBS_WEBSOCKET_MAX_MESSAGE_MB=$WS_MAX_MB \
-  exec .venv/bin/python docker/entrypoint.py --warm "${SHOW_ARG[@]}" "$@"
+  .venv/bin/python docker/entrypoint.py "${SHOW_ARG[@]}" "$@" &
+SERVER=$!
+# Ctrl-C reaches the server too (same process group); a TERM sent to this script is passed on
+trap 'kill -TERM "$SERVER" 2>/dev/null; wait "$SERVER"; exit 143' TERM
+# the URL once the port accepts connections (within seconds: the warm-up runs after)
+until .venv/bin/python -c 'import socket, sys
+socket.create_connection((sys.argv[1], int(sys.argv[2])), timeout=1).close()' \
+  "$HOST" "$PORT" 2>/dev/null; do
+  if ! kill -0 "$SERVER" 2>/dev/null; then
+    wait "$SERVER"
+    exit $?
+  fi
+  sleep 0.5
+done
+echo "== dashboard ready: http://${HOST}:${PORT}/main   (Ctrl-C stops it)"
+wait "$SERVER"

@@ -1,0 +1,219 @@
+"""The first page, side by side: server start -> listening, page request -> first plot (issue 33).
+
+Starts one server per ``--tree`` (source checkouts of the project; default this one) at the
+same time, through ``docker/entrypoint.py`` as ``scripts/serve.sh`` does (``--panel``: plain
+``panel serve app/main.py`` as ``bench_dashboard.py`` does), with Panel's ``--warm`` (the
+page run once before the port opens) for ``--warm yes`` (default), without it for ``no``,
+and as the tree's own ``scripts/serve.sh`` does for ``serve-sh`` (before issue 33 it passed
+``--warm``), and prints for each:
+
+- server start -> the port accepts a connection (a browser could connect);
+- server start -> "Bokeh app running" (the server's own line);
+- then, ``--samples`` times, the trees alternated so that every tree sees the same machine
+  load: a fresh browser page (chromium, playwright) requested until the coupled response's
+  plot (``mobility.truncated``) holds data in the page, and the page closed again.
+
+``bench_dashboard.py`` prints a "page request -> plot" for its first page too, but its
+trees' first pages are opened one after the other and each waits for its band, so the
+second tree's figure there includes the first tree's page and band: use this benchmark to
+compare first pages.
+
+The server's CPU seconds from request to plot (all its threads, from ``/proc``) are printed
+beside: less sensitive to the machine's load than the wall time. The load average
+(``os.getloadavg``) is printed with every figure: on a shared machine only the ratios of
+one run count.
+
+Usage::
+
+    .venv/bin/python bench/bench_first_page.py [--samples 5] [--tree /tmp/old --tree .]
+    .venv/bin/python bench/bench_first_page.py --warm serve-sh --tree /tmp/old --tree .
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+from playwright.sync_api import sync_playwright
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_dashboard import ARGS, CHROMIUM, JS_READY, free_port  # noqa: E402
+
+
+def load() -> str:
+    a, b, c = os.getloadavg()
+    return f"load {a:.1f} {b:.1f} {c:.1f}"
+
+
+def warmed(tree: Path, how: str) -> bool:
+    """Whether the server of ``tree`` gets Panel's ``--warm`` (``how``: yes, no, serve-sh)."""
+    if how == "serve-sh":
+        script = (tree / "scripts" / "serve.sh").read_text()
+        return "entrypoint.py --warm" in script
+    return how == "yes"
+
+
+def start(
+    tree: Path, port: int, panel: bool, threads: int, warm: bool
+) -> tuple[subprocess.Popen, dict]:
+    """Start a server of ``tree`` on ``port``; returns the process and a dict the pump fills
+    with the time of "Bokeh app running"."""
+    extra = ["--warm"] if warm else []
+    if panel:
+        cmd = [sys.executable, "-m", "panel", "serve", "app/main.py", *extra]
+        cmd += ["--port", str(port), "--address", "127.0.0.1", "--num-threads", str(threads)]
+        env = {**os.environ}
+    else:
+        cmd = [sys.executable, "docker/entrypoint.py", *extra]
+        env = {
+            **os.environ,
+            "FBS_APP": "app/main.py",
+            "FBS_PORT": str(port),
+            "FBS_ADDRESS": "127.0.0.1",
+            "FBS_NUM_THREADS": str(threads),
+        }
+    env["PYTHONUNBUFFERED"] = "1"
+    env["PYTHONPATH"] = os.pathsep.join([str(tree), env.get("PYTHONPATH", "")])
+    proc = subprocess.Popen(
+        cmd, cwd=tree, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
+    marks: dict = {"log": []}
+
+    def pump() -> None:
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            marks["log"].append(line)
+            if "Bokeh app running" in line and "running" not in marks:
+                marks["running"] = time.perf_counter()
+
+    threading.Thread(target=pump, daemon=True).start()
+    return proc, marks
+
+
+def cpu_s(pid: int) -> float:
+    """CPU seconds (user + system, all threads) the process used so far (Linux)."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def listening(port: int) -> bool:
+    with socket.socket() as s:
+        s.settimeout(0.2)
+        return s.connect_ex(("127.0.0.1", port)) == 0
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--tree", action="append", type=Path, help="a source checkout (repeat)")
+    ap.add_argument("--samples", type=int, default=5)
+    ap.add_argument("--threads", type=int, default=4)
+    ap.add_argument("--panel", action="store_true", help="plain `panel serve`")
+    ap.add_argument("--warm", choices=["yes", "no", "serve-sh"], default="yes")
+    ap.add_argument("--timeout", type=float, default=600.0, help="seconds per step")
+    args = ap.parse_args()
+    trees = [t.resolve() for t in (args.tree or [ROOT])]
+    names = [
+        f"{t.name}#{i}" if [u.name for u in trees].count(t.name) > 1 else t.name
+        for i, t in enumerate(trees)
+    ]
+    how = "panel serve" if args.panel else "docker/entrypoint.py"
+    warm = [warmed(t, args.warm) for t in trees]
+    print(f"cores {os.cpu_count()}; {how}; --num-threads {args.threads}; {load()}")
+    for name, w in zip(names, warm, strict=True):
+        print(f"[{name}] {'with' if w else 'without'} --warm")
+    servers = []
+    try:
+        t0 = time.perf_counter()
+        for tree, w in zip(trees, warm, strict=True):
+            port = free_port()
+            servers.append((tree, port, *start(tree, port, args.panel, args.threads, w)))
+        pending = {name: s for name, s in zip(names, servers, strict=True)}
+        while pending:  # the port of each, polled every 50 ms
+            for name, (_tree, port, proc, marks) in list(pending.items()):
+                if listening(port):
+                    print(
+                        f"[{name}] start -> listening      {time.perf_counter() - t0:7.1f} s"
+                        f"   ({load()})"
+                    )
+                    del pending[name]
+                elif proc.poll() is not None or time.perf_counter() - t0 > args.timeout:
+                    print("".join(marks["log"][-30:]))
+                    raise RuntimeError(f"server of {name} did not listen")
+            time.sleep(0.05)
+        for name, (_tree, _port, _proc, marks) in zip(names, servers, strict=True):
+            while "running" not in marks and time.perf_counter() - t0 < args.timeout:
+                time.sleep(0.05)
+            print(
+                f"[{name}] start -> 'app running'  {marks.get('running', np.nan) - t0:7.1f} s"
+                f"   ({load()})"
+            )
+        launch: dict = {"args": ARGS}
+        if Path(CHROMIUM).exists():
+            launch["executable_path"] = CHROMIUM
+        out: dict[str, list[float]] = {name: [] for name in names}
+        cpu: dict[str, list[float]] = {name: [] for name in names}
+        with sync_playwright() as p:
+            browser = p.chromium.launch(**launch)
+            for k in range(args.samples):
+                order = list(zip(names, servers, strict=True))
+                if k % 2:  # alternate which tree goes first
+                    order.reverse()
+                for name, (_tree, port, proc, _marks) in order:
+                    page = browser.new_page(viewport={"width": 1600, "height": 1200})
+                    c = cpu_s(proc.pid)
+                    t = time.perf_counter()
+                    page.goto(
+                        f"http://127.0.0.1:{port}/main",
+                        timeout=args.timeout * 1e3,
+                        wait_until="commit",
+                    )
+                    page.wait_for_function(
+                        JS_READY, arg="mobility.truncated", timeout=args.timeout * 1e3, polling=20
+                    )
+                    dt = time.perf_counter() - t
+                    out[name].append(dt)
+                    cpu[name].append(cpu_s(proc.pid) - c)
+                    print(
+                        f"[{name}] page {k + 1}: request -> first plot {dt:6.2f} s, "
+                        f"server CPU {cpu[name][-1]:5.2f} s   ({load()})"
+                    )
+                    page.close()
+            browser.close()
+        print("page request -> first plot, per tree:")
+        for name in names:
+            a = np.asarray(out[name])
+            print(
+                f"[{name}] median {np.median(a):6.2f} s   min {a.min():6.2f}   "
+                f"max {a.max():6.2f}   (n={a.size}); server CPU median "
+                f"{np.median(cpu[name]):5.2f} s"
+            )
+        if len(names) > 1:
+            base = np.median(out[names[0]])
+            cbase = np.median(cpu[names[0]])
+            for name in names[1:]:
+                print(
+                    f"ratio {name} / {names[0]} (medians): wall "
+                    f"{np.median(out[name]) / base:.2f}, server CPU "
+                    f"{np.median(cpu[name]) / cbase:.2f}"
+                )
+    finally:
+        for _tree, _port, proc, _marks in servers:
+            proc.terminate()
+        for _tree, _port, proc, _marks in servers:
+            try:
+                proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+
+
+if __name__ == "__main__":
+    main()
