@@ -8,7 +8,7 @@ from bokeh.models import SaveTool
 from bokeh.plotting import figure
 from test_report_titles import snap
 
-from app.page.bokeh import STYLES, ErrorMapLayers, TitleBlockModels, style_figure
+from app.page.bokeh import STYLES, ErrorMapLayers, TitleBlockModels, style_figure, wrap_line
 from app.report import file_stem, threshold_contour, title_block
 
 
@@ -75,3 +75,30 @@ def test_error_map_layers_follow_threshold_and_map():
     np.testing.assert_array_equal(layers.contour.data["xs"][0], line[:, 0])
     layers.update(f, n, err, 1e6)  # not crossed: no contour
     assert layers.contour.data["xs"] == []
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "a" * 90 + "&",  # a piece longer than the width, then its separator at the end
+        "&" * 200,
+        "x | " * 40,
+        " | ".join(["k=" + "v" * 70 + "&" + "w" * 70] * 3),
+        "pins=" + "~".join(["p" * 30] * 9) + " | link: /main?" + "&".join(["key=val"] * 30),
+    ],
+)
+def test_wrap_line_ends_and_keeps_every_line_within_the_width(text):
+    # the vehicle scope's title block once recursed without end on a piece that ended in
+    # its separator (the page's draws failed with RecursionError)
+    rng = np.random.default_rng(len(text))
+    for width in (8, 40, 77):
+        lines = wrap_line(text, width)
+        assert all(len(line) <= width for line in lines)
+        # nothing is lost: the characters other than blanks come back in order
+        assert "".join(lines).replace(" ", "") == text.replace(" ", "")
+    alphabet = list("ab &|~")
+    for _ in range(200):
+        t = "".join(rng.choice(alphabet, size=int(rng.integers(0, 300))))
+        lines = wrap_line(t, 20)
+        assert all(len(line) <= 20 for line in lines)
+        assert "".join(lines).replace(" ", "") == t.replace(" ", "")

@@ -52,18 +52,22 @@ WRAP = {"normal": 72, "present": 62}
 LEGEND_COLUMNS = {"normal": 3, "present": 2}
 
 
-def wrap_line(text: str, width: int) -> list[str]:
+def wrap_line(text: str, width: int, seps: tuple[str, ...] = (" | ", "&", " ", "~")) -> list[str]:
     """``text`` as lines of at most ``width`` characters, broken after its ``" | "``
     separators, then after the ``&`` of a link's query, then between words, then after
-    the ``~`` between a pin's fields (a piece longer than ``width`` is cut)."""
+    the ``~`` between a pin's fields (a piece longer than ``width`` is cut).
+
+    A piece still too long is broken at the next separators only (``seps``), so every
+    step shortens the list of separators tried and the wrap ends for any text."""
     if len(text) <= width:
         return [text]
-    for sep in (" | ", "&", " ", "~"):
+    for i, sep in enumerate(seps):
         parts = text.split(sep)
         if len(parts) > 1:
             break
     else:
         return [text[i : i + width] for i in range(0, len(text), width)]
+    rest = seps[i + 1 :]
     keep = sep.rstrip()  # the separator stays at the line's end
     lines: list[str] = []
     cur = parts[0]
@@ -76,7 +80,7 @@ def wrap_line(text: str, width: int) -> list[str]:
     lines.append(cur)
     out: list[str] = []
     for line in lines:
-        out.extend(wrap_line(line, width) if len(line) > width else [line])
+        out.extend(wrap_line(line, width, rest) if len(line) > width else [line])
     return out
 
 
