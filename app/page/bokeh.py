@@ -61,13 +61,11 @@ def wrap_line(text: str, width: int, seps: tuple[str, ...] = (" | ", "&", " ", "
     step shortens the list of separators tried and the wrap ends for any text."""
     if len(text) <= width:
         return [text]
-    for i, sep in enumerate(seps):
-        parts = text.split(sep)
-        if len(parts) > 1:
-            break
-    else:
+    found = [k for k, sep in enumerate(seps) if sep in text]
+    if not found:
         return [text[i : i + width] for i in range(0, len(text), width)]
-    rest = seps[i + 1 :]
+    sep, rest = seps[found[0]], seps[found[0] + 1 :]
+    parts = text.split(sep)
     keep = sep.rstrip()  # the separator stays at the line's end
     lines: list[str] = []
     cur = parts[0]

@@ -25,6 +25,7 @@ __all__ = [
     "Snapshot",
     "csv_name",
     "duration_text",
+    "made_of_same",
     "progress_status",
 ]
 
@@ -238,6 +239,15 @@ class Result:
     core: Mapping[str, Any] = field(default_factory=dict)
     snapshot: Snapshot | None = None
     key: tuple = ()
+
+
+def made_of_same(a: Result | None, b: Result | None, fields: tuple[str, ...]) -> bool:
+    """Whether results ``a`` and ``b`` describe snapshots with the same values of
+    ``fields`` (a view that draws one result over another checks that they belong
+    together: their keys have the fields of their own rows, in their own order)."""
+    if a is None or b is None or a.snapshot is None or b.snapshot is None:
+        return False
+    return all(getattr(a.snapshot, f) == getattr(b.snapshot, f) for f in fields)
 
 
 def csv_name(s: Snapshot, *parts: object) -> str:

@@ -35,6 +35,7 @@ from bokeh.models import (
 )
 
 from .analysis_speed import SPEED_LABEL
+from .layout import plot_rows
 from .live import LiveView
 from .plots import new_figure, same_columns
 
@@ -107,7 +108,7 @@ class ParticipationView(LiveView):
     key = "participation"
     result_name = "participation"
     also = ("mode_shape",)
-    min_height = 300
+    css_height = plot_rows(1.15)  # its own height: the tab's views stand one below the other
 
     def _controls(self):
         a = self.store.state.analysis
@@ -182,7 +183,7 @@ class ModeShapeView(LiveView):
 
     key = "modeshape"
     result_name = "mode_shape"
-    min_height = 300
+    css_height = plot_rows(1.15)  # its own height: the tab's views stand one below the other
 
     def _build(self):
         self._plane = fig = new_figure(
@@ -268,7 +269,7 @@ class WavesView(LiveView):
     key = "waves"
     result_name = "waves"
     also = ("mode_shape",)
-    min_height = 300
+    css_height = plot_rows(1.15)  # its own height: the tab's views stand one below the other
 
     def _controls(self):
         a = self.store.state.analysis
@@ -323,7 +324,7 @@ class SelectedModesView(LiveView):
 
     key = "selected"
     result_name = "selected_modes"
-    min_height = 200
+    css_height = "calc(140px + 7.5em)"  # its own height: the views stand one below the other
 
     def _build(self):
         self._table_src = _src("selected.table", ("name", "n_modes", "n_first", "top", "pairs"))
@@ -365,7 +366,7 @@ class ChassisTruncationView(LiveView):
 
     key = "chassistrunc"
     result_name = "chassis_truncation"
-    min_height = 300
+    css_height = plot_rows(1)  # its own height: the tab's views stand one below the other
 
     def _build(self):
         self._fig = fig = new_figure(
@@ -397,15 +398,18 @@ class ChassisTruncationView(LiveView):
 
 
 def modes_tab(results) -> pn.Column:
-    """The "Modes" tab: the ranking and the picked mode's shape, the waves below."""
+    """The "Modes" tab: the two ways to pick a mode side by side (the ranking's bars, the
+    branches of the waves' Campbell diagram), the picked mode's shape below them at the
+    tab's full width (its two plots side by side need it: at half a card's width their
+    title lines were cut)."""
     return pn.Column(
         pn.Row(
             ParticipationView(store=results),
-            ModeShapeView(store=results),
-            sizing_mode="stretch_both",
+            WavesView(store=results),
+            sizing_mode="stretch_width",
         ),  # fmt: skip
-        WavesView(store=results),
-        sizing_mode="stretch_both",
+        ModeShapeView(store=results),
+        sizing_mode="stretch_width",
     )
 
 
@@ -414,5 +418,5 @@ def selection_tab(results) -> pn.Column:
     return pn.Column(
         SelectedModesView(store=results),
         ChassisTruncationView(store=results),
-        sizing_mode="stretch_both",
+        sizing_mode="stretch_width",
     )

@@ -17,6 +17,8 @@ from bokeh.models import ColumnDataSource, HoverTool, Label, Span
 
 from fbs_core.vocabulary import DIRECTIONS
 
+from ..results.base import made_of_same
+from ..store import CASE
 from .analysis_base import TERM_COLORS
 from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
 from .layout import font
@@ -168,8 +170,10 @@ class MobilityView(LiveView):
         c = r.columns
         f = c["freq_Hz"]
         p = self.store.response_plot
-        # the plot's extras only when made of the same case (they are published just after)
-        extras = p if p is not None and p.key[: len(r.key)] == r.key else None
+        # the plot's extras (a corner's) only over the corner's response of the same case
+        # (they are published just after it)
+        corner = r.snapshot is not None and not r.snapshot.vehicle
+        extras = p if corner and made_of_same(p, r, CASE) else None
         if extras is None:
             self._ref.data = {"freq": f, "level": c["reference_dB"]}
             self._tr.data = {"freq": f, "level": c["truncated_dB"]}

@@ -247,6 +247,26 @@ JS_OVERFLOW = """
 }
 """
 
+#: The page's controls shown (buttons, inputs, selects, through the shadow roots): their
+#: text and rectangle.
+JS_CONTROLS = """
+() => {
+  const out = [];
+  const walk = (root) => { for (const el of root.querySelectorAll('*')) {
+      if (el.shadowRoot) walk(el.shadowRoot);
+      if (!['BUTTON', 'INPUT', 'SELECT', 'TEXTAREA'].includes(el.tagName)) continue;
+      const r = el.getBoundingClientRect();
+      const st = getComputedStyle(el);
+      if (r.width < 1 || r.height < 1 || st.visibility === 'hidden' || st.display === 'none')
+        continue;
+      out.push({text: (el.innerText || el.value || el.tagName).slice(0, 30),
+                rect: {left: r.left, right: r.right, top: r.top, bottom: r.bottom}});
+  } };
+  walk(document);
+  return out;
+}
+"""
+
 
 def intersect(a: dict, b: dict, tol: float = 0.5) -> bool:
     """Whether rectangles ``a`` and ``b`` share an area (more than ``tol`` px each way)."""
@@ -270,7 +290,8 @@ def layout_problems(page, width: int) -> list[str]:
 
     Cards overlap; a card, a plot canvas, its legend or a title line reaches outside the
     window's width; a plot lies outside its own card or over another card, or its plot area
-    is smaller than :data:`MIN_FRAME`; the main area scrolls sideways.
+    is smaller than :data:`MIN_FRAME`; a control (button, input) lies over a plot; the main
+    area scrolls sideways.
     """
     out = []
     cs = cards(page)
@@ -293,6 +314,11 @@ def layout_problems(page, width: int) -> list[str]:
                 continue  # its own card (or a card around it)
             if intersect(p["canvas"], r):
                 out.append(f"{p['name']}: canvas over the card {c['title'][:40]!r}")
+    shown = plots(page)
+    for c in page.evaluate(JS_CONTROLS):  # a control over a plot takes its clicks
+        for p in shown:
+            if intersect(c["rect"], p["canvas"], tol=2.0):
+                out.append(f"the control {c['text']!r} lies over the plot {p['name']}")
     ov = page.evaluate(JS_OVERFLOW)
     if ov["main"] > 1 or ov["document"] > 1:
         out.append(f"the page scrolls sideways: {ov}")

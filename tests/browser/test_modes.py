@@ -18,6 +18,7 @@ import fbs_core
 from fbs_core.analysis import mode_participation, tire_mode_shape
 
 from .conftest import fingerprint, open_dashboard, source, wait_changed, wait_loaded
+from .layout_util import layout_problems, wait_stable
 from .test_analysis import _screen
 
 pytestmark = pytest.mark.browser
@@ -58,6 +59,9 @@ def test_a_click_on_a_bar_draws_that_modes_shape_and_animates_it(page, dashboard
     n = len(bars["mode"])
     assert [int(m) for m in bars["mode"]] == [int(m) for m in p.modes[order[:n]]]
     np.testing.assert_allclose(bars["value"], 100 * p.loo[order[:n], 2], rtol=1e-9)
+    # the tab's views stand one below the other: no control over a plot takes its clicks
+    wait_stable(page)
+    assert not layout_problems(page, 1600)
     # a real click on the third bar
     target = int(bars["mode"][2])
     before = fingerprint(page, "modeshape.frames")

@@ -60,9 +60,18 @@ def test_cursors_readout_snap_overlay_and_linear_axis(browser, dashboard):
     f, lv = np.asarray(ref["freq"], float), np.asarray(ref["level"], float)
     # two clicks in the plot: cursor 1, then cursor 2, at the frequencies clicked
     for k, i in ((1, 30), (2, 100)):
+        # as a user: the plot is looked at where it stands now (the readout above it
+        # appears with the first cursor)
+        wait_stable(page)
         x, y = page.evaluate(JS_SCREEN, ["mobility.figure", float(f[i]), float(lv[i])])
         page.mouse.click(x, y)
         _wait_query(page, f"mc{k}", "v !== null && parseFloat(v) > 0")
+        page.wait_for_function(
+            "(n) => [...Bokeh.documents[0].all_models].filter(m => m.name === n && m.visible)"
+            ".length === 1",
+            arg=f"mobility.cursor{k}",
+            timeout=60_000,
+        )
     c1, c2 = float(_query(page, "mc1")), float(_query(page, "mc2"))
     step = f[1] - f[0]
     assert abs(c1 - f[30]) < 2 * step and abs(c2 - f[100]) < 2 * step, (c1, c2)
