@@ -59,3 +59,15 @@ def test_scatter_band_rounds_are_bounded_before_any_allocation():
         fc.scatter_band(4, noise=0.1, rounds=10**12, n_modes=20)
     with pytest.raises(FBSError, match="rounds must be at most"):
         fc.scatter_band(4, noise=0.1, rounds=MAX_ROUNDS + 1, n_modes=20)
+
+
+def test_a_study_result_not_finite_names_its_first_line():
+    from fbs_core.studies._finite import require_finite
+
+    f = np.array([10.0, 12.5, 15.0, 17.5])
+    x = np.ones((4, 2, 2))
+    require_finite(x, f, "the band", "why")  # finite: nothing
+    x[2, 1, 0] = np.nan
+    x[3, 0, 0] = np.inf
+    with pytest.raises(SingularInterfaceError, match=r"^the band is not finite at 15 Hz \(why\)$"):
+        require_finite(x, f, "the band", "why")

@@ -10,6 +10,7 @@ header, file name, caption) from the same snapshot.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -28,6 +29,7 @@ __all__ = [
     "eigen_result",
     "error_map_result",
     "first_order_result",
+    "map_result",
     "residual_meta",
     "residual_work",
     "response_result",
@@ -167,10 +169,39 @@ def error_map_result(s: Snapshot) -> Result:
     what = f"bushing:{s.dof}" if s.map_dof else "max over 6 DOFs"
     if s.residual:
         what += ", with residuals"
-    nn, ff = np.meshgrid(d["n_modes"], d["centre_freq"], indexing="ij")
     tab, tab_r = _tables(s)
     shown = tab_r if s.residual else tab
     assert shown is not None  # with residual on, its table is computed (_tables)
+    return map_result(
+        s,
+        d,
+        what=what,
+        view="truncation error map (thesis eq. 5.1, figs. 5.3/5.6/5.7)",
+        filename=csv_name(
+            s, "truncation_map", f"h{s.harmonic}", s.map_dof or "maxdof", s.coupling, res_part(s)
+        ),
+        title=f"Harmonic {s.harmonic}, {what}",
+        suggested_n=int(shown["n_modes"][list(shown["harmonic"]).index(s.harmonic)]),
+        core_map=compute.error_map(s.harmonic, s.coupling, s.models, s.residual),
+    )
+
+
+def map_result(
+    s: Snapshot,
+    d: dict,
+    *,
+    what: str,
+    view: str,
+    filename: str,
+    title: str,
+    suggested_n: int,
+    core_map: Any,
+    scope_meta: dict | None = None,
+) -> Result:
+    """The Result of a truncation error map (eq. 5.1) ``d`` (``n_modes``, ``centre_freq``,
+    ``error_pct``), a corner's or the car's: its CSV in long layout (one row per N and
+    centre frequency), its header and what the view draws."""
+    nn, ff = np.meshgrid(d["n_modes"], d["centre_freq"], indexing="ij")
     return Result(
         columns={
             "n_modes": nn.ravel(),
@@ -178,7 +209,8 @@ def error_map_result(s: Snapshot) -> Result:
             "error_pct": d["error_pct"].ravel(),
         },
         meta={
-            "view": "truncation error map (thesis eq. 5.1, figs. 5.3/5.6/5.7)",
+            "view": view,
+            **(scope_meta or {}),
             "harmonic": s.harmonic,
             "coupling": s.coupling,
             "response DOF": what,
@@ -188,19 +220,17 @@ def error_map_result(s: Snapshot) -> Result:
             "models": s.models.describe(),
             **tire_meta(s),
         },
-        filename=csv_name(
-            s, "truncation_map", f"h{s.harmonic}", s.map_dof or "maxdof", s.coupling, res_part(s)
-        ),
+        filename=filename,
         draw={
             "map": d,
-            "title": f"Harmonic {s.harmonic}, {what}",
+            "title": title,
             "threshold": s.threshold,
             "f_max": s.f_max,
             "n_modes": s.n_modes,
-            "suggested_n": int(shown["n_modes"][list(shown["harmonic"]).index(s.harmonic)]),
+            "suggested_n": suggested_n,
             "freq": compute.frequencies(s.harmonic),
         },
-        core={"map": compute.error_map(s.harmonic, s.coupling, s.models, s.residual)},
+        core={"map": core_map},
     )
 
 

@@ -26,7 +26,7 @@ from fbs_core.vocabulary import HARMONIC_CASES, fraction, magnitude_db, percent
 from .. import compute
 from .. import vehicle_compute as vc
 from .base import Result, Snapshot, csv_name
-from .main import res_part, residual_meta, tire_meta
+from .main import map_result, res_part, residual_meta, tire_meta
 from .scope import file_parts, tracks_text, vehicle_caption, vehicle_meta, wheels_text
 
 __all__ = ["error_map_result", "response_result", "suggested_result", "wheels_result"]
@@ -140,26 +140,12 @@ def error_map_result(s: Snapshot) -> Result:
     what = dof or f"max over the 6 DOFs of {s.point}"
     if s.residual:
         what += ", with residuals"
-    nn, ff = np.meshgrid(d["n_modes"], d["centre_freq"], indexing="ij")
-    n_sugg = int(_suggested(s, s.residual)[list(HARMONIC_CASES).index(s.harmonic)])
-    return Result(
-        columns={
-            "n_modes": nn.ravel(),
-            "centre_freq_Hz": ff.ravel(),
-            "error_pct": d["error_pct"].ravel(),
-        },
-        meta={
-            "view": "truncation error map of the car (thesis eq. 5.1, figs. 5.3/5.6/5.7)",
-            **vehicle_meta(s),
-            "harmonic": s.harmonic,
-            "coupling": s.coupling,
-            "response DOF": what,
-            "reference": "all tire modes",
-            "residual compensation": residual_meta(s.residual),
-            "layout": "long: one row per (N, centre freq)",
-            "models": s.models.describe(),
-            **tire_meta(s),
-        },
+    return map_result(
+        s,
+        d,
+        what=what,
+        view="truncation error map of the car (thesis eq. 5.1, figs. 5.3/5.6/5.7)",
+        scope_meta=vehicle_meta(s),
         filename=csv_name(
             s,
             "vehicle_truncation_map",
@@ -170,17 +156,10 @@ def error_map_result(s: Snapshot) -> Result:
             res_part(s),
             *file_parts(s),
         ),
-        draw={
-            "map": d,
-            "title": f"Harmonic {s.harmonic}, {what} (vehicle, wheels {wheels_text(s.wheels)}, "
-            f"tracks {tracks_text(s)})",
-            "threshold": s.threshold,
-            "f_max": s.f_max,
-            "n_modes": s.n_modes,
-            "suggested_n": n_sugg,
-            "freq": compute.frequencies(s.harmonic),
-        },
-        core={"map": m},
+        title=f"Harmonic {s.harmonic}, {what} (vehicle, wheels {wheels_text(s.wheels)}, "
+        f"tracks {tracks_text(s)})",
+        suggested_n=int(_suggested(s, s.residual)[list(HARMONIC_CASES).index(s.harmonic)]),
+        core_map=m,
     )
 
 

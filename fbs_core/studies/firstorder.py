@@ -45,6 +45,7 @@ from ..harmonics import Harmonic
 from ..vocabulary import DIRECTIONS
 from ..vocabulary import readonly as _ro
 from . import _models
+from ._finite import require_finite
 
 __all__ = [
     "FirstOrderBand",
@@ -218,12 +219,12 @@ def first_order_band_arrays(
         idx = np.arange(ne)
         cov[:, idx, idx] += np.einsum("fak,fak->fa", RB, RB)
     cov *= var
-    if not np.all(np.isfinite(cov)):
-        line = int(np.argwhere(~np.isfinite(cov))[0][0])
-        raise SingularInterfaceError(
-            f"the first-order band is not finite at {f[line]:g} Hz (a zero response or a "
-            "singular interface matrix Y_jj^A + Y_jj^E)"
-        )
+    require_finite(
+        cov,
+        f,
+        "the first-order band",
+        "a zero response or a singular interface matrix Y_jj^A + Y_jj^E",
+    )
     return FirstOrderBand(
         freq=_ro(f),
         dofs=labels,

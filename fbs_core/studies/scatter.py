@@ -41,12 +41,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._typing import ComplexArray, FloatArray, IntArray
-from ..errors import DataFormatError, FBSError, SingularInterfaceError, StudyCancelled
+from ..errors import DataFormatError, FBSError, StudyCancelled
 from ..frf import check_grid
 from ..harmonics import Harmonic
 from ..vocabulary import DIRECTIONS, magnitude_db
 from ..vocabulary import readonly as _ro
 from . import _models, _noise_kernels
+from ._finite import require_finite
 from ._rng import as_seed, seed_key
 from .band_kernel import (
     LOCK,
@@ -489,12 +490,12 @@ def scatter_band_arrays(
     del mag
     lo, hi = st.minimum, st.maximum
     for name, x in (("reference", np.abs(ref)), ("upper edge", hi), ("lower edge", lo)):
-        if not np.all(np.isfinite(x)):
-            line = int(np.argwhere(~np.isfinite(x))[0][0])
-            raise SingularInterfaceError(
-                f"{name} of the scatter band is not finite at {f[line]:g} Hz: the (noisy) "
-                "interface matrix Y_jj^A + Y_jj^E is singular there"
-            )
+        require_finite(
+            x,
+            f,
+            f"{name} of the scatter band",
+            "the (noisy) interface matrix Y_jj^A + Y_jj^E is singular there",
+        )
     return ScatterBand(
         freq=_ro(f),
         dofs=dofs,
