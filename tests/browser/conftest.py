@@ -15,6 +15,7 @@ import threading
 from pathlib import Path
 
 import pytest
+from playwright.sync_api import TimeoutError as PlaywrightTimeoutError
 
 ROOT = Path(__file__).resolve().parents[2]
 SYSTEM_CHROMIUM = "/usr/bin/chromium"
@@ -27,6 +28,7 @@ CHROMIUM_ARGS = [
     "--disable-sync",
 ]
 #: Script served; overridable for debugging the harness itself.
+ARTIFACTS = Path(__file__).parent / "artifacts"
 APP_SCRIPT = os.environ.get("FBS_DASHBOARD_SCRIPT", str(ROOT / "app" / "main.py"))
 #: Names of the ColumnDataSources that every page shows (set by the views' hooks).
 SOURCES = [
@@ -193,20 +195,41 @@ def open_dashboard(page, url: str, timeout=180_000):
     wait_loaded(page, timeout=timeout)
 
 
+JS_SOURCES_SEEN = """(names) => Object.fromEntries(names.map(n => [n,
+    [...Bokeh.documents[0].all_models].filter(m => m.name === n && m.type === 'ColumnDataSource')
+      .map(m => { const k = Object.keys(m.data)[0];
+                  return k === undefined ? -1 : m.data[k].length; })
+  ]))"""
+
+
 def wait_loaded(page, names=SOURCES, timeout=90_000):
-    """Wait until the Bokeh document exists and every named source holds data."""
+    """Wait until the Bokeh document exists and every named source holds data.
+
+    On a timeout the error says what the page held: per name, the length of each source
+    of that name, and the page's query."""
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0", timeout=timeout)
-    page.wait_for_function(
-        """(names) => names.every(n => {
-             const ms = [...Bokeh.documents[0].all_models].filter(
-                 m => m.name === n && m.type === 'ColumnDataSource');
-             if (ms.length !== 1) return false;
-             const d = ms[0].data; const k = Object.keys(d)[0];
-             return k !== undefined && d[k].length > 0;
-           })""",
-        arg=list(names),
-        timeout=timeout,
-    )
+    try:
+        page.wait_for_function(
+            """(names) => names.every(n => {
+                 const ms = [...Bokeh.documents[0].all_models].filter(
+                     m => m.name === n && m.type === 'ColumnDataSource');
+                 if (ms.length !== 1) return false;
+                 const d = ms[0].data; const k = Object.keys(d)[0];
+                 return k !== undefined && d[k].length > 0;
+               })""",
+            arg=list(names),
+            timeout=timeout,
+        )
+    except PlaywrightTimeoutError:
+        seen = page.evaluate(JS_SOURCES_SEEN, list(names))
+        query = page.evaluate("() => window.location.search")
+        ARTIFACTS.mkdir(exist_ok=True)
+        shot_path = ARTIFACTS / "wait_loaded_timeout.png"
+        page.screenshot(path=str(shot_path))
+        raise AssertionError(
+            f"sources not loaded in {timeout / 1000:g} s: {seen} (lengths of the sources of "
+            f"each name; the page's query {query}; screenshot {shot_path})"
+        ) from None
 
 
 def wait_changed(page, name: str, before: str, timeout=30_000):

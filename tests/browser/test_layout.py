@@ -107,12 +107,13 @@ def test_every_card_opened_by_a_click_keeps_to_itself(browser, dashboard, size):
                      && m.items.some(i => i.label && i.label.value === 'baseline'))""",
                 timeout=60_000,
             )
-            labels = page.evaluate(
-                """() => [...Bokeh.documents[0].all_models].filter(m => m.type === 'Figure'
-                     && m.name === 'compare.band').flatMap(f => [...f.below, ...f.center]
-                     .filter(r => r.type === 'Legend').flatMap(l => l.items)
+            band_labels = """() => [...Bokeh.documents[0].all_models].filter(m => m.type
+                     === 'Figure' && m.name === 'compare.band').flatMap(f => [...f.below,
+                     ...f.center].filter(r => r.type === 'Legend').flatMap(l => l.items)
                      .filter(i => i.visible).map(i => i.label.value))"""
-            )
+            # the band plot's legend follows its own draw (after the curves' plot)
+            page.wait_for_function(f"() => ({band_labels})().includes('baseline')", timeout=60_000)
+            labels = page.evaluate(band_labels)
             assert "baseline" in labels and not any(x.startswith("pin ") for x in labels), labels
             _check(page, size, "tab Compare, one pin", problems)
             shot(page, f"layout_{_tag(size)}_tab_compare_pinned")
