@@ -226,7 +226,8 @@ def _spans(page, prefix):
 def test_compare_pin_change_and_difference(page, dashboard):
     _tab(page, "Compare")
     page.wait_for_function("() => window.location.search.includes('atab=compare')", timeout=180_000)
-    wait_loaded(page, ["compare.curve0", "mobility.truncated"])
+    # (the previous test's harmonic 5 starts a new band: on a loaded machine it takes long)
+    wait_loaded(page, ["compare.curve0", "mobility.truncated"], timeout=180_000)
     before = source(page, "mobility.truncated")
     box = page.locator(".ctl-analysis-pin_name input").first
     box.fill("base")
@@ -236,11 +237,14 @@ def test_compare_pin_change_and_difference(page, dashboard):
     wait_loaded(page, ["compare.curve1"])
     # change N: the difference is the current main-view curve minus the pinned one
     fp = fingerprint(page, "compare.diff1")
+    fp_main = fingerprint(page, "mobility.truncated")
     from .conftest import set_model_value
 
     set_model_value(page, "ctl-case-n_modes", 14, "Slider")  # N = 150
     page.wait_for_function("() => window.location.search.includes('N=150')")
     wait_changed(page, "compare.diff1", fp)
+    # the shown analysis view is drawn before the main views: wait for the main curve too
+    wait_changed(page, "mobility.truncated", fp_main)
     page.wait_for_function(
         """() => { const d = [...Bokeh.documents[0].all_models].filter(
              m => m.name === 'compare.diff1')[0].data.diff;
