@@ -122,3 +122,16 @@ def test_the_plot_settings_are_in_the_link():
     third = DashboardState()
     sync_url(third, Location(search="?over=%5B%22w%22%5D&lvl=log&mc1=35"))
     assert (third.plot.overlay, third.plot.level_scale, third.plot.cursor1) == ([], "dB", 35.0)
+
+
+def test_clicks_place_cursor_1_then_2_rounded_and_within_range():
+    from app.views.common import tap_cursor
+
+    p = DashboardState().plot
+    k = tap_cursor(p, 40.004, 1)
+    assert (p.cursor1, k) == (40.0, 2)
+    k = tap_cursor(p, None, k)  # a click on no frequency places nothing
+    assert (p.cursor2, k) == (0.0, 2)
+    k = tap_cursor(p, 5000.0, k)
+    assert (p.cursor2, k) == (1000.0, 1)
+    assert tap_cursor(p, -3.0, k) == 2 and p.cursor1 == 0.01

@@ -26,7 +26,7 @@ from bokeh.models import (
 )
 
 from .analysis_base import PICK_COLOR, AnalysisView
-from .common import COLORS, FREQ_LABEL
+from .common import COLORS, FREQ_LABEL, tap_cursor
 from .layout import plot_rows, weight
 from .plots import frequency_range, new_figure, set_data
 from .typed import NumberField
@@ -202,16 +202,8 @@ class PhaseView(AnalysisView):
         return [column(top, bottom, sizing_mode="stretch_both")]
 
     def _tapped(self, event):
-        if event.x is None:
-            return
-        a = self.store.state.analysis
-        f = float(np.clip(round(event.x, 2), 0.01, 1000.0))
-        if self._next_cursor == 1:
-            a.cursor1 = f
-            self._next_cursor = 2
-        else:
-            a.cursor2 = f
-            self._next_cursor = 1
+        """A click on the plot places cursor 1, the next one cursor 2, and so on."""
+        self._next_cursor = tap_cursor(self.store.state.analysis, event.x, self._next_cursor)
 
     def _restyle_now(self) -> None:
         super()._restyle_now()

@@ -29,3 +29,14 @@ def level_label(dof: str, label: str = "Level") -> str:
 def level_tooltips(what: str, column: str = "level") -> list[tuple[str, str]]:
     """Hover lines of a level curve: what it is, frequency and level."""
     return [("", what), ("Frequency", "@freq{0.0} Hz"), ("Level", "@" + column + "{0.0} dB")]
+
+
+def tap_cursor(group, x: float | None, k: int) -> int:
+    """A click at frequency ``x`` (Hz) places cursor ``k`` (1 or 2) of the state ``group``
+    (its ``cursor1`` / ``cursor2``, rounded to 0.01 Hz within 0.01-1000 Hz); returns the
+    cursor the next click places (1, 2, 1, ...; ``k`` again when the click hit no frequency)."""
+    if x is None:
+        return k
+    f = min(max(round(float(x), 2), 0.01), 1000.0)
+    setattr(group, f"cursor{k}", f)
+    return 2 if k == 1 else 1

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import html
 
-import numpy as np
 import panel as pn
 import param
 from bokeh.core.property.vectorization import value
@@ -20,7 +19,7 @@ from fbs_core.vocabulary import DIRECTIONS
 from ..results.base import made_of_same
 from ..store import CASE
 from .analysis_base import TERM_COLORS
-from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
+from .common import COLORS, FREQ_LABEL, level_label, level_tooltips, tap_cursor
 from .layout import font
 from .live import LiveText, LiveView
 from .plots import add_line, frequency_range, new_figure
@@ -130,16 +129,7 @@ class MobilityView(LiveView):
 
     def _tapped(self, event):
         """A click on the plot places cursor 1, the next one cursor 2, and so on."""
-        if event.x is None:
-            return
-        p = self.store.state.plot
-        f = float(np.clip(round(event.x, 2), 0.01, 1000.0))
-        if self._next_cursor == 1:
-            p.cursor1 = f
-            self._next_cursor = 2
-        else:
-            p.cursor2 = f
-            self._next_cursor = 1
+        self._next_cursor = tap_cursor(self.store.state.plot, event.x, self._next_cursor)
 
     def _restyle_now(self) -> None:
         super()._restyle_now()
