@@ -256,6 +256,7 @@ class PhaseView(AnalysisView):
             self._cursors.data = {"freq": [], "level": []}
         self._set_log(bool(d["log"]))
         self._fit(self.x_range, f)
+        self._drawn = r
 
     def _peak_data(self, r) -> dict:
         """The peak labels of result ``r``, with the modes nearby once they arrived."""
@@ -283,6 +284,11 @@ class PhaseView(AnalysisView):
     def _apply_labels(self) -> None:
         r = self.result()
         if self._layout is None or self.store.closed or r is None:
+            return
+        if getattr(self, "_drawn", None) is not r:
+            # the curves of this result are not on the page yet (their draw was lost or is
+            # still to come: the full suite once showed the labels over empty plots)
+            self._apply()
             return
         self._peaks.data = self._peak_data(r)
 
