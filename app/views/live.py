@@ -281,7 +281,12 @@ class LiveView(Viewer):
         self._on_document(self._apply)
 
     def _on_document(self, fn) -> None:
-        """Run ``fn`` (changes of Bokeh models) where it may change the served document."""
+        """Run ``fn`` (changes of Bokeh models) where it may change the served document:
+        the one current when the view was built, else the one its figures belong to (a view
+        built where no document was current would otherwise change served models off the
+        session's event loop)."""
+        if self._doc is None and self._figures:
+            self._doc = self._figures[0].document
         on_document(self._doc, fn)
 
     def _apply(self) -> None:
