@@ -48,6 +48,7 @@ class PhaseView(AnalysisView):
     def __init__(self, **params):
         super().__init__(**params)
         self._next_cursor = 1
+        self._drawn = None  # the result whose curves were last drawn
         a = self.store.state.analysis
         # typed cursors (Hz; 0: off), read as a person means them (app/views/typed.py)
         self._cursor_fields = [
@@ -285,7 +286,7 @@ class PhaseView(AnalysisView):
         r = self.result()
         if self._layout is None or self.store.closed or r is None:
             return
-        if getattr(self, "_drawn", None) is not r:
+        if self._drawn is not r:
             # the curves of this result are not on the page yet (their draw was lost or is
             # still to come: the full suite once showed the labels over empty plots)
             self._apply()
