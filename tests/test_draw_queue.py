@@ -11,10 +11,15 @@ from __future__ import annotations
 
 import asyncio
 import gc
+import inspect
 import threading
 import weakref
 
+from bokeh.document import Document
+
+from app.runtime import draw as draw_module
 from app.runtime.draw import DrawQueue, on_document
+from app.runtime.panel_private import panel_writes_pending
 
 
 class _Context:
@@ -23,8 +28,10 @@ class _Context:
 
     async def with_locked_document(self, func):
         self.log.append("lock")
-        try:
-            func(self._doc())
+        try:  # as Bokeh's: an awaitable result is awaited inside the lock
+            r = func(self._doc())
+            if inspect.isawaitable(r):
+                await r
         finally:
             await asyncio.sleep(0)  # the patches' writes: other tasks may run meanwhile
             self.log.append("written")
@@ -113,3 +120,56 @@ def test_an_ended_page_is_not_kept_alive_by_draws_that_never_ran():
     del doc
     gc.collect()
     assert ref() is None
+
+
+def test_a_draw_waits_inside_the_lock_for_the_messages_panel_serialized_before_it(monkeypatch):
+    """Panel writes some changes (a clicked dynamic tab's new views) from a task that polls
+    the socket; a draw queued behind them must not overtake them (its patches would reach the
+    page before the models they change: the phase tab's plots stayed empty)."""
+    log = []
+    doc = _Doc(log)
+    pending = {"messages": 3}
+
+    def panel_pending(d):
+        assert d is doc
+        return pending["messages"] > 0
+
+    async def panel_writer():  # Panel's write task: one message per turn of the loop
+        while pending["messages"]:
+            await asyncio.sleep(0)
+            pending["messages"] -= 1
+            log.append("panel message written")
+
+    monkeypatch.setattr(draw_module, "panel_writes_pending", panel_pending)
+    on_document(doc, lambda: log.append("phase drawn"))
+    drain = doc.ticks.pop(0)
+
+    async def main():
+        await asyncio.gather(drain(), panel_writer())
+
+    errors: list = []
+    t = threading.Thread(target=lambda: _capture(errors, lambda: asyncio.run(main())))
+    t.start()
+    t.join(timeout=60)
+    assert not t.is_alive() and errors == []
+    assert log == ["lock", *["panel message written"] * 3, "phase drawn", "written"]
+
+
+def test_pending_panel_writes_are_read_from_panel_itself():
+    """The predicate reads Panel's own record of serialized, unwritten messages (it fails
+    here if Panel renames or drops it)."""
+    from panel.io import document as pdoc
+
+    doc = Document()
+    assert not panel_writes_pending(doc)
+    pdoc._WRITE_BLOCK[doc] = True
+    try:
+        assert panel_writes_pending(doc)
+    finally:
+        del pdoc._WRITE_BLOCK[doc]
+    pdoc._WRITE_MSGS[doc] = {"connection": ["message"]}
+    try:
+        assert panel_writes_pending(doc)
+    finally:
+        del pdoc._WRITE_MSGS[doc]
+    assert not panel_writes_pending(doc)

@@ -12,8 +12,10 @@ queue of a session that ended is dropped (:meth:`DrawQueue.discard`).
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import threading
+import time
 import weakref
 from collections import deque
 from functools import partial
@@ -21,6 +23,8 @@ from functools import partial
 import panel as pn
 from bokeh.document import without_document_lock
 from panel.io.state import set_curdoc
+
+from .panel_private import panel_writes_pending
 
 __all__ = ["DrawQueue", "on_document", "served", "served_document"]
 
@@ -125,9 +129,33 @@ class DrawQueue:
             if doc is None or doc.session_context is None:
                 continue
             try:  # returns once the draw's patches are written (or the session ended)
-                await doc.session_context.with_locked_document(partial(_run_on, fn))
+                await doc.session_context.with_locked_document(partial(_draw_locked, fn))
             except Exception:
                 log.exception("drawing on the page failed")
+
+
+#: Longest wait of a draw for Panel's pending messages (s): a safeguard only; they are
+#: written as soon as the socket is free (tens of ms under load).
+PANEL_WRITES_WAIT = 10.0
+
+
+async def _after_panel_writes(doc) -> None:
+    """Wait until the messages Panel serialized for ``doc`` earlier are written, so that a
+    draw's patches never reach the page before the models they change
+    (:mod:`app.runtime.panel_private`)."""
+    end = time.monotonic() + PANEL_WRITES_WAIT
+    while panel_writes_pending(doc) and doc.session_context is not None:
+        if time.monotonic() > end:
+            log.warning("Panel's messages to a page waited more than %g s", PANEL_WRITES_WAIT)
+            return
+        await asyncio.sleep(0.002)
+
+
+async def _draw_locked(fn, doc) -> None:
+    """``fn`` under the document lock, once the messages Panel serialized before it are
+    written (waiting inside the lock: no change of Panel's can be serialized in between)."""
+    await _after_panel_writes(doc)
+    _run_on(fn, doc)
 
 
 def _run_on(fn, doc) -> None:

@@ -18,6 +18,16 @@ sessions changing, ``bench/load_test.py``), and Bokeh's ``Div`` makes the browse
 out the whole page on every text change (~36 ms each in the page, against 0.2-0.6 ms for
 Panel's HTML model). The text is sent escaped once, as the pane sends it (the page decodes
 it once); ``tests/test_app_views.py`` fails if the pane's convention changes.
+
+Panel writes some of a page's changes later than it serializes them: when a layout changes
+(e.g. a dynamic tab's views are rendered when the tab is clicked) while the page's socket is
+busy writing, Panel turns the changes into messages at once and writes them from a task that
+polls the socket's write lock every 10 ms (``panel.io.document.schedule_write_events``).
+A draw of the app's own (:class:`app.runtime.draw.DrawQueue`) queues on that lock and so
+overtook those messages: its patches reached the page before the models they change, which
+the page dropped, and the models then arrived as serialized before the draw (the phase
+view's plots stayed empty after a click on its tab). :func:`panel_writes_pending` tells the
+draw queue to wait for them.
 """
 
 from __future__ import annotations
@@ -26,7 +36,13 @@ import html
 
 import panel as pn
 
-__all__ = ["DEBOUNCE_MS", "html_model", "html_text", "respond_at_once"]
+__all__ = [
+    "DEBOUNCE_MS",
+    "html_model",
+    "html_text",
+    "panel_writes_pending",
+    "respond_at_once",
+]
 
 #: Milliseconds Panel waits after a browser-side widget change before handling it.
 DEBOUNCE_MS = 5
@@ -49,3 +65,11 @@ def html_model(html_source: str = "", **props):
     from panel.models import HTML
 
     return HTML(text=html_text(html_source), disable_math=True, **props)
+
+
+def panel_writes_pending(doc) -> bool:
+    """Whether Panel holds messages for ``doc``'s page that it serialized but has not
+    written yet (see the module docstring)."""
+    from panel.io import document as pdoc
+
+    return doc in pdoc._WRITE_BLOCK or bool(pdoc._WRITE_MSGS.get(doc))
