@@ -15,6 +15,7 @@ modules under ``app/views/``) add themselves with one line.
 from __future__ import annotations
 
 import functools
+import logging
 import sys
 import urllib.parse
 import weakref
@@ -70,6 +71,8 @@ from app.views.wheels import wheels_card
 pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
 public_base()  # a wrong FBS_PUBLIC_URL stops the server at start, naming the variable
 pn.config.param.update(**PANEL_CONFIG)  # stated sizing modes hold (app/views/layout.py)
+
+log = logging.getLogger("app.main")  # (run as a script by panel serve: no module name)
 
 ACCENT = "#1c7ed6"
 
@@ -455,6 +458,7 @@ def create_app(
         # (the document by weak reference: held strongly by its own session-destroyed
         # callback it kept the page alive, tests/test_server_pages.py)
         doc_ref = weakref.ref(doc)
+        log.info("a page's session started")  # (bench/load_test.py counts them)
         doc.on_session_destroyed(
             lambda _ctx, close=close_page, drop=DrawQueue.discard: (
                 drop(doc_ref()),
@@ -471,7 +475,7 @@ def create_app(
     return template
 
 
-def close_page(page: pn.template.BootstrapTemplate) -> None:
+def close_page(page: pn.template.BootstrapTemplate, log: logging.Logger = log) -> None:
     """End a page of :func:`create_app`: its band is cancelled, nothing more is published,
     and the watchers of its components are dropped (the draws still waiting for its
     document are dropped beside it, ``DrawQueue.discard``).
@@ -484,6 +488,9 @@ def close_page(page: pn.template.BootstrapTemplate) -> None:
     its data alive for the life of the process (finding 2 of issue 20).
     """
     page.results.close()
+    # (``log`` is bound as a default: Bokeh may clear the module's namespace before the
+    # session-destroyed callbacks run, and a global name then raised here)
+    log.info("a page's session ended")  # (bench/load_test.py counts them)
     # the template's areas, not ``page.select()``: in a served page the template renders
     # Panel's BrowserInfo too, which has no ``select`` (the callback failed there, and the
     # watchers stayed)

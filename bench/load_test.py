@@ -28,6 +28,13 @@ Checks (any failure -> exit status 1):
 Prints page-load and change latencies (median, p95, max) per number of sessions, and the
 largest number of sessions whose p95 first-update latency stays under ``--target`` (1 s).
 
+A session's cost in memory (``--serve`` and ``--docker``): the resident memory of the server
+(its process and the processes it started) before a level, once all its sessions are open,
+and after they all closed: the closed sessions destroyed by Bokeh (its log says so for each)
+and the server idle again, which includes Panel's garbage collection after destroyed
+sessions. Per session: (open - before) / n and (after - before) / n, what the closed
+sessions kept.
+
 Servers (loopback only, stopped at the end by PID or container ID):
   --url URL          an already running server
   --serve            ``panel serve`` of the app via docker/entrypoint.py (no Docker)
@@ -107,15 +114,18 @@ CLIENT_LIMIT = 0.75
 class AllOpen:
     """Lets the sessions start changing only once every session has opened (or failed)."""
 
-    def __init__(self, n: int, server_cpu_s=None):
+    def __init__(self, n: int, server_cpu_s=None, server_rss_mb=None):
         self._left, self._event = n, asyncio.Event()
         self._server_cpu_s = server_cpu_s or (lambda: None)
+        self._server_rss_mb = server_rss_mb or (lambda: None)
+        self.rss_open_mb = None
 
     def arrive(self) -> None:
         self._left -= 1
         if self._left <= 0 and not self._event.is_set():
             # the change phase starts: where this script's CPU time goes from here on
             self.at = (time.monotonic(), time.process_time(), self._server_cpu_s())
+            self.rss_open_mb = self._server_rss_mb()  # every session open, none changed yet
             self._event.set()
 
     async def wait(self) -> None:
@@ -285,12 +295,13 @@ async def run_level(
     check_isolation: bool,
     cpu_s=None,
     client: str = "browser",
+    rss_mb=None,
 ) -> dict:
     async with contextlib.AsyncExitStack() as stack:
         new_session = await session_factory(client, stack)
 
         t0 = time.monotonic()
-        all_open = AllOpen(n, cpu_s)
+        all_open = AllOpen(n, cpu_s, rss_mb)
         results = await asyncio.gather(
             *(
                 run_session(new_session, url, i, changes, title, timeout_s, 0.1 * i, all_open)
@@ -368,6 +379,8 @@ async def run_level(
         "change_phase_s": change_wall,
         "script_core_share": script_share,
         "server_cpu_per_change_s": server_per_change,
+        "rss_open_mb": all_open.rss_open_mb,
+        "reference_sessions": len(refs),
     }
 
 
@@ -380,6 +393,46 @@ def host_busy_s() -> float:
         fields = [int(x) for x in f.readline().split()[1:]]
     busy = sum(fields) - fields[3] - (fields[4] if len(fields) > 4 else 0)  # minus idle, iowait
     return busy / os.sysconf("SC_CLK_TCK")
+
+
+def proc_tree_rss_mb(pid: int) -> float:
+    """Resident memory (MB) of a process and its live descendants (VmRSS, /proc)."""
+    children: dict[int, list[int]] = {}
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open(f"/proc/{d}/stat") as f:
+                ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+        except OSError:
+            continue
+        children.setdefault(ppid, []).append(int(d))
+    total, todo = 0.0, [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            with open(f"/proc/{p}/status") as f:
+                total += next(int(x.split()[1]) for x in f if x.startswith("VmRSS")) / 1024
+        except (OSError, StopIteration):
+            pass
+        todo.extend(children.get(p, []))
+    return total
+
+
+#: What the app logs when a page's session starts and when Bokeh destroyed it (app/main.py).
+SESSION_STARTED, SESSION_ENDED = "a page's session started", "a page's session ended"
+
+
+async def wait_sessions_ended(server, timeout_s: float) -> bool:
+    """Wait until every page's session the server started has ended, by its log (Bokeh
+    destroys a closed session after its unused lifetime, 15 s, checked every 17 s)."""
+    t_end = time.monotonic() + timeout_s
+    while time.monotonic() < t_end:
+        logs = server.logs()
+        if logs.count(SESSION_ENDED) >= logs.count(SESSION_STARTED):
+            return True
+        await asyncio.sleep(1.0)
+    return False
 
 
 def proc_tree_cpu_s(pid: int) -> float:
@@ -457,6 +510,9 @@ class LocalServer:
     def cpu_s(self) -> float | None:
         return proc_tree_cpu_s(self.proc.pid)
 
+    def rss_mb(self) -> float | None:
+        return proc_tree_rss_mb(self.proc.pid)
+
     def stop(self) -> None:
         self.proc.terminate()
         try:
@@ -529,6 +585,15 @@ class DockerServer:
                 if line.startswith(key):
                     return int(line.split()[1]) * scale
         return None
+
+    def rss_mb(self) -> float | None:
+        """Resident memory of the container's processes (its main process's tree)."""
+        pid = subprocess.run(
+            ["docker", "inspect", "-f", "{{.State.Pid}}", self.cid],
+            capture_output=True,
+            text=True,
+        ).stdout.strip()
+        return proc_tree_rss_mb(int(pid)) if pid.isdigit() and int(pid) > 0 else None
 
     def stop(self) -> None:
         subprocess.run(["docker", "rm", "-f", self.cid], capture_output=True)
@@ -618,17 +683,25 @@ def main(argv: list[str] | None = None) -> int:
         f"load average {os.getloadavg()[0]:.1f}"
     )
     rows, failed = [], False
+
+    def settle() -> tuple[bool, float | None]:
+        """Wait until every page's session has ended and the server is idle; its resident
+        memory then (None without a server of ours)."""
+        if server is None:
+            return False, None
+        ended = asyncio.run(wait_sessions_ended(server, 120))
+        asyncio.run(wait_server_idle(server.cpu_s, 60))
+        return ended, server.rss_mb()
+
     try:
         if not args.cold:
             took = asyncio.run(run_warm_up(url, args.slider, args.timeout, args.client))
             print(f"warm-up: one session visited every slider value in {took:.1f} s")
-        for k, n in enumerate(levels):
-            if k and server is not None:
-                # Bokeh destroys the closed sessions of the last level within about 32 s
-                # (unused-session lifetime 15 s, checked every 17 s): let that happen
-                # before this level rather than during its changes
-                time.sleep(35)
-                asyncio.run(wait_server_idle(server.cpu_s, 60))
+        for _k, n in enumerate(levels):
+            # Bokeh destroys the closed sessions of the last level within about 32 s
+            # (unused-session lifetime 15 s, checked every 17 s): let that happen before
+            # this level rather than during its changes
+            _, rss0 = settle()
             cpu0 = server.cpu_s() if server is not None else None
             host0, t0, self0 = host_busy_s(), time.monotonic(), time.process_time()
             row = asyncio.run(
@@ -641,8 +714,12 @@ def main(argv: list[str] | None = None) -> int:
                     not args.no_isolation_check,
                     server.cpu_s if server is not None else None,
                     args.client,
+                    server.rss_mb if server is not None else None,
                 )
             )
+            ended, rss1 = settle()
+            row["rss_mb"] = (rss0, row["rss_open_mb"], rss1)
+            row["sessions_ended"] = ended
             cpu1 = server.cpu_s() if server is not None else None
             row["host_cpu_s"] = host_busy_s() - host0
             row["script_cpu_s"] = time.process_time() - self0  # incl. Bokeh clients
@@ -684,6 +761,14 @@ def main(argv: list[str] | None = None) -> int:
                     f"script{' and its Bokeh clients' if args.client == 'bokeh' else ''} "
                     f"{row['script_cpu_s']:.1f} s), of {os.cpu_count() * row['accounted_s']:.0f}"
                     " core-seconds"
+                )
+            if rss0 is not None and row["rss_open_mb"] is not None and rss1 is not None:
+                print(
+                    f"   server memory (RSS, MB): before {rss0:.0f}, all {n} open "
+                    f"{row['rss_open_mb']:.0f} (+{(row['rss_open_mb'] - rss0) / n:.1f} per "
+                    f"session), after all closed{'' if ended else ' (NOT all ended in 120 s)'}"
+                    f" and idle {rss1:.0f} ({rss1 - rss0:+.0f}: "
+                    f"{(rss1 - rss0) / n:+.1f} per closed session)"
                 )
             if row["problems"]:
                 failed = True

@@ -70,6 +70,8 @@ from fbs_auth import (  # noqa: F401  (re-exported: the server's login in one im
 from server_private import cancel_queued_panel_work, cleanup_document
 
 log = logging.getLogger("tire_fbs.server")
+#: The app's loggers, logged at the level panel serve gives Bokeh's (``--log-level``).
+APP_LOGGERS = ("app", "tire-fbs")
 
 #: Seconds after SIGTERM after which the process ends, orderly or not.
 SHUTDOWN_DEADLINE_S = 6.0
@@ -370,7 +372,10 @@ def _serve_class():
 
         def customize_kwargs(self, args, server_kwargs):
             # the level panel serve gave Bokeh's loggers (--log-level)
-            log.setLevel(logging.getLogger("bokeh").getEffectiveLevel())
+            level = logging.getLogger("bokeh").getEffectiveLevel()
+            log.setLevel(level)
+            for name in APP_LOGGERS:  # the app's own lines (a page's session ended, ...)
+                logging.getLogger(name).setLevel(level)
             if args.liveness:
                 log.warning("--liveness ignored: the server has its own cheap /liveness")
                 args.liveness = False

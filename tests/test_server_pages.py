@@ -61,6 +61,30 @@ def test_a_page_built_by_the_app_handler_without_a_session_is_freed(results_made
     assert results_made[0]() is None, "the page's results outlive its document"
 
 
+def test_a_page_ends_even_when_bokeh_cleared_its_script_namespace_first(results_made, caplog):
+    """Bokeh may clear the app script's module namespace before the session-destroyed
+    callbacks run (seen under load: "name 'close_page' is not defined"); the page's end uses
+    no global name of the script, so it still closes the page and logs that it ended."""
+    from panel.command.serve import build_single_handler_applications
+
+    apps = build_single_handler_applications([str(ROOT / "app" / "main.py")], {})
+    doc = apps["/main"].create_document()
+    script = str(ROOT / "app" / "main.py")
+    callbacks = [
+        cb
+        for cb in doc.session_destroyed_callbacks
+        if getattr(getattr(cb, "__code__", None), "co_filename", None) == script
+    ]  # the page's own (not Panel's)
+    assert len(callbacks) == 1
+    for cb in callbacks:
+        cb.__globals__.clear()  # the script's module (a fresh one per document)
+    with caplog.at_level("INFO", logger="app.main"):
+        for cb in callbacks:
+            cb(None)
+    assert results_made[0]().closed
+    assert "a page's session ended" in caplog.text
+
+
 def test_a_page_of_create_app_in_a_document_is_freed_with_it(results_made):
     """``create_app`` in a document of its own (a warm-up, a test): freed with it."""
     from bokeh.document import Document
