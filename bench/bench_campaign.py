@@ -11,7 +11,10 @@ worker):
 - ``in-process``: the default of ``python -m fbs_core.campaign run``: one worker thread in
   this process, the compiled kernels on all cores;
 - ``1 process`` / ``2 processes``: LocalCluster worker processes, one core each (one
-  kernel thread per worker), so efficiency = throughput(2) / (2 x throughput(1)).
+  kernel thread per worker), so efficiency = throughput(2) / (2 x throughput(1));
+- ``plain``: the same cases as plain :func:`fbs_core.studies.scatter_band_arrays` calls in
+  this process (the inputs of each harmonic prepared once, as the campaign does), the kernels
+  on all cores: the in-process campaign's efficiency = plain time / in-process time.
 
 Then it measures the scheduler's cost per task with a flood of empty tasks on the
 2-process cluster, and projects the task size that keeps the overhead under 5 % on 100
@@ -68,6 +71,35 @@ def scheduler_overhead(client, n: int) -> float:
     return (time.perf_counter() - t0) / n
 
 
+def run_plain(camp) -> float:
+    """Seconds of the campaign's scatter cases as plain scatter_band_arrays calls (inputs of
+    each harmonic prepared once, as the campaign does)."""
+    from fbs_core.campaign import work
+    from fbs_core.studies import scatter_band_arrays
+
+    t0 = time.perf_counter()
+    inputs = {}
+    for c in camp.band_cases:
+        inp = inputs.get(c.inputs_name)
+        if inp is None:
+            inp = inputs[c.inputs_name] = work.prepare_inputs(
+                c.tire, c.chassis, c.harmonic, c.n_modes, c.coupling, c.df
+            )
+        scatter_band_arrays(
+            inp.YjjA,
+            inp.vj,
+            inp.YjjE,
+            inp.YejE,
+            c.noise,
+            c.target,
+            c.rounds,
+            c.frequency_dependent,
+            seed=c.seed,
+            percentiles=c.percentiles,
+        )
+    return time.perf_counter() - t0
+
+
 def run_config(label, client, workers, threads, tmp, args):
     from fbs_core.campaign import parse_campaign, run_campaign
 
@@ -93,7 +125,7 @@ def main(argv=None) -> None:
         help="work per task (rounds x lines); default about 1 s on one core",
     )
     p.add_argument("--noop-tasks", type=int, default=2000)
-    p.add_argument("--configs", nargs="+", default=["in-process", "1", "2"])
+    p.add_argument("--configs", nargs="+", default=["plain", "in-process", "1", "2"])
     args = p.parse_args(argv)
 
     from distributed import Client, LocalCluster
@@ -116,7 +148,13 @@ def main(argv=None) -> None:
     )
     rows = {}
     overhead = None
+    plain_s = None
     for cfg in args.configs:
+        if cfg == "plain":
+            warm = parse_campaign(campaign_text(tmp / "warm-plain.h5", 50, [1], 10**9), tmp)
+            run_plain(warm)  # compiled kernels loaded
+            plain_s = run_plain(camp)
+            continue
         t0 = time.perf_counter()
         if cfg == "in-process":
             cluster = LocalCluster(
@@ -162,6 +200,17 @@ def main(argv=None) -> None:
             f"{cfg:<14s} {n:>7d} {rep.tasks_done:>6d} {rep.seconds:8.1f} {rate:10,.0f} "
             f"{rl:15.2f} {mean_task:14.3f} {ovh:16.4f} {sp} {eff}"
         )
+    if plain_s is not None:
+        print(
+            f"{'plain calls':<14s} {1:>7d} {len(camp.band_cases):>6d} {plain_s:8.1f} "
+            f"{total_rounds / plain_s:10,.0f} {work / plain_s / 1e6:15.2f}"
+        )
+        if "in-process" in rows:
+            ip = rows["in-process"][1].seconds
+            print(
+                f"\nin-process campaign against plain scatter_band calls (both on all cores): "
+                f"{plain_s:.1f} s / {ip:.1f} s = {plain_s / ip:.2f} (issue 33: >= 0.9)"
+            )
     print()
     for cfg, (_n, rep, start) in rows.items():
         print(
