@@ -395,8 +395,8 @@ def host_busy_s() -> float:
     return busy / os.sysconf("SC_CLK_TCK")
 
 
-def proc_tree_rss_mb(pid: int) -> float:
-    """Resident memory (MB) of a process and its live descendants (VmRSS, /proc)."""
+def proc_tree(pid: int) -> list[int]:
+    """A process and its live descendants (their PIDs, from /proc)."""
     children: dict[int, list[int]] = {}
     for d in os.listdir("/proc"):
         if not d.isdigit():
@@ -407,15 +407,23 @@ def proc_tree_rss_mb(pid: int) -> float:
         except OSError:
             continue
         children.setdefault(ppid, []).append(int(d))
-    total, todo = 0.0, [pid]
+    out, todo = [], [pid]
     while todo:
         p = todo.pop()
+        out.append(p)
+        todo.extend(children.get(p, []))
+    return out
+
+
+def proc_tree_rss_mb(pid: int) -> float:
+    """Resident memory (MB) of a process and its live descendants (VmRSS, /proc)."""
+    total = 0.0
+    for p in proc_tree(pid):
         try:
             with open(f"/proc/{p}/status") as f:
                 total += next(int(x.split()[1]) for x in f if x.startswith("VmRSS")) / 1024
         except (OSError, StopIteration):
             pass
-        todo.extend(children.get(p, []))
     return total
 
 
@@ -438,23 +446,14 @@ async def wait_sessions_ended(server, timeout_s: float) -> bool:
 def proc_tree_cpu_s(pid: int) -> float:
     """CPU seconds of a process and its live descendants (utime + stime, /proc)."""
     tick = os.sysconf("SC_CLK_TCK")
-    children: dict[int, list[int]] = {}
-    times: dict[int, float] = {}
-    for d in os.listdir("/proc"):
-        if not d.isdigit():
-            continue
+    total = 0.0
+    for p in proc_tree(pid):
         try:
-            with open(f"/proc/{d}/stat") as f:
+            with open(f"/proc/{p}/stat") as f:
                 st = f.read().rsplit(")", 1)[1].split()
         except OSError:
             continue
-        children.setdefault(int(st[1]), []).append(int(d))
-        times[int(d)] = (int(st[11]) + int(st[12])) / tick
-    total, todo = 0.0, [pid]
-    while todo:
-        p = todo.pop()
-        total += times.get(p, 0.0)
-        todo.extend(children.get(p, []))
+        total += (int(st[11]) + int(st[12])) / tick
     return total
 
 
@@ -697,7 +696,7 @@ def main(argv: list[str] | None = None) -> int:
         if not args.cold:
             took = asyncio.run(run_warm_up(url, args.slider, args.timeout, args.client))
             print(f"warm-up: one session visited every slider value in {took:.1f} s")
-        for _k, n in enumerate(levels):
+        for n in levels:
             # Bokeh destroys the closed sessions of the last level within about 32 s
             # (unused-session lifetime 15 s, checked every 17 s): let that happen before
             # this level rather than during its changes
