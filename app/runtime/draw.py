@@ -159,5 +159,11 @@ async def _draw_locked(fn, doc) -> None:
 
 
 def _run_on(fn, doc) -> None:
-    with set_curdoc(doc):  # Panel components changed by ``fn`` find their document
+    # Panel components changed by ``fn`` find their document; the draw's changes leave as
+    # one PATCH-DOC message (Panel's ``unlocked``: the document held during the draw, its
+    # events serialized together). Bokeh alone sends one message per property set, each
+    # building the serializer's map of the page's ~750 models: a quarter of the server's
+    # CPU with 20 sessions changing (``bench/load_test.py``, profiled; tested by
+    # ``tests/test_draw_messages.py``).
+    with set_curdoc(doc), pn.io.unlocked():
         fn()

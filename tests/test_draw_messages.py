@@ -1,0 +1,153 @@
+"""A draw on a served page leaves as one Bokeh message (app.runtime.draw).
+
+A Panel server in this process serves a small page; a Bokeh protocol client (the messages a
+browser receives, read off the websocket) opens it and says the page is ready, as BokehJS
+does. A draw asked for from another thread changes several properties of several models;
+the client must receive all of them in one PATCH-DOC message (Bokeh alone sends one per
+property, and each message builds the serializer's map of every model of the page), and its
+replica of the document must hold the drawn values.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+import threading
+import time
+
+import numpy as np
+import panel as pn
+import pytest
+from bokeh.document import Document
+from bokeh.document.events import MessageSentEvent
+from bokeh.events import DocumentReady
+from bokeh.models import ColumnDataSource, Div
+from bokeh.plotting import figure
+from bokeh.protocol import Protocol
+from bokeh.protocol.receiver import Receiver
+from bokeh.util.token import generate_jwt_token, generate_session_id
+from tornado.httpclient import HTTPRequest
+from tornado.websocket import websocket_connect
+
+from app.runtime.draw import on_document
+
+TIMEOUT = 60.0
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class _Page:
+    """What the served page's app made: its document and models (set by the app)."""
+
+    def __init__(self) -> None:
+        self.loaded = threading.Event()
+        self.doc = None
+        self.source = self.fig = self.div = None
+
+    def app(self):
+        self.source = ColumnDataSource({"x": np.arange(3.0), "y": np.zeros(3)})
+        self.fig = figure(title="before", width=300, height=200)
+        self.fig.line("x", "y", source=self.source)
+        self.div = Div(text="before")
+        self.doc = pn.state.curdoc
+        pn.state.onload(self.loaded.set)  # Panel handled the page's ready event
+        return pn.Column(pn.pane.Bokeh(self.fig), pn.pane.Bokeh(self.div))
+
+
+async def _client(url: str, page: _Page, draw) -> tuple[list, Document]:
+    """Open the page, say it is ready, ask for ``draw`` from a thread, and collect the
+    PATCH-DOC messages that arrive until the drawn values are all in the replica."""
+    protocol, receiver = Protocol(), Receiver(Protocol())
+    ws = await websocket_connect(
+        HTTPRequest(url), subprotocols=["bokeh", generate_jwt_token(generate_session_id())]
+    )
+
+    async def pop():
+        while True:
+            frag = await ws.read_message()
+            assert frag is not None, "the server closed the websocket"
+            msg = await receiver.consume(frag)
+            if msg is not None:
+                return msg
+
+    from bokeh.client.websocket import WebSocketClientConnectionWrapper
+
+    sock = WebSocketClientConnectionWrapper(ws)
+    assert (await asyncio.wait_for(pop(), TIMEOUT)).msgtype == "ACK"
+    await protocol.create("PULL-DOC-REQ").send(sock)
+    reply = await asyncio.wait_for(pop(), TIMEOUT)
+    while reply.msgtype == "PATCH-DOC":
+        reply = await asyncio.wait_for(pop(), TIMEOUT)
+    doc = Document()
+    reply.push_to_document(doc)
+    await protocol.create(
+        "PATCH-DOC", [MessageSentEvent(doc, "bokeh_event", DocumentReady())]
+    ).send(sock)
+    loaded = await asyncio.get_running_loop().run_in_executor(None, page.loaded.wait, TIMEOUT)
+    assert loaded, "the page never loaded"
+    threading.Thread(target=on_document, args=(page.doc, draw)).start()
+
+    patches = []
+    end = time.monotonic() + TIMEOUT
+    while True:
+        remaining = end - time.monotonic()
+        assert remaining > 0, f"the draw never fully arrived ({len(patches)} patches)"
+        msg = await asyncio.wait_for(pop(), remaining)
+        if msg.msgtype != "PATCH-DOC":
+            continue
+        patches.append(msg)
+        msg.apply_to_document(doc)
+        div = doc.get_model_by_id(page.div.id)
+        if div.text == "after":
+            break
+    ws.close()
+    return patches, doc
+
+
+@pytest.fixture
+def served_page():
+    page = _Page()
+    port = _free_port()
+    server = pn.serve(
+        {"page": page.app},
+        port=port,
+        address="127.0.0.1",
+        websocket_origin=[f"127.0.0.1:{port}"],
+        threaded=True,
+        show=False,
+        start=True,
+    )
+    end = time.monotonic() + TIMEOUT
+    while True:  # the server thread listens once it started
+        try:
+            socket.create_connection(("127.0.0.1", port), timeout=1).close()
+            break
+        except OSError:
+            assert time.monotonic() < end, "the server never listened"
+            time.sleep(0.05)
+    try:
+        yield page, f"ws://127.0.0.1:{port}/page/ws"
+    finally:
+        server.stop()
+
+
+def test_a_draw_reaches_the_page_as_one_message_holding_all_its_changes(served_page):
+    page, url = served_page
+
+    def draw():  # several properties of several models, as a view's redraw
+        page.source.data = {"x": np.arange(4.0), "y": np.ones(4)}
+        page.fig.title.text = "after"
+        page.fig.x_range.start = -1.0
+        page.div.text = "after"
+
+    patches, replica = asyncio.run(asyncio.wait_for(_client(url, page, draw), 2 * TIMEOUT))
+    assert len(patches) == 1, [len(p.content["events"]) for p in patches]
+    assert len(patches[0].content["events"]) >= 4
+    src = replica.get_model_by_id(page.source.id)
+    np.testing.assert_array_equal(np.asarray(src.data["y"]), np.ones(4))
+    assert replica.get_model_by_id(page.fig.title.id).text == "after"
+    assert replica.get_model_by_id(page.fig.x_range.id).start == -1.0
