@@ -9,6 +9,7 @@ scatter band computed directly, and the CSV read back.
 from __future__ import annotations
 
 import datetime as dt
+import html
 import threading
 import time
 
@@ -98,6 +99,21 @@ def test_harmonic_text_has_wavelength_speeds_and_band(k):
     assert f"band {lo:.1f}-{hi:.1f} Hz" in text
     # the band is the speed range over the wavelength (f = v / lambda)
     assert abs(lo - 30 / 3.6 / h.wavelength) < 0.05 and abs(hi - 120 / 3.6 / h.wavelength) < 0.05
+
+
+def test_the_line_under_the_harmonic_slider_follows_the_harmonic():
+    # the wavelength/speeds/band line changes in place with the harmonic (its model is kept:
+    # one text property changes, no new models are sent)
+    state = DashboardState()
+    controls = Controls(state=state)
+    controls.__panel__()
+    info = controls.harmonic_info
+    model = info.model
+    assert info.text == html.escape(harmonic_text(state.case.harmonic))
+    for k in (3, 7, 1):
+        state.case.harmonic = k
+        assert info.text == html.escape(harmonic_text(k))
+        assert f"Harmonic {k}: road wavelength" in model.text and info.model is model
 
 
 # -- progress and cancel ----------------------------------------------------------------

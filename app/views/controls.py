@@ -17,9 +17,11 @@ from panel.viewable import Viewer
 
 import fbs_core
 
+from ..runtime.draw import on_document, served_document
 from ..runtime.panel_private import respond_at_once
 from ..state import VEHICLE_ROUNDS, DashboardState
 from .layout import font
+from .live import LiveText
 from .typed import NumberField, refusal
 
 #: Typed numeric controls: key -> (label, with a slider).
@@ -64,6 +66,8 @@ class Controls(Viewer):
         self._widgets: dict[str, pn.widgets.Widget] | None = None
         self._fields: dict[str, NumberField] = {}
         self._messages: dict[str, pn.pane.HTML] = {}
+        #: The harmonic's wavelength, speeds and band under its slider (once laid out).
+        self.harmonic_info: LiveText | None = None
 
     @property
     def fields(self) -> dict[str, NumberField]:
@@ -176,13 +180,22 @@ class Controls(Viewer):
         w: dict[str, object] = {**self.widgets(), **self.fields}
         label = pn.pane.Markdown
         case = self.state.case
-        info = pn.pane.HTML(
-            pn.bind(_harmonic_html, case.param.harmonic),
+        # set in place on the page's draw queue: a pane bound to the harmonic re-sent its
+        # whole model (new stylesheets: the document's model graph walked, ~45 ms on the
+        # event loop per change, which held every session's draws back when 20 sessions
+        # changed the harmonic at once: bench/load_test.py)
+        info = self.harmonic_info = LiveText(
+            _harmonic_html(case.harmonic),
             css_classes=["ctl-harmonic-info"],
             styles={"font-size": font("0.9em"), "color": "#343a40"},
             margin=(0, 12),
-            sizing_mode="stretch_width",
         )
+        doc = served_document()
+
+        def show() -> None:
+            info.text = _harmonic_html(case.harmonic)  # the harmonic in force when drawn
+
+        case.param.watch(lambda _e: on_document(doc, show), "harmonic")
         vehicle = case.param.scope.rx.pipe(lambda v: v == "vehicle")
         car = pn.Column(
             label(

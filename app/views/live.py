@@ -179,7 +179,9 @@ class LiveText:
     stays escaped (:func:`inline_html`).
     """
 
-    def __init__(self, text: str = "", *, css_classes=(), styles=None, height=None) -> None:
+    def __init__(
+        self, text: str = "", *, css_classes=(), styles=None, height=None, margin=(0, 10)
+    ) -> None:
         self._text = text
         self.model = html_model(
             text,
@@ -187,7 +189,7 @@ class LiveText:
             styles=dict(styles or {}),
             sizing_mode="stretch_width",
             height=height,
-            margin=(0, 10),
+            margin=margin,
         )
         self._pane = pn.pane.Bokeh(self.model, sizing_mode="stretch_width", height=height)
 
