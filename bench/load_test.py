@@ -374,6 +374,10 @@ async def run_level(
         "load_ms": loads,
         "first_ms": first,
         "settled_ms": settled,
+        # by change round: the first round is every session changing at the same instant
+        "first_ms_by_round": [
+            [r.first_ms[k] for r in results if len(r.first_ms) > k] for k in range(changes)
+        ],
         "problems": problems,
         "distinct_final_states": len(refs),
         "change_phase_s": change_wall,
@@ -736,6 +740,16 @@ def main(argv: list[str] | None = None) -> int:
                 "once all are open)"
             )
             print(f"   change -> settled        {summary(row['settled_ms'])}")
+            rounds = [x for x in row["first_ms_by_round"] if x]
+            if len(rounds) > 1:  # the first round: all sessions changing at one instant
+                print(
+                    "   first update by round    "
+                    + "; ".join(
+                        f"{k + 1}: {statistics.median(x):.0f}/{pct(x, 95):.0f}"
+                        for k, x in enumerate(rounds)
+                    )
+                    + "   (median/p95 ms)"
+                )
             print(
                 f"   change phase {row['change_phase_s']:.1f} s; this script"
                 f"{' and its Bokeh clients' if args.client == 'bokeh' else ''} busy "
