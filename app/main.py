@@ -429,6 +429,11 @@ def create_app(
         header_background=ACCENT,
         sidebar_width=340,
         collapsed_sidebar=page.sidebar_collapsed,
+        # no header spinner: Panel's busy flag is one for the process, and every browser
+        # change of a widget in any session set every open page's spinner twice (resolving
+        # the spinner's design files each time: an eighth of the server's CPU with 20
+        # sessions changing, bench/load_test.py profiled); the page has its own progress
+        busy_indicator=None,
     )
     above, below = plot_rows(parts, views)
     main = pn.Column(
