@@ -39,6 +39,8 @@ from app.page.titles import page_url
 from app.public_url import public_base
 from app.report.session import provenance_of, report_data
 from app.runtime import background, closed_pages
+from app.runtime.collector import session_ended
+from app.runtime.collector import start as start_quiet_collections
 from app.runtime.draw import DrawQueue, served
 from app.state import URL_KEYS, DashboardState
 from app.store import Results
@@ -465,9 +467,10 @@ def create_app(
         doc_ref = weakref.ref(doc)
         log.info("a page's session started")  # (bench/load_test.py counts them)
         doc.on_session_destroyed(
-            lambda _ctx, close=close_page, drop=DrawQueue.discard: (
+            lambda _ctx, close=close_page, drop=DrawQueue.discard, ended=session_ended: (
                 drop(doc_ref()),
                 close(template),
+                ended(),  # the quiet collection thaws what was frozen with the page
             )
         )
     if served():
@@ -475,6 +478,7 @@ def create_app(
         pn.state.onload(results.request_band)
         # once per process, after the first page: the other harmonics' reference studies
         pn.state.onload(background.warm_reference_studies)
+        pn.state.onload(start_quiet_collections)  # once per process (runtime/collector.py)
     else:
         results.request_band(wait=True)
     return template

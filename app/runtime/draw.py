@@ -24,6 +24,7 @@ import panel as pn
 from bokeh.document import without_document_lock
 from panel.io.state import set_curdoc
 
+from . import collector
 from .panel_private import panel_writes_pending
 
 __all__ = ["DrawQueue", "on_document", "served", "served_document"]
@@ -102,6 +103,7 @@ class DrawQueue:
 
     def add(self, fn) -> None:
         """Run ``fn`` after the draws already waiting (from any thread)."""
+        collector.touch()  # not quiet: the next full collection waits
         with self._lock:
             self._fns.append(fn)
             if self._running:

@@ -1,0 +1,135 @@
+"""Full garbage collections when the server is quiet, not in the middle of a change.
+
+CPython's full collection walks every tracked object with all threads stopped, and the
+open sessions are most of them: with 50 sessions open one took 0.6-1.2 s, and the
+collections that the pages' openings had made due ran during the next changes (the server's
+log of the collections beside ``bench/load_test.py --sessions 50``: 1148 ms 1.4 s after the
+sessions started changing, 565 ms four seconds later: those rounds' first updates took
+1.2-1.5 s). The long-lived objects of the warm-up are frozen once
+(:func:`app.runtime.background.freeze_long_lived`); this collector does the same for the
+open sessions, at a quiet moment:
+
+- every draw asked for marks activity (:func:`touch`); once nothing was asked for during
+  :data:`QUIET` seconds after some activity, the collector makes a full collection and
+  freezes what is alive (``gc.freeze``), so the collections that come with the next changes
+  walk only what was made since;
+- a session that ended is frozen with the rest: :func:`session_ended` thaws everything
+  (``gc.unfreeze``) before the next quiet collection, which then frees its cycles; and at
+  least every :data:`THAW_EVERY` seconds a quiet collection thaws first, so that cycles
+  dropped by the open sessions are not kept for longer than that.
+
+The decision is :meth:`IdleCollector.step`, a pure function of the clock and what happened
+(tested without threads); :func:`start` runs it on a daemon thread.
+"""
+
+from __future__ import annotations
+
+import gc
+import logging
+import threading
+import time
+from collections.abc import Callable
+
+__all__ = ["QUIET", "THAW_EVERY", "IdleCollector", "session_ended", "start", "touch"]
+
+log = logging.getLogger(__name__)
+
+#: Seconds without a draw after which the server counts as quiet.
+QUIET = 0.5
+#: Longest time (s) between two thawed collections while there is activity.
+THAW_EVERY = 120.0
+#: How often the collector's thread looks (s).
+PERIOD = 0.1
+
+
+class IdleCollector:
+    """When to collect and freeze, and when to thaw first (see the module docstring)."""
+
+    def __init__(
+        self,
+        collect: Callable[[], object] = gc.collect,
+        freeze: Callable[[], None] = gc.freeze,
+        unfreeze: Callable[[], None] = gc.unfreeze,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._collect, self._freeze, self._unfreeze, self._clock = (
+            collect,
+            freeze,
+            unfreeze,
+            clock,
+        )
+        self._lock = threading.Lock()
+        self._last_activity: float | None = None  # None: nothing since the last collection
+        self._thaw_due = False
+        self._thawed_at = clock()
+        self.collections = 0
+
+    def touch(self) -> None:
+        """Something happened (a draw was asked for)."""
+        now = self._clock()
+        with self._lock:
+            self._last_activity = now
+
+    def session_ended(self) -> None:
+        """A session ended: its objects are to be freed by the next quiet collection."""
+        now = self._clock()
+        with self._lock:
+            self._thaw_due = True
+            self._last_activity = now
+
+    def step(self) -> bool:
+        """Collect (thawing first when due) if the server is quiet after activity; True if
+        it did."""
+        now = self._clock()
+        with self._lock:
+            if self._last_activity is None or now - self._last_activity < QUIET:
+                return False
+            thaw = self._thaw_due or now - self._thawed_at >= THAW_EVERY
+            self._last_activity = None
+            self._thaw_due = False
+        t0 = time.perf_counter()
+        if thaw:
+            self._unfreeze()
+            self._thawed_at = now
+        self._collect()
+        self._freeze()
+        self.collections += 1
+        log.debug(
+            "quiet full collection%s: %.0f ms",
+            " (thawed)" if thaw else "",
+            1000 * (time.perf_counter() - t0),
+        )
+        return True
+
+
+COLLECTOR = IdleCollector()
+_started = threading.Event()
+
+
+def touch() -> None:
+    """Mark activity (cheap: called for every draw)."""
+    COLLECTOR.touch()
+
+
+def session_ended() -> None:
+    """A session ended (see :meth:`IdleCollector.session_ended`)."""
+    COLLECTOR.session_ended()
+
+
+def start() -> threading.Thread | None:
+    """Run the collector on a daemon thread, once per process (None if already running)."""
+    if _started.is_set():
+        return None
+    _started.set()
+
+    def loop() -> None:
+        while True:
+            time.sleep(PERIOD)
+            try:
+                COLLECTOR.step()
+            except Exception:  # never kill the server for a collection
+                log.exception("quiet collection failed")
+
+    t = threading.Thread(target=loop, name="fbs-collector", daemon=True)
+    t.start()
+    return t

@@ -1,0 +1,100 @@
+"""Full collections at quiet moments (app.runtime.collector), decided on a fake clock."""
+
+from __future__ import annotations
+
+import gc
+import weakref
+
+from app.runtime.collector import QUIET, THAW_EVERY, IdleCollector
+
+
+class _Clock:
+    def __init__(self) -> None:
+        self.t = 1000.0
+
+    def __call__(self) -> float:
+        return self.t
+
+
+def _collector():
+    calls: list[str] = []
+    clock = _Clock()
+    c = IdleCollector(
+        collect=lambda: calls.append("collect"),
+        freeze=lambda: calls.append("freeze"),
+        unfreeze=lambda: calls.append("unfreeze"),
+        clock=clock,
+    )
+    return c, clock, calls
+
+
+def test_nothing_happens_before_activity_or_while_it_goes_on():
+    c, clock, calls = _collector()
+    clock.t += 10
+    assert not c.step() and calls == []  # never active: nothing to collect
+    c.touch()
+    for _ in range(20):  # a draw every QUIET/2 s: never quiet
+        clock.t += QUIET / 2
+        assert not c.step()
+        c.touch()
+    assert calls == []
+
+
+def test_one_collection_and_freeze_once_quiet_then_none_until_new_activity():
+    c, clock, calls = _collector()
+    c.touch()
+    clock.t += QUIET
+    assert c.step() and calls == ["collect", "freeze"]
+    clock.t += 100
+    assert not c.step() and calls == ["collect", "freeze"]  # nothing happened since
+    c.touch()
+    clock.t += QUIET
+    assert c.step() and calls == ["collect", "freeze"] * 2
+
+
+def test_an_ended_session_is_thawed_before_the_next_quiet_collection():
+    c, clock, calls = _collector()
+    c.session_ended()
+    assert not c.step()  # not quiet yet
+    clock.t += QUIET
+    assert c.step() and calls == ["unfreeze", "collect", "freeze"]
+    c.touch()
+    clock.t += QUIET
+    assert c.step() and calls[3:] == ["collect", "freeze"]  # thawed once only
+
+
+def test_frozen_objects_are_thawed_at_least_every_thaw_every_seconds_of_activity():
+    c, clock, calls = _collector()
+    clock.t += THAW_EVERY
+    c.touch()
+    clock.t += QUIET
+    assert c.step() and calls == ["unfreeze", "collect", "freeze"]
+    c.touch()
+    clock.t += QUIET
+    assert c.step() and calls[3:] == ["collect", "freeze"]
+
+
+class _Cycle:
+    def __init__(self) -> None:
+        self.me = self
+
+
+def test_a_thawed_quiet_collection_frees_cycles_that_were_frozen():
+    # with the real gc: a cycle frozen by one quiet collection is freed by the thawed one
+    clock = _Clock()
+    c = IdleCollector(clock=clock)
+    try:
+        obj = _Cycle()
+        ref = weakref.ref(obj)
+        c.touch()
+        clock.t += QUIET
+        assert c.step()
+        del obj
+        gc.collect()
+        assert ref() is not None, "frozen: a full collection leaves it"
+        c.session_ended()
+        clock.t += QUIET
+        assert c.step()
+        assert ref() is None, "thawed and collected"
+    finally:
+        gc.unfreeze()  # leave the test process as it was
