@@ -5,7 +5,7 @@ from __future__ import annotations
 import gc
 import weakref
 
-from app.runtime.collector import QUIET, THAW_EVERY, IdleCollector
+from app.runtime.collector import BUSY_SHARE, QUIET, THAW_EVERY, IdleCollector
 
 
 class _Clock:
@@ -72,6 +72,31 @@ def test_frozen_objects_are_thawed_at_least_every_thaw_every_seconds_of_activity
     c.touch()
     clock.t += QUIET
     assert c.step() and calls[3:] == ["collect", "freeze"]
+
+
+def test_no_collection_while_the_process_computes_without_drawing():
+    # a page being built or a band computed asks for no draw for a while: the process's
+    # CPU time says it is not quiet
+    calls: list[str] = []
+    clock, cpu = _Clock(), [0.0]
+    c = IdleCollector(
+        collect=lambda: calls.append("collect"),
+        freeze=lambda: calls.append("freeze"),
+        unfreeze=lambda: None,
+        clock=clock,
+        cpu=lambda: cpu[0],
+    )
+    c.touch()
+    for _ in range(30):  # 3 s without a draw, a core busy
+        clock.t += 0.1
+        cpu[0] += 0.1
+        assert not c.step()
+    for _ in range(int(QUIET / 0.1) - 1):  # the work ends: quiet, but not for QUIET s yet
+        clock.t += 0.1
+        cpu[0] += 0.1 * BUSY_SHARE / 4
+        assert not c.step()
+    clock.t += 0.2
+    assert c.step() and calls == ["collect", "freeze"]
 
 
 class _Cycle:

@@ -10,9 +10,11 @@ sessions started changing, 565 ms four seconds later: those rounds' first update
 open sessions, at a quiet moment:
 
 - every draw asked for marks activity (:func:`touch`); once nothing was asked for during
-  :data:`QUIET` seconds after some activity, the collector makes a full collection and
-  freezes what is alive (``gc.freeze``), so the collections that come with the next changes
-  walk only what was made since;
+  :data:`QUIET` seconds after some activity, and the process used less than
+  :data:`BUSY_SHARE` of a core meanwhile (a page being built or a band computed draws
+  nothing for a while), the collector makes a full collection and freezes what is alive
+  (``gc.freeze``), so the collections that come with the next changes walk only what was
+  made since;
 - a session that ended is frozen with the rest: :func:`session_ended` thaws everything
   (``gc.unfreeze``) before the next quiet collection, which then frees its cycles; and at
   least every :data:`THAW_EVERY` seconds a quiet collection thaws first, so that cycles
@@ -28,9 +30,18 @@ import gc
 import logging
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 
-__all__ = ["QUIET", "THAW_EVERY", "IdleCollector", "session_ended", "start", "touch"]
+__all__ = [
+    "BUSY_SHARE",
+    "QUIET",
+    "THAW_EVERY",
+    "IdleCollector",
+    "session_ended",
+    "start",
+    "touch",
+]
 
 log = logging.getLogger(__name__)
 
@@ -38,6 +49,8 @@ log = logging.getLogger(__name__)
 QUIET = 0.5
 #: Longest time (s) between two thawed collections while there is activity.
 THAW_EVERY = 120.0
+#: Share of a core the process may use during the quiet seconds (its CPU time, all threads).
+BUSY_SHARE = 0.2
 #: How often the collector's thread looks (s).
 PERIOD = 0.1
 
@@ -51,6 +64,7 @@ class IdleCollector:
         freeze: Callable[[], None] = gc.freeze,
         unfreeze: Callable[[], None] = gc.unfreeze,
         clock: Callable[[], float] = time.monotonic,
+        cpu: Callable[[], float] | None = None,
     ) -> None:
         self._collect, self._freeze, self._unfreeze, self._clock = (
             collect,
@@ -58,6 +72,8 @@ class IdleCollector:
             unfreeze,
             clock,
         )
+        self._cpu = cpu  # the process's CPU seconds (None: not looked at)
+        self._samples: deque[tuple[float, float]] = deque()
         self._lock = threading.Lock()
         self._last_activity: float | None = None  # None: nothing since the last collection
         self._thaw_due = False
@@ -81,6 +97,8 @@ class IdleCollector:
         """Collect (thawing first when due) if the server is quiet after activity; True if
         it did."""
         now = self._clock()
+        if not self._cpu_quiet(now):
+            return False
         with self._lock:
             if self._last_activity is None or now - self._last_activity < QUIET:
                 return False
@@ -101,8 +119,22 @@ class IdleCollector:
         )
         return True
 
+    def _cpu_quiet(self, now: float) -> bool:
+        """Whether the process used less than :data:`BUSY_SHARE` of a core over the last
+        :data:`QUIET` seconds (True when CPU time is not looked at)."""
+        if self._cpu is None:
+            return True
+        cpu = self._cpu()
+        self._samples.append((now, cpu))
+        while len(self._samples) > 1 and self._samples[1][0] <= now - QUIET:
+            self._samples.popleft()  # keep one sample at or before the window's start
+        t0, c0 = self._samples[0]
+        if now - t0 < QUIET:
+            return False  # not looked at long enough yet
+        return (cpu - c0) / (now - t0) < BUSY_SHARE
 
-COLLECTOR = IdleCollector()
+
+COLLECTOR = IdleCollector(cpu=time.process_time)
 _started = threading.Event()
 
 
