@@ -108,6 +108,26 @@ async def _client(url: str, page: _Page, draw) -> tuple[list, Document]:
     return patches, doc
 
 
+def _in_own_loop(coro):
+    """Run ``coro`` on an event loop of its own, in a thread of its own (an earlier test may
+    have left a loop running in this one); its result, or its exception raised here."""
+    out: dict = {}
+
+    def run() -> None:
+        try:
+            out["value"] = asyncio.run(coro)
+        except BaseException as e:  # re-raised in the test's thread
+            out["error"] = e
+
+    t = threading.Thread(target=run)
+    t.start()
+    t.join(3 * TIMEOUT)
+    assert not t.is_alive(), "the client never finished"
+    if "error" in out:
+        raise out["error"]
+    return out["value"]
+
+
 @pytest.fixture
 def served_page():
     page = _Page()
@@ -144,7 +164,7 @@ def test_a_draw_reaches_the_page_as_one_message_holding_all_its_changes(served_p
         page.fig.x_range.start = -1.0
         page.div.text = "after"
 
-    patches, replica = asyncio.run(asyncio.wait_for(_client(url, page, draw), 2 * TIMEOUT))
+    patches, replica = _in_own_loop(asyncio.wait_for(_client(url, page, draw), 2 * TIMEOUT))
     assert len(patches) == 1, [len(p.content["events"]) for p in patches]
     assert len(patches[0].content["events"]) >= 4
     src = replica.get_model_by_id(page.source.id)
