@@ -157,24 +157,7 @@ wait_dashboard() {
         sleep 1
     done
     [[ "$status" == "running healthy" ]] || fail "dashboard not healthy after ${health_timeout} s"
-    "$PY" - "$port" <<'PY'
-import sys, time, urllib.error, urllib.request
-url = f"http://127.0.0.1:{sys.argv[1]}/liveness?endpoint=/main"
-# 503 until the server has proved the app (a page built once after the port opened, seconds
-# on a busy machine): wait for that, not for a fixed time
-end = time.monotonic() + 300
-while True:
-    try:
-        with urllib.request.urlopen(url, timeout=120) as r:
-            body = r.read().decode()
-            assert r.status == 200 and "true" in body, body
-        break
-    except urllib.error.HTTPError as e:
-        if e.code != 503 or time.monotonic() > end:
-            raise
-        time.sleep(0.5)
-print(f"    {url} -> {body}")
-PY
+    "$PY" scripts/wait_app_document.py "$port"
 }
 
 smoke_campaign() {  # one case in 8 blocks on the cluster; the band as scatter_band's
