@@ -14,9 +14,12 @@ A cheap health check
     ``/liveness`` answers from memory, without login: ``{"/liveness": true}``, and with
     ``?endpoint=/main`` whether that app built a page (503 ``{"/main": false}`` while the
     proof still runs). The app is proved *once*, right after the port is open, on a thread
-    of its own: one page is built and cleaned up (which also warms the server: reference
-    models loaded, kernels compiled, the first page's results cached), and a script that
-    fails stops the server with the error (the container exits; a restart policy retries).
+    of its own: one page is built, loaded as a browser would load it (Bokeh's "document
+    ready" event: the page's on-load callbacks run, e.g. the part of the dashboard built
+    after the first screen) and cleaned up, which also warms the server (reference models
+    loaded, kernels compiled, the first page's results cached); a script or an on-load
+    callback that fails stops the server with the error (the container exits; a restart
+    policy retries).
     The port opens within seconds of the start (issue 33: 23.6 s when a warm-up and the
     proof ran before listening); a page requested meanwhile is served, computing what it
     needs beside the proof. No request, authenticated or not, makes the health check build
@@ -81,6 +84,8 @@ CHILD_GRACE_S = 1.0
 HTTP_MAX_BODY_BYTES = 16 * 1024
 #: Room in a connection's read buffer beyond the largest websocket message (frame headers).
 READ_BUFFER_SLACK = 1 << 20
+#: Seconds the proof waits for a page's on-load callbacks (a failing one is reported at once).
+ONLOAD_TIMEOUT_S = 300.0
 #: Packages whose loaded modules Panel's component-resource route may serve files of.
 COMPONENT_PACKAGES = ("panel",)
 
@@ -164,14 +169,52 @@ def applications(files: list[str], args: list[str]) -> dict:
     return panel_serve.build_single_handler_applications(files, {f: args for f in files})
 
 
+def script_imports(path: str) -> list[str]:
+    """The modules a script imports at its top level, in order (read, not run)."""
+    import ast
+    from pathlib import Path
+
+    tree = ast.parse(Path(path).read_text(encoding="utf-8"), filename=path)
+    names: list[str] = []
+    for node in tree.body:
+        if isinstance(node, ast.Import):
+            names += [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.append(node.module)
+    return list(dict.fromkeys(n for n in names if n != "__future__"))
+
+
+def preload_imports(files: list[str]) -> float:
+    """Import the modules the app scripts ``files`` import at their top level; seconds.
+
+    Run before the port opens (1.5 s for the dashboard: its libraries and the reference
+    models' code), so that the first page requested does not wait for them (issue 33).
+    A module that fails to import is left to the proof, which reports the script's error.
+    """
+    import importlib
+
+    t0 = time.perf_counter()
+    for path in files:
+        for name in script_imports(path):
+            try:
+                importlib.import_module(name)
+            except Exception as exc:  # noqa: BLE001 (the proof reports the script's error)
+                log.warning("preloading %s for %s failed: %s", name, path, exc)
+    dt = time.perf_counter() - t0
+    log.info("the apps' imports preloaded (%.1f s)", dt)
+    return dt
+
+
 def prove_applications(apps: dict, proved: dict[str, float] | None = None) -> dict[str, float]:
-    """Build and clean up one page of each app of :func:`applications`; seconds per app
-    path, entered in ``proved`` (a new dict by default) as each app is proved.
+    """Build, load (:func:`load_as_browser`) and clean up one page of each app of
+    :func:`applications`; seconds per app path, entered in ``proved`` (a new dict by
+    default) as each app is proved.
 
     Raises
     ------
     RuntimeError
-        If an app script fails or builds an empty page (the message names the error).
+        If an app script fails, builds an empty page or fails when loaded (the message
+        names the error).
     """
     from panel.io.session import generate_session
 
@@ -189,11 +232,62 @@ def prove_applications(apps: dict, proved: dict[str, float] | None = None) -> di
                 )
             if not doc.roots:
                 raise RuntimeError(f"the app {path} built an empty page")
+            load_as_browser(doc, path)
         finally:
             cleanup_document(doc)
         proved[path] = time.perf_counter() - t0
         log.info("app %s builds a page (%.1f s); /liveness reports it", path, proved[path])
     return proved
+
+
+def load_as_browser(doc, path: str, timeout_s: float = ONLOAD_TIMEOUT_S) -> None:
+    """Send ``doc`` Bokeh's "document ready" event, as a browser does once it shows the
+    page, and wait until the page's on-load callbacks (``pn.state.onload``) have run.
+
+    Panel runs them on its worker threads (``--num-threads``) and hands an exception of
+    one of them to ``pn.config.exception_handler`` with the page's document current; the
+    handler is chained for the wait, so a failure ends the wait at once.
+
+    Raises
+    ------
+    RuntimeError
+        If an on-load callback fails, or they have not all run within ``timeout_s``.
+    """
+    import panel as pn
+    from bokeh.events import DocumentReady
+    from panel.io.state import set_curdoc
+
+    done = threading.Event()
+    errors: list[BaseException] = []
+    previous = pn.config.exception_handler
+
+    def handler(exc: BaseException) -> None:
+        if pn.state.curdoc is doc:
+            errors.append(exc)
+            done.set()
+        elif previous is not None:
+            previous(exc)
+        else:
+            raise exc
+
+    pn.config.exception_handler = handler
+    try:
+        with set_curdoc(doc):
+            pn.state.onload(done.set)  # after the page's own callbacks, in their order
+        doc.callbacks.trigger_event(DocumentReady())
+        if not done.wait(timeout_s):
+            raise RuntimeError(
+                f"the app {path} built a page whose on-load callbacks did not finish "
+                f"within {timeout_s:g} s"
+            )
+    finally:
+        if pn.config.exception_handler is handler:
+            pn.config.exception_handler = previous
+    if errors:
+        exc = errors[0]
+        raise RuntimeError(
+            f"the app {path} failed when its page was loaded: {type(exc).__name__}: {exc}"
+        ) from exc
 
 
 def prove_in_background(apps: dict, proved: dict[str, float]) -> threading.Thread:
@@ -401,6 +495,7 @@ def _serve_class():
                 "max_buffer_size": int(ws_max) + READ_BUFFER_SLACK,
             }
             apps = applications(args.files, args.args or [])
+            preload_imports(args.files)  # before the port opens: no page waits for them
             proved: dict[str, float] = {}
             kwargs["extra_patterns"].append(
                 (

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 import re
 import sys
 import time
@@ -143,6 +144,91 @@ def test_an_app_that_cannot_build_a_page_stops_the_server(tmp_path):
         assert "failed to build a page" in srv.log() and "broken-app-marker" in srv.log()
     finally:
         srv.stop()
+
+
+def test_an_app_whose_page_fails_when_loaded_stops_the_server(tmp_path):
+    """The proof loads its page as a browser would (Bokeh's "document ready"): a page whose
+    on-load callback fails (the dashboard builds what is below its first screen there)
+    stops the server with the error, as a script that fails does."""
+    app = (
+        "import panel as pn\n"
+        "def fail():\n"
+        "    raise RuntimeError('broken-onload-marker')\n"
+        "pn.state.onload(fail)\n"
+        "pn.pane.Markdown('a page').servable()\n"
+    )
+    srv = Server(tmp_path, app, {})
+    try:
+        srv.proc.wait(120)
+        assert srv.proc.returncode != 0
+        log = srv.log()
+        assert "failed when its page was loaded" in log and "broken-onload-marker" in log
+    finally:
+        srv.stop()
+
+
+def test_the_proof_reports_the_app_once_its_page_is_loaded(tmp_path):
+    """``/liveness?endpoint=`` answers 200 only after the proof's page ran its on-load
+    callbacks (held here at a gate: 503 meanwhile)."""
+    gate, loaded = tmp_path / "gate", tmp_path / "loaded"
+    app = (
+        "import pathlib, time\n"
+        "import panel as pn\n"
+        "def load():\n"
+        f"    gate = pathlib.Path({str(gate)!r})\n"
+        "    t0 = time.monotonic()\n"
+        "    while not gate.exists() and time.monotonic() - t0 < 300:\n"
+        "        time.sleep(0.05)\n"
+        f"    pathlib.Path({str(loaded)!r}).write_text('loaded')\n"
+        "pn.state.onload(load)\n"
+        "pn.pane.Markdown('a page').servable()\n"
+    )
+    srv = Server(tmp_path, app, {}, name="gatedapp")
+    try:
+        srv.listening(120)
+        opener = urllib.request.build_opener(NoRedirect)
+        # the script ran (the port is open, its proof started); its page is not loaded yet
+        status, _, body = get(opener, srv.base + "/liveness?endpoint=/gatedapp")
+        assert status == 503 and not loaded.exists()
+        gate.write_text("open")
+        srv.started(120)
+        assert loaded.read_text() == "loaded"
+    finally:
+        srv.stop()
+
+
+def test_the_apps_imports_are_loaded_before_the_port_opens(tmp_path):
+    """Issue 33: the modules the app script imports are imported on the server's main
+    thread before it listens, so that the first page does not wait for them (the proof
+    imports on a thread of its own, after the port is open)."""
+    (tmp_path / "marker_mod.py").write_text(
+        "import pathlib, threading\n"
+        "pathlib.Path(__file__).with_name('imported_on.txt').write_text("
+        "threading.current_thread().name)\n"
+    )
+    app = "import marker_mod\nimport panel as pn\npn.pane.Markdown('a page').servable()\n"
+    env = {"PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    srv = Server(tmp_path, app, env)
+    try:
+        srv.started(120)
+        assert (tmp_path / "imported_on.txt").read_text() == "MainThread"
+        assert "the apps' imports preloaded" in srv.log()
+    finally:
+        srv.stop()
+
+
+def test_script_imports_reads_the_top_level_imports(tmp_path):
+    script = tmp_path / "s.py"
+    script.write_text(
+        "from __future__ import annotations\n"
+        "import os, json as j\n"
+        "from pathlib import Path\n"
+        "from . import sibling\n"
+        "import os\n"
+        "def f():\n"
+        "    import csv\n"
+    )
+    assert fbs_server.script_imports(str(script)) == ["os", "json", "pathlib"]
 
 
 # ---- secrets -------------------------------------------------------------------------------
