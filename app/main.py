@@ -6,10 +6,13 @@ URL query (``?h=5&N=150&dof=z...``), so that a link reproduces the view; the pag
 (:class:`~app.page.layout.PageState`).
 
 Layout, top to bottom: the page bar (report, help, layout switches), the notice of a link
-that needs uploads, the first plot row (coupled response, error map: on the first screen
-at 1280x720), the "Your data" card, the other built-in plot rows (:func:`plot_rows`), then
-one card per entry of :data:`EXTRA_CARDS`, the place where further views (in their own
-modules under ``app/views/``) add themselves with one line.
+that needs uploads, the first screen (:func:`first_screen`: coupled response and error map,
+on the first screen also at 1280x720), then (:func:`below_first_screen`) the suggested modes
+and eigenfrequencies, the "Your data" card, the noise band and one card per entry of
+:data:`EXTRA_CARDS`, the place where further views (in their own modules under
+``app/views/``) add themselves with one line. A served page sends its first screen first and
+builds the rest once the browser shows it (issue 33: the first plot of a page of ~1,000 Bokeh
+models waited 2.5 s for all of them).
 """
 
 from __future__ import annotations
@@ -216,14 +219,16 @@ class PlotViews:
         r, p, mode = parts.results, parts.page, parts.page.view
         self.parts = parts
         self.mobility = MobilityView(store=r, x_range=parts.freq, mode=mode)
-        self.scatter = ScatterBandView(store=r, x_range=parts.freq, mode=mode)
-        self.eigen = EigenView(store=r, n_range=parts.modes, mode=mode)
         # the views themselves are kept: a layout holds what a view's __panel__ returned, so
         # the error map in its column never heard of the Presentation button (issue 29)
         self.map_view = self._map(p.n_axis)
         self.uncoupled_view: UncoupledView | None = None
         self.truncation = pn.Column(self.map_view, sizing_mode="stretch_both")
-        self.suggested = SuggestedModesView(store=r)
+        # the views below the first screen: built by build_below (a served page: once the
+        # browser shows the first screen, so the first plot does not wait for them)
+        self.scatter: ScatterBandView | None = None
+        self.eigen: EigenView | None = None
+        self.suggested: SuggestedModesView | None = None
         # the uncoupled subsystems are built on first request (two plots less per page load)
         self.uncoupled = pn.Row(
             visible=r.state.case.param.show_uncoupled,
@@ -234,6 +239,15 @@ class PlotViews:
         self._show_uncoupled(r.state.case.show_uncoupled)
         p.param.watch(lambda e: self._rebuild_map(e.new), "n_axis")
         p.param.watch(lambda e: self._restyle(e.new), "view")
+
+    def build_below(self) -> None:
+        """The plot views below the first screen (noise band, suggested modes,
+        eigenfrequencies), in the page's view as it is now."""
+        pa = self.parts
+        r, mode = pa.results, pa.page.view
+        self.scatter = ScatterBandView(store=r, x_range=pa.freq, mode=mode)
+        self.eigen = EigenView(store=r, n_range=pa.modes, mode=mode)
+        self.suggested = SuggestedModesView(store=r)
 
     def _map(self, n_axis: str) -> TruncationView:
         pa = self.parts
@@ -261,35 +275,43 @@ class PlotViews:
 
     def live(self) -> list:
         """The plot views now on the page."""
-        unc = [] if self.uncoupled_view is None else [self.uncoupled_view]
-        return [self.mobility, self.scatter, self.eigen, self.map_view, *unc]
+        built = (self.scatter, self.eigen, self.uncoupled_view)
+        return [self.mobility, self.map_view, *(v for v in built if v is not None)]
 
     def _restyle(self, view: str) -> None:
         for v in self.live():
             v.mode = view
 
 
-def plot_rows(parts: PageParts, views: PlotViews) -> tuple[list, list]:
-    """The built-in plots: the rows above the data card and those below it.
-
-    Above: the coupled response and the error map (on the first screen), the uncoupled
-    subsystems when asked for, then the rest of the truncation study (the suggested modes
-    and the eigenfrequencies, one screen down). Below: the noise study.
-    """
+def first_screen(parts: PageParts, views: PlotViews) -> list:
+    """The plots of the first screen: the coupled response and the error map (also at
+    1280x720), and the uncoupled subsystems below them when asked for."""
     card = parts.card
-    above = [
+    return [
         pn.Row(
             card("Coupled response at the bushing (thesis eq. 4.1)", views.mobility),
             card("Truncation error map (eq. 5.1, figs. 5.3, 5.6, 5.7)", views.truncation),
         ),
         views.uncoupled,
+    ]
+
+
+def below_first_screen(parts: PageParts, views: PlotViews) -> list:
+    """Everything below the first screen, top to bottom: the rest of the truncation study
+    (suggested modes, eigenfrequencies), the "Your data" card, the noise study, then the
+    cards of :data:`EXTRA_CARDS`. Builds the views it shows (:meth:`PlotViews.build_below`).
+    """
+    views.build_below()
+    card = parts.card
+    return [
         pn.Row(
             card("Suggested number of modes (thesis table 5.1)", views.suggested),
             card("Eigenfrequency versus number of modes (fig. 5.8)", views.eigen),
         ),
+        data_card(parts),
+        pn.Row(card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", views.scatter)),
+        *extra_cards(parts),
     ]
-    below = [pn.Row(card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", views.scatter))]
-    return above, below
 
 
 def data_card(parts: PageParts) -> pn.Card:
@@ -437,16 +459,21 @@ def create_app(
         # sessions changing, bench/load_test.py profiled); the page has its own progress
         busy_indicator=None,
     )
-    above, below = plot_rows(parts, views)
     main = pn.Column(
         page_bar(parts, report, template.open_modal),
         link_notice_pane(parts),
-        *above,  # a plot on the first screen, also at 1280x720
-        data_card(parts),
-        *below,
-        *extra_cards(parts),
+        *first_screen(parts, views),  # a plot on the first screen, also at 1280x720
         sizing_mode="stretch_width",
     )
+
+    def complete() -> None:  # the rest of the page, below the first screen
+        # made as the first screen was, before the template set the page's design: with no
+        # design of their own, the template's reaches them as it reaches the first screen
+        # (with one of their own, Panel skips them: no margins inside the cards)
+        with pn.config.set(design=None):
+            below = below_first_screen(parts, views)
+        main.extend(below)
+
     help_close.on_click(lambda _e: template.close_modal())
     template.main.append(main)
     template.config.raw_css.append(PAGE_CSS)
@@ -475,11 +502,15 @@ def create_app(
         )
     if served():
         closed_pages.quiet_closed_page_writes()  # once per process: the server's loop
+        # the first screen is sent and shown first (issue 33: a page of ~1,000 Bokeh models
+        # took 2.5 s to its first plot); the rest follows once the browser shows it
+        pn.state.onload(complete)
         pn.state.onload(results.request_band)
         # once per process, after the first page: the other harmonics' reference studies
         pn.state.onload(background.warm_reference_studies)
         pn.state.onload(start_quiet_collections)  # once per process (runtime/collector.py)
     else:
+        complete()
         results.request_band(wait=True)
     return template
 

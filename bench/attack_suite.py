@@ -609,14 +609,16 @@ def hostile_files(big: bool) -> list[tuple[str, str, str, bytes]]:
     return files
 
 
-def _upload_widgets(sess: BokehSession) -> dict:
-    out = {}
-    for m in sess.doc.models:
-        if type(m).__name__ == "FileInput":
-            for css in getattr(m, "css_classes", []):
-                if css.startswith("upload-"):
-                    out[css[len("upload-") :]] = m
-    return out
+async def _upload_widget(sess: BokehSession, which: str, timeout_s: float = 120):
+    """The page's upload widget ``which`` ("chassis", "tire"), once the page holds it (the
+    dashboard builds its data card once the page is shown); None if it never comes."""
+    return await sess.find(
+        lambda m: (
+            type(m).__name__ == "FileInput"
+            and f"upload-{which}" in (getattr(m, "css_classes", None) or [])
+        ),
+        timeout_s,
+    )
 
 
 def _alerts(sess: BokehSession) -> tuple[str, str]:
@@ -654,7 +656,7 @@ def attack_files(rep: Report, base: str, app: str, cookie: str, server, big: boo
         sess = await _open(base, app, cookie)
         try:
             await sess.settle(60, 0.5)
-            widget = _upload_widgets(sess).get(which)
+            widget = await _upload_widget(sess, which)
             if widget is None:
                 return "no upload widget found in the page", False
             err0, summ0 = _alerts(sess)
@@ -1055,7 +1057,7 @@ async def _uploads_attack(base, app, cookie, args, stop) -> str:
     try:
         while not stop.is_set():
             for sess in tabs:
-                widget = _upload_widgets(sess).get("chassis")
+                widget = await _upload_widget(sess, "chassis")
                 await _upload(sess, widget, name.format(sent), content)
                 sent += 1
             try:

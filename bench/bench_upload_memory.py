@@ -122,7 +122,7 @@ def part_server(sessions: int) -> None:
             for i, sess in enumerate(tabs):
                 await sess.settle(120, 0.5)
                 content = chassis_file(1.0 + 0.01 * (k * sessions + i))  # every user's own
-                await a._upload(sess, a._upload_widgets(sess)["chassis"], f"c{i}.mat", content)
+                await a._upload(sess, await a._upload_widget(sess, "chassis"), f"c{i}.mat", content)
             t0 = time.perf_counter()
             while time.perf_counter() - t0 < 300:
                 answers = [a._alerts(s) for s in tabs]

@@ -350,6 +350,17 @@ class BokehSession:
             return sliders[k] if k < len(sliders) else None
         return next((m for m in sliders if not title or title in str(m.title)), None)
 
+    async def find(self, predicate, timeout_s: float):
+        """The first model of the replica for which ``predicate(model)`` holds, once one does
+        (a page builds what is below its first screen once it is shown: the upload widgets
+        of the dashboard arrive after the first document); None after ``timeout_s``."""
+        t0 = time.perf_counter()
+        while True:
+            m = next((m for m in self.doc.models if predicate(m)), None)
+            if m is not None or time.perf_counter() - t0 > timeout_s:
+                return m
+            await asyncio.sleep(0.05)
+
     async def settle(self, timeout_s: float, quiet_s: float) -> str | None:
         t0 = time.perf_counter()
         last = max(t0, self._changed_at)

@@ -171,11 +171,15 @@ def test_a_large_http_body_is_refused_before_it_is_read(image_server):
 # ---- 9. an upload larger than Tornado's default read buffer ---------------------------------
 
 
-def _upload_widget(sess, css: str):
-    for m in sess.doc.models:
-        if type(m).__name__ == "FileInput" and css in (m.css_classes or []):
-            return m
-    raise LookupError(css)
+async def _upload_widget(sess, css: str):
+    """The upload widget of class ``css``, once the page holds it (the dashboard builds its
+    data card once the page is shown, after the first screen)."""
+    m = await sess.find(
+        lambda m: type(m).__name__ == "FileInput" and css in (m.css_classes or []), 120
+    )
+    if m is None:
+        raise LookupError(css)
+    return m
 
 
 def _error_text(sess) -> str:
@@ -197,7 +201,7 @@ async def _upload_big(base: str, cookie: str, n_bytes: int) -> str:
     await sess.open(base + "/main", 120)
     try:
         await sess.settle(120, 0.5)
-        widget = _upload_widget(sess, "upload-chassis")
+        widget = await _upload_widget(sess, "upload-chassis")
         content = b"freq,a\n" + b"1" * (n_bytes - 7)
         events = []
         for attr, value in (

@@ -1,0 +1,169 @@
+"""A served page sends its first screen first, the rest once the browser shows it (issue 33).
+
+A page of ~1,000 Bokeh models took 2.5 s from request to its first plot, most of it building,
+sending and rendering what is below the first screen. The dashboard is served here by a Panel
+server in this process; a Bokeh protocol client (what a browser receives, read off the
+websocket) opens it: the document it pulls holds the first screen (the coupled response and
+the error map with their data) and none of the views below it; once the client says the page
+is ready, as BokehJS does, the rest arrives and the replica holds every view.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+import threading
+import time
+
+import panel as pn
+import pytest
+from bokeh.client.websocket import WebSocketClientConnectionWrapper
+from bokeh.document import Document
+from bokeh.document.events import MessageSentEvent
+from bokeh.events import DocumentReady
+from bokeh.models import ColumnDataSource
+from bokeh.protocol import Protocol
+from bokeh.protocol.receiver import Receiver
+from bokeh.util.token import generate_jwt_token, generate_session_id
+from tornado.httpclient import HTTPRequest
+from tornado.websocket import websocket_connect
+
+from app.main import create_app
+
+TIMEOUT = 120.0
+FIRST_SCREEN = {"mobility.figure", "truncation.figure"}
+BELOW = {"eigen.figure", "scatter.figure", "wheels.figure"}
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _names(doc: Document) -> set[str]:
+    return {m.name for m in doc.models if getattr(m, "name", None)}
+
+
+def _dressing(doc: Document, name: str) -> list[tuple]:
+    """From the model named ``name`` up to the page's root: each model's type, margin and
+    stylesheets (what the page's design gave it)."""
+    parents = {}
+    for m in doc.models:
+        for c in getattr(m, "children", None) or []:
+            parents[(c[0] if isinstance(c, tuple) else c).id] = m
+    out, x = [], next(m for m in doc.models if getattr(m, "name", None) == name)
+    while x is not None:
+        sheets = tuple(getattr(s, "url", None) or "inline" for s in x.stylesheets)
+        out.append((type(x).__name__, tuple(x.margin or ()), sheets))
+        x = parents.get(x.id)
+    return out
+
+
+def _has_data(doc: Document, name: str) -> bool:
+    src = [m for m in doc.models if isinstance(m, ColumnDataSource) and m.name == name]
+    return bool(src) and any(len(v) for v in src[0].data.values())
+
+
+async def _client(url: str) -> tuple[Document, set[str], bool]:
+    """Pull the page as a browser does; return the replica after the page said it is ready
+    and every view arrived, the model names of the first document, and whether the first
+    document held the coupled response's data."""
+    receiver = Receiver(Protocol())
+    ws = await websocket_connect(
+        HTTPRequest(url), subprotocols=["bokeh", generate_jwt_token(generate_session_id())]
+    )
+    sock = WebSocketClientConnectionWrapper(ws)
+
+    async def pop():
+        while True:
+            frag = await ws.read_message()
+            assert frag is not None, "the server closed the websocket"
+            msg = await receiver.consume(frag)
+            if msg is not None:
+                return msg
+
+    try:
+        assert (await asyncio.wait_for(pop(), TIMEOUT)).msgtype == "ACK"
+        await Protocol().create("PULL-DOC-REQ").send(sock)
+        reply = await asyncio.wait_for(pop(), TIMEOUT)
+        while reply.msgtype == "PATCH-DOC":
+            reply = await asyncio.wait_for(pop(), TIMEOUT)
+        doc = Document()
+        reply.push_to_document(doc)
+        first, first_data = _names(doc), _has_data(doc, "mobility.truncated")
+        await (
+            Protocol()
+            .create("PATCH-DOC", [MessageSentEvent(doc, "bokeh_event", DocumentReady())])
+            .send(sock)
+        )
+        end = time.monotonic() + TIMEOUT
+        while not BELOW <= _names(doc):
+            remaining = end - time.monotonic()
+            assert remaining > 0, f"the rest of the page never arrived: {_names(doc)}"
+            msg = await asyncio.wait_for(pop(), remaining)
+            if msg.msgtype == "PATCH-DOC":
+                msg.apply_to_document(doc)
+        return doc, first, first_data
+    finally:
+        ws.close()
+
+
+def _in_own_loop(coro):
+    """Run ``coro`` on an event loop of its own in a thread of its own; its result."""
+    out: dict = {}
+
+    def run() -> None:
+        try:
+            out["value"] = asyncio.run(coro)
+        except BaseException as e:  # re-raised in the test's thread
+            out["error"] = e
+
+    t = threading.Thread(target=run)
+    t.start()
+    t.join(3 * TIMEOUT)
+    assert not t.is_alive(), "the client never finished"
+    if "error" in out:
+        raise out["error"]
+    return out["value"]
+
+
+@pytest.fixture
+def served_dashboard():
+    port = _free_port()
+    server = pn.serve(
+        {"main": create_app},
+        port=port,
+        address="127.0.0.1",
+        websocket_origin=[f"127.0.0.1:{port}"],
+        threaded=True,
+        show=False,
+        start=True,
+    )
+    end = time.monotonic() + TIMEOUT
+    while True:  # the server thread listens once it started
+        try:
+            socket.create_connection(("127.0.0.1", port), timeout=1).close()
+            break
+        except OSError:
+            assert time.monotonic() < end, "the server never listened"
+            time.sleep(0.05)
+    try:
+        yield f"ws://127.0.0.1:{port}/main/ws"
+    finally:
+        server.stop()
+
+
+def test_the_first_screen_comes_first_and_the_rest_once_the_page_is_shown(served_dashboard):
+    doc, first, first_data = _in_own_loop(asyncio.wait_for(_client(served_dashboard), 2 * TIMEOUT))
+    assert FIRST_SCREEN <= first, first
+    assert first_data, "the first document has no coupled response to show"
+    assert not (BELOW & first), BELOW & first
+    # the whole page once shown: every view of the first screen kept, the rest added
+    assert FIRST_SCREEN | BELOW <= _names(doc)
+    # dressed by the page's design as the first screen is (inset in their cards, the same
+    # stylesheets); the views built later once had their own design: no inset, plots
+    # outside their cards at 1280x720 (tests/browser/test_layout.py)
+    first = _dressing(doc, "mobility.figure")
+    for name in ("eigen.figure", "scatter.figure"):
+        assert _dressing(doc, name) == first, name
