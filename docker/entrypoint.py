@@ -60,6 +60,9 @@ Variables (all optional; the table with examples is in docs/deployment.md):
 ``FBS_PORT``, ``FBS_ADDRESS``
     Port and address the server listens on inside the container, default 5006 and 0.0.0.0
     (publish another host port with ``docker run -p HOSTPORT:5006`` instead).
+``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS``
+    Threads of the native libraries' pools in the server; default 1 each (the server's
+    matrices are small and its cores are busy with sessions: :func:`server_environment`).
 """
 
 from __future__ import annotations
@@ -81,6 +84,8 @@ FALSE = ("", "0", "false", "no", "off")
 MIN_SECRET_LEN = 32
 #: Variables holding secrets: read here, handed to the server privately, removed from the
 #: server's environment.
+#: Thread counts of native libraries' pools, one each unless set (:func:`server_environment`).
+NATIVE_THREAD_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 SECRET_VARS = (
     "FBS_BASIC_AUTH",
     "FBS_COOKIE_SECRET",
@@ -345,9 +350,25 @@ def exec_server(launch: Launch, env: dict[str, str]) -> None:
         fd = os.dup(f.fileno())
     os.lseek(fd, 0, os.SEEK_SET)
     os.set_inheritable(fd, True)
-    clean = {k: v for k, v in env.items() if k not in SECRET_VARS}
     argv = [sys.executable, str(Path(__file__).resolve()), SERVE_FD, str(fd), "--", *launch.args]
-    os.execve(sys.executable, argv, clean)
+    os.execve(sys.executable, argv, server_environment(env))
+
+
+def server_environment(env: dict[str, str]) -> dict[str, str]:
+    """The server stage's environment: ``env`` without the secrets, and one thread per
+    native thread pool (BLAS, OpenMP) unless ``env`` sets its own.
+
+    The server's dense linear algebra is small (6x6 interface solves, the chassis' 264-DOF
+    eigenproblem) and runs beside the event loop, the numba kernels' threads and other
+    sessions' bands: OpenBLAS's threads, which spin while they wait for work, only fight
+    them for the cores. On the 2-core machine with its cores busy the chassis' modal
+    decomposition took 1.4-2.2 s with OpenBLAS's default of a thread per core, 0.08-0.12 s
+    with one (``bench/bench_blas_threads.py``).
+    """
+    clean = {k: v for k, v in env.items() if k not in SECRET_VARS}
+    for name in NATIVE_THREAD_VARS:
+        clean.setdefault(name, "1")
+    return clean
 
 
 def run_server(argv: list[str]) -> int:

@@ -91,6 +91,16 @@ def test_default_command(app_file):
     assert args[-1] == "--dev-flag" and launch.warnings == [] and launch.private == {}
 
 
+def test_the_server_gets_one_native_thread_per_pool_and_no_secret():
+    env = {"FBS_BASIC_AUTH": "a:b", "FBS_COOKIE_SECRET": "s" * 40, "PATH": "/bin"}
+    out = entrypoint.server_environment(env)
+    assert not set(entrypoint.SECRET_VARS) & set(out) and out["PATH"] == "/bin"
+    assert all(out[v] == "1" for v in entrypoint.NATIVE_THREAD_VARS)
+    # a count the deployment sets is kept
+    out = entrypoint.server_environment({"OPENBLAS_NUM_THREADS": "2"})
+    assert out["OPENBLAS_NUM_THREADS"] == "2" and out["OMP_NUM_THREADS"] == "1"
+
+
 def test_basic_auth_users_and_secret_stay_off_the_command_line(app_file):
     env = {
         "FBS_APP": str(app_file),
