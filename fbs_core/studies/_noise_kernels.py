@@ -76,7 +76,6 @@ def n_elements(nj: int, ne: int) -> int:
 def _lane_factors(
     key: np.uint64,
     rids: IntArray,
-    nv: int,
     line: int,
     p: float,
     k0: int,
@@ -85,12 +84,13 @@ def _lane_factors(
     base: NDArray[np.uint64],
 ) -> None:
     """Factors of words ``k0 .. k1-1`` of the ``LANES`` rounds ``rids`` at stream line ``line``
-    into ``s (n_el, LANES)``; ``nv`` (valid lanes) is unused: padded lanes cost nothing extra.
+    into ``s (n_el, LANES)`` (padded lanes cost nothing extra).
 
     ``base (3, LANES)`` is workspace: the lanes' stream bases, then the two halves of a
     word as the bits of ``2**52 + u`` (``u`` the 32-bit half), read back as float64 and
     less ``2**52``: exactly ``float(u)``, without the scalar integer conversion AVX2 lacks,
-    so that the words of all lanes are hashed and converted in vector registers.
+    so that the words of all lanes are hashed and converted in vector registers. Arrays
+    are indexed in full, never sliced: a view costs two atomic reference counts.
     """
     n_el = s.shape[0]
     for v in range(LANES):
@@ -103,13 +103,11 @@ def _lane_factors(
             w = mix64(base[0, v] + kk)
             base[1, v] = (w >> _S32) | _EXP52
             base[2, v] = (w & _LO32) | _EXP52
-        se = s[e]
         for v in range(LANES):
-            se[v] = 1.0 + p * (2.0 * ((as_float[1, v] - _TWO52) * _INV32) - 1.0)
+            s[e, v] = 1.0 + p * (2.0 * ((as_float[1, v] - _TWO52) * _INV32) - 1.0)
         if e + 1 < n_el:
-            so = s[e + 1]
             for v in range(LANES):
-                so[v] = 1.0 + p * (2.0 * ((as_float[2, v] - _TWO52) * _INV32) - 1.0)
+                s[e + 1, v] = 1.0 + p * (2.0 * ((as_float[2, v] - _TWO52) * _INV32) - 1.0)
 
 
 @njit(**_JIT)
@@ -123,124 +121,152 @@ def _lane_solve(
     Br: FloatArray,
     Bi: FloatArray,
     order: IntArray,
+    line: int,
     s: FloatArray,
-    nv: int,
-    Wr: FloatArray,
-    Wi: FloatArray,
-    xr: FloatArray,
-    xi: FloatArray,
-    Pr: FloatArray,
-    Pi: FloatArray,
+    W: FloatArray,
+    X: FloatArray,
     piv: IntArray,
     pm: FloatArray,
-    yr: FloatArray,
-    yi: FloatArray,
+    Y: FloatArray,
 ) -> None:
-    """Noisy eq. 4.1 at one line for all lanes: ``y (n_e, LANES)`` from factors ``s``.
+    """Noisy eq. 4.1 at line ``line`` for all lanes: ``Y (2, n_e, LANES)`` (real and
+    imaginary parts) from factors ``s``.
 
-    Rows enter in ``order`` (the partial-pivoting order of the noise-free matrix),
+    Rows enter in ``order[line]`` (the partial-pivoting order of the noise-free matrix),
     which changes no result but makes row exchanges in the noisy lanes rare; each
-    factor stays bound to its original matrix element.
+    factor stays bound to its original matrix element. Workspace: ``W (2, n_j, n_j,
+    LANES)`` the matrix and its LU factors, ``X (4, n_j, LANES)`` the solution and the
+    reciprocal pivots. Arrays are indexed in full, never sliced (a view costs two atomic
+    reference counts).
     """
-    nj = Ar.shape[0]
-    ne = Br.shape[0]
+    nj = Ar.shape[1]
     oa = nj * nj
     oE = oa + nj
-    oB = oE + nj * nj
     # interface matrix and right-hand side
     for i in range(nj):
-        o = order[i]
+        o = order[line, i]
         for k in range(nj):
-            sa = s[o * nj + k]
-            se = s[oE + o * nj + k]
-            A_r = Ar[o, k]
-            A_i = Ai[o, k]
-            E_r = Er[o, k]
-            E_i = Ei[o, k]
+            ia = o * nj + k
+            ie = oE + o * nj + k
+            A_r = Ar[line, o, k]
+            A_i = Ai[line, o, k]
+            E_r = Er[line, o, k]
+            E_i = Ei[line, o, k]
             for v in range(LANES):
-                Wr[i, k, v] = sa[v] * A_r + se[v] * E_r
-                Wi[i, k, v] = sa[v] * A_i + se[v] * E_i
-        sv = s[oa + o]
-        a_r = ar[o]
-        a_i = ai[o]
+                W[0, i, k, v] = s[ia, v] * A_r + s[ie, v] * E_r
+                W[1, i, k, v] = s[ia, v] * A_i + s[ie, v] * E_i
+        a_r = ar[line, o]
+        a_i = ai[line, o]
         for v in range(LANES):
-            xr[i, v] = sv[v] * a_r
-            xi[i, v] = sv[v] * a_i
-    # LU with partial pivoting per lane, applied to x on the fly
+            X[0, i, v] = s[oa + o, v] * a_r
+            X[1, i, v] = s[oa + o, v] * a_i
     for k in range(nj):
+        _pivot(W, X, k, piv, pm)
+        _eliminate(W, X, k)
+    _back_substitute(W, X)
+    _transfer(Br, Bi, line, s, oE + oa, X, Y)
+
+
+@njit(**_JIT)
+def _pivot(W: FloatArray, X: FloatArray, k: int, piv: IntArray, pm: FloatArray) -> None:
+    """Partial pivoting in column ``k``, per lane (pivot ``|Re| + |Im|``), rows of ``W``
+    and ``X[:2]`` exchanged; the search runs in vector registers, the exchanges (rare:
+    rows enter in the noise-free pivot order) lane by lane."""
+    nj = W.shape[1]
+    for v in range(LANES):
+        pm[v] = abs(W[0, k, k, v]) + abs(W[1, k, k, v])
+        piv[v] = k
+    for i in range(k + 1, nj):
         for v in range(LANES):
-            pm[v] = abs(Wr[k, k, v]) + abs(Wi[k, k, v])
-            piv[v] = k
-        for i in range(k + 1, nj):
-            for v in range(LANES):
-                t = abs(Wr[i, k, v]) + abs(Wi[i, k, v])
-                if t > pm[v]:
-                    pm[v] = t
-                    piv[v] = i
+            t = abs(W[0, i, k, v]) + abs(W[1, i, k, v])
+            if t > pm[v]:
+                pm[v] = t
+                piv[v] = i
+    swaps = 0
+    for v in range(LANES):
+        swaps += piv[v] != k
+    if swaps == 0:
+        return
+    for v in range(LANES):
+        q = piv[v]
+        if q != k:
+            for j in range(k, nj):
+                for c in range(2):
+                    t = W[c, k, j, v]
+                    W[c, k, j, v] = W[c, q, j, v]
+                    W[c, q, j, v] = t
+            for c in range(2):
+                t = X[c, k, v]
+                X[c, k, v] = X[c, q, v]
+                X[c, q, v] = t
+
+
+@njit(**_JIT)
+def _eliminate(W: FloatArray, X: FloatArray, k: int) -> None:
+    """Step ``k`` of the LU elimination of ``W``, applied to ``x = X[:2]`` on the fly:
+    ``X[2:4, k]`` the reciprocal pivot, the multipliers stored in place of column ``k``."""
+    nj = W.shape[1]
+    for v in range(LANES):
+        pr = W[0, k, k, v]
+        pi = W[1, k, k, v]
+        d = pr * pr + pi * pi
+        X[2, k, v] = pr / d
+        X[3, k, v] = -pi / d
+    for i in range(k + 1, nj):
+        # multipliers m = W[i, k] / W[k, k], stored in place of W[i, k]
         for v in range(LANES):
-            q = piv[v]
-            if q != k:
-                for j in range(k, nj):
-                    t = Wr[k, j, v]
-                    Wr[k, j, v] = Wr[q, j, v]
-                    Wr[q, j, v] = t
-                    t = Wi[k, j, v]
-                    Wi[k, j, v] = Wi[q, j, v]
-                    Wi[q, j, v] = t
-                t = xr[k, v]
-                xr[k, v] = xr[q, v]
-                xr[q, v] = t
-                t = xi[k, v]
-                xi[k, v] = xi[q, v]
-                xi[q, v] = t
+            wr = W[0, i, k, v]
+            wi = W[1, i, k, v]
+            W[0, i, k, v] = wr * X[2, k, v] - wi * X[3, k, v]
+            W[1, i, k, v] = wr * X[3, k, v] + wi * X[2, k, v]
+        for j in range(k + 1, nj):
+            for v in range(LANES):
+                mr = W[0, i, k, v]
+                mi = W[1, i, k, v]
+                W[0, i, j, v] -= mr * W[0, k, j, v] - mi * W[1, k, j, v]
+                W[1, i, j, v] -= mr * W[1, k, j, v] + mi * W[0, k, j, v]
         for v in range(LANES):
-            pr = Wr[k, k, v]
-            pi = Wi[k, k, v]
-            d = pr * pr + pi * pi
-            Pr[k, v] = pr / d
-            Pi[k, v] = -pi / d
-        for i in range(k + 1, nj):
-            # multipliers m = W[i, k] / W[k, k], stored in place of W[i, k]
-            for v in range(LANES):
-                wr = Wr[i, k, v]
-                wi = Wi[i, k, v]
-                Wr[i, k, v] = wr * Pr[k, v] - wi * Pi[k, v]
-                Wi[i, k, v] = wr * Pi[k, v] + wi * Pr[k, v]
-            for j in range(k + 1, nj):
-                for v in range(LANES):
-                    mr = Wr[i, k, v]
-                    mi = Wi[i, k, v]
-                    Wr[i, j, v] -= mr * Wr[k, j, v] - mi * Wi[k, j, v]
-                    Wi[i, j, v] -= mr * Wi[k, j, v] + mi * Wr[k, j, v]
-            for v in range(LANES):
-                mr = Wr[i, k, v]
-                mi = Wi[i, k, v]
-                xr[i, v] -= mr * xr[k, v] - mi * xi[k, v]
-                xi[i, v] -= mr * xi[k, v] + mi * xr[k, v]
+            mr = W[0, i, k, v]
+            mi = W[1, i, k, v]
+            X[0, i, v] -= mr * X[0, k, v] - mi * X[1, k, v]
+            X[1, i, v] -= mr * X[1, k, v] + mi * X[0, k, v]
+
+
+@njit(**_JIT)
+def _back_substitute(W: FloatArray, X: FloatArray) -> None:
+    """``x = X[:2]`` from the upper triangle of ``W`` and the reciprocal pivots ``X[2:4]``."""
+    nj = W.shape[1]
     for i in range(nj - 1, -1, -1):
         for j in range(i + 1, nj):
             for v in range(LANES):
-                xr[i, v] -= Wr[i, j, v] * xr[j, v] - Wi[i, j, v] * xi[j, v]
-                xi[i, v] -= Wr[i, j, v] * xi[j, v] + Wi[i, j, v] * xr[j, v]
+                X[0, i, v] -= W[0, i, j, v] * X[0, j, v] - W[1, i, j, v] * X[1, j, v]
+                X[1, i, v] -= W[0, i, j, v] * X[1, j, v] + W[1, i, j, v] * X[0, j, v]
         for v in range(LANES):
-            cr = xr[i, v]
-            ci = xi[i, v]
-            xr[i, v] = cr * Pr[i, v] - ci * Pi[i, v]
-            xi[i, v] = cr * Pi[i, v] + ci * Pr[i, v]
-    # v_e = (S_B o B) x
+            cr = X[0, i, v]
+            ci = X[1, i, v]
+            X[0, i, v] = cr * X[2, i, v] - ci * X[3, i, v]
+            X[1, i, v] = cr * X[3, i, v] + ci * X[2, i, v]
+
+
+@njit(**_JIT)
+def _transfer(
+    Br: FloatArray, Bi: FloatArray, line: int, s: FloatArray, oB: int, X: FloatArray, Y: FloatArray
+) -> None:
+    """``v_e = (S_B o B) x`` into ``Y (2, n_e, LANES)``; ``S_B`` from row ``oB`` of ``s``."""
+    ne, nj = Br.shape[1], Br.shape[2]
     for e in range(ne):
         for v in range(LANES):
-            yr[e, v] = 0.0
-            yi[e, v] = 0.0
+            Y[0, e, v] = 0.0
+            Y[1, e, v] = 0.0
         for k in range(nj):
-            sb = s[oB + e * nj + k]
-            b_r = Br[e, k]
-            b_i = Bi[e, k]
+            sb = oB + e * nj + k
+            b_r = Br[line, e, k]
+            b_i = Bi[line, e, k]
             for v in range(LANES):
-                br = sb[v] * b_r
-                bi = sb[v] * b_i
-                yr[e, v] += br * xr[k, v] - bi * xi[k, v]
-                yi[e, v] += br * xi[k, v] + bi * xr[k, v]
+                br = s[sb, v] * b_r
+                bi = s[sb, v] * b_i
+                Y[0, e, v] += br * X[0, k, v] - bi * X[1, k, v]
+                Y[1, e, v] += br * X[1, k, v] + bi * X[0, k, v]
 
 
 @njit(**_JIT)
@@ -300,32 +326,10 @@ def _block(
         if freq_dep or line == l0:
             stream_line = line if freq_dep else 0
             if tire:
-                _lane_factors(key, lane_ids, nv, stream_line, p, 0, k_tire, s, base)
+                _lane_factors(key, lane_ids, stream_line, p, 0, k_tire, s, base)
             if vehicle:
-                _lane_factors(key, lane_ids, nv, stream_line, p, k_tire, k_all, s, base)
-        _lane_solve(
-            Ar[line],
-            Ai[line],
-            ar[line],
-            ai[line],
-            Er[line],
-            Ei[line],
-            Br[line],
-            Bi[line],
-            order[line],
-            s,
-            nv,
-            W[0],
-            W[1],
-            X[0],
-            X[1],
-            X[2],
-            X[3],
-            piv,
-            pm,
-            Y[0],
-            Y[1],
-        )
+                _lane_factors(key, lane_ids, stream_line, p, k_tire, k_all, s, base)
+        _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, line, s, W, X, piv, pm, Y)
         if want_mag:
             for e in range(ne):
                 for v in range(nv):
