@@ -45,12 +45,17 @@ from ._rng import GOLDEN, mix64, mix64_np, stream_base
 # serves all the others
 class _JitOptions(TypedDict):
     cache: bool
-    fastmath: bool
+    fastmath: bool | set[str]
     error_model: Literal["python", "numpy"]
     nogil: bool
 
 
 _JIT = _JitOptions(cache=True, fastmath=False, error_model="numpy", nogil=True)
+#: The solve's options: fused multiply-add allowed ("contract"; the updates are written as
+#: ``w - m_r b_r + m_i b_i``, two FMAs each), no other fast-math flag (NaN and inf keep
+#: their meaning). The factors and the magnitudes stay uncontracted: numpy recomputes
+#: both bit for bit (:func:`noise_factors`, the tests' ``sqrt(re**2 + im**2)``).
+_JIT_FMA = _JitOptions(cache=True, fastmath={"contract"}, error_model="numpy", nogil=True)
 
 #: Rounds solved together in one vectorised block.
 LANES = 64
@@ -110,7 +115,7 @@ def _lane_factors(
                 s[e + 1, v] = 1.0 + p * (2.0 * ((as_float[2, v] - _TWO52) * _INV32) - 1.0)
 
 
-@njit(**_JIT)
+@njit(**_JIT_FMA)
 def _lane_solve(
     Ar: FloatArray,
     Ai: FloatArray,
@@ -167,7 +172,7 @@ def _lane_solve(
     _transfer(Br, Bi, line, s, oE + oa, X, Y)
 
 
-@njit(**_JIT)
+@njit(**_JIT_FMA)
 def _pivot(W: FloatArray, X: FloatArray, k: int, piv: IntArray, pm: FloatArray) -> None:
     """Partial pivoting in column ``k``, per lane (pivot ``|Re| + |Im|``), rows of ``W``
     and ``X[:2]`` exchanged; the search runs in vector registers, the exchanges (rare:
@@ -201,7 +206,7 @@ def _pivot(W: FloatArray, X: FloatArray, k: int, piv: IntArray, pm: FloatArray) 
                 X[c, q, v] = t
 
 
-@njit(**_JIT)
+@njit(**_JIT_FMA)
 def _eliminate(W: FloatArray, X: FloatArray, k: int) -> None:
     """Step ``k`` of the LU elimination of ``W``, applied to ``x = X[:2]`` on the fly:
     ``X[2:4, k]`` the reciprocal pivot, the multipliers stored in place of column ``k``."""
@@ -223,24 +228,24 @@ def _eliminate(W: FloatArray, X: FloatArray, k: int) -> None:
             for v in range(LANES):
                 mr = W[0, i, k, v]
                 mi = W[1, i, k, v]
-                W[0, i, j, v] -= mr * W[0, k, j, v] - mi * W[1, k, j, v]
-                W[1, i, j, v] -= mr * W[1, k, j, v] + mi * W[0, k, j, v]
+                W[0, i, j, v] = W[0, i, j, v] - mr * W[0, k, j, v] + mi * W[1, k, j, v]
+                W[1, i, j, v] = W[1, i, j, v] - mr * W[1, k, j, v] - mi * W[0, k, j, v]
         for v in range(LANES):
             mr = W[0, i, k, v]
             mi = W[1, i, k, v]
-            X[0, i, v] -= mr * X[0, k, v] - mi * X[1, k, v]
-            X[1, i, v] -= mr * X[1, k, v] + mi * X[0, k, v]
+            X[0, i, v] = X[0, i, v] - mr * X[0, k, v] + mi * X[1, k, v]
+            X[1, i, v] = X[1, i, v] - mr * X[1, k, v] - mi * X[0, k, v]
 
 
-@njit(**_JIT)
+@njit(**_JIT_FMA)
 def _back_substitute(W: FloatArray, X: FloatArray) -> None:
     """``x = X[:2]`` from the upper triangle of ``W`` and the reciprocal pivots ``X[2:4]``."""
     nj = W.shape[1]
     for i in range(nj - 1, -1, -1):
         for j in range(i + 1, nj):
             for v in range(LANES):
-                X[0, i, v] -= W[0, i, j, v] * X[0, j, v] - W[1, i, j, v] * X[1, j, v]
-                X[1, i, v] -= W[0, i, j, v] * X[1, j, v] + W[1, i, j, v] * X[0, j, v]
+                X[0, i, v] = X[0, i, v] - W[0, i, j, v] * X[0, j, v] + W[1, i, j, v] * X[1, j, v]
+                X[1, i, v] = X[1, i, v] - W[0, i, j, v] * X[1, j, v] - W[1, i, j, v] * X[0, j, v]
         for v in range(LANES):
             cr = X[0, i, v]
             ci = X[1, i, v]
@@ -248,7 +253,7 @@ def _back_substitute(W: FloatArray, X: FloatArray) -> None:
             X[1, i, v] = cr * X[3, i, v] + ci * X[2, i, v]
 
 
-@njit(**_JIT)
+@njit(**_JIT_FMA)
 def _transfer(
     Br: FloatArray, Bi: FloatArray, line: int, s: FloatArray, oB: int, X: FloatArray, Y: FloatArray
 ) -> None:
@@ -265,8 +270,8 @@ def _transfer(
             for v in range(LANES):
                 br = s[sb, v] * b_r
                 bi = s[sb, v] * b_i
-                Y[0, e, v] += br * X[0, k, v] - bi * X[1, k, v]
-                Y[1, e, v] += br * X[1, k, v] + bi * X[0, k, v]
+                Y[0, e, v] = Y[0, e, v] + br * X[0, k, v] - bi * X[1, k, v]
+                Y[1, e, v] = Y[1, e, v] + br * X[1, k, v] + bi * X[0, k, v]
 
 
 @njit(**_JIT)
