@@ -42,11 +42,11 @@ from app.page.titles import page_url
 from app.public_url import public_base
 from app.report.session import provenance_of, report_data
 from app.runtime import background, closed_pages
-from app.runtime.collector import session_ended
+from app.runtime.collector import count_alive, session_ended
 from app.runtime.collector import start as start_quiet_collections
 from app.runtime.draw import DrawQueue, served
 from app.state import URL_KEYS, DashboardState
-from app.store import Results
+from app.store import LIVE, Results
 from app.views import (
     Controls,
     EigenView,
@@ -509,6 +509,8 @@ def create_app(
         # once per process, after the first page: the other harmonics' reference studies
         pn.state.onload(background.warm_reference_studies)
         pn.state.onload(start_quiet_collections)  # once per process (runtime/collector.py)
+        count_alive("pages", LIVE.__len__)  # logged after thawed collections (a bound method:
+        # Bokeh may clear this script's namespace before the collection runs)
     else:
         complete()
         results.request_band(wait=True)

@@ -42,6 +42,7 @@ import dataclasses
 import functools
 import threading
 import time
+import weakref
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -73,7 +74,7 @@ from .runtime import background, bands
 from .runtime.draw import served
 from .state import MODE_COUNTS, DashboardState
 
-__all__ = ["ALWAYS", "TABLE", "Results", "Row", "depends"]
+__all__ = ["ALWAYS", "LIVE", "TABLE", "Results", "Row", "depends"]
 
 #: When a row is computed: on every change of what it depends on.
 ALWAYS = "always"
@@ -463,6 +464,10 @@ def _done_status(band: Band) -> BandStatus:
     return BandStatus(False, bands.done_text(band.result, band.seconds, band.settings.band_key()))
 
 
+#: Every :class:`Results` not yet freed (a page's store lives as long as its page).
+LIVE: weakref.WeakSet[Results] = weakref.WeakSet()
+
+
 class Results(param.Parameterized):
     """The published results of one browser session (see the module docstring); one
     parameter per row of :data:`TABLE`, added below the class."""
@@ -484,6 +489,7 @@ class Results(param.Parameterized):
     )
 
     def __init__(self, state: DashboardState | None = None, **params):
+        LIVE.add(self)
         self._lock = threading.RLock()
         self._band_job: bands.Job | None = None
         self._keys: dict[str, tuple] = {}  # the key of each published row

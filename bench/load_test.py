@@ -33,7 +33,9 @@ A session's cost in memory (``--serve`` and ``--docker``): the resident memory o
 and after they all closed: the closed sessions destroyed by Bokeh (its log says so for each)
 and the server idle again, which includes Panel's garbage collection after destroyed
 sessions. Per session: (open - before) / n and (after - before) / n, what the closed
-sessions kept.
+sessions kept in resident memory (the allocator keeps freed memory for reuse); and the
+pages the server itself counts alive at its first thawed collection after they all ended
+(``app/runtime/collector.py``: 0 when no closed page was kept).
 
 Servers (loopback only, stopped at the end by PID or container ID):
   --url URL          an already running server
@@ -53,6 +55,7 @@ import asyncio
 import contextlib
 import json
 import os
+import re
 import socket
 import statistics
 import subprocess
@@ -435,6 +438,23 @@ def proc_tree_rss_mb(pid: int) -> float:
 SESSION_STARTED, SESSION_ENDED = "a page's session started", "a page's session ended"
 
 
+#: What the quiet collector logs after a thawed collection (app/runtime/collector.py).
+ALIVE = re.compile(r"quiet full collection \(thawed\): \d+ ms; alive: pages (\d+)")
+
+
+async def pages_alive(server, timeout_s: float) -> int | None:
+    """The pages alive at the server's first thawed collection after the last session
+    ended (its log), waited for up to ``timeout_s``; None if none came."""
+    t_end = time.monotonic() + timeout_s
+    while time.monotonic() < t_end:
+        logs = server.logs()
+        found = list(ALIVE.finditer(logs, max(0, logs.rfind(SESSION_ENDED))))
+        if found:
+            return int(found[-1].group(1))
+        await asyncio.sleep(0.5)
+    return None
+
+
 async def wait_sessions_ended(server, timeout_s: float) -> bool:
     """Wait until every page's session the server started has ended, by its log (Bokeh
     destroys a closed session after its unused lifetime, 15 s, checked every 17 s)."""
@@ -696,6 +716,9 @@ def main(argv: list[str] | None = None) -> int:
         asyncio.run(wait_server_idle(server.cpu_s, 60))
         return ended, server.rss_mb()
 
+    def kept() -> int | None:  # pages alive once all ended and collected (None: no server)
+        return None if server is None else asyncio.run(pages_alive(server, 60))
+
     try:
         if not args.cold:
             took = asyncio.run(run_warm_up(url, args.slider, args.timeout, args.client))
@@ -722,6 +745,7 @@ def main(argv: list[str] | None = None) -> int:
             )
             ended, rss1 = settle()
             row["rss_mb"] = (rss0, row["rss_open_mb"], rss1)
+            row["pages_alive"] = kept()
             row["sessions_ended"] = ended
             cpu1 = server.cpu_s() if server is not None else None
             row["host_cpu_s"] = host_busy_s() - host0
@@ -782,6 +806,12 @@ def main(argv: list[str] | None = None) -> int:
                     f"session), after all closed{'' if ended else ' (NOT all ended in 120 s)'}"
                     f" and idle {rss1:.0f} ({rss1 - rss0:+.0f}: "
                     f"{(rss1 - rss0) / n:+.1f} per closed session)"
+                )
+            if server is not None:
+                alive = row["pages_alive"]
+                print(
+                    "   pages alive after all closed and a collection (the server's count): "
+                    + ("none logged within 60 s" if alive is None else str(alive))
                 )
             if row["problems"]:
                 failed = True

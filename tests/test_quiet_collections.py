@@ -123,3 +123,33 @@ def test_a_thawed_quiet_collection_frees_cycles_that_were_frozen():
         assert ref() is None, "thawed and collected"
     finally:
         gc.unfreeze()  # leave the test process as it was
+
+
+def test_the_counts_of_what_outlived_the_sessions_are_logged_after_a_thawed_collection(caplog):
+    c, clock, calls = _collector()
+    alive = [3]
+    c.alive["pages"] = lambda: alive[0]
+    caplog.set_level("INFO", logger="app.runtime.collector")
+    c.touch()
+    clock.t += QUIET
+    assert c.step() and "alive" not in caplog.text  # not thawed: nothing was freed
+    c.session_ended()
+    alive[0] = 0  # counted after the collection, which freed the ended session
+    clock.t += QUIET
+    assert c.step() and calls[-3:] == ["unfreeze", "collect", "freeze"]
+    assert "alive: pages 0" in caplog.text
+
+
+def test_live_holds_the_stores_not_yet_freed():
+    from app.state import DashboardState
+    from app.store import LIVE, Results
+
+    state = DashboardState()
+    state.noise.rounds = 30
+    n0 = len(LIVE)
+    r = Results(state)
+    assert len(LIVE) == n0 + 1 and r in LIVE
+    r.close()
+    del r, state  # (the state's watchers hold its store)
+    gc.collect()
+    assert len(LIVE) == n0

@@ -38,6 +38,7 @@ __all__ = [
     "QUIET",
     "THAW_EVERY",
     "IdleCollector",
+    "count_alive",
     "session_ended",
     "start",
     "touch",
@@ -79,6 +80,8 @@ class IdleCollector:
         self._thaw_due = False
         self._thawed_at = clock()
         self.collections = 0
+        #: Counts of objects logged after each thawed collection, by name (:func:`count_alive`).
+        self.alive: dict[str, Callable[[], int]] = {}
 
     def touch(self) -> None:
         """Something happened (a draw was asked for)."""
@@ -112,11 +115,12 @@ class IdleCollector:
         self._collect()
         self._freeze()
         self.collections += 1
-        log.debug(
-            "quiet full collection%s: %.0f ms",
-            " (thawed)" if thaw else "",
-            1000 * (time.perf_counter() - t0),
-        )
+        ms = 1000 * (time.perf_counter() - t0)
+        if thaw and self.alive:  # what outlived the ended sessions (bench/load_test.py)
+            counts = ", ".join(f"{name} {count()}" for name, count in self.alive.items())
+            log.info("quiet full collection (thawed): %.0f ms; alive: %s", ms, counts)
+        else:
+            log.debug("quiet full collection%s: %.0f ms", " (thawed)" if thaw else "", ms)
         return True
 
     def _cpu_quiet(self, now: float) -> bool:
@@ -146,6 +150,13 @@ def touch() -> None:
 def session_ended() -> None:
     """A session ended (see :meth:`IdleCollector.session_ended`)."""
     COLLECTOR.session_ended()
+
+
+def count_alive(name: str, count: Callable[[], int]) -> None:
+    """Log ``count()`` as ``name`` after every thawed quiet collection: what outlives the
+    ended sessions (e.g. the open pages; ``bench/load_test.py`` reads it once every session
+    of a level has closed)."""
+    COLLECTOR.alive[name] = count
 
 
 def start() -> threading.Thread | None:
