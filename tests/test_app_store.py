@@ -253,14 +253,21 @@ def test_a_bands_setup_runs_in_its_turn(turns, monkeypatch):
         return real(*args, **kw)
 
     chunks = []
-    kernel = scatter._noise_kernels.noisy_block_run
 
-    def chunk(*args):
-        chunks.append(turns.holder)
-        return kernel(*args)
+    def counted(kernel):
+        def chunk(*args):
+            chunks.append(turns.holder)
+            return kernel(*args)
+
+        return chunk
 
     monkeypatch.setattr(_models, "tire_arrays", tire_arrays)
-    monkeypatch.setattr(scatter._noise_kernels, "noisy_block_run", chunk)
+    # a chunk of lines runs one of the two parallel kernels: the fused rounds and statistics
+    # (as many lines as threads or more), or the rounds shared by the threads (fewer)
+    for name in ("noisy_band_stats", "noisy_block_run"):
+        monkeypatch.setattr(
+            scatter._noise_kernels, name, counted(getattr(scatter._noise_kernels, name))
+        )
     res = _results(seed=61, rounds=5_000)
     res.request_band()
     _wait(lambda: res.band is not None and not res.band_status.busy, "the band")

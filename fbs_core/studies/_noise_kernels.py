@@ -295,6 +295,73 @@ def _workspace(
 
 
 @njit(**_JIT)
+def _block_lines(
+    b: int,
+    Ar: FloatArray,
+    Ai: FloatArray,
+    ar: FloatArray,
+    ai: FloatArray,
+    Er: FloatArray,
+    Ei: FloatArray,
+    Br: FloatArray,
+    Bi: FloatArray,
+    order: IntArray,
+    l0: int,
+    l1: int,
+    key: np.uint64,
+    rids: IntArray,
+    p: float,
+    tire: bool,
+    vehicle: bool,
+    freq_dep: bool,
+    mag: FloatArray,
+    m0: int,
+    cplx: ComplexArray,
+    s: FloatArray,
+    base: NDArray[np.uint64],
+    W: FloatArray,
+    X: FloatArray,
+    Y: FloatArray,
+    piv: IntArray,
+    pm: FloatArray,
+    lane_ids: IntArray,
+) -> None:
+    """Block ``b`` of ``LANES`` rounds at lines ``l0 .. l1-1`` in the given workspace
+    (:func:`_workspace`, ``lane_ids`` ``LANES`` int64): ``|v_e|`` into
+    ``mag[line - m0, e, round]`` if ``mag.size``, else the complex response into ``cplx``.
+    Frequency-independent noise draws the factors once, at line ``l0``."""
+    nj = Ar.shape[1]
+    ne = Br.shape[1]
+    n_el = 2 * nj * nj + nj + ne * nj
+    k_tire = (nj * nj + nj) // 2
+    k_all = (n_el + 1) // 2
+    nr = rids.size
+    want_mag = mag.size > 0
+    r0 = b * LANES
+    nv = min(LANES, nr - r0)
+    for v in range(LANES):
+        lane_ids[v] = rids[r0 + min(v, nv - 1)]  # pad with the last round (not written)
+    for line in range(l0, l1):
+        if freq_dep or line == l0:
+            stream_line = line if freq_dep else 0
+            if tire:
+                _lane_factors(key, lane_ids, stream_line, p, 0, k_tire, s, base)
+            if vehicle:
+                _lane_factors(key, lane_ids, stream_line, p, k_tire, k_all, s, base)
+        _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, line, s, W, X, piv, pm, Y)
+        if want_mag:
+            for e in range(ne):
+                for v in range(nv):
+                    mag[line - m0, e, r0 + v] = np.sqrt(
+                        Y[0, e, v] * Y[0, e, v] + Y[1, e, v] * Y[1, e, v]
+                    )
+        else:
+            for e in range(ne):
+                for v in range(nv):
+                    cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
+
+
+@njit(**_JIT)
 def _block(
     b: int,
     Ar: FloatArray,
@@ -321,34 +388,12 @@ def _block(
     nj = Ar.shape[1]
     ne = Br.shape[1]
     n_el = 2 * nj * nj + nj + ne * nj
-    k_tire = (nj * nj + nj) // 2
-    k_all = (n_el + 1) // 2
-    nr = rids.size
-    want_mag = mag.size > 0
-    r0 = b * LANES
-    nv = min(LANES, nr - r0)
-    lane_ids = np.empty(LANES, np.int64)
-    for v in range(LANES):
-        lane_ids[v] = rids[r0 + min(v, nv - 1)]  # pad with the last round (not written)
     s, base, W, X, Y, piv, pm = _workspace(nj, ne, n_el)
-    for line in range(l0, l1):
-        if freq_dep or line == l0:
-            stream_line = line if freq_dep else 0
-            if tire:
-                _lane_factors(key, lane_ids, stream_line, p, 0, k_tire, s, base)
-            if vehicle:
-                _lane_factors(key, lane_ids, stream_line, p, k_tire, k_all, s, base)
-        _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, line, s, W, X, piv, pm, Y)
-        if want_mag:
-            for e in range(ne):
-                for v in range(nv):
-                    mag[line - l0, e, r0 + v] = np.sqrt(
-                        Y[0, e, v] * Y[0, e, v] + Y[1, e, v] * Y[1, e, v]
-                    )
-        else:
-            for e in range(ne):
-                for v in range(nv):
-                    cplx[r0 + v, line, e] = complex(Y[0, e, v], Y[1, e, v])
+    lane_ids = np.empty(LANES, np.int64)
+    _block_lines(
+        b, Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, l0, l1, key, rids, p, tire, vehicle,
+        freq_dep, mag, l0, cplx, s, base, W, X, Y, piv, pm, lane_ids,
+    )  # fmt: skip
 
 
 @njit(parallel=True, **_JIT)
@@ -629,6 +674,83 @@ def _order_stats_histogram(
     return True
 
 
+@njit(**_JIT)
+def _column_stats(
+    col: FloatArray,
+    qs: FloatArray,
+    checkpoints: IntArray,
+    lo: FloatArray,
+    hi: FloatArray,
+    arg_lo: IntArray,
+    arg_hi: IntArray,
+    pct: FloatArray,
+    conv_lo: FloatArray,
+    conv_hi: FloatArray,
+    line: int,
+    e: int,
+) -> None:
+    """The statistics of :func:`band_stats` of one column ``col (R,)`` (the rounds of
+    line ``line``, response ``e``; ``col`` is not changed)."""
+    R = col.size
+    mn = col[0]
+    mx = col[0]
+    imn = 0
+    imx = 0
+    kc = 0
+    for r in range(R):
+        v = col[r]
+        if v < mn:
+            mn = v
+            imn = r
+        if v > mx:
+            mx = v
+            imx = r
+        while kc < checkpoints.size and checkpoints[kc] == r + 1:
+            conv_lo[kc, line, e] = mn
+            conv_hi[kc, line, e] = mx
+            kc += 1
+    lo[line, e] = mn
+    hi[line, e] = mx
+    arg_lo[line, e] = imn
+    arg_hi[line, e] = imx
+    if qs.size == 0:
+        return
+    big = R > 4 * _SAMPLE
+    from_hist = False
+    if big:
+        # all percentiles of the column from one histogram (two passes in all)
+        ranks = np.empty(2 * qs.size, np.int64)
+        for iq in range(qs.size):
+            k = min(int(np.floor((R - 1) * qs[iq] / 100.0)), R - 2)
+            ranks[2 * iq] = k
+            ranks[2 * iq + 1] = k + 1
+        stats = np.empty(2 * qs.size)
+        from_hist = _order_stats_histogram(col, mn, mx, ranks, stats)
+        if not from_hist:  # declined: sample-bracketed selection, one pass per level
+            sample = np.empty(_SAMPLE)
+            for i in range(_SAMPLE):
+                sample[i] = col[(i * R) // _SAMPLE]
+            sample.sort()
+            mid = np.empty(R + 1)
+    for iq in range(qs.size):
+        h = (R - 1) * qs[iq] / 100.0
+        k = int(np.floor(h))
+        if k >= R - 1:
+            pct[iq, line, e] = mx
+            continue
+        t = h - k
+        if from_hist:
+            a0 = stats[2 * iq]
+            b0 = stats[2 * iq + 1]
+        elif big:
+            a0, b0 = _order_stat_pair_sampled(col, k, sample, mid)
+        else:
+            a0, b0 = _order_stat_pair(col.copy(), k)
+        d = b0 - a0
+        # numpy's _lerp: a + d t, evaluated from b for t >= 0.5
+        pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t
+
+
 @njit(parallel=True, **_JIT)
 def band_stats(
     mag: FloatArray,
@@ -656,62 +778,81 @@ def band_stats(
     for c in prange(nl * ne):
         li = c // ne
         e = c - li * ne
-        col = mag[li, e]
-        line = l0 + li
-        mn = col[0]
-        mx = col[0]
-        imn = 0
-        imx = 0
-        kc = 0
-        for r in range(R):
-            v = col[r]
-            if v < mn:
-                mn = v
-                imn = r
-            if v > mx:
-                mx = v
-                imx = r
-            while kc < checkpoints.size and checkpoints[kc] == r + 1:
-                conv_lo[kc, line, e] = mn
-                conv_hi[kc, line, e] = mx
-                kc += 1
-        lo[line, e] = mn
-        hi[line, e] = mx
-        arg_lo[line, e] = imn
-        arg_hi[line, e] = imx
-        if qs.size == 0:
-            continue
-        big = R > 4 * _SAMPLE
-        from_hist = False
-        if big:
-            # all percentiles of the column from one histogram (two passes in all)
-            ranks = np.empty(2 * qs.size, np.int64)
-            for iq in range(qs.size):
-                k = min(int(np.floor((R - 1) * qs[iq] / 100.0)), R - 2)
-                ranks[2 * iq] = k
-                ranks[2 * iq + 1] = k + 1
-            stats = np.empty(2 * qs.size)
-            from_hist = _order_stats_histogram(col, mn, mx, ranks, stats)
-            if not from_hist:  # declined: sample-bracketed selection, one pass per level
-                sample = np.empty(_SAMPLE)
-                for i in range(_SAMPLE):
-                    sample[i] = col[(i * R) // _SAMPLE]
-                sample.sort()
-                mid = np.empty(R + 1)
-        for iq in range(qs.size):
-            h = (R - 1) * qs[iq] / 100.0
-            k = int(np.floor(h))
-            if k >= R - 1:
-                pct[iq, line, e] = mx
-                continue
-            t = h - k
-            if from_hist:
-                a0 = stats[2 * iq]
-                b0 = stats[2 * iq + 1]
-            elif big:
-                a0, b0 = _order_stat_pair_sampled(col, k, sample, mid)
-            else:
-                a0, b0 = _order_stat_pair(col.copy(), k)
-            d = b0 - a0
-            # numpy's _lerp: a + d t, evaluated from b for t >= 0.5
-            pct[iq, line, e] = b0 - d * (1.0 - t) if t >= 0.5 else a0 + d * t
+        _column_stats(
+            mag[li, e], qs, checkpoints, lo, hi, arg_lo, arg_hi, pct, conv_lo, conv_hi,
+            l0 + li, e,
+        )  # fmt: skip
+
+
+# -- rounds and statistics fused, line by line ----------------------------------------------
+
+
+@njit(parallel=True, **_JIT)
+def noisy_band_stats(
+    Ar: FloatArray,
+    Ai: FloatArray,
+    ar: FloatArray,
+    ai: FloatArray,
+    Er: FloatArray,
+    Ei: FloatArray,
+    Br: FloatArray,
+    Bi: FloatArray,
+    order: IntArray,
+    l0: int,
+    l1: int,
+    key: np.uint64,
+    rids: IntArray,
+    p: float,
+    tire: bool,
+    vehicle: bool,
+    freq_dep: bool,
+    group: int,
+    buf: FloatArray,
+    qs: FloatArray,
+    checkpoints: IntArray,
+    lo: FloatArray,
+    hi: FloatArray,
+    arg_lo: IntArray,
+    arg_hi: IntArray,
+    pct: FloatArray,
+    conv_lo: FloatArray,
+    conv_hi: FloatArray,
+    row: int,
+) -> None:
+    """:func:`noisy_block_run` (band mode) then :func:`band_stats`, fused: bit for bit their
+    statistics of lines ``l0 .. l1-1``, written at rows ``row ..`` of the outputs.
+
+    Worker ``w`` (``buf (n_workers, group, n_e, R)``, one worker per thread) takes the
+    groups of ``group`` lines ``w, w + n_workers, ...``, runs all rounds of a group into
+    ``buf[w]`` (a few hundred kB: it stays in the core's cache) and computes the group's
+    statistics from there, instead of writing the magnitudes of all lines to memory and
+    reading them back. Each value is computed exactly as in the two kernels; only the
+    order of the work changes, so the numbers do not depend on the number of threads.
+    Frequency-independent noise draws the factors once per group and block of rounds.
+    """
+    nj = Ar.shape[1]
+    ne = Br.shape[1]
+    n_el = 2 * nj * nj + nj + ne * nj
+    n_workers = buf.shape[0]
+    n_groups = (l1 - l0 + group - 1) // group
+    n_blocks = (rids.size + LANES - 1) // LANES
+    for w in prange(n_workers):
+        s, base, W, X, Y, piv, pm = _workspace(nj, ne, n_el)
+        lane_ids = np.empty(LANES, np.int64)
+        no_cplx = np.empty((0, 0, 0), np.complex128)
+        mag = buf[w]
+        for g in range(w, n_groups, n_workers):
+            g0 = l0 + g * group
+            g1 = min(l1, g0 + group)
+            for b in range(n_blocks):
+                _block_lines(
+                    b, Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, g0, g1, key, rids, p, tire,
+                    vehicle, freq_dep, mag, g0, no_cplx, s, base, W, X, Y, piv, pm,
+                    lane_ids,
+                )  # fmt: skip
+            for line in range(g0, g1):
+                for e in range(ne):
+                    _column_stats(
+                        mag[line - g0, e], qs, checkpoints, lo, hi, arg_lo, arg_hi, pct,
+                        conv_lo, conv_hi, row + line - l0, e,
+                    )  # fmt: skip

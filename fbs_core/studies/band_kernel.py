@@ -24,6 +24,7 @@ import time
 import warnings
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -58,6 +59,10 @@ _OLD_TARGETS = {"vehicle": "chassis"}
 LOCK = threading.Lock()
 
 _EMPTY_MAG = np.empty((0, 0, 0))
+#: Lines per group of the fused kernel (:func:`._noise_kernels.noisy_band_stats`), by
+#: ``frequency_dependent``: one line (its rounds stay in the core's cache); several lines
+#: share the factors of frequency-independent noise.
+_GROUP = {True: 1, False: 4}
 _EMPTY_CPLX = np.empty((0, 0, 0), np.complex128)
 
 #: The kernel inputs of a band: real and imaginary parts of ``Y_jj^A (n_f, n_j, n_j)``,
@@ -241,6 +246,10 @@ def band_lines(
         Written at rows ``row .. row + l1 - l0 - 1``.
     work : ndarray, shape (>= l1 - l0, n_e, R), optional
         Working memory of the magnitudes (``8 R n_e`` bytes per line), reused across calls.
+        Each thread computes all rounds of one line at a time and that line's statistics
+        while they are in its cache (:func:`._noise_kernels.noisy_band_stats`), so only
+        its first lines are used (one per thread), unless the block has fewer lines than
+        there are threads: then the threads share the rounds of all its lines.
 
     Returns
     -------
@@ -259,39 +268,36 @@ def band_lines(
     if not (0 <= row and row + nl <= out.minimum.shape[0]):
         raise FBSError(f"rows {row}..{row + nl} outside the {out.minimum.shape[0]} of the stats")
     R = int(rounds.size)
-    if work is None:
-        work = np.empty((nl, ne, R))
-    elif work.shape[0] < nl or work.shape[1:] != (ne, R):
+    if work is not None and (work.shape[0] < nl or work.shape[1:] != (ne, R)):
         raise FBSError(f"work must have shape (>= {nl}, {ne}, {R}), got {work.shape}")
-    m = work[:nl]
+    fd = bool(frequency_dependent)
     with LOCK:
         t0 = time.perf_counter()
+        n_workers = numba.get_num_threads()
+        group = _GROUP[fd]
+        if nl >= n_workers * group:
+            # each thread runs all rounds of its lines and their statistics in its cache
+            n_buf = n_workers * group
+            if work is not None and work.shape[0] >= n_buf:
+                buf = work[:n_buf].reshape(n_workers, group, ne, R)
+            else:
+                buf = np.empty((n_workers, group, ne, R))
+            _noise_kernels.noisy_band_stats(
+                *arrays, l0, l1, key, rounds, float(noise), bool(tire), bool(chassis), fd,
+                group, buf, q, checkpoints, out.minimum, out.maximum, out.argmin_round,
+                out.argmax_round, out.percentiles, out.conv_minimum, out.conv_maximum, row,
+            )  # fmt: skip
+            return time.perf_counter() - t0
+        # fewer lines than threads (a first, probing chunk): the threads share the rounds
+        m = np.empty((nl, ne, R)) if work is None else work[:nl]
         _noise_kernels.noisy_block_run(
-            *arrays,
-            l0,
-            l1,
-            key,
-            rounds,
-            float(noise),
-            bool(tire),
-            bool(chassis),
-            bool(frequency_dependent),
-            m,
+            *arrays, l0, l1, key, rounds, float(noise), bool(tire), bool(chassis), fd, m,
             _EMPTY_CPLX,
-        )
+        )  # fmt: skip
         _noise_kernels.band_stats(
-            m,
-            q,
-            checkpoints,
-            out.minimum,
-            out.maximum,
-            out.argmin_round,
-            out.argmax_round,
-            out.percentiles,
-            out.conv_minimum,
-            out.conv_maximum,
-            row,
-        )
+            m, q, checkpoints, out.minimum, out.maximum, out.argmin_round, out.argmax_round,
+            out.percentiles, out.conv_minimum, out.conv_maximum, row,
+        )  # fmt: skip
         return time.perf_counter() - t0
 
 
