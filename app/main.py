@@ -44,7 +44,7 @@ from app.report.session import provenance_of, report_data
 from app.runtime import background, closed_pages
 from app.runtime.collector import count_alive, session_ended
 from app.runtime.collector import start as start_quiet_collections
-from app.runtime.draw import DrawQueue, served
+from app.runtime.draw import DrawQueue, on_document, served, served_document
 from app.state import URL_KEYS, DashboardState
 from app.store import LIVE, Results
 from app.views import (
@@ -472,7 +472,11 @@ def create_app(
         # (with one of their own, Panel skips them: no margins inside the cards)
         with pn.config.set(design=None):
             below = below_first_screen(parts, views)
-        main.extend(below)
+        # added on the page's draw queue, in order with its draws and sent as one message
+        # as they are (added from Panel's worker thread, Panel sent it through its held
+        # events, and with 10 sessions opening at once a later draw of a session never
+        # reached its page: bench/load_test.py)
+        on_document(served_document(), lambda: main.extend(below))
 
     help_close.on_click(lambda _e: template.close_modal())
     template.main.append(main)

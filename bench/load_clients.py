@@ -228,6 +228,7 @@ class BokehSession:
         self._queue: asyncio.Queue = asyncio.Queue()
         self._digest = ""
         self._change_times: list[float] = []  # arrival of each patch of plot data
+        self._patched_at = 0.0  # arrival of the last patch of any kind
         self._sources: set[str] = set()  # ids of the ColumnDataSources
         self._progress: list = []  # the progress bars of long computations (class name)
         self._n_models = 0
@@ -316,6 +317,7 @@ class BokehSession:
             if msg.msgtype == "ERROR":
                 self.errors.append(f"server error: {msg.content.get('text')}")
             elif msg.msgtype == "PATCH-DOC":
+                self._patched_at = time.perf_counter()
                 if any(_event_model_id(e) in self._sources for e in msg.content["events"]):
                     self._change_times.append(time.perf_counter())
                 self._queue.put_nowait(msg)
@@ -363,13 +365,15 @@ class BokehSession:
 
     async def settle(self, timeout_s: float, quiet_s: float) -> str | None:
         t0 = time.perf_counter()
-        last = max(t0, self._changed_at)
+        last = max(t0, self._changed_at, self._patched_at)
         while time.perf_counter() - t0 < timeout_s:
             await asyncio.sleep(0.05)
             now = time.perf_counter()
             if self._busy() or not self._queue.empty():
                 last = now
-            last = max(last, self._changed_at)
+            # any message is activity: a page still building (the dashboard adds what is
+            # below its first screen once shown) is not settled
+            last = max(last, self._changed_at, self._patched_at)
             if now - last > quiet_s:
                 return self._digest
         return None
