@@ -99,6 +99,9 @@ NOTICE_STYLE = {
     "padding": "2px 12px",
 }
 
+#: Class of the page's main column until what is below the first screen is added.
+BUILDING = "page-building"
+
 #: Height of a plot card's content: the window's height within limits (app/views/layout.py).
 PLOT_ROW = "plot"
 
@@ -464,6 +467,7 @@ def create_app(
         link_notice_pane(parts),
         *first_screen(parts, views),  # a plot on the first screen, also at 1280x720
         sizing_mode="stretch_width",
+        css_classes=[BUILDING],  # until the rest is added (tests and benchmarks wait for it)
     )
 
     def complete() -> None:  # the rest of the page, below the first screen
@@ -476,7 +480,13 @@ def create_app(
         # as they are (added from Panel's worker thread, Panel sent it through its held
         # events, and with 10 sessions opening at once a later draw of a session never
         # reached its page: bench/load_test.py)
-        on_document(served_document(), lambda: main.extend(below))
+        on_document(
+            served_document(),
+            lambda: main.param.update(
+                objects=[*main.objects, *below],
+                css_classes=[c for c in main.css_classes if c != BUILDING],
+            ),
+        )
 
     help_close.on_click(lambda _e: template.close_modal())
     template.main.append(main)

@@ -84,8 +84,11 @@ CHANGE_JS = f"""async ([title, value, timeout, quiet]) => {{
 
 #: True while the page reports a computation in progress (the scatter band's progress bar):
 #: under load a band can take longer than any fixed quiet time.
-BUSY_JS = """() => [...Bokeh.documents[0].all_models].some(
-  m => m.css_classes && m.css_classes.includes('scatter-progress') && m.active === true)"""
+#: Busy: a band computing (its progress bar active) or the page still adding what is below
+#: its first screen (its main column marked ``page-building``, app/main.py).
+BUSY_JS = """() => [...Bokeh.documents[0].all_models].some(m => m.css_classes && (
+  (m.css_classes.includes('scatter-progress') && m.active === true)
+  || m.css_classes.includes('page-building')))"""
 
 SETTLE_JS = f"""async ([timeout, quiet]) => {{
   const digest = {DIGEST_JS};
@@ -231,6 +234,7 @@ class BokehSession:
         self._patched_at = 0.0  # arrival of the last patch of any kind
         self._sources: set[str] = set()  # ids of the ColumnDataSources
         self._progress: list = []  # the progress bars of long computations (class name)
+        self._building: list = []  # the page's column while it is being completed
         self._n_models = 0
 
     @property
@@ -292,6 +296,11 @@ class BokehSession:
             for m in self.doc.models
             if "css_classes" in m.properties() and "scatter-progress" in m.css_classes
         ]
+        self._building = [  # the page's main column while it adds the rest (app/main.py)
+            m
+            for m in self.doc.models
+            if "css_classes" in m.properties() and "page-building" in m.css_classes
+        ]
 
     async def _pop(self):
         while True:
@@ -343,7 +352,9 @@ class BokehSession:
         return self._change_times[-1] if self._change_times else 0.0
 
     def _busy(self) -> bool:
-        return any(getattr(m, "active", False) for m in self._progress)
+        return any(getattr(m, "active", False) for m in self._progress) or any(
+            "page-building" in m.css_classes for m in self._building
+        )
 
     def _slider(self, title: str):
         sliders = [m for m in self.doc.models if type(m).__name__.endswith("Slider")]

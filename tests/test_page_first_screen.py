@@ -28,7 +28,7 @@ from bokeh.util.token import generate_jwt_token, generate_session_id
 from tornado.httpclient import HTTPRequest
 from tornado.websocket import websocket_connect
 
-from app.main import create_app
+from app.main import BUILDING, create_app
 
 TIMEOUT = 120.0
 FIRST_SCREEN = {"mobility.figure", "truncation.figure"}
@@ -58,6 +58,11 @@ def _dressing(doc: Document, name: str) -> list[tuple]:
         out.append((type(x).__name__, tuple(x.margin or ()), sheets))
         x = parents.get(x.id)
     return out
+
+
+def _building(doc: Document) -> bool:
+    """Whether the page marks itself as still adding what is below its first screen."""
+    return any(BUILDING in (getattr(m, "css_classes", None) or []) for m in doc.models)
 
 
 def _has_data(doc: Document, name: str) -> bool:
@@ -92,6 +97,7 @@ async def _client(url: str) -> tuple[Document, set[str], bool]:
         doc = Document()
         reply.push_to_document(doc)
         first, first_data = _names(doc), _has_data(doc, "mobility.truncated")
+        assert _building(doc), "the first document is not marked as building"
         await (
             Protocol()
             .create("PATCH-DOC", [MessageSentEvent(doc, "bokeh_event", DocumentReady())])
@@ -101,6 +107,12 @@ async def _client(url: str) -> tuple[Document, set[str], bool]:
         while not BELOW <= _names(doc):
             remaining = end - time.monotonic()
             assert remaining > 0, f"the rest of the page never arrived: {_names(doc)}"
+            msg = await asyncio.wait_for(pop(), remaining)
+            if msg.msgtype == "PATCH-DOC":
+                msg.apply_to_document(doc)
+        while _building(doc):  # the mark goes in the message that adds the rest
+            remaining = end - time.monotonic()
+            assert remaining > 0, "the page stayed marked as building"
             msg = await asyncio.wait_for(pop(), remaining)
             if msg.msgtype == "PATCH-DOC":
                 msg.apply_to_document(doc)
