@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
+import contextlib
 import json
 import os
 import socket
 import subprocess
 import sys
+import threading
 import time
 import urllib.error
 import urllib.request
@@ -27,6 +29,57 @@ def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+def in_own_loop(coro, timeout_s: float):
+    """Run ``coro`` on an event loop of its own, in a thread of its own (an earlier test may
+    have left a loop running in this one); its result, or its exception raised here."""
+    out: dict = {}
+
+    def run() -> None:
+        try:
+            out["value"] = asyncio.run(coro)
+        except BaseException as e:  # re-raised in the test's thread
+            out["error"] = e
+
+    t = threading.Thread(target=run)
+    t.start()
+    t.join(timeout_s)
+    assert not t.is_alive(), "the client never finished"
+    if "error" in out:
+        raise out["error"]
+    return out["value"]
+
+
+@contextlib.contextmanager
+def served_in_process(apps: dict, timeout_s: float):
+    """A Panel server in this process (its own thread) serving ``apps`` (``{name: function
+    building a page}``) on a free loopback port, once it listens; yields the port."""
+    import panel as pn
+
+    port = free_port()
+    server = pn.serve(
+        apps,
+        port=port,
+        address="127.0.0.1",
+        websocket_origin=[f"127.0.0.1:{port}"],
+        threaded=True,
+        show=False,
+        start=True,
+    )
+    try:
+        wait_for(lambda: _accepts(port), timeout_s, what="the in-process server listening")
+        yield port
+    finally:
+        server.stop()
+
+
+def _accepts(port: int) -> bool:
+    try:
+        socket.create_connection(("127.0.0.1", port), timeout=1).close()
+        return True
+    except OSError:
+        return False
 
 
 def wait_for(condition, timeout_s: float, interval_s: float = 0.05, what: str = "condition"):

@@ -11,7 +11,6 @@ replica of the document must hold the drawn values.
 from __future__ import annotations
 
 import asyncio
-import socket
 import threading
 import time
 
@@ -26,18 +25,13 @@ from bokeh.plotting import figure
 from bokeh.protocol import Protocol
 from bokeh.protocol.receiver import Receiver
 from bokeh.util.token import generate_jwt_token, generate_session_id
+from server_util import in_own_loop, served_in_process
 from tornado.httpclient import HTTPRequest
 from tornado.websocket import websocket_connect
 
 from app.runtime.draw import on_document
 
 TIMEOUT = 60.0
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 class _Page:
@@ -108,51 +102,11 @@ async def _client(url: str, page: _Page, draw) -> tuple[list, Document]:
     return patches, doc
 
 
-def _in_own_loop(coro):
-    """Run ``coro`` on an event loop of its own, in a thread of its own (an earlier test may
-    have left a loop running in this one); its result, or its exception raised here."""
-    out: dict = {}
-
-    def run() -> None:
-        try:
-            out["value"] = asyncio.run(coro)
-        except BaseException as e:  # re-raised in the test's thread
-            out["error"] = e
-
-    t = threading.Thread(target=run)
-    t.start()
-    t.join(3 * TIMEOUT)
-    assert not t.is_alive(), "the client never finished"
-    if "error" in out:
-        raise out["error"]
-    return out["value"]
-
-
 @pytest.fixture
 def served_page():
     page = _Page()
-    port = _free_port()
-    server = pn.serve(
-        {"page": page.app},
-        port=port,
-        address="127.0.0.1",
-        websocket_origin=[f"127.0.0.1:{port}"],
-        threaded=True,
-        show=False,
-        start=True,
-    )
-    end = time.monotonic() + TIMEOUT
-    while True:  # the server thread listens once it started
-        try:
-            socket.create_connection(("127.0.0.1", port), timeout=1).close()
-            break
-        except OSError:
-            assert time.monotonic() < end, "the server never listened"
-            time.sleep(0.05)
-    try:
+    with served_in_process({"page": page.app}, TIMEOUT) as port:
         yield page, f"ws://127.0.0.1:{port}/page/ws"
-    finally:
-        server.stop()
 
 
 def test_a_draw_reaches_the_page_as_one_message_holding_all_its_changes(served_page):
@@ -164,7 +118,9 @@ def test_a_draw_reaches_the_page_as_one_message_holding_all_its_changes(served_p
         page.fig.x_range.start = -1.0
         page.div.text = "after"
 
-    patches, replica = _in_own_loop(asyncio.wait_for(_client(url, page, draw), 2 * TIMEOUT))
+    patches, replica = in_own_loop(
+        asyncio.wait_for(_client(url, page, draw), 2 * TIMEOUT), 3 * TIMEOUT
+    )
     assert len(patches) == 1, [len(p.content["events"]) for p in patches]
     assert len(patches[0].content["events"]) >= 4
     src = replica.get_model_by_id(page.source.id)

@@ -11,11 +11,8 @@ is ready, as BokehJS does, the rest arrives and the replica holds every view.
 from __future__ import annotations
 
 import asyncio
-import socket
-import threading
 import time
 
-import panel as pn
 import pytest
 from bokeh.client.websocket import WebSocketClientConnectionWrapper
 from bokeh.document import Document
@@ -25,6 +22,7 @@ from bokeh.models import ColumnDataSource
 from bokeh.protocol import Protocol
 from bokeh.protocol.receiver import Receiver
 from bokeh.util.token import generate_jwt_token, generate_session_id
+from server_util import in_own_loop, served_in_process
 from tornado.httpclient import HTTPRequest
 from tornado.websocket import websocket_connect
 
@@ -33,12 +31,6 @@ from app.main import BUILDING, create_app
 TIMEOUT = 120.0
 FIRST_SCREEN = {"mobility.figure", "truncation.figure"}
 BELOW = {"eigen.figure", "scatter.figure", "wheels.figure"}
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _names(doc: Document) -> set[str]:
@@ -121,53 +113,16 @@ async def _client(url: str) -> tuple[Document, set[str], bool]:
         ws.close()
 
 
-def _in_own_loop(coro):
-    """Run ``coro`` on an event loop of its own in a thread of its own; its result."""
-    out: dict = {}
-
-    def run() -> None:
-        try:
-            out["value"] = asyncio.run(coro)
-        except BaseException as e:  # re-raised in the test's thread
-            out["error"] = e
-
-    t = threading.Thread(target=run)
-    t.start()
-    t.join(3 * TIMEOUT)
-    assert not t.is_alive(), "the client never finished"
-    if "error" in out:
-        raise out["error"]
-    return out["value"]
-
-
 @pytest.fixture
 def served_dashboard():
-    port = _free_port()
-    server = pn.serve(
-        {"main": create_app},
-        port=port,
-        address="127.0.0.1",
-        websocket_origin=[f"127.0.0.1:{port}"],
-        threaded=True,
-        show=False,
-        start=True,
-    )
-    end = time.monotonic() + TIMEOUT
-    while True:  # the server thread listens once it started
-        try:
-            socket.create_connection(("127.0.0.1", port), timeout=1).close()
-            break
-        except OSError:
-            assert time.monotonic() < end, "the server never listened"
-            time.sleep(0.05)
-    try:
+    with served_in_process({"main": create_app}, TIMEOUT) as port:
         yield f"ws://127.0.0.1:{port}/main/ws"
-    finally:
-        server.stop()
 
 
 def test_the_first_screen_comes_first_and_the_rest_once_the_page_is_shown(served_dashboard):
-    doc, first, first_data = _in_own_loop(asyncio.wait_for(_client(served_dashboard), 2 * TIMEOUT))
+    doc, first, first_data = in_own_loop(
+        asyncio.wait_for(_client(served_dashboard), 2 * TIMEOUT), 3 * TIMEOUT
+    )
     assert FIRST_SCREEN <= first, first
     assert first_data, "the first document has no coupled response to show"
     assert not (BELOW & first), BELOW & first
