@@ -42,7 +42,7 @@ from app.page.titles import page_url
 from app.public_url import public_base
 from app.report.session import provenance_of, report_data
 from app.runtime import background, closed_pages
-from app.runtime.collector import count_alive, session_ended
+from app.runtime.collector import count_alive, session_ended, session_started
 from app.runtime.collector import start as start_quiet_collections
 from app.runtime.draw import DrawQueue, on_document, served, served_document
 from app.state import URL_KEYS, DashboardState
@@ -507,6 +507,7 @@ def create_app(
         # callback it kept the page alive, tests/test_server_pages.py)
         doc_ref = weakref.ref(doc)
         log.info("a page's session started")  # (bench/load_test.py counts them)
+        session_started()  # (the quiet collector weighs ended sessions against open ones)
         doc.on_session_destroyed(
             lambda _ctx, close=close_page, drop=DrawQueue.discard, ended=session_ended: (
                 drop(doc_ref()),

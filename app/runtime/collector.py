@@ -15,10 +15,13 @@ open sessions, at a quiet moment:
   nothing for a while), the collector makes a full collection and freezes what is alive
   (``gc.freeze``), so the collections that come with the next changes walk only what was
   made since;
-- a session that ended is frozen with the rest: :func:`session_ended` thaws everything
-  (``gc.unfreeze``) before the next quiet collection, which then frees its cycles; and at
+- a session that ended is frozen with the rest: once the sessions ended since the last
+  thaw are :data:`THAW_SHARE` of the open ones, the next quiet collection thaws everything
+  (``gc.unfreeze``) first and then frees their cycles (a thawed collection walks every
+  object: with 50 pages open it took 2.2 s, and one warm-up session ending made it due
+  just when 50 sessions started changing: ``bench/load_test.py --sessions 50``); and at
   least every :data:`THAW_EVERY` seconds a quiet collection thaws first, so that cycles
-  dropped by the open sessions are not kept for longer than that.
+  dropped by the open sessions, or left by ended ones, are not kept for longer than that.
 
 The decision is :meth:`IdleCollector.step`, a pure function of the clock and what happened
 (tested without threads); :func:`start` runs it on a daemon thread.
@@ -38,8 +41,10 @@ __all__ = [
     "QUIET",
     "THAW_EVERY",
     "IdleCollector",
+    "THAW_SHARE",
     "count_alive",
     "session_ended",
+    "session_started",
     "start",
     "touch",
 ]
@@ -50,6 +55,10 @@ log = logging.getLogger(__name__)
 QUIET = 0.5
 #: Longest time (s) between two thawed collections while there is activity.
 THAW_EVERY = 120.0
+#: Ended sessions, as a share of the open ones, whose objects are worth a thawed collection
+#: (it walks every object: 2.2 s with 50 pages open; one ended session among 50 open pages
+#: waits for more, or for THAW_EVERY).
+THAW_SHARE = 0.25
 #: Share of a core the process may use during the quiet seconds (its CPU time, all threads).
 BUSY_SHARE = 0.2
 #: How often the collector's thread looks (s).
@@ -77,7 +86,8 @@ class IdleCollector:
         self._samples: deque[tuple[float, float]] = deque()
         self._lock = threading.Lock()
         self._last_activity: float | None = None  # None: nothing since the last collection
-        self._thaw_due = False
+        self._open = 0  # sessions started and not ended
+        self._ended = 0  # sessions ended since the last thaw
         self._thawed_at = clock()
         self.collections = 0
         #: Counts of objects logged after each thawed collection, by name (:func:`count_alive`).
@@ -89,11 +99,19 @@ class IdleCollector:
         with self._lock:
             self._last_activity = now
 
+    def session_started(self) -> None:
+        """A session started (its page counts as open until :meth:`session_ended`)."""
+        with self._lock:
+            self._open += 1
+
     def session_ended(self) -> None:
-        """A session ended: its objects are to be freed by the next quiet collection."""
+        """A session ended: its objects are to be freed by a thawed quiet collection, once
+        the ended sessions are :data:`THAW_SHARE` of the open ones (or :data:`THAW_EVERY`
+        seconds after the last thaw)."""
         now = self._clock()
         with self._lock:
-            self._thaw_due = True
+            self._open = max(0, self._open - 1)
+            self._ended += 1
             self._last_activity = now
 
     def step(self) -> bool:
@@ -105,9 +123,13 @@ class IdleCollector:
         with self._lock:
             if self._last_activity is None or now - self._last_activity < QUIET:
                 return False
-            thaw = self._thaw_due or now - self._thawed_at >= THAW_EVERY
+            thaw = (
+                self._ended >= THAW_SHARE * max(self._open, 1)
+                or now - self._thawed_at >= THAW_EVERY
+            )
             self._last_activity = None
-            self._thaw_due = False
+            if thaw:
+                self._ended = 0
         t0 = time.perf_counter()
         if thaw:
             self._unfreeze()
@@ -145,6 +167,11 @@ _started = threading.Event()
 def touch() -> None:
     """Mark activity (cheap: called for every draw)."""
     COLLECTOR.touch()
+
+
+def session_started() -> None:
+    """A session started (see :meth:`IdleCollector.session_started`)."""
+    COLLECTOR.session_started()
 
 
 def session_ended() -> None:
