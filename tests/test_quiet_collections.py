@@ -21,6 +21,7 @@ def _collector():
     clock = _Clock()
     c = IdleCollector(
         collect=lambda: calls.append("collect"),
+        collect_young=lambda: calls.append("young"),
         freeze=lambda: calls.append("freeze"),
         unfreeze=lambda: calls.append("unfreeze"),
         clock=clock,
@@ -44,12 +45,12 @@ def test_one_collection_and_freeze_once_quiet_then_none_until_new_activity():
     c, clock, calls = _collector()
     c.touch()
     clock.t += QUIET
-    assert c.step() and calls == ["collect", "freeze"]
+    assert c.step() and calls == ["young", "freeze"]
     clock.t += 100
-    assert not c.step() and calls == ["collect", "freeze"]  # nothing happened since
+    assert not c.step() and calls == ["young", "freeze"]  # nothing happened since
     c.touch()
     clock.t += QUIET
-    assert c.step() and calls == ["collect", "freeze"] * 2
+    assert c.step() and calls == ["young", "freeze"] * 2
 
 
 def test_an_ended_session_is_thawed_before_the_next_quiet_collection():
@@ -60,7 +61,7 @@ def test_an_ended_session_is_thawed_before_the_next_quiet_collection():
     assert c.step() and calls == ["unfreeze", "collect", "freeze"]
     c.touch()
     clock.t += QUIET
-    assert c.step() and calls[3:] == ["collect", "freeze"]  # thawed once only
+    assert c.step() and calls[3:] == ["young", "freeze"]  # thawed once only
 
 
 def test_frozen_objects_are_thawed_at_least_every_thaw_every_seconds_of_activity():
@@ -71,7 +72,7 @@ def test_frozen_objects_are_thawed_at_least_every_thaw_every_seconds_of_activity
     assert c.step() and calls == ["unfreeze", "collect", "freeze"]
     c.touch()
     clock.t += QUIET
-    assert c.step() and calls[3:] == ["collect", "freeze"]
+    assert c.step() and calls[3:] == ["young", "freeze"]
 
 
 def test_no_collection_while_the_process_computes_without_drawing():
@@ -81,6 +82,7 @@ def test_no_collection_while_the_process_computes_without_drawing():
     clock, cpu = _Clock(), [0.0]
     c = IdleCollector(
         collect=lambda: calls.append("collect"),
+        collect_young=lambda: calls.append("young"),
         freeze=lambda: calls.append("freeze"),
         unfreeze=lambda: None,
         clock=clock,
@@ -96,7 +98,7 @@ def test_no_collection_while_the_process_computes_without_drawing():
         cpu[0] += 0.1 * BUSY_SHARE / 4
         assert not c.step()
     clock.t += 0.2
-    assert c.step() and calls == ["collect", "freeze"]
+    assert c.step() and calls == ["young", "freeze"]
 
 
 class _Cycle:
@@ -163,7 +165,7 @@ def test_one_ended_session_among_many_open_waits_for_more_or_for_thaw_every():
         c.session_started()
     c.session_ended()  # 1 ended, 7 open
     clock.t += QUIET
-    assert c.step() and calls == ["collect", "freeze"]  # not thawed
+    assert c.step() and calls == ["young", "freeze"]  # not thawed
     c.session_ended()  # 2 ended since the last thaw, 6 open: a quarter
     clock.t += QUIET
     assert c.step() and calls[-3:] == ["unfreeze", "collect", "freeze"]

@@ -12,9 +12,10 @@ open sessions, at a quiet moment:
 - every draw asked for marks activity (:func:`touch`); once nothing was asked for during
   :data:`QUIET` seconds after some activity, and the process used less than
   :data:`BUSY_SHARE` of a core meanwhile (a page being built or a band computed draws
-  nothing for a while), the collector makes a full collection and freezes what is alive
-  (``gc.freeze``), so the collections that come with the next changes walk only what was
-  made since;
+  nothing for a while), the collector collects the young generations and freezes what is
+  alive (``gc.freeze``), so the collections that come with the next changes walk only what
+  was made since (a full collection there walked the 50 pages just opened: 1.4 s, at the
+  quiet moment when 50 sessions started changing: ``bench/load_test.py --sessions 50``);
 - a session that ended is frozen with the rest: once the sessions ended since the last
   thaw are :data:`THAW_SHARE` of the open ones, the next quiet collection thaws everything
   (``gc.unfreeze``) first and then frees their cycles (a thawed collection walks every
@@ -65,12 +66,18 @@ BUSY_SHARE = 0.2
 PERIOD = 0.1
 
 
+def _collect_young() -> int:
+    """Collect the two young generations (not the oldest, which holds the open pages)."""
+    return gc.collect(1)
+
+
 class IdleCollector:
     """When to collect and freeze, and when to thaw first (see the module docstring)."""
 
     def __init__(
         self,
         collect: Callable[[], object] = gc.collect,
+        collect_young: Callable[[], object] = _collect_young,
         freeze: Callable[[], None] = gc.freeze,
         unfreeze: Callable[[], None] = gc.unfreeze,
         clock: Callable[[], float] = time.monotonic,
@@ -82,6 +89,7 @@ class IdleCollector:
             unfreeze,
             clock,
         )
+        self._collect_young = collect_young
         self._cpu = cpu  # the process's CPU seconds (None: not looked at)
         self._samples: deque[tuple[float, float]] = deque()
         self._lock = threading.Lock()
@@ -131,10 +139,12 @@ class IdleCollector:
             if thaw:
                 self._ended = 0
         t0 = time.perf_counter()
-        if thaw:
+        if thaw:  # a full collection: it frees what ended sessions and dropped results left
             self._unfreeze()
             self._thawed_at = now
-        self._collect()
+            self._collect()
+        else:  # the young generations only: the rest is frozen without a walk
+            self._collect_young()
         self._freeze()
         self.collections += 1
         ms = 1000 * (time.perf_counter() - t0)
@@ -142,7 +152,7 @@ class IdleCollector:
             counts = ", ".join(f"{name} {count()}" for name, count in self.alive.items())
             log.info("quiet full collection (thawed): %.0f ms; alive: %s", ms, counts)
         else:
-            log.debug("quiet full collection%s: %.0f ms", " (thawed)" if thaw else "", ms)
+            log.debug("quiet %s collection: %.0f ms", "full (thawed)" if thaw else "young", ms)
         return True
 
     def _cpu_quiet(self, now: float) -> bool:
