@@ -51,6 +51,61 @@ def in_own_loop(coro, timeout_s: float):
     return out["value"]
 
 
+class PageClient:
+    """A served page's websocket read as BokehJS reads it (raw Bokeh protocol messages):
+    :meth:`pull` the document, say it is :meth:`ready`, :meth:`pop` what arrives."""
+
+    @classmethod
+    async def open(cls, url: str) -> PageClient:
+        from bokeh.client.websocket import WebSocketClientConnectionWrapper
+        from bokeh.protocol import Protocol
+        from bokeh.protocol.receiver import Receiver
+        from bokeh.util.token import generate_jwt_token, generate_session_id
+        from tornado.httpclient import HTTPRequest
+        from tornado.websocket import websocket_connect
+
+        self = cls()
+        self.protocol, self.receiver = Protocol(), Receiver(Protocol())
+        self.ws = await websocket_connect(
+            HTTPRequest(url), subprotocols=["bokeh", generate_jwt_token(generate_session_id())]
+        )
+        self.sock = WebSocketClientConnectionWrapper(self.ws)
+        return self
+
+    async def pop(self):
+        """The next whole message from the server."""
+        while True:
+            frag = await self.ws.read_message()
+            assert frag is not None, "the server closed the websocket"
+            msg = await self.receiver.consume(frag)
+            if msg is not None:
+                return msg
+
+    async def pull(self, timeout_s: float):
+        """The page's document, as the server sends it on connection (a replica)."""
+        from bokeh.document import Document
+
+        assert (await asyncio.wait_for(self.pop(), timeout_s)).msgtype == "ACK"
+        await self.protocol.create("PULL-DOC-REQ").send(self.sock)
+        reply = await asyncio.wait_for(self.pop(), timeout_s)
+        while reply.msgtype == "PATCH-DOC":
+            reply = await asyncio.wait_for(self.pop(), timeout_s)
+        doc = Document()
+        reply.push_to_document(doc)
+        return doc
+
+    async def ready(self, doc) -> None:
+        """Say the page is shown (BokehJS's document-ready event): its on-load work starts."""
+        from bokeh.document.events import MessageSentEvent
+        from bokeh.events import DocumentReady
+
+        event = MessageSentEvent(doc, "bokeh_event", DocumentReady())
+        await self.protocol.create("PATCH-DOC", [event]).send(self.sock)
+
+    def close(self) -> None:
+        self.ws.close()
+
+
 @contextlib.contextmanager
 def served_in_process(apps: dict, timeout_s: float):
     """A Panel server in this process (its own thread) serving ``apps`` (``{name: function

@@ -18,16 +18,9 @@ import numpy as np
 import panel as pn
 import pytest
 from bokeh.document import Document
-from bokeh.document.events import MessageSentEvent
-from bokeh.events import DocumentReady
 from bokeh.models import ColumnDataSource, Div
 from bokeh.plotting import figure
-from bokeh.protocol import Protocol
-from bokeh.protocol.receiver import Receiver
-from bokeh.util.token import generate_jwt_token, generate_session_id
-from server_util import in_own_loop, served_in_process
-from tornado.httpclient import HTTPRequest
-from tornado.websocket import websocket_connect
+from server_util import PageClient, in_own_loop, served_in_process
 
 from app.runtime.draw import on_document
 
@@ -55,32 +48,10 @@ class _Page:
 async def _client(url: str, page: _Page, draw) -> tuple[list, Document]:
     """Open the page, say it is ready, ask for ``draw`` from a thread, and collect the
     PATCH-DOC messages that arrive until the drawn values are all in the replica."""
-    protocol, receiver = Protocol(), Receiver(Protocol())
-    ws = await websocket_connect(
-        HTTPRequest(url), subprotocols=["bokeh", generate_jwt_token(generate_session_id())]
-    )
-
-    async def pop():
-        while True:
-            frag = await ws.read_message()
-            assert frag is not None, "the server closed the websocket"
-            msg = await receiver.consume(frag)
-            if msg is not None:
-                return msg
-
-    from bokeh.client.websocket import WebSocketClientConnectionWrapper
-
-    sock = WebSocketClientConnectionWrapper(ws)
-    assert (await asyncio.wait_for(pop(), TIMEOUT)).msgtype == "ACK"
-    await protocol.create("PULL-DOC-REQ").send(sock)
-    reply = await asyncio.wait_for(pop(), TIMEOUT)
-    while reply.msgtype == "PATCH-DOC":
-        reply = await asyncio.wait_for(pop(), TIMEOUT)
-    doc = Document()
-    reply.push_to_document(doc)
-    await protocol.create(
-        "PATCH-DOC", [MessageSentEvent(doc, "bokeh_event", DocumentReady())]
-    ).send(sock)
+    client = await PageClient.open(url)
+    pop = client.pop
+    doc = await client.pull(TIMEOUT)
+    await client.ready(doc)
     loaded = await asyncio.get_running_loop().run_in_executor(None, page.loaded.wait, TIMEOUT)
     assert loaded, "the page never loaded"
     threading.Thread(target=on_document, args=(page.doc, draw)).start()
@@ -98,7 +69,7 @@ async def _client(url: str, page: _Page, draw) -> tuple[list, Document]:
         div = doc.get_model_by_id(page.div.id)
         if div.text == "after":
             break
-    ws.close()
+    client.close()
     return patches, doc
 
 

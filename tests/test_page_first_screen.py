@@ -14,17 +14,9 @@ import asyncio
 import time
 
 import pytest
-from bokeh.client.websocket import WebSocketClientConnectionWrapper
 from bokeh.document import Document
-from bokeh.document.events import MessageSentEvent
-from bokeh.events import DocumentReady
 from bokeh.models import ColumnDataSource
-from bokeh.protocol import Protocol
-from bokeh.protocol.receiver import Receiver
-from bokeh.util.token import generate_jwt_token, generate_session_id
-from server_util import in_own_loop, served_in_process
-from tornado.httpclient import HTTPRequest
-from tornado.websocket import websocket_connect
+from server_util import PageClient, in_own_loop, served_in_process
 
 from app.main import BUILDING, create_app
 
@@ -66,35 +58,14 @@ async def _client(url: str) -> tuple[Document, set[str], bool]:
     """Pull the page as a browser does; return the replica after the page said it is ready
     and every view arrived, the model names of the first document, and whether the first
     document held the coupled response's data."""
-    receiver = Receiver(Protocol())
-    ws = await websocket_connect(
-        HTTPRequest(url), subprotocols=["bokeh", generate_jwt_token(generate_session_id())]
-    )
-    sock = WebSocketClientConnectionWrapper(ws)
-
-    async def pop():
-        while True:
-            frag = await ws.read_message()
-            assert frag is not None, "the server closed the websocket"
-            msg = await receiver.consume(frag)
-            if msg is not None:
-                return msg
+    client = await PageClient.open(url)
+    pop = client.pop
 
     try:
-        assert (await asyncio.wait_for(pop(), TIMEOUT)).msgtype == "ACK"
-        await Protocol().create("PULL-DOC-REQ").send(sock)
-        reply = await asyncio.wait_for(pop(), TIMEOUT)
-        while reply.msgtype == "PATCH-DOC":
-            reply = await asyncio.wait_for(pop(), TIMEOUT)
-        doc = Document()
-        reply.push_to_document(doc)
+        doc = await client.pull(TIMEOUT)
         first, first_data = _names(doc), _has_data(doc, "mobility.truncated")
         assert _building(doc), "the first document is not marked as building"
-        await (
-            Protocol()
-            .create("PATCH-DOC", [MessageSentEvent(doc, "bokeh_event", DocumentReady())])
-            .send(sock)
-        )
+        await client.ready(doc)
         end = time.monotonic() + TIMEOUT
         while not BELOW <= _names(doc):
             remaining = end - time.monotonic()
@@ -110,7 +81,7 @@ async def _client(url: str) -> tuple[Document, set[str], bool]:
                 msg.apply_to_document(doc)
         return doc, first, first_data
     finally:
-        ws.close()
+        client.close()
 
 
 @pytest.fixture
