@@ -41,7 +41,7 @@ from app.page.layout import (
 from app.page.titles import page_url
 from app.public_url import public_base
 from app.report.session import provenance_of, report_data
-from app.runtime import background, closed_pages
+from app.runtime import background, closed_pages, libraries  # noqa: F401 (libraries: preloaded)
 from app.runtime.collector import count_alive, session_ended, session_started
 from app.runtime.collector import start as start_quiet_collections
 from app.runtime.draw import DrawQueue, on_document, served, served_document

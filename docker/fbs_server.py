@@ -169,33 +169,70 @@ def applications(files: list[str], args: list[str]) -> dict:
     return panel_serve.build_single_handler_applications(files, {f: args for f in files})
 
 
-def script_imports(path: str) -> list[str]:
-    """The modules a script imports at its top level, in order (read, not run)."""
+def _top_level_imports(path: str) -> list:
     import ast
     from pathlib import Path
 
     tree = ast.parse(Path(path).read_text(encoding="utf-8"), filename=path)
+    return [n for n in tree.body if isinstance(n, ast.Import | ast.ImportFrom)]
+
+
+def script_imports(path: str) -> list[str]:
+    """The modules a script imports at its top level, in order (read, not run)."""
+    import ast
+
     names: list[str] = []
-    for node in tree.body:
+    for node in _top_level_imports(path):
         if isinstance(node, ast.Import):
             names += [a.name for a in node.names]
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+        elif node.module and node.level == 0:
             names.append(node.module)
     return list(dict.fromkeys(n for n in names if n != "__future__"))
 
 
-def preload_imports(files: list[str]) -> float:
-    """Import the modules the app scripts ``files`` import at their top level; seconds.
+def script_submodules(path: str) -> list[str]:
+    """``X.a`` of each top-level ``from X import a`` of a script: the names that may be
+    submodules of a package ``X`` (read, not run; :func:`preload_imports` imports those
+    that are)."""
+    import ast
 
-    Run before the port opens (1.5 s for the dashboard: its libraries and the reference
-    models' code), so that the first page requested does not wait for them (issue 33).
-    A module that fails to import is left to the proof, which reports the script's error.
+    names: list[str] = []
+    for node in _top_level_imports(path):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names += [f"{node.module}.{a.name}" for a in node.names if a.name != "*"]
+    return list(dict.fromkeys(n for n in names if not n.startswith("__future__.")))
+
+
+def _is_submodule(name: str) -> bool:
+    """Whether ``name`` (``X.a``) names a module of the imported package ``X``."""
+    import importlib.util
+
+    parent = sys.modules.get(name.rpartition(".")[0])
+    if parent is None or not hasattr(parent, "__path__"):
+        return False
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def preload_imports(files: list[str]) -> float:
+    """Import the modules the app scripts ``files`` import at their top level, and the
+    submodules they import names of; seconds.
+
+    Run before the port opens (1.5-2 s for the dashboard: its libraries, the reference
+    models' code and what its pages import on first use, ``app/runtime/libraries.py``), so
+    that the first page requested does not wait for them (issue 33). A module that fails
+    to import is left to the proof, which reports the script's error.
     """
     import importlib
 
     t0 = time.perf_counter()
     for path in files:
-        for name in script_imports(path):
+        subs = [n for n in script_submodules(path) if n not in sys.modules]
+        for name in script_imports(path) + subs:
+            if name in subs and not _is_submodule(name):
+                continue  # a function or class of the package, or the package failed
             try:
                 importlib.import_module(name)
             except Exception as exc:  # noqa: BLE001 (the proof reports the script's error)

@@ -198,21 +198,34 @@ def test_the_proof_reports_the_app_once_its_page_is_loaded(tmp_path):
 
 
 def test_the_apps_imports_are_loaded_before_the_port_opens(tmp_path):
-    """Issue 33: the modules the app script imports are imported on the server's main
-    thread before it listens, so that the first page does not wait for them (the proof
-    imports on a thread of its own, after the port is open)."""
-    (tmp_path / "marker_mod.py").write_text(
+    """Issue 33: the modules the app script imports, and the submodules it imports from a
+    package, are imported on the server's main thread before it listens, so that the first
+    page does not wait for them (the proof imports on a thread of its own, after the port
+    is open); a name imported from a package that is not a module is left alone."""
+    marker = (
         "import pathlib, threading\n"
-        "pathlib.Path(__file__).with_name('imported_on.txt').write_text("
+        "pathlib.Path({0!r}).joinpath(__name__ + '.txt').write_text("
         "threading.current_thread().name)\n"
     )
-    app = "import marker_mod\nimport panel as pn\npn.pane.Markdown('a page').servable()\n"
+    (tmp_path / "marker_mod.py").write_text(marker.format(str(tmp_path)))
+    (tmp_path / "markerpkg").mkdir()
+    (tmp_path / "markerpkg" / "__init__.py").write_text("def helper():\n    return 1\n")
+    (tmp_path / "markerpkg" / "sub.py").write_text(marker.format(str(tmp_path)))
+    app = (
+        "import marker_mod\n"
+        "from markerpkg import helper, sub\n"
+        "import panel as pn\n"
+        "pn.pane.Markdown('a page').servable()\n"
+    )
     env = {"PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
     srv = Server(tmp_path, app, env)
     try:
         srv.started(120)
-        assert (tmp_path / "imported_on.txt").read_text() == "MainThread"
-        assert "the apps' imports preloaded" in srv.log()
+        assert (tmp_path / "marker_mod.txt").read_text() == "MainThread"
+        assert (tmp_path / "markerpkg.sub.txt").read_text() == "MainThread"
+        log = srv.log()
+        assert "the apps' imports preloaded" in log
+        assert "preloading" not in log.replace("the apps' imports preloaded", "")
     finally:
         srv.stop()
 
@@ -229,6 +242,7 @@ def test_script_imports_reads_the_top_level_imports(tmp_path):
         "    import csv\n"
     )
     assert fbs_server.script_imports(str(script)) == ["os", "json", "pathlib"]
+    assert fbs_server.script_submodules(str(script)) == ["pathlib.Path"]
 
 
 # ---- secrets -------------------------------------------------------------------------------

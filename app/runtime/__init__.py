@@ -12,6 +12,8 @@
 - :mod:`~app.runtime.reports`: reports drawn one at a time in a process of their own while
   the click waits on the event loop;
 - :mod:`~app.runtime.priority`: lower CPU priority of the threads that are not interactive;
+- :mod:`~app.runtime.libraries`: what a page imports on first use, imported with the app
+  (the server preloads it before its port opens);
 - :mod:`~app.runtime.closed_pages`: a write to a page that has just closed is one log line;
 - :mod:`~app.runtime.panel_private`: the only module of the app that touches Panel's private
   attributes (``tests/test_app_private_api.py`` scans every other one).

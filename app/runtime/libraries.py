@@ -1,0 +1,33 @@
+"""The modules a page imports on first use, imported with the app.
+
+A page's Markdown texts load Panel's Markdown libraries, its tables pandas and narwhals
+(Panel's Tabulator), its studies numba, and its Analysis card the modules of its views,
+each on first use. The server imports the modules an app script imports before its port
+opens (``docker/fbs_server.py``, ``preload_imports``), this one included: without it, the
+first page requested after a start imported them itself (0.4 s of imports on an idle
+machine, 0.7 s while the server's own proof of the app ran beside it; issue 33).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+
+import numba  # noqa: F401
+
+from app.views import (  # noqa: F401
+    analysis_compare,
+    analysis_contrib,
+    analysis_modes,
+    analysis_phase,
+    analysis_speed,
+)
+from fbs_core.tire import quality  # noqa: F401
+
+#: Panel's own dependencies that Panel imports when a pane first renders (left out
+#: quietly if a Panel version no longer uses one).
+PANEL_LAZY = ("markdown", "markdown_it", "narwhals.stable.v1", "pandas")
+
+for _name in PANEL_LAZY:
+    with contextlib.suppress(ImportError):
+        importlib.import_module(_name)
