@@ -9,6 +9,10 @@ and as the tree's own ``scripts/serve.sh`` does for ``serve-sh`` (before issue 3
 
 - server start -> the port accepts a connection (a browser could connect);
 - server start -> "Bokeh app running" (the server's own line);
+- with ``--first proved``: server start -> the app proved (``/liveness`` answers 200:
+  the server's own page of the app is built and loaded), and the first page requested only
+  then (default ``--first listening``: requested as soon as the port accepts, so the first
+  page shares the machine with the proof, the worst case);
 - then, ``--samples`` times, the trees alternated so that every tree sees the same machine
   load: a fresh browser page (chromium, playwright) requested until the coupled response's
   plot (``mobility.truncated``) holds data in the page, and the page closed again.
@@ -38,6 +42,7 @@ import subprocess
 import sys
 import threading
 import time
+import urllib.request
 from pathlib import Path
 
 import numpy as np
@@ -105,6 +110,17 @@ def cpu_s(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def proved(port: int) -> bool:
+    """Whether the server's ``/liveness`` answers 200 for the app (its proof is done)."""
+    try:
+        with urllib.request.urlopen(
+            f"http://127.0.0.1:{port}/liveness?endpoint=/main", timeout=2
+        ) as r:
+            return r.status == 200
+    except OSError:
+        return False
+
+
 def listening(port: int) -> bool:
     with socket.socket() as s:
         s.settimeout(0.2)
@@ -119,6 +135,12 @@ def main() -> None:
     ap.add_argument("--panel", action="store_true", help="plain `panel serve`")
     ap.add_argument("--warm", choices=["yes", "no", "serve-sh"], default="yes")
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per step")
+    ap.add_argument(
+        "--first",
+        choices=["listening", "proved"],
+        default="listening",
+        help="request the first page once the port accepts (default) or once /liveness is 200",
+    )
     args = ap.parse_args()
     trees = [t.resolve() for t in (args.tree or [ROOT])]
     names = [
@@ -156,6 +178,17 @@ def main() -> None:
                 f"[{name}] start -> 'app running'  {marks.get('running', np.nan) - t0:7.1f} s"
                 f"   ({load()})"
             )
+        if args.first == "proved" and not args.panel:
+            for name, (_tree, port, proc, marks) in zip(names, servers, strict=True):
+                while not proved(port):
+                    if proc.poll() is not None or time.perf_counter() - t0 > args.timeout:
+                        print("".join(marks["log"][-30:]))
+                        raise RuntimeError(f"server of {name} was not proved")
+                    time.sleep(0.05)
+                print(
+                    f"[{name}] start -> proved (/liveness 200) {time.perf_counter() - t0:7.1f} s"
+                    f"   ({load()})"
+                )
         launch: dict = {"args": ARGS}
         if Path(CHROMIUM).exists():
             launch["executable_path"] = CHROMIUM
