@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import html
 
+import numpy as np
 import panel as pn
 import param
 from bokeh.core.property.vectorization import value
 from bokeh.events import Tap
-from bokeh.models import ColumnDataSource, HoverTool, Label, Span
+from bokeh.models import ColumnDataSource, HoverTool, Label, LegendItem, Span
 
 from fbs_core.vocabulary import DIRECTIONS
 
@@ -78,18 +79,21 @@ class MobilityView(LiveView):
             dash="dashed",
             tooltips=level_tooltips("N retained modes"),
         )
-        # one line per DOF that may be overlaid (hidden while not), Okabe-Ito colours
-        self._over = {}
-        for d, color in zip(DIRECTIONS, TERM_COLORS, strict=True):
-            src = add_line(
-                fig,
-                f"mobility.overlay_{d}",
-                color=color,
-                legend=f"bushing:{d}",
-                tooltips=level_tooltips(f"bushing:{d}"),
-            )
-            self._over[d] = src
-        self._set_overlays(())
+        # the lines of the DOFs overlaid are made when first overlaid (six lines made up
+        # front were 66 of the first screen's ~400 models, issue 33); their legend entries
+        # and hover tools are here from the start, empty and hidden: a tool added later
+        # lays the toolbar out again, and BokehJS then left the legend outside the canvas
+        self._over: dict[str, ColumnDataSource] = {}
+        self._over_items = {
+            d: LegendItem(label=value(f"bushing:{d}"), renderers=[], visible=False)
+            for d in DIRECTIONS
+        }
+        fig.legend[0].items = [*fig.legend[0].items, *self._over_items.values()]
+        self._over_tools = {
+            d: HoverTool(renderers=[], tooltips=level_tooltips(f"bushing:{d}"), mode="vline")
+            for d in DIRECTIONS
+        }
+        fig.add_tools(*self._over_tools.values())
         self._cursor_spans = [
             Span(
                 location=0,
@@ -140,21 +144,45 @@ class MobilityView(LiveView):
     def _legend_items(self):
         return self._fig.legend[0].items if self._fig.legend else []
 
+    def _overlay(self, dof: str) -> ColumnDataSource:
+        """The source of ``dof``'s overlaid line, the line made on first use (Okabe-Ito
+        colours) and given to its legend entry and hover tool."""
+        src = self._over.get(dof)
+        if src is not None:
+            return src
+        src = self._over[dof] = ColumnDataSource(
+            {"freq": np.zeros(0), "level": np.zeros(0)}, name=f"mobility.overlay_{dof}"
+        )
+        line = self._fig.line(
+            "freq",
+            "level",
+            source=src,
+            line_color=TERM_COLORS[DIRECTIONS.index(dof)],
+            line_width=2.0,
+            visible=False,  # shown with its legend entry (_set_overlays)
+        )
+        self._over_items[dof].renderers = [line]
+        self._over_tools[dof].renderers = [line]
+        return src
+
     def _set_overlays(self, shown) -> None:
-        for item in self._legend_items():
-            for src_dof, src in self._over.items():
-                if item.renderers and item.renderers[0].data_source is src:
-                    item.visible = src_dof in shown
-                    item.renderers[0].visible = src_dof in shown
+        for dof, item in self._over_items.items():
+            item.visible = dof in shown
+            for r in item.renderers:
+                r.visible = dof in shown
 
     def _set_scale(self, scale: str) -> None:
         """Hover lines in the level scale's unit (dB, or the magnitude's)."""
         if scale == self._scale:
             return
         self._scale = scale
-        fmt = "{0.0} dB" if scale == "dB" else "{0.000}"
         for tool in self._fig.select({"type": HoverTool}):
-            tool.tooltips = [(a, "@level" + fmt if a == "Level" else b) for a, b in tool.tooltips]
+            self._format_tool(tool)
+
+    def _format_tool(self, tool: HoverTool) -> None:
+        """The hover tool's level in the current scale's unit."""
+        fmt = "{0.0} dB" if self._scale == "dB" else "{0.000}"
+        tool.tooltips = [(a, "@level" + fmt if a == "Level" else b) for a, b in tool.tooltips]
 
     def _draw(self, r):
         c = r.columns
@@ -184,12 +212,10 @@ class MobilityView(LiveView):
         self._tr.data = {"freq": f, "level": curves[1]["y"]}
         shown = []
         for cv in curves[2:]:
-            self._over[cv["dof"]].data = {"freq": f, "level": cv["y"]}
+            self._overlay(cv["dof"]).data = {"freq": f, "level": cv["y"]}
             shown.append(cv["dof"])
-        for item in self._legend_items():
-            for dof, src in self._over.items():
-                if dof in shown and item.renderers and item.renderers[0].data_source is src:
-                    item.label = value(next(cv["label"] for cv in curves if cv["dof"] == dof))
+        for cv in curves[2:]:
+            self._over_items[cv["dof"]].label = value(cv["label"])
         self._set_overlays(shown)
         self._fig.yaxis.axis_label = d["y_label"]
         on = {cur["k"]: cur for cur in d["cursors"]}
