@@ -5,7 +5,14 @@ from __future__ import annotations
 import gc
 import weakref
 
-from app.runtime.collector import BUSY_SHARE, QUIET, THAW_EVERY, IdleCollector
+from app.runtime.collector import (
+    BUSY_SHARE,
+    PERIOD,
+    QUIET,
+    THAW_EVERY,
+    IdleCollector,
+    wait_quiet,
+)
 
 
 class _Clock:
@@ -175,3 +182,31 @@ def test_one_ended_session_among_many_open_waits_for_more_or_for_thaw_every():
     c.touch()  # ... until THAW_EVERY after the last thaw
     clock.t += THAW_EVERY
     assert c.step() and calls[-3:] == ["unfreeze", "collect", "freeze"]
+
+
+def test_work_computed_ahead_waits_for_a_quiet_moment():
+    """Issue 33: the warm-up's steps wait until no draw was asked for and no session started
+    or ended during QUIET seconds, and a step runs once that is so (after a collection too)."""
+    c, clock, _ = _collector()
+    assert c.quiet()  # nothing ever happened
+    slept: list[float] = []
+
+    def sleep(dt: float) -> None:  # the fake clock moves as the poll sleeps
+        slept.append(dt)
+        clock.t += dt
+
+    for mark in (c.touch, c.session_started, c.session_ended):
+        mark()
+        assert not c.quiet()
+        clock.t += QUIET / 2
+        assert not c.quiet()
+        slept.clear()
+        wait_quiet(c, sleep)
+        assert c.quiet() and 0 < sum(slept) <= QUIET / 2 + PERIOD
+    c.touch()
+    for _ in range(3):  # a page drawing every QUIET / 2 s holds the work back
+        clock.t += QUIET / 2
+        assert not c.quiet()
+        c.touch()
+    clock.t += QUIET
+    assert c.step() and c.quiet()  # the quiet collection does not make it busy again

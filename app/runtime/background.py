@@ -31,6 +31,7 @@ from collections.abc import Callable, Hashable, Iterator
 from typing import Any
 
 from .. import compute
+from . import collector
 from .priority import BACKGROUND_NICE, lower_priority
 
 __all__ = [
@@ -137,8 +138,10 @@ def warm_reference_studies(coupling: str = "6dof") -> threading.Thread | None:
     """Once per process, on a thread of its own at a lower priority: the reference error
     maps of all seven harmonics (each holds the coupled responses of every N of the
     selector), so that the first change to another harmonic finds them computed; then the
-    long-lived objects are frozen (:func:`freeze_long_lived`). Returns the thread, or None
-    if the warm-up was already started."""
+    long-lived objects are frozen (:func:`freeze_long_lived`). Each map waits for a quiet
+    moment (:func:`app.runtime.collector.wait_quiet`): started by the first page, the
+    warm-up ran beside that page and the next ones opened (issue 33). Returns the thread,
+    or None if the warm-up was already started."""
     with _warm_lock:
         if _warmed.is_set():
             return None
@@ -149,6 +152,7 @@ def warm_reference_studies(coupling: str = "6dof") -> threading.Thread | None:
         lower_priority(BACKGROUND_NICE)
         try:
             for h in range(1, 8):
+                collector.wait_quiet()
                 compute.error_map(h, coupling)
             freeze_long_lived()
         except Exception:  # optional: log, never kill the server

@@ -48,6 +48,7 @@ __all__ = [
     "session_started",
     "start",
     "touch",
+    "wait_quiet",
 ]
 
 log = logging.getLogger(__name__)
@@ -94,6 +95,7 @@ class IdleCollector:
         self._samples: deque[tuple[float, float]] = deque()
         self._lock = threading.Lock()
         self._last_activity: float | None = None  # None: nothing since the last collection
+        self._last_touch = -float("inf")  # the last activity of all (never reset)
         self._open = 0  # sessions started and not ended
         self._ended = 0  # sessions ended since the last thaw
         self._thawed_at = clock()
@@ -105,12 +107,21 @@ class IdleCollector:
         """Something happened (a draw was asked for)."""
         now = self._clock()
         with self._lock:
-            self._last_activity = now
+            self._last_activity = self._last_touch = now
+
+    def quiet(self) -> bool:
+        """Whether nothing happened (no draw asked for, no session started or ended) during
+        the last :data:`QUIET` seconds."""
+        now = self._clock()
+        with self._lock:
+            return now - self._last_touch >= QUIET
 
     def session_started(self) -> None:
         """A session started (its page counts as open until :meth:`session_ended`)."""
+        now = self._clock()
         with self._lock:
             self._open += 1
+            self._last_touch = now
 
     def session_ended(self) -> None:
         """A session ended: its objects are to be freed by a thawed quiet collection, once
@@ -120,7 +131,7 @@ class IdleCollector:
         with self._lock:
             self._open = max(0, self._open - 1)
             self._ended += 1
-            self._last_activity = now
+            self._last_activity = self._last_touch = now
 
     def step(self) -> bool:
         """Collect (thawing first when due) if the server is quiet after activity; True if
@@ -187,6 +198,17 @@ def session_started() -> None:
 def session_ended() -> None:
     """A session ended (see :meth:`IdleCollector.session_ended`)."""
     COLLECTOR.session_ended()
+
+
+def wait_quiet(
+    collector: IdleCollector | None = None, sleep: Callable[[float], None] = time.sleep
+) -> None:
+    """Return once the server is quiet (:meth:`IdleCollector.quiet`; polled every
+    :data:`PERIOD` s): work computed ahead, which nobody waits for, starts its next step
+    then rather than beside a page being opened or changed."""
+    c = COLLECTOR if collector is None else collector
+    while not c.quiet():
+        sleep(PERIOD)
 
 
 def count_alive(name: str, count: Callable[[], int]) -> None:
