@@ -218,9 +218,10 @@ def _eliminate(W: FloatArray, X: FloatArray, k: int) -> None:
     for v in range(LANES):
         pr = W[0, k, k, v]
         pi = W[1, k, k, v]
-        d = pr * pr + pi * pi
-        X[2, k, v] = pr / d
-        X[3, k, v] = -pi / d
+        # one division, two products: divisions are the slowest vector operation
+        d = 1.0 / (pr * pr + pi * pi)
+        X[2, k, v] = pr * d
+        X[3, k, v] = -pi * d
     for i in range(k + 1, nj):
         # multipliers m = W[i, k] / W[k, k], stored in place of W[i, k]
         for v in range(LANES):
