@@ -57,8 +57,9 @@ _JIT = _JitOptions(cache=True, fastmath=False, error_model="numpy", nogil=True)
 #: both bit for bit (:func:`noise_factors`, the tests' ``sqrt(re**2 + im**2)``).
 _JIT_FMA = _JitOptions(cache=True, fastmath={"contract"}, error_model="numpy", nogil=True)
 
-#: Rounds solved together in one vectorised block.
-LANES = 64
+#: Rounds solved together in one vectorised block: per-loop overhead (index arithmetic,
+#: alias checks) dominates below; 128 measured faster than 64 and as fast as 256.
+LANES = 128
 
 _ONE = np.uint64(1)
 _S32 = np.uint64(32)
