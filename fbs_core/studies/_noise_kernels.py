@@ -65,11 +65,11 @@ _ONE = np.uint64(1)
 _S32 = np.uint64(32)
 _LO32 = np.uint64(0xFFFFFFFF)
 _INV32 = 2.0**-32
-#: The bits of the float64 2**52 (its exponent); OR-ed with a 32-bit ``u`` they are 2**52 + u.
-_EXP52 = np.uint64(0x4330000000000000)
-#: ``(2**52 + u) 2**-31 - (2**21 + 1)`` is ``2 u 2**-32 - 1`` exactly (a power-of-two scaling,
-#: then a difference that is representable), in two operations instead of four.
-_INV31 = 2.0**-31
+#: The bits of the float64 2**21, whose mantissa step is 2**-31: OR-ed with a 32-bit ``u``
+#: they are the float64 ``2**21 + u 2**-31``.
+_EXP21 = np.uint64(0x4140000000000000)
+#: ``(2**21 + u 2**-31) - (2**21 + 1)`` is ``2 u 2**-32 - 1`` exactly (a representable
+#: difference), in one operation instead of four.
 _SHIFT = 2.0**21 + 1.0
 
 
@@ -96,8 +96,8 @@ def _lane_factors(
     into ``s (n_el, LANES)`` (padded lanes cost nothing extra).
 
     ``base (3, LANES)`` is workspace: the lanes' stream bases, then the two halves of a
-    word as the bits of ``2**52 + u`` (``u`` the 32-bit half), read back as float64:
-    ``(2**52 + u) 2**-31 - (2**21 + 1)`` is exactly ``2 u 2**-32 - 1``, without the scalar
+    word as the bits of ``2**21 + u 2**-31`` (``u`` the 32-bit half), read back as float64:
+    ``(2**21 + u 2**-31) - (2**21 + 1)`` is exactly ``2 u 2**-32 - 1``, without the scalar
     integer conversion AVX2 lacks, so that the words of all lanes are hashed and
     converted in vector registers (bit for bit the factors of :func:`noise_factors`). Arrays
     are indexed in full, never sliced: a view costs two atomic reference counts.
@@ -111,13 +111,13 @@ def _lane_factors(
         e = 2 * k
         for v in range(LANES):
             w = mix64(base[0, v] + kk)
-            base[1, v] = (w >> _S32) | _EXP52
-            base[2, v] = (w & _LO32) | _EXP52
+            base[1, v] = (w >> _S32) | _EXP21
+            base[2, v] = (w & _LO32) | _EXP21
         for v in range(LANES):
-            s[e, v] = 1.0 + p * (as_float[1, v] * _INV31 - _SHIFT)
+            s[e, v] = 1.0 + p * (as_float[1, v] - _SHIFT)
         if e + 1 < n_el:
             for v in range(LANES):
-                s[e + 1, v] = 1.0 + p * (as_float[2, v] * _INV31 - _SHIFT)
+                s[e + 1, v] = 1.0 + p * (as_float[2, v] - _SHIFT)
 
 
 @njit(**_JIT_FMA)
