@@ -312,3 +312,46 @@ def test_histogram_order_statistics_are_exact(shape):
     qs = (1.0, 5.0, 50.0, 95.0, 99.0)
     _, pct = _stats(mag.copy(), qs)
     np.testing.assert_allclose(pct[:, 0, 0], np.percentile(col, qs), rtol=1e-14, atol=0)
+
+
+def _running_reference(col, ck):
+    """Minimum, maximum, first rounds attaining them and the checkpoint values, as the
+    plain round-by-round loop ``v < mn`` / ``v > mx`` gives them (NaN never wins)."""
+    mn = mx = col[0]
+    imn = imx = 0
+    conv = {}
+    for r, v in enumerate(col):
+        if v < mn:
+            mn, imn = v, r
+        if v > mx:
+            mx, imx = v, r
+        conv[r + 1] = (mn, mx)
+    return mn, mx, imn, imx, np.array([conv[c] for c in ck])
+
+
+@pytest.mark.parametrize("case", ["repeats", "nan_inside", "nan_first", "inf"])
+def test_extremes_and_checkpoints_equal_the_round_loop(case):
+    """The blocked minimum / maximum pass: the first round attaining an extreme when it
+    recurs in later blocks, checkpoints on and beside block edges (and repeated), NaN
+    skipped unless it is round 0, against the round-by-round loop."""
+    R = 3000
+    rng = np.random.default_rng(5)
+    col = rng.lognormal(size=R)
+    b = _noise_kernels._BLOCK
+    col[[b - 1, b + 3, 2 * b + 1, R - 1]] = col.min() / 2  # the minimum, 4 times
+    col[[3, b, 7 * b + 2]] = col.max() * 2
+    if case == "nan_inside":
+        col[[1, b + 1, R - 2]] = np.nan
+    elif case == "nan_first":
+        col[0] = np.nan
+    elif case == "inf":
+        col[b + 5] = np.inf
+    ck = np.array([1, 3, b - 1, b, b, b + 1, 2 * b + 2, R], np.int64)
+    mag = np.ascontiguousarray(np.broadcast_to(col, (1, 1, R)))
+    out = [np.empty((1, 1)) for _ in range(2)] + [np.empty((1, 1), np.int64) for _ in range(2)]
+    conv = [np.empty((ck.size, 1, 1)) for _ in range(2)]
+    _noise_kernels.band_stats(mag, np.empty(0), ck, *out, np.empty((0, 1, 1)), *conv, 0)
+    mn, mx, imn, imx, want = _running_reference(col, ck)
+    np.testing.assert_array_equal([o[0, 0] for o in out], [mn, mx, imn, imx])
+    np.testing.assert_array_equal(conv[0][:, 0, 0], want[:, 0])
+    np.testing.assert_array_equal(conv[1][:, 0, 0], want[:, 1])

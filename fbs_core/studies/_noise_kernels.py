@@ -676,6 +676,52 @@ def _order_stats_histogram(
     return True
 
 
+#: Rounds per block of the minimum and maximum pass (:func:`_column_stats`): the first
+#: round attaining an extreme is searched again inside its block only.
+_BLOCK = 256
+
+
+@njit(**_JIT)
+def _running_extremes(col: FloatArray, a: int, b: int, mn: float, mx: float) -> tuple[float, float]:
+    """``mn, mx`` updated by ``col[a:b]`` as ``v < mn`` / ``v > mx`` in round order would
+    (NaN never wins, a NaN ``mn`` stays), in four independent chains that run in parallel."""
+    l0 = l1 = l2 = l3 = mn
+    h0 = h1 = h2 = h3 = mx
+    n4 = a + (b - a) // 4 * 4
+    for r in range(a, n4, 4):
+        v0 = col[r]
+        v1 = col[r + 1]
+        v2 = col[r + 2]
+        v3 = col[r + 3]
+        l0 = v0 if v0 < l0 else l0
+        l1 = v1 if v1 < l1 else l1
+        l2 = v2 if v2 < l2 else l2
+        l3 = v3 if v3 < l3 else l3
+        h0 = v0 if v0 > h0 else h0
+        h1 = v1 if v1 > h1 else h1
+        h2 = v2 if v2 > h2 else h2
+        h3 = v3 if v3 > h3 else h3
+    for r in range(n4, b):
+        v = col[r]
+        l0 = v if v < l0 else l0
+        h0 = v if v > h0 else h0
+    # the chains started from mn, so any value below it is a value of col
+    l0 = l1 if l1 < l0 else l0
+    l2 = l3 if l3 < l2 else l2
+    h0 = h1 if h1 > h0 else h0
+    h2 = h3 if h3 > h2 else h2
+    return (l2 if l2 < l0 else l0), (h2 if h2 > h0 else h0)
+
+
+@njit(**_JIT)
+def _first_index(col: FloatArray, start: int, x: float) -> int:
+    """The first round from ``start`` on whose value is ``x`` (``start`` if none: NaN)."""
+    for r in range(start, col.size):
+        if col[r] == x:
+            return r
+    return start
+
+
 @njit(**_JIT)
 def _column_stats(
     col: FloatArray,
@@ -696,21 +742,28 @@ def _column_stats(
     R = col.size
     mn = col[0]
     mx = col[0]
-    imn = 0
+    imn = 0  # start of the block where the minimum is first attained
     imx = 0
     kc = 0
-    for r in range(R):
-        v = col[r]
-        if v < mn:
-            mn = v
-            imn = r
-        if v > mx:
-            mx = v
-            imx = r
-        while kc < checkpoints.size and checkpoints[kc] == r + 1:
+    a = 0
+    while a < R:
+        end = min(a + _BLOCK, R)
+        if kc < checkpoints.size and a < checkpoints[kc] < end:
+            end = checkpoints[kc]
+        bmn, bmx = _running_extremes(col, a, end, mn, mx)
+        if bmn < mn:
+            mn = bmn
+            imn = a
+        if bmx > mx:
+            mx = bmx
+            imx = a
+        while kc < checkpoints.size and checkpoints[kc] == end:
             conv_lo[kc, line, e] = mn
             conv_hi[kc, line, e] = mx
             kc += 1
+        a = end
+    imn = _first_index(col, imn, mn)
+    imx = _first_index(col, imx, mx)
     lo[line, e] = mn
     hi[line, e] = mx
     arg_lo[line, e] = imn
