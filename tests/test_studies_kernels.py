@@ -355,3 +355,25 @@ def test_extremes_and_checkpoints_equal_the_round_loop(case):
     np.testing.assert_array_equal([o[0, 0] for o in out], [mn, mx, imn, imx])
     np.testing.assert_array_equal(conv[0][:, 0, 0], want[:, 0])
     np.testing.assert_array_equal(conv[1][:, 0, 0], want[:, 1])
+
+
+def test_histogram_declines_a_column_with_nan():
+    """A NaN between finite values has no histogram bin: the histogram declines (instead of
+    counting it at a stray index) and the band statistics still come out, minimum and
+    maximum skipping the NaN."""
+    R = 5000
+    col = np.random.default_rng(2).lognormal(size=R)
+    col[[7, 100, 4000]] = np.nan
+    lo, hi = np.nanmin(col), np.nanmax(col)
+    out = np.full(2, -1.0)
+    assert not _noise_kernels._order_stats_histogram(col, lo, hi, np.array([10, 11]), out)
+    np.testing.assert_array_equal(out, -1.0)
+    mag = np.ascontiguousarray(np.broadcast_to(col, (1, 1, R)))
+    (mn, mx, amn, amx), pct = _stats(mag.copy(), (5.0, 95.0))
+    assert (mn[0, 0], mx[0, 0], amn[0, 0], amx[0, 0]) == (
+        lo,
+        hi,
+        np.nanargmin(col),
+        np.nanargmax(col),
+    )
+    assert pct.shape == (2, 1, 1)

@@ -619,6 +619,25 @@ _BINS = 4096
 
 
 @njit(**_JIT)
+def _bin_indices(col: FloatArray, mn: float, scale: float) -> NDArray[np.int32]:
+    """The histogram bin ``min(floor((x - mn) scale), _BINS - 1)`` of every value of ``col``
+    (at least ``mn``), computed once for both passes of :func:`_order_stats_histogram` in a
+    vectorised loop (no memory dependence between values); empty if ``col`` holds a NaN
+    (whose bin would be no index at all)."""
+    n = col.size
+    bins = np.empty(n, np.int32)
+    top = np.int32(_BINS - 1)
+    nan = 0
+    for i in range(n):
+        x = col[i]
+        nan += x != x
+        bins[i] = min(np.int32((x - mn) * scale), top)
+    if nan:
+        return np.empty(0, np.int32)
+    return bins
+
+
+@njit(**_JIT)
 def _order_stats_histogram(
     col: FloatArray, mn: float, mx: float, ranks: IntArray, out: FloatArray
 ) -> bool:
@@ -628,9 +647,10 @@ def _order_stats_histogram(
     ``floor((x - mn) * scale)`` is monotone in ``x``: every floating-point step is), the
     bin prefix counts locate each rank's bin, a second pass gathers the values of those
     few bins, and an exact selection runs inside each. Two passes serve all ranks (the
-    sampled bracket needs one pass per percentile). Returns False, with nothing written,
-    when a rank's bin is too full (heavy outliers stretch the bins) or the data are not
-    finite; the caller then falls back to :func:`_order_stat_pair_sampled`.
+    sampled bracket needs one pass per percentile; the bins are computed once,
+    :func:`_bin_indices`). Returns False, with nothing written, when a rank's bin is too
+    full (heavy outliers stretch the bins) or the data are not finite (a NaN has no bin);
+    the caller then falls back to :func:`_order_stat_pair_sampled`.
     """
     n = col.size
     if not (np.isfinite(mn) and np.isfinite(mx)) or mx <= mn:
@@ -638,10 +658,12 @@ def _order_stats_histogram(
     scale = _BINS / (mx - mn)
     if not np.isfinite(scale):
         return False
-    top = _BINS - 1
+    bins = _bin_indices(col, mn, scale)
+    if bins.size == 0:
+        return False
     counts = np.zeros(_BINS, np.int64)
     for i in range(n):
-        counts[min(int((col[i] - mn) * scale), top)] += 1
+        counts[bins[i]] += 1
     starts = np.empty(_BINS + 1, np.int64)
     starts[0] = 0
     for b in range(_BINS):
@@ -660,11 +682,10 @@ def _order_stats_histogram(
             total += counts[b]
     buf = np.empty(total + 1)
     for i in range(n):
-        x = col[i]
-        b = min(int((x - mn) * scale), top)
+        b = bins[i]
         o = fill[b]
         if o >= 0:
-            buf[o] = x
+            buf[o] = col[i]
             fill[b] = o + 1
     for i in range(ranks.size):
         b = rank_bin[i]
