@@ -38,7 +38,7 @@ from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
 from .._typing import ComplexArray, FloatArray, IntArray
-from ._rng import GOLDEN, mix64, mix64_np, stream_base
+from ._rng import GOLDEN, mix64, mix64_np
 
 
 # nogil: a band computed for one dashboard session must not stall the event loop that
@@ -82,9 +82,15 @@ def n_elements(nj: int, ne: int) -> int:
 
 
 @njit(**_JIT)
+def _round_keys(key: np.uint64, rids: IntArray, base: NDArray[np.uint64]) -> None:
+    """``base[3] = mix(key + (r + 1) G)`` of the ``LANES`` rounds ``rids``: the first level of
+    :func:`._rng.stream_base`, the same at every line of a block of rounds."""
+    for v in range(LANES):
+        base[3, v] = mix64(key + (np.uint64(rids[v]) + _ONE) * GOLDEN)
+
+
+@njit(**_JIT)
 def _lane_factors(
-    key: np.uint64,
-    rids: IntArray,
     line: int,
     p: float,
     k0: int,
@@ -92,10 +98,11 @@ def _lane_factors(
     s: FloatArray,
     base: NDArray[np.uint64],
 ) -> None:
-    """Factors of words ``k0 .. k1-1`` of the ``LANES`` rounds ``rids`` at stream line ``line``
-    into ``s (n_el, LANES)`` (padded lanes cost nothing extra).
+    """Factors of words ``k0 .. k1-1`` of the ``LANES`` rounds whose keys are in ``base[3]``
+    (:func:`_round_keys`) at stream line ``line`` into ``s (n_el, LANES)`` (padded lanes cost
+    nothing extra).
 
-    ``base (3, LANES)`` is workspace: the lanes' stream bases, then the two halves of a
+    ``base (4, LANES)`` is workspace: the lanes' stream bases, then the two halves of a
     word as the bits of ``2**21 + u 2**-31`` (``u`` the 32-bit half), read back as float64:
     ``(2**21 + u 2**-31) - (2**21 + 1)`` is exactly ``2 u 2**-32 - 1``, without the scalar
     integer conversion AVX2 lacks, so that the words of all lanes are hashed and
@@ -104,7 +111,7 @@ def _lane_factors(
     """
     n_el = s.shape[0]
     for v in range(LANES):
-        base[0, v] = stream_base(key, rids[v], line)
+        base[0, v] = mix64(base[3, v] + (np.uint64(line) + _ONE) * GOLDEN)  # stream_base
     as_float = base.view(np.float64)
     for k in range(k0, k1):
         kk = (np.uint64(k) + _ONE) * GOLDEN
@@ -287,7 +294,7 @@ def _workspace(
     FloatArray, NDArray[np.uint64], FloatArray, FloatArray, FloatArray, IntArray, FloatArray
 ]:
     s = np.ones((n_el, LANES))
-    base = np.empty((3, LANES), np.uint64)
+    base = np.empty((4, LANES), np.uint64)
     W = np.empty((2, nj, nj, LANES))
     X = np.empty((4, nj, LANES))
     Y = np.empty((2, ne, LANES))
@@ -343,13 +350,13 @@ def _block_lines(
     nv = min(LANES, nr - r0)
     for v in range(LANES):
         lane_ids[v] = rids[r0 + min(v, nv - 1)]  # pad with the last round (not written)
+    _round_keys(key, lane_ids, base)
+    # the words of the noisy subsystems (the tire's first): one call, one stream base a line
+    k0 = 0 if tire else k_tire
+    k1 = k_all if vehicle else k_tire
     for line in range(l0, l1):
-        if freq_dep or line == l0:
-            stream_line = line if freq_dep else 0
-            if tire:
-                _lane_factors(key, lane_ids, stream_line, p, 0, k_tire, s, base)
-            if vehicle:
-                _lane_factors(key, lane_ids, stream_line, p, k_tire, k_all, s, base)
+        if (freq_dep or line == l0) and k0 < k1:
+            _lane_factors(line if freq_dep else 0, p, k0, k1, s, base)
         _lane_solve(Ar, Ai, ar, ai, Er, Ei, Br, Bi, order, line, s, W, X, piv, pm, Y)
         if want_mag:
             for e in range(ne):
