@@ -7,7 +7,12 @@ browser tab. Two kinds of client (``bench/load_clients.py``):
   are measured inside the page with ``performance.now()``;
 - ``--client bokeh``: a Bokeh websocket protocol client holding a replica of the document
   (what the page holds, without rendering); a small fraction of a browser's CPU, so on one
-  machine the figures are the server's rather than the browsers'.
+  machine the figures are the server's rather than the browsers';
+- ``--client raw``: the Bokeh websocket protocol without a replica (the page fetched for its
+  session token, document-ready and slider changes sent as BokehJS sends them, only message
+  headers and patch contents decoded); a fraction of the Bokeh client's CPU, so 50 sessions
+  do not saturate the clients' core. Its isolation check pulls each session's document
+  once more at the end.
 
 All sessions open at once and wait for their plots to settle ("open to settled plots");
 once every session is open, each moves a slider through its own sequence of values
@@ -24,6 +29,9 @@ Checks (any failure -> exit status 1):
   session set last, and its plot data equal those of a fresh reference session that set the
   same value alone (sessions ending on the same value agree; a cross-session leak of state
   or of cached mutable results would make them differ).
+
+The clients' cores' busy share during the changes (all processes, /proc/stat) and this
+script's own share say whether a figure is the server's or the clients' (CLIENT-LIMITED).
 
 Prints page-load and change latencies (median, p95, max) per number of sessions, and the
 largest number of sessions whose p95 first-update latency stays under ``--target`` (1 s).
@@ -68,7 +76,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from load_clients import BokehSession, BrowserSession, chromium_args  # noqa: E402
+from load_clients import BokehSession, BrowserSession, RawSession, chromium_args  # noqa: E402
 
 
 @dataclass
@@ -108,10 +116,44 @@ def targets(values: list[float], index: int, changes: int, current: float) -> li
     return seq
 
 
-#: Above this share of a core the single-threaded Bokeh clients throttle themselves (they
-#: send a session's next change only once its last one is applied): such a level does not
-#: count for the capacity figure.
+#: Above this share of a core the single-threaded protocol clients (bokeh, raw) throttle
+#: themselves (they send a session's next change only once its last one is done): such a
+#: level does not count for the capacity figure.
 CLIENT_LIMIT = 0.75
+#: Above this busy share of the clients' cores (every process on them: the machine may be
+#: shared) the clients wait for a core, whatever their own share.
+CORES_LIMIT = 0.9
+
+
+def client_limited(row: dict) -> str | None:
+    """Why a level's figures are (also) the clients', or None."""
+    if row["client"] != "browser" and row["script_core_share"] > CLIENT_LIMIT:
+        return (
+            f"the protocol clients used {100 * row['script_core_share']:.0f}% of their core"
+            f" (limit {100 * CLIENT_LIMIT:.0f}%)"
+        )
+    busy = row.get("clients_cores_busy")
+    if row.get("other_cores_busy") is not None and busy is not None and busy > CORES_LIMIT:
+        return (
+            f"the clients' cores were {100 * busy:.0f}% busy, all processes"
+            f" (limit {100 * CORES_LIMIT:.0f}%)"
+        )
+    return None
+
+
+def core_shares(row: dict, client: str) -> str:
+    """Who kept which cores busy during the changes, in words."""
+    script = "this script" + (" and its protocol clients" if client != "browser" else "")
+    own = f"{script} {100 * row['script_core_share']:.0f}% of a core"
+    server = row.get("server_core_share")
+    server_text = "" if server is None else f"the server {100 * server:.0f}% of a core"
+    if row.get("other_cores_busy") is None:  # nothing pinned: every core is everyone's
+        return f"{own}" + (f", {server_text}" if server_text else "")
+    return (
+        f"clients' core(s) busy {100 * row['clients_cores_busy']:.0f}% ({own}); "
+        f"other core(s) busy {100 * row['other_cores_busy']:.0f}%"
+        + (f" ({server_text})" if server_text else "")
+    )
 
 
 class AllOpen:
@@ -128,6 +170,7 @@ class AllOpen:
         if self._left <= 0 and not self._event.is_set():
             # the change phase starts: where this script's CPU time goes from here on
             self.at = (time.monotonic(), time.process_time(), self._server_cpu_s())
+            self.cores_at = cores_busy_s()
             self.rss_open_mb = self._server_rss_mb()  # every session open, none changed yet
             self._event.set()
 
@@ -185,7 +228,8 @@ async def final_digest(res: SessionResult, timeout_s: float) -> None:
     """Plot data of a session once nothing changes for 3 s any more; closes the session."""
     try:
         if not res.errors:
-            res.final_digest = await res.session.settle(timeout_s, 3.0)
+            if await res.session.settle(timeout_s, 3.0) is not None:
+                res.final_digest = await res.session.plot_digest(timeout_s)
     finally:
         await res.session.close()
 
@@ -230,6 +274,8 @@ def session_factory(client: str, stack: contextlib.AsyncExitStack):
     async def make():
         if client == "bokeh":
             return BokehSession
+        if client == "raw":
+            return RawSession
         from playwright.async_api import async_playwright
 
         p = await stack.enter_async_context(async_playwright())
@@ -248,7 +294,9 @@ async def run_warm_up(url: str, title: str, timeout_s: float, client: str) -> fl
 async def session_digest(sess, timeout_s: float) -> str | None:
     """Plot data of a session once nothing changes for 3 s any more; closes it."""
     try:
-        return await sess.settle(timeout_s, 3.0)
+        if await sess.settle(timeout_s, 3.0) is None:
+            return None
+        return await sess.plot_digest(timeout_s)
     finally:
         await sess.close()
 
@@ -316,6 +364,19 @@ async def run_level(
         # near 1 would mean the clients themselves delayed what they measured
         change_wall = time.monotonic() - all_open.at[0]
         script_share = (time.process_time() - all_open.at[1]) / change_wall
+        # every process's share of the clients' cores and of the others (the server's when
+        # pinned): the machine is shared, a busy core need not be this script's doing
+        cores = cores_busy_s()
+        mine = os.sched_getaffinity(0)
+
+        def share(cpus: set[int]) -> float | None:
+            if not cpus:
+                return None
+            busy = sum(cores[c] - all_open.cores_at[c] for c in cpus)
+            return busy / (change_wall * len(cpus))
+
+        clients_share, others_share = share(mine), share(set(cores) - mine)
+        server_share = None if all_open.at[2] is None else (cpu_s() - all_open.at[2]) / change_wall
         n_changes = sum(len(r.first_ms) for r in results)
         server_per_change = (
             None
@@ -385,6 +446,9 @@ async def run_level(
         "distinct_final_states": len(refs),
         "change_phase_s": change_wall,
         "script_core_share": script_share,
+        "clients_cores_busy": clients_share,
+        "other_cores_busy": others_share,
+        "server_core_share": server_share,
         "server_cpu_per_change_s": server_per_change,
         "rss_open_mb": all_open.rss_open_mb,
         "reference_sessions": len(refs),
@@ -400,6 +464,22 @@ def host_busy_s() -> float:
         fields = [int(x) for x in f.readline().split()[1:]]
     busy = sum(fields) - fields[3] - (fields[4] if len(fields) > 4 else 0)  # minus idle, iowait
     return busy / os.sysconf("SC_CLK_TCK")
+
+
+def cores_busy_s() -> dict[int, float]:
+    """CPU seconds each core has been busy (all processes), from /proc/stat."""
+    tick = os.sysconf("SC_CLK_TCK")
+    out = {}
+    with open("/proc/stat") as f:
+        for line in f:
+            name, *fields = line.split()
+            if not name.startswith("cpu") or name == "cpu":
+                continue
+            if not name[3:].isdigit():
+                break
+            v = [int(x) for x in fields]
+            out[int(name[3:])] = (sum(v) - v[3] - (v[4] if len(v) > 4 else 0)) / tick
+    return out
 
 
 def proc_tree(pid: int) -> list[int]:
@@ -641,10 +721,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument(
         "--client",
-        choices=("browser", "bokeh"),
+        choices=("browser", "bokeh", "raw"),
         default="browser",
-        help="sessions as chromium pages (browser) or as Bokeh protocol clients "
-        "(bokeh: no rendering, a small fraction of a browser's CPU)",
+        help="sessions as chromium pages (browser), as Bokeh protocol clients with a "
+        "document replica (bokeh: no rendering, a small fraction of a browser's CPU) or "
+        "as raw protocol clients (raw: no replica, a fraction of the bokeh client's CPU)",
     )
     ap.add_argument("--target", type=float, default=1000.0, help="p95 target in ms (1000)")
     ap.add_argument("--timeout", type=float, default=120.0, help="seconds per wait (120)")
@@ -774,28 +855,26 @@ def main(argv: list[str] | None = None) -> int:
                     )
                     + "   (median/p95 ms)"
                 )
-            print(
-                f"   change phase {row['change_phase_s']:.1f} s; this script"
-                f"{' and its Bokeh clients' if args.client == 'bokeh' else ''} busy "
-                f"{100 * row['script_core_share']:.0f}% of one core meanwhile"
-                + (
-                    ""
-                    if row["server_cpu_per_change_s"] is None
-                    else f"; server CPU {1000 * row['server_cpu_per_change_s']:.0f} ms per change"
-                )
-            )
-            if args.client == "bokeh" and row["script_core_share"] > CLIENT_LIMIT:
+            print(f"   change phase {row['change_phase_s']:.1f} s; {core_shares(row, args.client)}")
+            if row["server_cpu_per_change_s"] is not None:
                 print(
-                    "   CLIENT-LIMITED: the clients' core was nearly saturated; they sent their"
-                    " changes late and this level loaded the server less than it says"
+                    f"   server CPU {1000 * row['server_cpu_per_change_s']:.0f} ms per change"
+                    f" ({row['changes']} changes)"
                 )
+            limited = client_limited(row)
+            print(
+                f"   CLIENT-LIMITED: {limited}; they sent their changes late or stamped the "
+                "server's patches late, and this level measured the clients as well"
+                if limited
+                else "   not client-limited: the latencies are the server's"
+            )
             if row["server_cpu_s"] is not None:
                 # where the cores went: on one machine the browsers compete with the server
                 print(
                     f"   CPU over {row['accounted_s']:.0f} s (sessions and isolation check): "
                     f"server {row['server_cpu_s']:.1f} s, everything else on the host "
                     f"{row['host_cpu_s'] - row['server_cpu_s']:.1f} s (of which this "
-                    f"script{' and its Bokeh clients' if args.client == 'bokeh' else ''} "
+                    f"script{' and its protocol clients' if args.client != 'browser' else ''} "
                     f"{row['script_cpu_s']:.1f} s), of {os.cpu_count() * row['accounted_s']:.0f}"
                     " core-seconds"
                 )
@@ -837,11 +916,11 @@ def main(argv: list[str] | None = None) -> int:
         if not r["problems"]
         and r["first_ms"]
         and pct(r["first_ms"], 95) < args.target
-        and r["script_core_share"] <= CLIENT_LIMIT
+        and not client_limited(r)
     ]
     print(
         f"\nlargest tested number of sessions with p95 first update < {args.target:.0f} ms"
-        f"{' (clients below saturation)' if args.client == 'bokeh' else ''}: "
+        " (clients below saturation)" + ": "
         f"{max(ok) if ok else 'none'}"
     )
     if args.json:
