@@ -707,9 +707,14 @@ class RawSession:
             (scheme, parts.netloc, parts.path.rstrip("/") + "/ws", "", "")
         )
         headers = {"Origin": f"{parts.scheme}://{parts.netloc}", **self._headers}
+        # a browser waits for the handshake as long as it takes (tornado: 20 s); a server
+        # building many pages answers it late
+        request = HTTPRequest(
+            ws_url, headers=headers, connect_timeout=timeout_s, request_timeout=timeout_s
+        )
         self._ws = await asyncio.wait_for(
             websocket_connect(
-                HTTPRequest(ws_url, headers=headers),
+                request,
                 subprotocols=["bokeh", token],
                 max_message_size=self._max_bytes,
             ),
@@ -764,7 +769,9 @@ class RawSession:
                         self._data_times.append(now)
                         self._data_arrived.set()
                 elif kind == "PULL-DOC-REPLY" and self._pulls:
-                    self._pulls.pop(0).set_result(msg)
+                    pulled = self._pulls.pop(0)
+                    if not pulled.done():  # else the puller gave up waiting
+                        pulled.set_result(msg)
                 elif kind == "ERROR":
                     self.errors.append(f"server error: {json.loads(msg.content_json).get('text')}")
         except Exception as exc:  # a message this client cannot read is a finding
