@@ -123,6 +123,9 @@ CLIENT_LIMIT = 0.75
 #: Above this busy share of the clients' cores the browsers (whose CPU this script does not
 #: see) wait for a core.
 CORES_LIMIT = 0.9
+#: On a saturated clients' core (other processes on it), protocol clients using more than
+#: this share of it wanted more than they got.
+CLIENT_SHARED_LIMIT = 0.25
 #: Above this share of a core taken by processes other than ours (the machine is shared)
 #: the figures carry their noise: said in the output.
 NEIGHBOURS_LIMIT = 0.25
@@ -131,14 +134,23 @@ NEIGHBOURS_LIMIT = 0.25
 def client_limited(row: dict) -> str | None:
     """Why a level's figures are (also) the clients', or None. The protocol clients are
     this script; a browser's CPU shows only as the busy share of the clients' cores."""
+    busy = row.get("clients_cores_busy")
     if row["client"] != "browser":
-        if row["script_core_share"] > CLIENT_LIMIT:
+        own = row["script_core_share"]
+        if own > CLIENT_LIMIT:
             return (
-                f"the protocol clients used {100 * row['script_core_share']:.0f}% of their "
-                f"core (limit {100 * CLIENT_LIMIT:.0f}%)"
+                f"the protocol clients used {100 * own:.0f}% of their core"
+                f" (limit {100 * CLIENT_LIMIT:.0f}%)"
+            )
+        # a full core shared with other processes: clients needing a good part of it
+        # got less than they needed (a mostly idle client is still served promptly)
+        if busy is not None and busy > CORES_LIMIT and own > CLIENT_SHARED_LIMIT:
+            return (
+                f"the clients' core was {100 * busy:.0f}% busy, other processes included, and"
+                f" the protocol clients needed {100 * own:.0f}% of it"
+                f" (limit {100 * CLIENT_SHARED_LIMIT:.0f}% on a full core)"
             )
         return None
-    busy = row.get("clients_cores_busy")
     if row.get("other_cores_busy") is not None and busy is not None and busy > CORES_LIMIT:
         return f"the clients' cores were {100 * busy:.0f}% busy (limit {100 * CORES_LIMIT:.0f}%)"
     return None
