@@ -11,14 +11,17 @@ agree to rounding (1e-12 of the largest, per line), not bit for bit. Then: a lin
 do not depend on the other lines of the call (bit for bit), whatever came before.
 """
 
+import multiprocessing
+import os
 import subprocess
 import sys
+import threading
 
 import numpy as np
 import pytest
 
 from fbs_core import harmonic
-from fbs_core.tire import TireModel, interp, reference_tire
+from fbs_core.tire import TireModel, interp, reference_tire, sums
 
 
 @pytest.fixture(scope="module")
@@ -249,3 +252,77 @@ def test_interval_refuses_what_it_does_not_hold(tire):
     iv = tire.interval(3, [0, 7])
     assert iv.residues.shape == (iv.speeds.size, tire.n_modes, 2)
     assert not iv.residues.flags.writeable
+
+
+def _threaded(monkeypatch, n):
+    """The kernel's tiles on ``n`` threads; the threads that ran a tile are recorded."""
+    ran = set()
+    kernel = sums._kernel
+
+    def kernel_here(*args):
+        ran.add(threading.get_ident())
+        return kernel(*args)
+
+    monkeypatch.setattr(sums, "_threads", lambda n_tiles: min(n, max(1, n_tiles)))
+    monkeypatch.setattr(sums, "_kernel", kernel_here)
+    return ran
+
+
+def test_the_tiles_on_several_threads_give_the_same_bits(tire, monkeypatch):
+    """Issue 33: a call's tiles dealt to helper threads (the kernel releases the GIL); each
+    line is still summed by one thread from its own data: bit for bit one thread's sums."""
+    h = harmonic(5)
+    f = h.frequencies(0.5)
+    ns = [10, 60, 140, 400]
+    ran = _threaded(monkeypatch, 1)
+    Y1, v1 = tire.truncations(f, h, ns, residual=True)
+    assert len(ran) == 1
+    ran = _threaded(monkeypatch, 3)
+    Y3, v3 = tire.truncations(f, h, ns, residual=True)
+    assert len(ran) == 3 and threading.get_ident() in ran
+    assert np.array_equal(Y3, Y1) and np.array_equal(v3, v1)
+
+
+def test_work_at_a_lowered_priority_keeps_to_its_own_thread():
+    """Work computed ahead runs niced (app.runtime.background): it takes no helper threads,
+    which would run at the normal priority beside the pages."""
+    out = {}
+
+    def probe(lower):
+        if lower:
+            os.setpriority(
+                os.PRIO_PROCESS, threading.get_native_id(), os.getpriority(os.PRIO_PROCESS, 0) + 5
+            )
+        out[lower] = sums._threads(1000)
+
+    for lower in (False, True):
+        t = threading.Thread(target=probe, args=(lower,))
+        t.start()
+        t.join()
+    cores = len(os.sched_getaffinity(0))
+    assert out == {False: min(cores, sums.MAX_THREADS), True: 1}
+
+
+def _child_sums(q):
+    import fbs_core
+
+    sums._threads = lambda n_tiles: 2  # the parent's pool has no threads in this process
+    h = harmonic(2)
+    Y, _ = fbs_core.reference_tire().truncations(h.frequencies(1.0), h, [40, 400])
+    q.put(Y)
+
+
+def test_a_forked_child_makes_its_own_helper_threads(tire, monkeypatch):
+    """A process forked after the pool was made (report and upload children) gets a pool of
+    its own; with the parent's copy, whose threads do not exist there, the call would hang."""
+    _threaded(monkeypatch, 2)
+    h = harmonic(2)
+    Y, _ = tire.truncations(h.frequencies(1.0), h, [40, 400])
+    assert sums._pool is not None  # made by the call above
+    ctx = multiprocessing.get_context("fork")
+    q = ctx.Queue()
+    p = ctx.Process(target=_child_sums, args=(q,))
+    p.start()
+    got = q.get(timeout=300)  # waits for the child's result (a hang fails here)
+    p.join(300)
+    assert np.array_equal(got, Y)
