@@ -258,11 +258,13 @@ def test_cli_summary_and_errors(tmp_path, capsys):
 
 def test_ctrl_c_stops_cleanly_and_the_same_command_resumes(tmp_path):
     camp = tmp_path / "k.toml"
-    # 5 cases of one block each (harmonic 5: 301 lines)
+    # 5 cases of one block each (harmonic 5: 301 lines), a task each (a case's work is the
+    # task size: no two go together)
     camp.write_text(
         _toml(
             tmp_path / "k.h5",
             rounds=1000,
+            task_round_lines=301_000,
             scatter='harmonics = [5]\nnoise = [0.01, 0.02, 0.05, 0.1, 0.2]\ntargets = ["both"]\n',
         )
     )
@@ -331,3 +333,39 @@ def test_run_in_process_gives_the_signal_handlers_back(tmp_path):
     finally:
         for s, h in before.items():
             signal.signal(s, h)
+
+
+def test_small_cases_sharing_their_arrays_go_as_one_task_each_with_its_own_unit(tmp_path):
+    """Issue 33: blocks far smaller than a task (few rounds) go to the cluster together while
+    they share their subsystem arrays and fit the task size; each keeps its own unit and its
+    numbers are those of the case alone (scatter_band)."""
+    from fbs_core.campaign import group_blocks
+    from fbs_core.campaign.run import n_lines
+
+    rounds = 100
+    per_case = rounds * n_lines(2, 0.5)  # harmonic 2 has the more lines of the two
+    text = _toml(
+        tmp_path / "g.h5",
+        rounds=rounds,
+        task_round_lines=int(2.5 * per_case),  # two cases of harmonic 2 a task, not three
+        scatter='harmonics = [1, 2]\nnoise = [0.02, 0.05, 0.1]\ntargets = ["tire", "both"]\n',
+    )
+    camp = parse_campaign(text, tmp_path)
+    tasks, _ = plan(camp)
+    assert len(tasks) == 12  # one block a case
+    groups = group_blocks(tasks, camp.task_round_lines)
+    assert sorted(t.unit for g in groups for t in g) == sorted(t.unit for t in tasks)
+    assert all(len({t.inputs for t in g}) == 1 for g in groups)  # one harmonic's arrays
+    assert all(sum(t.work for t in g) <= camp.task_round_lines for g in groups)
+    h2 = [g for g in groups if g[0].case.harmonic == 2]
+    assert [len(g) for g in h2] == [2, 2, 2]
+    assert len(groups) < len(tasks)
+    rep = run_campaign(camp)
+    assert rep.status == "complete" and rep.tasks_done == 12
+    res = open_campaign(camp.output)
+    for x in camp.band_cases:
+        direct = fbs_core.scatter_band(
+            x.harmonic, x.noise, x.target, rounds, False, seed=x.seed,
+            percentiles=(5.0, 50.0, 95.0),
+        )  # fmt: skip
+        _same_band(res.band(x.name), direct)

@@ -22,7 +22,7 @@ Example
 """
 
 from .browse import CampaignResult, CaseEntry, TruncationEntry, open_campaign
-from .run import SCHEDULER_ENV, RunReport, Task, make_client, plan, run_campaign
+from .run import SCHEDULER_ENV, RunReport, Task, group_blocks, make_client, plan, run_campaign
 from .spec import (
     BandCase,
     Campaign,
@@ -52,5 +52,6 @@ __all__ = [
     "open_campaign",
     "parse_campaign",
     "plan",
+    "group_blocks",
     "run_campaign",
 ]

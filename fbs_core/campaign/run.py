@@ -41,7 +41,15 @@ if TYPE_CHECKING:
     from ..frf import FRF
     from .variants import VariantsCase
 
-__all__ = ["Task", "plan", "run_campaign", "RunReport", "make_client", "SCHEDULER_ENV"]
+__all__ = [
+    "Task",
+    "plan",
+    "group_blocks",
+    "run_campaign",
+    "RunReport",
+    "make_client",
+    "SCHEDULER_ENV",
+]
 
 SCHEDULER_ENV = "FBS_DASK_SCHEDULER"
 
@@ -171,6 +179,34 @@ def plan(campaign: Campaign, done: set[str] | None = None) -> tuple[list[Task], 
                     )
                 )
     return tasks, n_done
+
+
+def group_blocks(tasks: list[Task], task_round_lines: float) -> list[list[Task]]:
+    """The tasks as they are sent to the cluster: band blocks of cases that share their
+    subsystem arrays go together, in order, while their work (rounds x lines) stays within
+    ``task_round_lines``; every other task alone.
+
+    A block is a case's lines cut to about ``task_round_lines`` (:func:`block_lines`), but a
+    case of few rounds is smaller than that whole: at 2,000 rounds a case was a task of
+    0.04-0.07 s, where Dask's cost per task (~1.6 ms on the scheduler and client, ~5 ms of
+    writing on the client, beside the workers on the same cores) took a quarter of two
+    workers' throughput (``bench/bench_campaign.py``). Each block keeps its own unit and
+    result (:func:`.work.band_blocks`).
+    """
+    groups: list[list[Task]] = []
+    open_: dict[str, list[Task]] = {}  # the group still filling, by subsystem arrays
+    for t in tasks:
+        if t.kind != "band":
+            groups.append([t])
+            continue
+        g = open_.get(t.inputs)
+        if g is not None and sum(x.work for x in g) + t.work <= task_round_lines:
+            g.append(t)
+            continue
+        g = [t]
+        groups.append(g)
+        open_[t.inputs] = g
+    return groups
 
 
 def make_client(scheduler: str | None = None, workers: int | None = None) -> tuple[Any, Any]:
@@ -500,17 +536,51 @@ def run_campaign(
                         _write_inputs(store, t.inputs, c, inp)
                     inputs_f[t.inputs] = client.scatter(inp)
             grids_f = {g: client.scatter(work.frf_payload(v)) for g, v in grids.items()}
-            futures: dict[Any, Task] = {}
+            futures: dict[Any, list[Task]] = {}
             token = uuid.uuid4().hex[:12]
             t_submit = time.perf_counter()
-            for t in tasks:
+            # small blocks of cases sharing their arrays go as one task (a partial run,
+            # max_tasks, counts single blocks)
+            groups = (
+                group_blocks(tasks, campaign.task_round_lines)
+                if max_tasks is None
+                else [[t] for t in tasks]
+            )
+            for group in groups:
+                t = group[0]
                 c = t.case
                 if t.kind == "variants":
                     fut = _variants.submit(client, t, numba_threads, token)
-                    futures[fut] = t
+                    futures[fut] = group
                     continue
                 assert isinstance(c, BandCase | TruncationCase)
-                if t.kind == "band":
+                if len(group) > 1:
+                    blocks = []
+                    for b in group:
+                        bc = b.case
+                        assert isinstance(bc, BandCase)
+                        blocks.append(
+                            (
+                                bc.noise,
+                                bc.target,
+                                bc.rounds,
+                                bc.frequency_dependent,
+                                bc.seed,
+                                bc.percentiles,
+                                b.l0,
+                                b.l1,
+                            )
+                        )
+                    fut = client.submit(
+                        work.band_blocks,
+                        inputs_f[t.inputs],
+                        blocks,
+                        campaign.max_chunk_bytes,
+                        numba_threads,
+                        key=f"bands-{c.name}-{t.l0}-{len(group)}-{token}",
+                        pure=False,
+                    )
+                elif t.kind == "band":
                     assert isinstance(c, BandCase)
                     fut = client.submit(
                         work.band_block,
@@ -537,36 +607,38 @@ def run_campaign(
                         key=f"trunc-{c.name}-{token}",
                         pure=False,
                     )
-                futures[fut] = t
+                futures[fut] = group
             ac = as_completed(list(futures))
             try:
                 for fut in ac:
-                    t = futures.pop(fut)
+                    group = futures.pop(fut)
                     if fut.status == "error":
                         exc = fut.exception()
-                        report.errors.append((t.unit, f"{type(exc).__name__}: {exc}"))
-                        if bar:
-                            bar.update(1, 0.0)
+                        for t in group:
+                            report.errors.append((t.unit, f"{type(exc).__name__}: {exc}"))
+                            if bar:
+                                bar.update(1, 0.0)
                         continue
                     if fut.status == "cancelled":
                         continue
-                    res = fut.result()
-                    report.task_seconds += float(res.get("seconds", 0.0))
-                    tw = time.perf_counter()
-                    WRITING.set()
-                    try:
-                        _write(store, campaign, t, res)
-                    finally:
-                        WRITING.clear()
-                    report.write_seconds += time.perf_counter() - tw
-                    report.compute_wall = time.perf_counter() - t_submit
+                    results = fut.result()
                     fut.release()
-                    report.tasks_done += 1
-                    report.rounds_done += t.rounds
-                    if bar:
-                        bar.update(1, t.rounds, t.work)
-                    elif callable(progress):
-                        progress(report.tasks_done, len(todo), report.rounds_done)
+                    for t, res in zip(group, results if len(group) > 1 else [results], strict=True):
+                        report.task_seconds += float(res.get("seconds", 0.0))
+                        tw = time.perf_counter()
+                        WRITING.set()
+                        try:
+                            _write(store, campaign, t, res)
+                        finally:
+                            WRITING.clear()
+                        report.write_seconds += time.perf_counter() - tw
+                        report.compute_wall = time.perf_counter() - t_submit
+                        report.tasks_done += 1
+                        report.rounds_done += t.rounds
+                        if bar:
+                            bar.update(1, t.rounds, t.work)
+                        elif callable(progress):
+                            progress(report.tasks_done, len(todo), report.rounds_done)
                     if (stop is not None and stop.is_set()) or (
                         max_tasks is not None and report.tasks_done >= max_tasks
                     ):

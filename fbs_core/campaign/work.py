@@ -267,6 +267,36 @@ def band_block(
     }
 
 
+def band_blocks(
+    inputs: BandInputs,
+    blocks: list[tuple[Any, ...]],
+    max_chunk_bytes: float = 64e6,
+    numba_threads: int | None = None,
+) -> list[dict[str, Any]]:
+    """:func:`band_block` of every ``(noise, target, rounds, frequency_dependent, seed,
+    percentiles, l0, l1)`` of ``blocks`` (cases sharing ``inputs``), one after the other:
+    one task for blocks too small to be a task each (each result exactly that of its own
+    :func:`band_block`)."""
+    out = []
+    for noise, target, rounds, frequency_dependent, seed, percentiles, l0, l1 in blocks:
+        out.append(
+            band_block(
+                inputs,
+                noise,
+                target,
+                rounds,
+                frequency_dependent,
+                seed,
+                percentiles,
+                l0,
+                l1,
+                max_chunk_bytes,
+                numba_threads,
+            )  # fmt: skip
+        )
+    return out
+
+
 BLOCK_KEYS: tuple[str, ...] = ("lower", "upper", "argmin_round", "argmax_round", "percentiles")
 BLOCK_KEYS += ("conv_lower", "conv_upper")
 
