@@ -554,7 +554,7 @@ def run_campaign(
                     futures[fut] = group
                     continue
                 assert isinstance(c, BandCase | TruncationCase)
-                if len(group) > 1:
+                if t.kind == "band":  # one block, or small ones sharing their arrays
                     blocks = []
                     for b in group:
                         bc = b.case
@@ -577,25 +577,7 @@ def run_campaign(
                         blocks,
                         campaign.max_chunk_bytes,
                         numba_threads,
-                        key=f"bands-{c.name}-{t.l0}-{len(group)}-{token}",
-                        pure=False,
-                    )
-                elif t.kind == "band":
-                    assert isinstance(c, BandCase)
-                    fut = client.submit(
-                        work.band_block,
-                        inputs_f[t.inputs],
-                        c.noise,
-                        c.target,
-                        c.rounds,
-                        c.frequency_dependent,
-                        c.seed,
-                        c.percentiles,
-                        t.l0,
-                        t.l1,
-                        campaign.max_chunk_bytes,
-                        numba_threads,
-                        key=f"band-{c.name}-{t.l0}-{token}",
+                        key=f"band-{c.name}-{t.l0}-{len(group)}-{token}",
                         pure=False,
                     )
                 else:
@@ -623,7 +605,9 @@ def run_campaign(
                         continue
                     results = fut.result()
                     fut.release()
-                    for t, res in zip(group, results if len(group) > 1 else [results], strict=True):
+                    # a band task returns its blocks' results, any other task its own
+                    each = results if group[0].kind == "band" else [results]
+                    for t, res in zip(group, each, strict=True):
                         report.task_seconds += float(res.get("seconds", 0.0))
                         tw = time.perf_counter()
                         WRITING.set()
