@@ -86,6 +86,16 @@ def in_background() -> bool:
     return bool(getattr(_thread_kind, "background", False))
 
 
+#: Every function of :func:`shared_cache`, for :func:`clear_shared_caches`.
+_SHARED_CACHES: list = []
+
+
+def clear_shared_caches() -> None:
+    """Empty every :func:`shared_cache` of the process (tests: a build that computes)."""
+    for wrapper in _SHARED_CACHES:
+        wrapper.cache_clear()
+
+
 def shared_cache(maxsize: int):
     """``functools.lru_cache`` that computes a missing entry once for all threads.
 
@@ -124,6 +134,7 @@ def shared_cache(maxsize: int):
 
         wrapper.cache_clear = cached.cache_clear
         wrapper.cache_info = cached.cache_info
+        _SHARED_CACHES.append(wrapper)
         return wrapper
 
     return decorate

@@ -45,6 +45,7 @@ from app.runtime import background, closed_pages, libraries  # noqa: F401 (libra
 from app.runtime.collector import count_alive, session_ended, session_started
 from app.runtime.collector import start as start_quiet_collections
 from app.runtime.draw import DrawQueue, on_document, served, served_document
+from app.runtime.pace import step_aside
 from app.state import URL_KEYS, DashboardState
 from app.store import LIVE, Results
 from app.views import (
@@ -212,7 +213,13 @@ EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to th
 
 def extra_cards(parts: PageParts) -> list:
     """The cards of :data:`EXTRA_CARDS` for this session."""
-    return [c for c in (build(parts) for build in EXTRA_CARDS) if c is not None]
+    cards = []
+    for build in EXTRA_CARDS:
+        step_aside()
+        card = build(parts)
+        if card is not None:
+            cards.append(card)
+    return cards
 
 
 class PlotViews:
@@ -304,17 +311,19 @@ def below_first_screen(parts: PageParts, views: PlotViews) -> list:
     (suggested modes, eigenfrequencies), the "Your data" card, the noise study, then the
     cards of :data:`EXTRA_CARDS`. Builds the views it shows (:meth:`PlotViews.build_below`).
     """
+    step_aside()  # (safe points: nothing held that another page may wait for)
     views.build_below()
+    step_aside()
     card = parts.card
-    return [
-        pn.Row(
-            card("Suggested number of modes (thesis table 5.1)", views.suggested),
-            card("Eigenfrequency versus number of modes (fig. 5.8)", views.eigen),
-        ),
-        data_card(parts),
-        pn.Row(card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", views.scatter)),
-        *extra_cards(parts),
-    ]
+    truncation = pn.Row(
+        card("Suggested number of modes (thesis table 5.1)", views.suggested),
+        card("Eigenfrequency versus number of modes (fig. 5.8)", views.eigen),
+    )
+    step_aside()
+    data = data_card(parts)
+    step_aside()
+    noise = pn.Row(card("Noise scatter band (thesis 5.2, figs. 5.9-5.11)", views.scatter))
+    return [truncation, data, noise, *extra_cards(parts)]
 
 
 def data_card(parts: PageParts) -> pn.Card:
@@ -427,7 +436,9 @@ def create_app(
     The page's :class:`~app.store.Results` computes everything it shows; when served, it
     is closed with the session (its running band is cancelled).
     """
+    step_aside()  # (safe points: nothing held that another page may wait for)
     results = results if results is not None else Results(state)
+    step_aside()
     state = results.state
     sync_url(state)
     page = PageState()
@@ -437,6 +448,7 @@ def create_app(
     # one N range for the error map and the eigenfrequency plot
     parts = PageParts(results=results, page=page, freq=frequency_range(), modes=modes_range())
     views = PlotViews(parts)
+    step_aside()
 
     def report():  # the page's published results, as they are when the button is clicked
         return report_data(results, url=page_url(), n_axis=page.n_axis)
@@ -462,6 +474,7 @@ def create_app(
         # sessions changing, bench/load_test.py profiled); the page has its own progress
         busy_indicator=None,
     )
+    step_aside()
     main = pn.Column(
         page_bar(parts, report, template.open_modal),
         link_notice_pane(parts),
@@ -489,6 +502,7 @@ def create_app(
         )
 
     help_close.on_click(lambda _e: template.close_modal())
+    step_aside()
     template.main.append(main)
     template.config.raw_css.append(PAGE_CSS)
     # the presentation view's larger type follows the view switch without a reload
@@ -562,4 +576,6 @@ if pn.state.served:
     # (Bokeh recomputes it on every change of the graph): about a fifth of the server's
     # CPU time for a new session (bench/load_test.py)
     with pn.state.curdoc.models.freeze():
-        create_app().servable(title="tire-fbs dashboard")
+        _page = create_app()
+        step_aside()
+        _page.servable(title="tire-fbs dashboard")

@@ -70,6 +70,7 @@ from fbs_auth import (  # noqa: F401  (re-exported: the server's login in one im
     check_password,
     parse_networks,
 )
+from page_gate import PageGate
 from server_private import cancel_queued_panel_work, cleanup_document
 
 log = logging.getLogger("tire_fbs.server")
@@ -245,7 +246,8 @@ def preload_imports(files: list[str]) -> float:
 def prove_applications(apps: dict, proved: dict[str, float] | None = None) -> dict[str, float]:
     """Build, load (:func:`load_as_browser`) and clean up one page of each app of
     :func:`applications`; seconds per app path, entered in ``proved`` (a new dict by
-    default) as each app is proved.
+    default) as each app is proved. Before it builds a page and before it loads it, it
+    steps aside (the ``step_aside`` of its thread, if any: :mod:`page_gate`).
 
     Raises
     ------
@@ -257,6 +259,7 @@ def prove_applications(apps: dict, proved: dict[str, float] | None = None) -> di
 
     proved = {} if proved is None else proved
     for path, app in apps.items():
+        step_aside()
         t0 = time.perf_counter()
         # a session context as in a served session: .servable() adds the page's roots
         doc = generate_session(app).document
@@ -269,12 +272,22 @@ def prove_applications(apps: dict, proved: dict[str, float] | None = None) -> di
                 )
             if not doc.roots:
                 raise RuntimeError(f"the app {path} built an empty page")
+            step_aside()
+            # the page's on-load callbacks step aside too (on Panel's worker threads)
+            doc.step_aside = getattr(threading.current_thread(), "step_aside", None)
             load_as_browser(doc, path)
         finally:
             cleanup_document(doc)
         proved[path] = time.perf_counter() - t0
         log.info("app %s builds a page (%.1f s); /liveness reports it", path, proved[path])
     return proved
+
+
+def step_aside() -> None:
+    """Wait while users' pages open, if this thread is asked to (:mod:`page_gate`)."""
+    wait = getattr(threading.current_thread(), "step_aside", None)
+    if wait is not None:
+        wait()
 
 
 def load_as_browser(doc, path: str, timeout_s: float = ONLOAD_TIMEOUT_S) -> None:
@@ -327,13 +340,19 @@ def load_as_browser(doc, path: str, timeout_s: float = ONLOAD_TIMEOUT_S) -> None
         ) from exc
 
 
-def prove_in_background(apps: dict, proved: dict[str, float]) -> threading.Thread:
+def prove_in_background(
+    apps: dict, proved: dict[str, float], gate: PageGate | None = None
+) -> threading.Thread:
     """:func:`prove_applications` on a thread of its own, once the server listens; an app
-    that cannot build a page stops the server (as a failed start would)."""
+    that cannot build a page stops the server (as a failed start would). With ``gate``, the
+    proof steps aside while users' pages open (:class:`page_gate.PageGate`)."""
 
     def work() -> None:
         try:
-            prove_applications(apps, proved)
+            if gate is None:
+                prove_applications(apps, proved)
+            else:
+                gate.run(lambda: prove_applications(apps, proved))
         except Exception as exc:  # noqa: BLE001 (any failure of the app: stop with it)
             log.error("the server stopped: %s", exc)
             print(f"tire-fbs: the server stopped: {exc}", file=sys.stderr, flush=True)
@@ -544,8 +563,13 @@ def _serve_class():
             from tornado.ioloop import IOLoop
 
             IOLoop.current().add_callback(_install_stop_signals, self.shutdown_deadline_s)
-            # once the loop runs (the port is open): the proof, which warms the server
-            IOLoop.current().add_callback(prove_in_background, apps, proved)
+            # once the loop runs (the port is open): the proof, which warms the server and
+            # steps aside while a user's page opens (both are work for the one interpreter)
+            from panel.io.state import state
+
+            gate = PageGate()
+            state.on_session_created(gate.watch_session)
+            IOLoop.current().add_callback(prove_in_background, apps, proved, gate)
             return kwargs
 
         def customize_server(self, server):

@@ -52,9 +52,8 @@ SERVER=$!
 # Ctrl-C reaches the server too (same process group); a TERM sent to this script is passed on
 trap 'kill -TERM "$SERVER" 2>/dev/null; wait "$SERVER"; exit 143' TERM
 # the URL once the app is proved (/liveness 200: the server's own page of it built and
-# loaded, within a few seconds of the port opening): a page opened then takes its usual
-# time (bench/bench_first_page.py --first proved: 1.9 s to the first plot), one opened while
-# the proof still runs shares the machine with it (--first listening: 2.8 s)
+# loaded, within a few seconds of the port opening); a page opened earlier goes first, the
+# proof steps aside until it is shown (docker/page_gate.py)
 until .venv/bin/python -c 'import sys, urllib.request
 urllib.request.urlopen(f"http://{sys.argv[1]}:{sys.argv[2]}/liveness?endpoint=/main", timeout=2)' \
   "$HOST" "$PORT" 2>/dev/null; do

@@ -2,7 +2,8 @@
 
 A page's Markdown texts load Panel's Markdown libraries, its tables pandas and narwhals
 (Panel's Tabulator), its studies numba, and its Analysis card the modules of its views,
-each on first use. The server imports the modules an app script imports before its port
+each on first use (and numba registers its implementations on its first kernel).
+The server imports the modules an app script imports before its port
 opens (``docker/fbs_server.py``, ``preload_imports``), this one included: without it, the
 first page requested after a start imported them itself (0.4 s of imports on an idle
 machine, 0.7 s while the server's own proof of the app ran beside it; issue 33).
@@ -14,6 +15,7 @@ import contextlib
 import importlib
 
 import numba  # noqa: F401
+from numba.core.registry import cpu_target
 
 from app.views import (  # noqa: F401
     analysis_compare,
@@ -31,3 +33,8 @@ PANEL_LAZY = ("markdown", "markdown_it", "narwhals.stable.v1", "pandas")
 for _name in PANEL_LAZY:
     with contextlib.suppress(ImportError):
         importlib.import_module(_name)
+
+# numba registers its implementations (numpy functions, random generators, typed
+# containers, ...) when its first kernel is compiled or loaded from its cache: 0.3 s of
+# imports, paid by the first page's first study (holding the GIL) unless done here
+cpu_target.target_context.refresh()

@@ -1,0 +1,243 @@
+"""The server's proof steps aside while users' pages open (issue 33: the first page).
+
+``docker/page_gate.py`` (the gate: pages opening, bounded waits), its use by the server's
+proof (a real server: the proof waits at a safe point of the app until the user's page says
+it is shown), and the app's safe points (``app/runtime/pace.py``): a page of a user is built
+while the proof waits at any of them (paused inside a computation the pages share, the proof
+held a user's page back until its hold ran out: 13 s).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import sys
+import threading
+import time
+import urllib.request
+
+import panel  # noqa: F401 (a page's replica holds Panel's models)
+from server_util import ROOT, NoRedirect, PageClient, Server, get, in_own_loop, wait_for
+
+sys.path.insert(0, str(ROOT / "docker"))
+from page_gate import PageGate  # noqa: E402
+
+
+def _waiter(gate: PageGate) -> tuple[threading.Thread, dict]:
+    out: dict = {}
+
+    def run() -> None:
+        t0 = time.monotonic()
+        out["again"] = gate.wait()
+        out["waited"] = time.monotonic() - t0
+
+    t = threading.Thread(target=run, daemon=True)
+    t.start()
+    return t, out
+
+
+def test_nothing_opening_no_wait():
+    gate = PageGate()
+    assert gate.wait() is True and gate.waited_s < 1
+
+
+def test_the_proof_waits_until_the_page_is_shown():
+    gate = PageGate(hold_s=600, budget_s=600)
+    gate.opened("a")
+    gate.opened("b")
+    t, out = _waiter(gate)
+    wait_for(gate.waiting, 30, what="the proof waiting")
+    gate.shown("a")  # one of two pages shown: still waiting
+    wait_for(lambda: gate.opening() == 1, 30)
+    assert t.is_alive() and gate.waiting()
+    gate.shown("b")
+    t.join(30)
+    assert not t.is_alive() and out["again"] is True
+    assert gate.opening() == 0 and not gate.waiting()
+
+
+def test_a_page_that_is_never_shown_holds_the_proof_for_hold_s_only():
+    gate = PageGate(hold_s=0.3, budget_s=600)
+    t0 = time.monotonic()
+    gate.opened("bare http request")
+    t, out = _waiter(gate)
+    t.join(60)
+    assert not t.is_alive() and out["again"] is True
+    assert time.monotonic() - t0 >= 0.3 and gate.opening() == 0
+
+
+def test_the_proof_yields_its_budget_at_most():
+    gate = PageGate(hold_s=600, budget_s=0.3)
+    gate.opened("x")
+    t, out = _waiter(gate)
+    t.join(60)
+    assert not t.is_alive() and out["again"] is False  # spent: no need to ask again
+    assert out["waited"] >= 0.3
+    t0 = time.monotonic()
+    assert gate.wait() is False and time.monotonic() - t0 < 1  # runs beside pages now
+
+
+def test_retiring_the_gate_frees_a_waiter_and_ends_tracking():
+    gate = PageGate(hold_s=600, budget_s=600)
+    gate.opened("x")
+    t, out = _waiter(gate)
+    wait_for(gate.waiting, 30, what="the proof waiting")
+    gate.retire()
+    t.join(30)
+    assert not t.is_alive() and out["again"] is False
+    gate.opened("later")  # sessions after the proof are not tracked
+    assert gate.opening() == 0
+
+
+def test_a_session_opens_until_document_ready_or_its_end():
+    from bokeh.document import Document
+    from bokeh.events import DocumentReady
+
+    class Context:  # what watch_session reads of Bokeh's session context
+        def __init__(self, key):
+            self.id, self._document = key, Document()
+
+    gate = PageGate()
+    shown, closed = Context("shown"), Context("closed")
+    gate.watch_session(shown)
+    gate.watch_session(closed)
+    assert gate.opening() == 2
+    shown._document.callbacks.trigger_event(DocumentReady())
+    assert gate.opening() == 1
+    for callback in closed._document.session_destroyed_callbacks:
+        callback(closed)
+    assert gate.opening() == 0
+
+
+def test_the_server_proof_steps_aside_for_a_page_opened_meanwhile(tmp_path):
+    """A real server: its proof builds the app's page; a user's page opens meanwhile; the
+    proof, at the app's next safe point, waits until that page is shown, then goes on and
+    the app is reported proved."""
+    notes, gate_file = tmp_path / "notes.txt", tmp_path / "gate"
+    app = (
+        "import pathlib, threading, time\n"
+        "import panel as pn\n"
+        f"notes = pathlib.Path({str(notes)!r})\n"
+        "def note(s):\n"
+        "    with notes.open('a') as f:\n"
+        "        f.write(s + '\\n')\n"
+        "thread = threading.current_thread()\n"
+        "if thread.name == 'fbs-prove-apps':\n"
+        "    note('proof builds')\n"
+        f"    gate = pathlib.Path({str(gate_file)!r})\n"
+        "    t0 = time.monotonic()\n"
+        "    while not gate.exists() and time.monotonic() - t0 < 300:\n"
+        "        time.sleep(0.02)\n"
+        "    step = getattr(thread, 'step_aside', None)\n"
+        "    note(f'proof at a safe point ({step is not None})')\n"
+        "    if step is not None:\n"
+        "        step()\n"
+        "    note('proof goes on')\n"
+        "else:\n"
+        "    note('page builds')\n"
+        "pn.pane.Markdown('a page').servable()\n"
+    )
+    srv = Server(tmp_path, app, {}, name="gateapp")
+
+    def while_the_page_opens() -> None:
+        assert "page builds" in notes.read_text()
+        gate_file.write_text("open")
+        # the proof reached its safe point while the page opens: it waits there
+        wait_for(lambda: "the proof steps aside: 1 page(s) opening" in srv.log(), 60)
+        assert "proof at a safe point (True)" in notes.read_text()
+        assert "proof goes on" not in notes.read_text()
+        opener = urllib.request.build_opener(NoRedirect)
+        status, _, body = get(opener, srv.base + "/liveness?endpoint=/gateapp")
+        assert status == 503 and json.loads(body) == {"/gateapp": False}
+
+    async def user() -> None:
+        client = await PageClient.open(f"ws://127.0.0.1:{srv.port}/gateapp/ws")
+        try:
+            doc = await client.pull(60)  # a user's page opened (built, sent)
+            loop = asyncio.get_running_loop()
+            await loop.run_in_executor(None, while_the_page_opens)
+            await client.ready(doc)  # the browser shows the page
+            await loop.run_in_executor(
+                None, lambda: wait_for(lambda: "proof goes on" in notes.read_text(), 60)
+            )
+        finally:
+            client.close()
+
+    try:
+        srv.listening(120)
+        wait_for(lambda: notes.exists() and "proof builds" in notes.read_text(), 120)
+        in_own_loop(user(), 300)
+        srv.started(120)
+        assert "the proof goes on (" in srv.log()
+    finally:
+        srv.stop()
+
+
+def test_a_users_page_is_built_while_the_proof_waits_at_any_safe_point():
+    """The dashboard's own safe points (``step_aside`` in ``app/main.py``): with the proof
+    held at any of them, a user's page is built to the end (it never waits for the proof).
+    The results the pages share are computed afresh by each proof (the caches emptied), so
+    a safe point inside such a computation would hold the user's page."""
+    from app.compute import clear_shared_caches
+    from app.main import create_app
+    from app.state import DashboardState
+
+    def small() -> DashboardState:
+        state = DashboardState()
+        state.noise.rounds = 200
+        return state
+
+    class Stop(Exception):
+        """Ends a held proof once released (the rest of its build is of no interest)."""
+
+    def proof(step_aside) -> threading.Thread:
+        def build() -> None:
+            threading.current_thread().step_aside = step_aside  # type: ignore[attr-defined]
+            try:
+                create_app(small())
+            except Stop:
+                pass
+
+        t = threading.Thread(target=build, daemon=True)
+        t.start()
+        return t
+
+    calls: list[int] = []  # the safe points a proof passes
+    clear_shared_caches()
+    counting = proof(lambda: calls.append(1))
+    counting.join(300)
+    assert not counting.is_alive() and len(calls) >= 5
+    for stop_at in range(1, len(calls) + 1):
+        held, release = threading.Event(), threading.Event()
+        passed: list[int] = []
+
+        def step_aside(stop_at=stop_at, held=held, release=release, passed=passed) -> None:
+            passed.append(1)
+            if len(passed) == stop_at:
+                held.set()
+                assert release.wait(300)
+                raise Stop
+
+        clear_shared_caches()
+        proving = proof(step_aside)
+        wait_for(
+            lambda held=held, proving=proving: held.is_set() or not proving.is_alive(),
+            300,
+            what="the proof held",
+        )
+        assert held.is_set(), f"the proof passed {len(passed)} safe points, not {len(calls)}"
+        user: dict = {}
+        building = threading.Thread(target=lambda u=user: u.update(page=create_app(small())))
+        building.daemon = True
+        building.start()
+        building.join(120)
+        try:
+            assert not building.is_alive(), (
+                f"a user's page waited for the proof held at its safe point {stop_at}"
+            )
+            assert user["page"].main.objects
+            assert proving.is_alive()  # still held
+        finally:
+            release.set()
+        proving.join(300)
+        assert not proving.is_alive()
