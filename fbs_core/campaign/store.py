@@ -18,14 +18,18 @@ Layout (all groups carry their settings as attributes; ``settings`` is JSON text
     /runs/<started>/                    one record per run: scheduler, workers, versions,
                                         tasks done, status
 
-Every finished task is a *unit* (a group with attribute ``unit = 1``). A unit is first
-written as its own small HDF5 file in ``<output>.parts/`` (written to a temporary name,
-flushed and renamed: atomic), and :meth:`CampaignStore.commit` merges the parts into a
-copy of the result file and renames the copy over it (atomic again) before deleting the
-merged parts. A run killed at any moment therefore leaves the result file as it was at
-the last commit plus complete parts; the next run (or :func:`open_campaign`) sees both.
-(Parts are not fsynced one by one: after a power cut, as opposed to a killed process,
-the parts since the last commit may be lost and are recomputed.)
+Every finished task is a *unit* (a group with attribute ``unit = 1``). Units are first
+written as a small HDF5 file in ``<output>.parts/``, a *part* (written to a temporary name,
+flushed and renamed: atomic); a part holds one unit or several (the blocks of one cluster
+task, :meth:`CampaignStore.write_units`: all of them or none). :meth:`CampaignStore.commit`
+merges the parts into a copy of the result file and renames the copy over it (atomic
+again) before deleting the merged parts; during a run, :class:`Merging` keeps that copy
+open and merges each part as it is written, so that the end of the run has little left
+to merge. A run killed at any moment therefore leaves the result file as it was at the
+last commit plus complete parts (and maybe a stale copy, deleted by the next commit); the
+next run (or :func:`open_campaign`) sees both. (Parts are not fsynced one by one: after a
+power cut, as opposed to a killed process, the parts since the last commit may be lost
+and are recomputed.)
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ import json
 import os
 import shutil
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeAlias
 
@@ -47,6 +52,10 @@ if TYPE_CHECKING:
 
 #: An h5py File, Group or Dataset (h5py ships no type stubs).
 H5: TypeAlias = Any
+
+#: A finished unit to write: ``(path, data, attrs, parents)``, see
+#: :meth:`CampaignStore.write_unit`.
+Unit: TypeAlias = tuple[str, dict[str, Any], dict[str, Any], dict[str, dict[str, Any]] | None]
 
 __all__ = ["CampaignStore", "FORMAT_VERSION"]
 
@@ -90,21 +99,20 @@ def _is_unit(obj: H5) -> bool:
 
 
 def _merge(src: H5, dst: H5) -> None:
-    """Copy what ``dst`` lacks from ``src``: attributes, datasets, whole units."""
+    """Copy what ``dst`` lacks from ``src``: attributes, datasets, whole units, whole groups
+    (an object ``dst`` lacks is copied with all it holds, by HDF5 itself)."""
     import h5py
 
-    for k, v in src.attrs.items():
+    for k in src.attrs:
         if k not in dst.attrs:
-            dst.attrs[k] = v
-    for name, obj in src.items():
-        if name in dst:
-            if isinstance(obj, h5py.Group) and not _is_unit(obj):
-                _merge(obj, dst[name])
+            dst.attrs[k] = src.attrs[k]
+    for name in src:
+        if name not in dst:
+            src.copy(name, dst, name=name)
             continue
-        if isinstance(obj, h5py.Dataset) or _is_unit(obj):
-            src.copy(obj, dst, name=name)
-        else:
-            _merge(obj, dst.create_group(name))
+        obj = src[name]
+        if isinstance(obj, h5py.Group) and not _is_unit(obj):
+            _merge(obj, dst[name])
 
 
 def _units(h: H5, prefix: str = "") -> set[str]:
@@ -179,18 +187,42 @@ class CampaignStore:
         parents : dict of str to dict, optional
             Attributes of parent groups (e.g. the case's settings).
         """
+        return self.write_units([(path, data, attrs, parents)])
+
+    def write_units(self, units: Sequence[Unit]) -> Path:
+        """Write finished units atomically as one part file: all of them or none.
+
+        Parameters
+        ----------
+        units : sequence of (path, data, attrs, parents)
+            As the arguments of :meth:`write_unit` (a parent's attributes are written once
+            per part file, by its first unit).
+
+        Returns
+        -------
+        Path
+            The part file.
+        """
         import h5py
 
+        if not units:
+            raise ValueError("no units to write")
         self.parts.mkdir(parents=True, exist_ok=True)
-        final = self.parts / (path.replace("/", "__") + ".h5")
+        name = units[0][0].replace("/", "__") + (f"+{len(units) - 1}" if len(units) > 1 else "")
+        final = self.parts / (name + ".h5")
         tmp = final.with_name(final.name + f".{os.getpid()}.tmp")
+        finished = _now()
         with h5py.File(tmp, "w") as h:
-            for ppath, pattrs in (parents or {}).items():
-                _set_attrs(h.require_group(ppath), pattrs)
-            g = h.require_group(path)
-            for k, v in data.items():
-                _put(g, k, v)
-            _set_attrs(g, {**attrs, "unit": 1, "finished": _now()})
+            seen: set[str] = set()
+            for path, data, attrs, parents in units:
+                for ppath, pattrs in (parents or {}).items():
+                    if ppath not in seen:
+                        seen.add(ppath)
+                        _set_attrs(h.require_group(ppath), pattrs)
+                g = h.require_group(path)
+                for k, v in data.items():
+                    _put(g, k, v)
+                _set_attrs(g, {**attrs, "unit": 1, "finished": finished})
         # the rename is atomic for a killed process; no fsync per task (it cost 30-50 ms on
         # a busy disk, the client's whole budget per task): a power cut may lose the parts
         # since the last commit, which fsyncs the result file
@@ -199,48 +231,18 @@ class CampaignStore:
 
     def commit(self, root_attrs: dict[str, Any] | None = None) -> int:
         """Merge the parts into the result file (atomically); returns the units merged."""
-        import h5py
-
         parts = self._part_files()
         if not parts and (self.output.is_file() or root_attrs is None):
             return 0
-        tmp = self.output.with_name(self.output.name + f".{os.getpid()}.tmp")
-        if self.output.is_file():
-            shutil.copyfile(self.output, tmp)
-        n = 0
-        try:
-            with h5py.File(tmp, "a") as h:
-                if "format" not in h.attrs:
-                    _set_attrs(
-                        h,
-                        {
-                            "format": "tire-fbs",
-                            "content": "campaign",
-                            "format_version": FORMAT_VERSION,
-                            "created": _now(),
-                        },
-                    )
-                from .. import __version__
-
-                _set_attrs(h, {**(root_attrs or {}), "fbs_core_version": __version__})
-                h.attrs["updated"] = _now()
-                for p in parts:
-                    with h5py.File(p, "r") as src:
-                        n += len(_units(src))
-                        _merge(src, h)
-            with open(tmp, "rb+") as f:
-                os.fsync(f.fileno())
-            os.replace(tmp, self.output)
-        finally:
-            if tmp.exists():
-                tmp.unlink()
+        merge = self.merging(root_attrs)
         for p in parts:
-            p.unlink()
-        for p in self.parts.glob("*.tmp") if self.parts.is_dir() else ():
-            p.unlink()  # a write interrupted before its rename
-        if self.parts.is_dir() and not any(self.parts.iterdir()):
-            self.parts.rmdir()
-        return n
+            merge.merge(p)  # a failure drops the copy: the file and the parts as they were
+        return merge.finish(rest=False)
+
+    def merging(self, root_attrs: dict[str, Any] | None = None) -> Merging:
+        """A copy of the result file, open, into which parts are merged as they are written
+        (see :class:`Merging`)."""
+        return Merging(self, root_attrs)
 
     def unit_attrs(self, path: str) -> dict[str, Any] | None:
         """Attributes of a stored unit (result file or parts), None when absent."""
@@ -295,3 +297,136 @@ class CampaignStore:
                     f"(seed, percentiles, grid or model); write to a new output file or "
                     f"restore the campaign file it was made with (stored in the file)"
                 )
+
+
+class Merging:
+    """The result file being merged while a run goes on.
+
+    A copy of the result file (in the parts folder, ``*.tmp``) is opened and every part
+    :meth:`add`-ed is merged into it at once, while the workers compute, so that
+    :meth:`finish` has only the parts not added yet to merge before it closes the copy,
+    fsyncs it and renames it over the result file (atomic), and deletes the parts merged.
+    The parts stay on disk until then: a run killed at any moment leaves the result file as
+    it was and all the parts (the next commit deletes the stale copy). When a merge into the
+    copy fails (or is interrupted), the copy is dropped and :meth:`finish` merges all parts
+    afresh (:meth:`CampaignStore.commit`).
+
+    Parameters
+    ----------
+    store : CampaignStore
+    root_attrs : dict, optional
+        Attributes of the file's root (the campaign's name, seed, text ...).
+    """
+
+    def __init__(self, store: CampaignStore, root_attrs: dict[str, Any] | None = None) -> None:
+        import h5py
+
+        self.store, self.root_attrs = store, root_attrs
+        store.parts.mkdir(parents=True, exist_ok=True)
+        self.tmp = store.parts / f"{store.output.name}.{os.getpid()}.tmp"
+        self.merged: list[Path] = []
+        self.units = 0
+        if store.output.is_file():
+            shutil.copyfile(store.output, self.tmp)  # over a killed run's copy of this pid
+            self._h: H5 | None = h5py.File(self.tmp, "a")
+        else:
+            self._h = h5py.File(self.tmp, "w")
+        try:
+            self._root(self._h)
+        except BaseException:
+            self.abort()
+            raise
+
+    def _root(self, h: H5) -> None:
+        if "format" not in h.attrs:
+            _set_attrs(
+                h,
+                {
+                    "format": "tire-fbs",
+                    "content": "campaign",
+                    "format_version": FORMAT_VERSION,
+                    "created": _now(),
+                },
+            )
+        from .. import __version__
+
+        _set_attrs(h, {**(self.root_attrs or {}), "fbs_core_version": __version__})
+
+    @property
+    def broken(self) -> bool:
+        """Whether the copy was dropped (a merge into it failed)."""
+        return self._h is None
+
+    def add(self, part: Path) -> bool:
+        """Merge one part file into the copy; False when the copy is (or is now) dropped.
+
+        A failing merge drops the copy and is not the run's failure: the part is on disk and
+        :meth:`finish` merges all parts afresh. An interrupt (KeyboardInterrupt) drops the
+        copy too and is raised.
+        """
+        if self._h is None:
+            return False
+        try:
+            self.merge(part)
+        except Exception:
+            return False
+        return True
+
+    def merge(self, part: Path) -> None:
+        """Merge one part file into the copy; on any failure the copy is dropped and the
+        error raised."""
+        import h5py
+
+        if self._h is None:
+            raise CampaignError(f"{self.tmp}: the copy of the result file was dropped")
+        try:
+            with h5py.File(part, "r") as src:
+                n = len(_units(src))
+                _merge(src, self._h)
+        except BaseException:
+            self.abort()
+            raise
+        self.units += n
+        self.merged.append(part)
+
+    def abort(self) -> None:
+        """Drop the copy (the result file and the parts stay as they are)."""
+        h, self._h = self._h, None
+        try:
+            if h is not None:
+                h.close()
+        finally:
+            self.tmp.unlink(missing_ok=True)
+
+    def finish(self, rest: bool = True) -> int:
+        """Merge the parts not added yet (``rest``), make the copy the result file, delete the
+        merged parts; returns the units merged by this object."""
+        if self._h is None:
+            return self.store.commit(self.root_attrs)
+        if rest:
+            done = set(self.merged)
+            for p in self.store._part_files():
+                if p not in done and not self.add(p):
+                    return self.store.commit(self.root_attrs)
+        try:
+            h = self._h
+            h.attrs["updated"] = _now()
+            self._h = None
+            h.close()
+            with open(self.tmp, "rb+") as f:
+                os.fsync(f.fileno())
+            os.replace(self.tmp, self.store.output)
+        except BaseException:
+            self.abort()
+            raise
+        self._clean()
+        return self.units
+
+    def _clean(self) -> None:
+        parts = self.store.parts
+        for p in self.merged:
+            p.unlink()
+        for p in parts.glob("*.tmp"):
+            p.unlink()  # a write interrupted before its rename, a killed run's copy
+        if not any(parts.iterdir()):
+            parts.rmdir()
