@@ -8,13 +8,16 @@ in-process worker (threads of this process; the compiled kernels use all cores, 
 
 The work: model variants read from files are sent to the workers once
 (``client.scatter(..., broadcast=True)``); the subsystem arrays of every (harmonic, models,
-coupling) are one task whose result stays on the cluster and feeds the band blocks of all
-cases that use it; every scatter case is split into blocks of lines holding
-``task_round_lines`` (rounds x lines) of work (see :mod:`.work` for why lines); every
-truncation case is one task. Results are gathered with ``as_completed`` as they finish,
-each written at once as a unit of the result file (:mod:`.store`), so that a stop (Ctrl-C,
-``stop`` event, a killed process) loses at most the tasks in flight and a rerun computes
-only what is missing.
+coupling) are computed here once, stored and scattered, and feed the band blocks of all
+cases that use them; every scatter case is split into blocks of lines holding
+``task_round_lines`` (rounds x lines) of work (see :mod:`.work` for why lines), small blocks
+sharing their arrays going as one task (:func:`group_blocks`); every truncation case is one
+task. The tasks are submitted as soon as what they need is ready, so that the workers start
+on the first harmonic while the arrays of the next are prepared. Results are gathered with
+``as_completed`` as they finish, each task's units written at once as one part file and
+merged into the open copy of the result file (:mod:`.store`), so that a stop (Ctrl-C,
+``stop`` event, a killed process) loses at most the tasks in flight, a rerun computes only
+what is missing, and the end of a run has little left to merge.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ import time
 import uuid
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
@@ -35,7 +39,7 @@ import fbs_core
 from . import variants as _variants
 from . import work
 from .spec import BandCase, Campaign, CampaignError, TruncationCase
-from .store import CampaignStore, file_sha256
+from .store import CampaignStore, Merging, Unit, file_sha256
 
 if TYPE_CHECKING:
     from ..frf import FRF
@@ -338,11 +342,9 @@ def _write_inputs(store: CampaignStore, name: str, c: BandCase, inp: work.BandIn
     store.write_unit(f"inputs/{name}", data, attrs)
 
 
-def _write(store: CampaignStore, campaign: Campaign, t: Task, res: dict[str, Any]) -> None:
-    if t.kind == "variants":
-        assert isinstance(t.case, _variants.VariantsCase)
-        _variants.write_result(store, t.case, t.unit, list(t.rows), res)
-        return
+def _unit(campaign: Campaign, t: Task, res: dict[str, Any]) -> Unit:
+    """The unit of a finished band or truncation task, as :meth:`.CampaignStore.write_units`
+    takes it (the provenance keys are taken out of ``res``)."""
     assert isinstance(t.case, BandCase | TruncationCase)
     parents = {f"cases/{t.case.name}": _case_attrs(t.case)}
     prov: dict[str, Any] = {k: res.pop(k) for k in ("worker", "host", "pid", "seconds") if k in res}
@@ -362,29 +364,46 @@ def _write(store: CampaignStore, campaign: Campaign, t: Task, res: dict[str, Any
             "q": list(t.case.percentiles),
             **prov,
         }
-        store.write_unit(t.unit, {k: res[k] for k in keys}, attrs, parents)
-    else:
-        out = campaign.outputs["truncation"]
-        keys = ["n_modes", "centres"]
-        if "error" in out:
-            keys += ["error"]
-        if "suggested" in out:
-            keys += ["suggested"]
-        if "responses" in out:
-            keys += ["freq", "response", "reference"]
-        c = t.case
-        assert isinstance(c, TruncationCase)
-        attrs = {
-            "dofs": list(res["dofs"]),
-            "n_modes_total": res["n_modes_total"],
-            "thresholds": list(c.thresholds),
-            "f_max": list(c.f_max),
-            "width": res["width"],
-            "step": res["step"],
-            "edges": res["edges"],
-            **prov,
-        }
-        store.write_unit(t.unit, {k: res[k] for k in keys}, attrs, parents)
+        return t.unit, {k: res[k] for k in keys}, attrs, parents
+    out = campaign.outputs["truncation"]
+    keys = ["n_modes", "centres"]
+    if "error" in out:
+        keys += ["error"]
+    if "suggested" in out:
+        keys += ["suggested"]
+    if "responses" in out:
+        keys += ["freq", "response", "reference"]
+    c = t.case
+    assert isinstance(c, TruncationCase)
+    attrs = {
+        "dofs": list(res["dofs"]),
+        "n_modes_total": res["n_modes_total"],
+        "thresholds": list(c.thresholds),
+        "f_max": list(c.f_max),
+        "width": res["width"],
+        "step": res["step"],
+        "edges": res["edges"],
+        **prov,
+    }
+    return t.unit, {k: res[k] for k in keys}, attrs, parents
+
+
+def _write_group(
+    store: CampaignStore, campaign: Campaign, group: list[Task], results: list[dict[str, Any]]
+) -> Path:
+    """Write the units of one finished cluster task (a band group's blocks, or one task) as
+    one part file."""
+    t = group[0]
+    if t.kind == "variants":
+        assert isinstance(t.case, _variants.VariantsCase) and len(group) == 1
+        return _variants.write_result(store, t.case, t.unit, list(t.rows), results[0])
+    units = [_unit(campaign, x, r) for x, r in zip(group, results, strict=True)]
+    return store.write_units(units)
+
+
+def _write(store: CampaignStore, campaign: Campaign, t: Task, res: dict[str, Any]) -> Path:
+    """Write one finished task as its own part file."""
+    return _write_group(store, campaign, [t], [res])
 
 
 class Progress:
@@ -433,6 +452,161 @@ class Progress:
             end = "\n" if self.done == self.total else ""
             self.stream.write("\r" + self.line() + end)
             self.stream.flush()
+
+
+class _Sender:
+    """Submits a campaign's tasks to the cluster, preparing what a task needs when it is first
+    needed: a tire variant from a file (sent to every worker once), the chassis on a
+    harmonic's grid, the subsystem arrays of the scatter cases (computed here once, stored
+    as a unit and scattered; see :mod:`.work` for why here). The workers thus start on the
+    first task while the arrays of the next harmonics are prepared.
+    """
+
+    def __init__(
+        self,
+        client: Any,
+        campaign: Campaign,
+        store: CampaignStore,
+        done: set[str],
+        numba_threads: int | None,
+    ) -> None:
+        self.client, self.campaign, self.store, self.done = client, campaign, store, done
+        self.numba_threads = numba_threads
+        self.token = uuid.uuid4().hex[:12]
+        self.tire_objs = {n: work.load_model("tire", src) for n, src in campaign.tires.items()}
+        self.chassis_src = {n: work.load_model("chassis", s) for n, s in campaign.chassis.items()}
+        self.tires: dict[str, Any] = {}
+        self.grids: dict[tuple[int, float, str], FRF] = {}
+        self.grids_f: dict[tuple[int, float, str], Any] = {}
+        self.inputs_f: dict[str, Any] = {}
+
+    def _tire(self, name: str) -> Any:
+        """The tire as the tasks get it: "reference", or a future of the scattered model."""
+        if name not in self.tires:
+            o = self.tire_objs[name]
+            self.tires[name] = o if isinstance(o, str) else self.client.scatter(o, broadcast=True)
+        return self.tires[name]
+
+    def _grid(self, c: BandCase | TruncationCase) -> FRF:
+        g = (c.harmonic, c.df, c.chassis)
+        if g not in self.grids:
+            f = fbs_core.harmonic(c.harmonic).frequencies(c.df)
+            self.grids[g] = work.chassis_on(self.chassis_src[c.chassis], f)
+        return self.grids[g]
+
+    def _grid_future(self, c: TruncationCase) -> Any:
+        g = (c.harmonic, c.df, c.chassis)
+        if g not in self.grids_f:
+            self.grids_f[g] = self.client.scatter(work.frf_payload(self._grid(c)))
+        return self.grids_f[g]
+
+    def _inputs(self, t: Task) -> Any:
+        """The future of a band task's subsystem arrays (prepared, stored, scattered once)."""
+        if t.inputs not in self.inputs_f:
+            c = t.case
+            assert isinstance(c, BandCase)
+            inp = work.prepare_inputs(
+                self.tire_objs[c.tire], self._grid(c), c.harmonic, c.n_modes, c.coupling, c.df
+            )
+            if f"inputs/{t.inputs}" not in self.done:
+                _write_inputs(self.store, t.inputs, c, inp)
+            self.inputs_f[t.inputs] = self.client.scatter(inp)
+        return self.inputs_f[t.inputs]
+
+    def submit(self, group: list[Task]) -> Any:
+        """Submit one cluster task: band blocks sharing their arrays, or one other task."""
+        t, client = group[0], self.client
+        if t.kind == "variants":
+            return _variants.submit(client, t, self.numba_threads, self.token)
+        c = t.case
+        assert isinstance(c, BandCase | TruncationCase)
+        if t.kind == "band":
+            blocks = [_block_args(b) for b in group]
+            return client.submit(
+                work.band_blocks,
+                self._inputs(t),
+                blocks,
+                self.campaign.max_chunk_bytes,
+                self.numba_threads,
+                key=f"band-{c.name}-{t.l0}-{len(group)}-{self.token}",
+                pure=False,
+            )
+        assert isinstance(c, TruncationCase)
+        return client.submit(
+            work.truncation_case,
+            self._tire(c.tire),
+            self._grid_future(c),
+            c,
+            key=f"trunc-{c.name}-{self.token}",
+            pure=False,
+        )
+
+
+def _block_args(b: Task) -> tuple[Any, ...]:
+    """The arguments of :func:`.work.band_block` of a band task, as band_blocks takes them."""
+    c = b.case
+    assert isinstance(c, BandCase)
+    return (c.noise, c.target, c.rounds, c.frequency_dependent, c.seed, c.percentiles, b.l0, b.l1)
+
+
+def _collect(
+    fut: Any,
+    group: list[Task],
+    store: CampaignStore,
+    campaign: Campaign,
+    merge: Merging,
+    report: RunReport,
+) -> str:
+    """Take a finished cluster task: its units written as one part file and merged into the
+    result file's open copy (or its error recorded); the report updated. Returns the
+    future's status ("finished", "error" or "cancelled")."""
+    status = str(fut.status)
+    if status == "error":
+        exc = fut.exception()
+        for t in group:
+            report.errors.append((t.unit, f"{type(exc).__name__}: {exc}"))
+        return status
+    if status == "cancelled":
+        return status
+    results = fut.result()
+    fut.release()
+    # a band task returns its blocks' results, any other task its own
+    each = results if group[0].kind == "band" else [results]
+    report.task_seconds += sum(float(r.get("seconds", 0.0)) for r in each)
+    tw = time.perf_counter()
+    WRITING.set()
+    try:
+        merge.add(_write_group(store, campaign, group, each))
+    finally:
+        WRITING.clear()
+    report.write_seconds += time.perf_counter() - tw
+    report.tasks_done += len(group)
+    report.rounds_done += sum(t.rounds for t in group)
+    return status
+
+
+def _advance(
+    group: list[Task],
+    status: str,
+    report: RunReport,
+    bar: Progress | None,
+    progress: Callable[[int, int, float], object] | bool | None,
+    n_todo: int,
+) -> None:
+    """Move the progress bar (or call ``progress``) by the units of a cluster task taken by
+    :func:`_collect`, one unit at a time."""
+    if status == "cancelled":
+        return
+    ok = status == "finished"
+    done = report.tasks_done - (len(group) if ok else 0)
+    rounds = report.rounds_done - (sum(t.rounds for t in group) if ok else 0.0)
+    for t in group:
+        if bar:
+            bar.update(1, t.rounds if ok else 0.0, t.work if ok else 0.0)
+        elif callable(progress) and ok:
+            done += 1
+            rounds += t.rounds
+            progress(done, n_todo, rounds)
 
 
 def run_campaign(
@@ -496,49 +670,16 @@ def run_campaign(
     cluster = None
     if own and todo:
         client, cluster = make_client(scheduler, workers)
+    futures: dict[Any, list[Task]] = {}
+    merge: Merging | None = None
     try:
         if todo:
             report.scheduler = str(client.scheduler.address)
             report.workers = len(client.scheduler_info().get("workers", {}))
             if numba_threads is None and cluster is not None and workers:
                 numba_threads = max(1, (os.cpu_count() or 1) // int(workers))
-            # model variants from files: loaded here; tires sent to every worker once
-            tire_objs = {n: work.load_model("tire", src) for n, src in campaign.tires.items()}
-            tires = {
-                n: o if isinstance(o, str) else client.scatter(o, broadcast=True)
-                for n, o in tire_objs.items()
-            }
-            chassis_src = {n: work.load_model("chassis", s) for n, s in campaign.chassis.items()}
-            # the chassis on each harmonic's grid and the subsystem arrays of the scatter
-            # cases: computed here once (see fbs_core.campaign.work), stored, scattered
-            grids: dict[tuple[int, float, str], FRF] = {}
-            inputs_f: dict[str, Any] = {}
-            for t in tasks:
-                if t.kind == "variants":  # no subsystem arrays: the task builds its models
-                    continue
-                c = t.case
-                assert isinstance(c, BandCase | TruncationCase)
-                g = (c.harmonic, c.df, c.chassis)
-                if g not in grids:
-                    f = fbs_core.harmonic(c.harmonic).frequencies(c.df)
-                    grids[g] = work.chassis_on(chassis_src[c.chassis], f)
-                if t.kind == "band" and t.inputs not in inputs_f:
-                    assert isinstance(c, BandCase)
-                    inp = work.prepare_inputs(
-                        tire_objs[c.tire],
-                        grids[g],
-                        c.harmonic,
-                        c.n_modes,
-                        c.coupling,
-                        c.df,
-                    )
-                    if f"inputs/{t.inputs}" not in done:
-                        _write_inputs(store, t.inputs, c, inp)
-                    inputs_f[t.inputs] = client.scatter(inp)
-            grids_f = {g: client.scatter(work.frf_payload(v)) for g, v in grids.items()}
-            futures: dict[Any, list[Task]] = {}
-            token = uuid.uuid4().hex[:12]
-            t_submit = time.perf_counter()
+            merge = store.merging(_root_attrs(campaign))
+            sender = _Sender(client, campaign, store, done, numba_threads)
             # small blocks of cases sharing their arrays go as one task (a partial run,
             # max_tasks, counts single blocks)
             groups = (
@@ -546,83 +687,17 @@ def run_campaign(
                 if max_tasks is None
                 else [[t] for t in tasks]
             )
-            for group in groups:
-                t = group[0]
-                c = t.case
-                if t.kind == "variants":
-                    fut = _variants.submit(client, t, numba_threads, token)
-                    futures[fut] = group
-                    continue
-                assert isinstance(c, BandCase | TruncationCase)
-                if t.kind == "band":  # one block, or small ones sharing their arrays
-                    blocks = []
-                    for b in group:
-                        bc = b.case
-                        assert isinstance(bc, BandCase)
-                        blocks.append(
-                            (
-                                bc.noise,
-                                bc.target,
-                                bc.rounds,
-                                bc.frequency_dependent,
-                                bc.seed,
-                                bc.percentiles,
-                                b.l0,
-                                b.l1,
-                            )
-                        )
-                    fut = client.submit(
-                        work.band_blocks,
-                        inputs_f[t.inputs],
-                        blocks,
-                        campaign.max_chunk_bytes,
-                        numba_threads,
-                        key=f"band-{c.name}-{t.l0}-{len(group)}-{token}",
-                        pure=False,
-                    )
-                else:
-                    fut = client.submit(
-                        work.truncation_case,
-                        tires[c.tire],
-                        grids_f[(c.harmonic, c.df, c.chassis)],
-                        c,
-                        key=f"trunc-{c.name}-{token}",
-                        pure=False,
-                    )
-                futures[fut] = group
+            t_submit = 0.0
+            for group in groups:  # the workers start on the first while the next are prepared
+                futures[sender.submit(group)] = group
+                t_submit = t_submit or time.perf_counter()
             ac = as_completed(list(futures))
             try:
                 for fut in ac:
                     group = futures.pop(fut)
-                    if fut.status == "error":
-                        exc = fut.exception()
-                        for t in group:
-                            report.errors.append((t.unit, f"{type(exc).__name__}: {exc}"))
-                            if bar:
-                                bar.update(1, 0.0)
-                        continue
-                    if fut.status == "cancelled":
-                        continue
-                    results = fut.result()
-                    fut.release()
-                    # a band task returns its blocks' results, any other task its own
-                    each = results if group[0].kind == "band" else [results]
-                    for t, res in zip(group, each, strict=True):
-                        report.task_seconds += float(res.get("seconds", 0.0))
-                        tw = time.perf_counter()
-                        WRITING.set()
-                        try:
-                            _write(store, campaign, t, res)
-                        finally:
-                            WRITING.clear()
-                        report.write_seconds += time.perf_counter() - tw
-                        report.compute_wall = time.perf_counter() - t_submit
-                        report.tasks_done += 1
-                        report.rounds_done += t.rounds
-                        if bar:
-                            bar.update(1, t.rounds, t.work)
-                        elif callable(progress):
-                            progress(report.tasks_done, len(todo), report.rounds_done)
+                    status = _collect(fut, group, store, campaign, merge, report)
+                    report.compute_wall = time.perf_counter() - t_submit
+                    _advance(group, status, report, bar, progress, len(todo))
                     if (stop is not None and stop.is_set()) or (
                         max_tasks is not None and report.tasks_done >= max_tasks
                     ):
@@ -637,6 +712,8 @@ def run_campaign(
                 report.status = "failed"
     except KeyboardInterrupt:
         report.status = "stopped"
+        if futures:
+            client.cancel(list(futures))
     finally:
         report.seconds = time.perf_counter() - t_start
         if todo:
@@ -655,7 +732,10 @@ def run_campaign(
                     "versions": _versions(),
                 },
             )
-        store.commit(_root_attrs(campaign))
+        if merge is None:
+            store.commit(_root_attrs(campaign))
+        else:
+            merge.finish()
         if own and client is not None:
             client.close()
             if cluster is not None:

@@ -47,6 +47,8 @@ from ..vocabulary import COUPLINGS
 from ..vocabulary import readonly as _ro
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from ..variants import Design, VariantSettings, VariantStudy
     from .run import Task
     from .spec import Campaign
@@ -392,8 +394,9 @@ def write_design(store: CampaignStore, case: VariantsCase, design: Design) -> No
 
 def write_result(
     store: CampaignStore, case: VariantsCase, unit: str, rows: list[int], res: dict[str, Any]
-) -> None:
-    """Store a finished task: its rows, their parameter values and responses."""
+) -> Path:
+    """Store a finished task: its rows, their parameter values and responses (returns the part
+    file)."""
     design = _design(case)
     keys = ("worker", "host", "pid", "seconds", "cpu_seconds")
     prov: dict[str, Any] = {k: res[k] for k in keys if k in res}
@@ -402,7 +405,7 @@ def write_result(
         data["values"] = design.values[rows]
     for k, v in res["responses"].items():
         data[f"h{k}"] = np.asarray(v)
-    store.write_unit(
+    return store.write_unit(
         unit,
         data,
         {"n_rows": len(rows), **prov},
