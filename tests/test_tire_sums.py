@@ -303,6 +303,24 @@ def test_work_at_a_lowered_priority_keeps_to_its_own_thread():
     assert out == {False: min(cores, sums.MAX_THREADS), True: 1}
 
 
+def test_an_environment_variable_caps_the_threads(monkeypatch):
+    """``FBS_TIRE_SUM_THREADS=1`` keeps a call's tiles on the calling thread (the bench's
+    single-thread figures); a value that is no positive integer is refused."""
+    from fbs_core.errors import FBSError
+
+    monkeypatch.setattr(sums.os, "sched_getaffinity", lambda pid: set(range(8)))
+    monkeypatch.delenv(sums.THREADS_ENV, raising=False)
+    assert sums._threads(1000) == sums.MAX_THREADS
+    for raw, want in (("1", 1), ("2", 2), (" 3 ", 3), ("64", sums.MAX_THREADS)):
+        monkeypatch.setenv(sums.THREADS_ENV, raw)
+        assert sums._threads(1000) == want
+    assert sums._threads(4) == 1  # still no more threads than the tiles are worth
+    for raw in ("0", "-1", "two", "1.5"):
+        monkeypatch.setenv(sums.THREADS_ENV, raw)
+        with pytest.raises(FBSError, match=sums.THREADS_ENV):
+            sums._threads(1000)
+
+
 def _child_sums(q):
     import fbs_core
 

@@ -42,6 +42,7 @@ import numpy as np
 from numba import njit
 
 from .._typing import ComplexArray, FloatArray, IntArray
+from ..errors import FBSError
 from .interp import KMAX
 
 if TYPE_CHECKING:
@@ -247,14 +248,30 @@ def truncated_sums(
 MIN_TILES_PER_THREAD = 4
 #: Most threads one call uses.
 MAX_THREADS = 4
+#: Environment variable capping the threads of a call (a positive integer; ``1``: the
+#: calling thread only, e.g. to measure the CPU cost on a machine whose cores are busy).
+THREADS_ENV = "FBS_TIRE_SUM_THREADS"
+
+
+def _thread_cap() -> int:
+    """:data:`MAX_THREADS`, or less as :data:`THREADS_ENV` asks."""
+    raw = os.environ.get(THREADS_ENV, "").strip()
+    if not raw:
+        return MAX_THREADS
+    if not raw.isdigit() or int(raw) < 1:
+        raise FBSError(f"{THREADS_ENV}={raw!r}: must be a positive integer (threads per call)")
+    return min(int(raw), MAX_THREADS)
+
+
 _pool: tuple[int, ThreadPoolExecutor] | None = None
 _pool_lock = threading.Lock()
 
 
 def _threads(n_tiles: int) -> int:
-    """Threads for ``n_tiles`` tiles: one per usable core (at most :data:`MAX_THREADS`) with
-    at least :data:`MIN_TILES_PER_THREAD` tiles each; one on a thread of lowered priority
-    (work computed ahead, which must not take cores from interactive work)."""
+    """Threads for ``n_tiles`` tiles: one per usable core (at most :data:`MAX_THREADS`, or
+    the cap of :data:`THREADS_ENV`) with at least :data:`MIN_TILES_PER_THREAD` tiles each;
+    one on a thread of lowered priority (work computed ahead, which must not take cores
+    from interactive work)."""
     try:
         cores = len(os.sched_getaffinity(0))
         # nicer than the main thread (on Linux a thread's priority is its own; the main
@@ -265,7 +282,7 @@ def _threads(n_tiles: int) -> int:
         cores, niced = os.cpu_count() or 1, False
     if niced:
         return 1
-    return max(1, min(cores, MAX_THREADS, n_tiles // MIN_TILES_PER_THREAD))
+    return max(1, min(cores, _thread_cap(), n_tiles // MIN_TILES_PER_THREAD))
 
 
 def _executor() -> ThreadPoolExecutor:
