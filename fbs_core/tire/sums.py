@@ -20,8 +20,10 @@ a cluster costs no more than its members and no moments are stored. Lines of one
 interval and operating point are taken in tiles so that each residue row serves all of
 them from cache; a tile's ``1 / (s - lambda)`` of all modes come first, in one loop the
 compiler vectorises; the blocks' sums join the sums up to the previous block as each
-block ends (no array of all blocks' sums); the loops index elements, they take no array
-views (issue 33: the kernel's CPU time 0.18 -> 0.16 s for the seven maps, the same bits). Nothing is kept between calls: a line's sums depend on that line alone
+block ends (no array of all blocks' sums); the loops index elements and take no array
+views, each of which costs two atomic reference counts (issue 33: the kernel's CPU time
+for the seven maps 0.18 -> 0.15 s, the same bits). Nothing is kept between calls: a
+line's sums depend on that line alone
 (the same bits whatever else is computed, in any order, on any thread), so a call's tiles
 are dealt to a few threads of the process (the kernel releases the GIL; one per core,
 :func:`_run_tiles`): the seven truncation maps of the reference tire 0.21 -> 0.12 s on two
@@ -327,21 +329,25 @@ def _run_tiles(tiles: list[IntArray], args: tuple[Any, ...]) -> None:
 _EMPTY_EXTRA = np.zeros((0, 0), complex)
 
 
-class _JitOptions(TypedDict):
+class _JitOptions(TypedDict, total=False):
     cache: bool
     nogil: bool
     error_model: Literal["python", "numpy"]
     fastmath: bool
+    inline: Literal["never", "always"]
 
 
 # nogil: a session's sums must not stall the threads serving the others
 _JIT = _JitOptions(cache=True, nogil=True, error_model="numpy", fastmath=False)
+#: The same, inlined into the caller: no call, so no reference counts on the arguments
+#: (two atomic operations per array argument per call otherwise).
+_INLINE = _JitOptions(**_JIT, inline="always")
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def _mac(
-    accr: FloatArray,
-    acci: FloatArray,
+    acc: FloatArray,
+    slot: int,
     nt: int,
     cr: FloatArray,
     ci: FloatArray,
@@ -352,24 +358,25 @@ def _mac(
     r: int,
     p0: int,
 ) -> None:
-    """``acc[t, c] += sum_i coef[t, i] * Z[n0 + i, r, column c]`` for the tile's lines
-    ``t``: the 36 hub mobility columns, then the 6 of the patch at ``p0`` (none if
-    ``p0 < 0``). The rows of all nodes in one pass, real and imaginary parts apart and
-    fixed loop lengths, so that the compiler vectorises over the columns; every element by
-    full indices (no array views in the loops)."""
+    """``acc[slot, 0 / 1, t, c] += sum_i coef[t, i] * Z[n0 + i, r, column c]`` (real /
+    imaginary part) for the tile's lines ``t``: the 36 hub mobility columns, then the 6
+    of the patch at ``p0`` (none if ``p0 < 0``). The rows of all nodes in one pass, real
+    and imaginary parts apart and fixed loop lengths, so that the compiler vectorises over
+    the columns (the patch's 6, unrolled, stay scalar: faster than a vector loop with its
+    checks); every element by full indices (no array views)."""
     q = p0 - _N_MOB  # patch column c (from 36 on in acc) is column c + q of Z
     for t in range(nt):
         if nn == 4:
             a0, b0, a1, b1 = cr[t, 0], ci[t, 0], cr[t, 1], ci[t, 1]
             a2, b2, a3, b3 = cr[t, 2], ci[t, 2], cr[t, 3], ci[t, 3]
             for c in range(_N_MOB):
-                accr[t, c] += (
+                acc[slot, 0, t, c] += (
                     (a0 * Zr[n0, r, c] - b0 * Zi[n0, r, c])
                     + (a1 * Zr[n0 + 1, r, c] - b1 * Zi[n0 + 1, r, c])
                     + (a2 * Zr[n0 + 2, r, c] - b2 * Zi[n0 + 2, r, c])
                     + (a3 * Zr[n0 + 3, r, c] - b3 * Zi[n0 + 3, r, c])
                 )
-                acci[t, c] += (
+                acc[slot, 1, t, c] += (
                     (a0 * Zi[n0, r, c] + b0 * Zr[n0, r, c])
                     + (a1 * Zi[n0 + 1, r, c] + b1 * Zr[n0 + 1, r, c])
                     + (a2 * Zi[n0 + 2, r, c] + b2 * Zr[n0 + 2, r, c])
@@ -377,13 +384,13 @@ def _mac(
                 )
             if p0 >= 0:
                 for c in range(_N_MOB, _N_MOB + _N_PATCH):
-                    accr[t, c] += (
+                    acc[slot, 0, t, c] += (
                         (a0 * Zr[n0, r, c + q] - b0 * Zi[n0, r, c + q])
                         + (a1 * Zr[n0 + 1, r, c + q] - b1 * Zi[n0 + 1, r, c + q])
                         + (a2 * Zr[n0 + 2, r, c + q] - b2 * Zi[n0 + 2, r, c + q])
                         + (a3 * Zr[n0 + 3, r, c + q] - b3 * Zi[n0 + 3, r, c + q])
                     )
-                    acci[t, c] += (
+                    acc[slot, 1, t, c] += (
                         (a0 * Zi[n0, r, c + q] + b0 * Zr[n0, r, c + q])
                         + (a1 * Zi[n0 + 1, r, c + q] + b1 * Zr[n0 + 1, r, c + q])
                         + (a2 * Zi[n0 + 2, r, c + q] + b2 * Zr[n0 + 2, r, c + q])
@@ -392,34 +399,37 @@ def _mac(
         else:  # the end intervals: linear, two nodes
             a0, b0, a1, b1 = cr[t, 0], ci[t, 0], cr[t, 1], ci[t, 1]
             for c in range(_N_MOB):
-                accr[t, c] += (a0 * Zr[n0, r, c] - b0 * Zi[n0, r, c]) + (
+                acc[slot, 0, t, c] += (a0 * Zr[n0, r, c] - b0 * Zi[n0, r, c]) + (
                     a1 * Zr[n0 + 1, r, c] - b1 * Zi[n0 + 1, r, c]
                 )
-                acci[t, c] += (a0 * Zi[n0, r, c] + b0 * Zr[n0, r, c]) + (
+                acc[slot, 1, t, c] += (a0 * Zi[n0, r, c] + b0 * Zr[n0, r, c]) + (
                     a1 * Zi[n0 + 1, r, c] + b1 * Zr[n0 + 1, r, c]
                 )
             if p0 >= 0:
                 for c in range(_N_MOB, _N_MOB + _N_PATCH):
-                    accr[t, c] += (a0 * Zr[n0, r, c + q] - b0 * Zi[n0, r, c + q]) + (
+                    acc[slot, 0, t, c] += (a0 * Zr[n0, r, c + q] - b0 * Zi[n0, r, c + q]) + (
                         a1 * Zr[n0 + 1, r, c + q] - b1 * Zi[n0 + 1, r, c + q]
                     )
-                    acci[t, c] += (a0 * Zi[n0, r, c + q] + b0 * Zr[n0, r, c + q]) + (
+                    acc[slot, 1, t, c] += (a0 * Zi[n0, r, c + q] + b0 * Zr[n0, r, c + q]) + (
                         a1 * Zi[n0 + 1, r, c + q] + b1 * Zr[n0 + 1, r, c + q]
                     )
 
 
 @njit(**_JIT)
 def _fold(
-    accr: FloatArray,
-    acci: FloatArray,
+    acc: FloatArray,
+    slot: int,
     lines: IntArray,
     nt: int,
     w: FloatArray,
     nn: int,
     kc: int,
     H: ComplexArray,
-    z_cl: ComplexArray,
-    mem: IntArray,
+    ib: int,
+    ps_: int,
+    z_all: ComplexArray,
+    members: IntArray,
+    cc: int,
     n0: int,
     Zr: FloatArray,
     Zi: FloatArray,
@@ -427,19 +437,20 @@ def _fold(
     cr: FloatArray,
     ci: FloatArray,
 ) -> None:
-    """A cluster's terms ``w_i sum_q H[t, q] z_(i,j)^q Z_i[member j]``: its moments
-    ``sum_j z_(i,j)^q Z_i[member j]`` folded into the coefficients."""
+    """A cluster's terms ``w_i sum_q H[ib, ps_, t, q] z_(i,j)^q Z_i[member j]`` (cluster
+    ``cc``) into ``acc[slot]``: its moments ``sum_j z_(i,j)^q Z_i[member j]`` folded into
+    the coefficients."""
     for j in range(kc):
         for i in range(nn):
-            x = z_cl[i, j]
+            x = z_all[cc, i, j]
             for t in range(nt):
-                e = H[t, kc - 1]
+                e = H[ib, ps_, t, kc - 1]
                 for q in range(kc - 2, -1, -1):
-                    e = e * x + H[t, q]
+                    e = e * x + H[ib, ps_, t, q]
                 e = w[lines[t], i] * e
                 cr[t, i] = e.real
                 ci[t, i] = e.imag
-        _mac(accr, acci, nt, cr, ci, Zr, Zi, n0, nn, mem[j], p0)
+        _mac(acc, slot, nt, cr, ci, Zr, Zi, n0, nn, members[cc, j], p0)
 
 
 @njit(**_JIT)
@@ -730,7 +741,6 @@ def _tile(
     run: FloatArray,
     pend: FloatArray,
     has_pend: Any,
-    xacc: FloatArray,
     cum: FloatArray,
     Tr: FloatArray,
     Ti: FloatArray,
@@ -778,23 +788,21 @@ def _tile(
                     for i in range(nn):
                         cr[t, i] = w[ln, i] * tr
                         ci[t, i] = w[ln, i] * ti
-                _mac(acc[ps_, 0], acc[ps_, 1], nt, cr, ci, Zr, Zi, n0, nn, r, p0)
+                _mac(acc, ps_, nt, cr, ci, Zr, Zi, n0, nn, r, p0)
             continue
         # a cluster, all of it at its lowest-ranked member
         kc = size[cc]
-        mem = members[cc]
         first = True
         whole = True
         for j in range(kc):
-            if block[op, mem[j]] != b:
+            if block[op, members[cc, j]] != b:
                 whole = False
-            if rank[op, mem[j]] < rk:
+            if rank[op, members[cc, j]] < rk:
                 first = False
         if not first:
             continue
         c = cc_all[cc]
         rho = rho_all[cc]
-        z_cl = z_all[cc]
         n_blk = 0
         if whole:  # rational form N(z) / (rho P(z)): H_q = b_(k-1-q) / (rho b_k)
             blocks[0] = b
@@ -813,7 +821,7 @@ def _tile(
                         H[0, ps_, t, q] = bb[kc - 1 - q] * inv
         else:  # split by a block edge: roots, the lowest to the member ranked lowest here
             for j in range(kc):
-                smem[j] = mem[j]
+                smem[j] = members[cc, j]
             for j in range(1, kc):  # insertion sort by rank
                 m = smem[j]
                 i = j - 1
@@ -834,7 +842,7 @@ def _tile(
                 for j in range(kc):
                     x = 0j
                     for i in range(nn):
-                        x += w[ln, i] * z_cl[i, j]
+                        x += w[ln, i] * z_all[cc, i, j]
                     z0[j] = x
                 _roots(al, kc, z0, sign, zr)
                 for j in range(kc):  # root j: N(z_j) / P'(z_j) by moments, pole c + rho z_j
@@ -877,23 +885,58 @@ def _tile(
         for ib in range(n_blk):  # into this block's accumulator, or to wait for a later one
             bj = blocks[ib]
             for ps_ in range(n_pass):
-                here = bj == b
-                if here:
-                    ar, ai = acc[ps_, 0], acc[ps_, 1]
-                else:
-                    xacc[:, :nt] = 0.0
-                    ar, ai = xacc[0], xacc[1]
-                Hb = H[ib, ps_]
-                _fold(ar, ai, lines, nt, w, nn, kc, Hb, z_cl, mem, n0, Zr, Zi, p0, cr, ci)
-                if here:
+                if bj == b:
+                    _fold(
+                        acc,
+                        ps_,
+                        lines,
+                        nt,
+                        w,
+                        nn,
+                        kc,
+                        H,
+                        ib,
+                        ps_,
+                        z_all,
+                        members,
+                        cc,
+                        n0,
+                        Zr,
+                        Zi,
+                        p0,
+                        cr,
+                        ci,
+                    )
                     continue
+                acc[2, :, :nt] = 0.0  # the part of a later block, alone first
+                _fold(
+                    acc,
+                    2,
+                    lines,
+                    nt,
+                    w,
+                    nn,
+                    kc,
+                    H,
+                    ib,
+                    ps_,
+                    z_all,
+                    members,
+                    cc,
+                    n0,
+                    Zr,
+                    Zi,
+                    p0,
+                    cr,
+                    ci,
+                )
                 if not has_pend[ps_, bj]:
                     pend[ps_, bj, :, :nt] = 0.0
                     has_pend[ps_, bj] = True
                 for h in range(2):
                     for t in range(nt):
-                        for cl in range(xacc.shape[2]):
-                            pend[ps_, bj, h, t, cl] += xacc[h, t, cl]
+                        for cl in range(acc.shape[3]):
+                            pend[ps_, bj, h, t, cl] += acc[2, h, t, cl]
     while cur < n_blocks:
         _close(cur, n_pass, nt, acc, run, pend, has_pend, cum, lines, s, extra, Y, v)
         cur += 1
@@ -936,9 +979,10 @@ def _kernel(
     """All tiles one after the other, on the calling thread (the GIL released)."""
     nc = _N_MOB + (_N_PATCH if p0 >= 0 else 0)
     n_m = Pr.shape[1]
-    acc = np.zeros((2, 2, TILE, nc))  # the block's sums: [pass, re/im, line, column]
+    # the block's sums [pass, re/im, line, column], then a split cluster's part in a later
+    # block (acc[2])
+    acc = np.zeros((3, 2, TILE, nc))
     run = np.zeros((2, 2, TILE, nc))  # the sums of the blocks before it
-    xacc = np.zeros((2, TILE, nc))  # a split cluster's part in a later block
     pend = np.zeros((2, n_blocks, 2, TILE, nc))  # split clusters' parts in later blocks
     has_pend = np.zeros((2, n_blocks), np.bool_)
     cum = np.zeros((Y.shape[0] if static else 0, 2, 2, TILE, nc))  # static: sums up to b
@@ -979,7 +1023,6 @@ def _kernel(
             run,
             pend,
             has_pend,
-            xacc,
             cum,
             Tr,
             Ti,
