@@ -205,6 +205,45 @@ def test_numbers_do_not_depend_on_what_the_process_computed_before(tmp_path):
     assert np.array_equal(out[0], out[1])
 
 
+def test_the_reciprocals_are_complex_division_bit_for_bit():
+    """The kernel's vectorised ``u / d`` (u = +-1, lone modes' ``1 / (s - lambda)`` and
+    ``-1 / lambda``) against Python's complex division (the algorithm of compiled code)."""
+    rng = np.random.default_rng(5)
+    re = rng.normal(size=400) * 10.0 ** rng.uniform(-3, 4, 400)
+    im = rng.normal(size=400) * 10.0 ** rng.uniform(-3, 4, 400)
+    re[:5], im[5:10] = 0.0, 0.0  # on the axes
+    for u in (1.0, -1.0):
+        for a, b in zip(re, im, strict=True):
+            want = u / complex(a, b)
+            got = sums._inverse(a, b, u)
+            assert (got[0], got[1]) == (want.real, want.imag), (a, b, u)
+
+
+@pytest.mark.parametrize("kc", [3, 4])
+def test_the_roots_of_a_split_cluster_equal_the_companion_eigenvalues(kc):
+    """The Aberth iteration (one complex division per step) against numpy's eigenvalues
+    of the companion matrix, for the scaled poles of a cluster (``(lambda - c) / rho``:
+    around 0, within about 1, two of them closer), from start values off by a few
+    percent; sorted by ``sign * Im``."""
+    rng = np.random.default_rng(kc)
+    out = np.empty(4, complex)
+    for trial in range(300):
+        z = rng.uniform(-1, 1, kc) + 1j * rng.uniform(-1, 1, kc)
+        z[1] = z[0] + 10.0 ** rng.uniform(-2, 0) * np.exp(2j * np.pi * rng.random())
+        al = np.zeros(5, complex)
+        al[: kc + 1] = np.poly(z)
+        start = np.zeros(4, complex)
+        start[:kc] = z + 0.03 * (rng.normal(size=kc) + 1j * rng.normal(size=kc))
+        sign = 1.0 if trial % 2 else -1.0
+        sums._roots(al, kc, start, sign, out)
+        comp = np.zeros((kc, kc), complex)
+        comp[0] = -al[1 : kc + 1]
+        comp[np.arange(1, kc), np.arange(kc - 1)] = 1.0
+        want = np.linalg.eigvals(comp)
+        want = want[np.argsort(sign * want.imag, kind="stable")]
+        assert np.abs(out[:kc] - want).max() <= 1e-12, (trial, out[:kc], want)
+
+
 def _union_find_groups(lam0, lam1, kappa, moving):
     """The groups of close modes by a plain union-find (the former implementation)."""
     n = lam0.size

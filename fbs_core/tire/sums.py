@@ -453,7 +453,7 @@ def _fold(
         _mac(acc, slot, nt, cr, ci, Zr, Zi, n0, nn, members[cc, j], p0)
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def _partials(a: ComplexArray, kc: int, z: complex, out: ComplexArray) -> None:
     """Horner partial sums ``out[i] = sum_(i' <= i) a[i'] z^(i - i')``, i = 0..kc."""
     out[0] = a[0]
@@ -467,7 +467,7 @@ def _norm1(x: complex) -> float:
     return abs(x.real) + abs(x.imag)
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def _roots(al: ComplexArray, kc: int, z0: ComplexArray, sign: float, out: ComplexArray) -> None:
     """Roots of ``z^kc + al[1] z^(kc-1) + ... + al[kc]`` sorted by ``sign * Im`` (ascending).
 
@@ -511,12 +511,17 @@ def _roots(al: ComplexArray, kc: int, z0: ComplexArray, sign: float, out: Comple
                 if _norm1(p) <= _EPS * bnd:  # a root of a polynomial within rounding of al
                     continue
                 ok = False
-                ratio = p / dp
-                sm = 0j
+                # the Aberth step x - ratio / (1 - ratio sm), ratio = p / dp, with the sum
+                # sm = sum_(i != j) 1 / (x - x_i) as one fraction num / den: one complex
+                # division instead of kc + 1
+                num = 0j
+                den = 1.0 + 0j
                 for i in range(kc):
                     if i != j:
-                        sm += 1.0 / (x - out[i])
-                out[j] = x - ratio / (1.0 - ratio * sm)
+                        d = x - out[i]
+                        num = num * d + den
+                        den = den * d
+                out[j] = x - (p * den) / (dp * den - p * num)
             if ok:
                 break
         for j in range(kc):
