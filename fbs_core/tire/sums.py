@@ -21,8 +21,9 @@ interval and operating point are taken in tiles so that each residue row serves 
 them from cache; a tile's ``1 / (s - lambda)`` of all modes come first, in one loop the
 compiler vectorises; the blocks' sums join the sums up to the previous block as each
 block ends (no array of all blocks' sums); the loops index elements and take no array
-views, each of which costs two atomic reference counts (issue 33: the kernel's CPU time
-for the seven maps 0.18 -> 0.15 s, the same bits). Nothing is kept between calls: a
+views, and the innermost functions are inlined: each array view or argument of a call
+costs two atomic reference counts (issue 33: the kernel's CPU time for the seven maps
+0.18 -> 0.14 s, the numbers the same to rounding). Nothing is kept between calls: a
 line's sums depend on that line alone
 (the same bits whatever else is computed, in any order, on any thread), so a call's tiles
 are dealt to a few threads of the process (the kernel releases the GIL; one per core,
