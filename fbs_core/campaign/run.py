@@ -22,6 +22,7 @@ what is missing, and the end of a run has little left to merge.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import threading
@@ -101,7 +102,9 @@ class RunReport:
         return self.rounds_done / self.seconds if self.seconds > 0 else 0.0
 
 
+@functools.lru_cache(maxsize=256)
 def n_lines(harmonic: int, df: float) -> int:
+    """Lines of a harmonic's grid at ``df`` (asked for every unit written: cached)."""
     from ..harmonics import harmonic as _h
 
     return int(_h(harmonic).frequencies(df).size)

@@ -75,13 +75,14 @@ def file_sha256(path: str | os.PathLike[str]) -> str:
 
 
 def _set_attrs(obj: H5, attrs: dict[str, Any]) -> None:
+    a = obj.attrs  # (h5py makes a new attribute manager on every access)
     for k, v in attrs.items():
         if isinstance(v, bool | int | float | str | np.integer | np.floating):
-            obj.attrs[k] = v
+            a[k] = v
         elif v is None:
-            obj.attrs[k] = "none"
+            a[k] = "none"
         else:
-            obj.attrs[k] = json.dumps(v, default=str)
+            a[k] = json.dumps(v, default=str)
 
 
 def _put(g: H5, name: str, v: Any) -> None:
@@ -103,9 +104,10 @@ def _merge(src: H5, dst: H5) -> None:
     (an object ``dst`` lacks is copied with all it holds, by HDF5 itself)."""
     import h5py
 
-    for k in src.attrs:
-        if k not in dst.attrs:
-            dst.attrs[k] = src.attrs[k]
+    sa, da = src.attrs, dst.attrs
+    for k in sa:
+        if k not in da:
+            da[k] = sa[k]
     for name in src:
         if name not in dst:
             src.copy(name, dst, name=name)
