@@ -92,12 +92,18 @@ class PageGate:
             self._cond.notify_all()
 
     def watch_session(self, session_context: Any) -> None:
-        """Session-created callback (``pn.state.on_session_created``): the page of this
-        session opens until its browser sends "document ready" or the session ends."""
-        if self._retired:
+        """Session-created callback (``pn.state.on_session_created``; Panel runs it with the
+        session's document current): the page of this session opens until its browser
+        sends "document ready" or the session ends."""
+        import panel as pn
+
+        self.watch(str(session_context.id), pn.state.curdoc)
+
+    def watch(self, key: str, doc: Any) -> None:
+        """The page of ``doc`` opens now, until its "document ready" event or its
+        session's end."""
+        if self._retired or doc is None:
             return
-        key = str(session_context.id)
-        doc = session_context._document  # (Panel's own callbacks read it the same way)
         self.opened(key)
         doc.on_event("document_ready", lambda _event: self.shown(key))
         doc.on_session_destroyed(lambda _ctx: self.shown(key))

@@ -92,20 +92,22 @@ def test_retiring_the_gate_frees_a_waiter_and_ends_tracking():
 def test_a_session_opens_until_document_ready_or_its_end():
     from bokeh.document import Document
     from bokeh.events import DocumentReady
+    from panel.io.state import set_curdoc
 
     class Context:  # what watch_session reads of Bokeh's session context
         def __init__(self, key):
-            self.id, self._document = key, Document()
+            self.id = key
 
     gate = PageGate()
-    shown, closed = Context("shown"), Context("closed")
-    gate.watch_session(shown)
-    gate.watch_session(closed)
+    shown, closed = Document(), Document()
+    for key, doc in (("shown", shown), ("closed", closed)):
+        with set_curdoc(doc):  # as Panel runs session-created callbacks
+            gate.watch_session(Context(key))
     assert gate.opening() == 2
-    shown._document.callbacks.trigger_event(DocumentReady())
+    shown.callbacks.trigger_event(DocumentReady())
     assert gate.opening() == 1
-    for callback in closed._document.session_destroyed_callbacks:
-        callback(closed)
+    for callback in closed.session_destroyed_callbacks:
+        callback(None)
     assert gate.opening() == 0
 
 
