@@ -3,9 +3,9 @@
 Starts one server per ``--tree`` (source checkouts of the project; default this one) at the
 same time, through ``docker/entrypoint.py`` as ``scripts/serve.sh`` does (``--panel``: plain
 ``panel serve app/main.py`` as ``bench_dashboard.py`` does), with Panel's ``--warm`` (the
-page run once before the port opens) for ``--warm yes`` (default), without it for ``no``,
-and as the tree's own ``scripts/serve.sh`` does for ``serve-sh`` (before issue 33 it passed
-``--warm``), and prints for each:
+page run once before the port opens) for ``--warm yes``, without it for ``no``,
+and as the tree's own ``scripts/serve.sh`` does for ``serve-sh`` (the default; before issue
+33 it passed ``--warm``), and prints for each:
 
 - server start -> the port accepts a connection (a browser could connect);
 - server start -> "Bokeh app running" (the server's own line);
@@ -133,7 +133,13 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=5)
     ap.add_argument("--threads", type=int, default=4)
     ap.add_argument("--panel", action="store_true", help="plain `panel serve`")
-    ap.add_argument("--warm", choices=["yes", "no", "serve-sh"], default="yes")
+    ap.add_argument(
+        "--warm",
+        choices=["yes", "no", "serve-sh"],
+        default="serve-sh",
+        help="Panel's --warm before listening: as the tree's scripts/serve.sh starts it "
+        "(default: the README's start command), always (yes) or never (no)",
+    )
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per step")
     ap.add_argument(
         "--first",
