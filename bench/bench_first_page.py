@@ -1,21 +1,26 @@
 """The first page, side by side: server start -> listening, page request -> first plot (issue 33).
 
-Starts one server per ``--tree`` (source checkouts of the project; default this one) at the
-same time, through ``docker/entrypoint.py`` as ``scripts/serve.sh`` does (``--panel``: plain
-``panel serve app/main.py`` as ``bench_dashboard.py`` does), with Panel's ``--warm`` (the
-page run once before the port opens) for ``--warm yes``, without it for ``no``,
-and as the tree's own ``scripts/serve.sh`` does for ``serve-sh`` (the default; before issue
-33 it passed ``--warm``), and prints for each:
+Starts the server of each ``--tree`` (source checkouts of the project; default this one),
+``--starts`` times, one server at a time and the trees alternated (each start sees the
+machine to itself, as a user's start would; the trees take turns, so that a shared
+machine's load falls on all alike), through ``docker/entrypoint.py`` as
+``scripts/serve.sh`` does (``--panel``: plain ``panel serve app/main.py`` as
+``bench_dashboard.py`` does); with Panel's ``--warm`` (the page run once before the port
+opens) as the tree's own ``scripts/serve.sh`` passes it (``--warm serve-sh``, the default:
+before issue 33 it passed ``--warm``), always (``yes``) or never (``no``). For each start
+it prints:
 
 - server start -> the port accepts a connection (a browser could connect);
-- server start -> "Bokeh app running" (the server's own line);
 - with ``--first proved``: server start -> the app proved (``/liveness`` answers 200:
   the server's own page of the app is built and loaded), and the first page requested only
-  then (default ``--first listening``: requested as soon as the port accepts, so the first
-  page shares the machine with the proof, the worst case);
-- then, ``--samples`` times, the trees alternated so that every tree sees the same machine
-  load: a fresh browser page (chromium, playwright) requested until the coupled response's
-  plot (``mobility.truncated``) holds data in the page, and the page closed again.
+  then (default ``--first listening``: requested as soon as the port accepts, while the
+  server proves the app);
+- then ``--samples`` fresh browser pages (chromium, playwright) one after the other, each
+  requested until the coupled response's plot (``mobility.truncated``) holds data in the
+  page, and closed again; the first of them is "the first page" of that start.
+
+At the end, per tree, the medians over the starts (start -> listening, -> proved, first
+page, later pages) and the ratios of the trees' medians.
 
 ``bench_dashboard.py`` prints a "page request -> plot" for its first page too, but its
 trees' first pages are opened one after the other and each waits for its band, so the
@@ -29,8 +34,8 @@ one run count.
 
 Usage::
 
-    .venv/bin/python bench/bench_first_page.py [--samples 5] [--tree /tmp/old --tree .]
-    .venv/bin/python bench/bench_first_page.py --warm serve-sh --tree /tmp/old --tree .
+    .venv/bin/python bench/bench_first_page.py [--starts 3] [--samples 5] [--tree /tmp/old --tree .]
+    .venv/bin/python bench/bench_first_page.py --first proved --tree /tmp/old --tree .
 """
 
 from __future__ import annotations
@@ -130,7 +135,8 @@ def listening(port: int) -> bool:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tree", action="append", type=Path, help="a source checkout (repeat)")
-    ap.add_argument("--samples", type=int, default=5)
+    ap.add_argument("--samples", type=int, default=5, help="pages per start")
+    ap.add_argument("--starts", type=int, default=3, help="server starts per tree")
     ap.add_argument("--threads", type=int, default=4)
     ap.add_argument("--panel", action="store_true", help="plain `panel serve`")
     ap.add_argument(
@@ -158,100 +164,93 @@ def main() -> None:
     print(f"cores {os.cpu_count()}; {how}; --num-threads {args.threads}; {load()}")
     for name, w in zip(names, warm, strict=True):
         print(f"[{name}] {'with' if w else 'without'} --warm")
-    servers = []
-    try:
-        t0 = time.perf_counter()
-        for tree, w in zip(trees, warm, strict=True):
-            port = free_port()
-            servers.append((tree, port, *start(tree, port, args.panel, args.threads, w)))
-        pending = {name: s for name, s in zip(names, servers, strict=True)}
-        while pending:  # the port of each, polled every 50 ms
-            for name, (_tree, port, proc, marks) in list(pending.items()):
-                if listening(port):
-                    print(
-                        f"[{name}] start -> listening      {time.perf_counter() - t0:7.1f} s"
-                        f"   ({load()})"
-                    )
-                    del pending[name]
-                elif proc.poll() is not None or time.perf_counter() - t0 > args.timeout:
-                    print("".join(marks["log"][-30:]))
-                    raise RuntimeError(f"server of {name} did not listen")
-            time.sleep(0.05)
-        for name, (_tree, _port, _proc, marks) in zip(names, servers, strict=True):
-            while "running" not in marks and time.perf_counter() - t0 < args.timeout:
-                time.sleep(0.05)
-            print(
-                f"[{name}] start -> 'app running'  {marks.get('running', np.nan) - t0:7.1f} s"
-                f"   ({load()})"
-            )
-        if args.first == "proved" and not args.panel:
-            for name, (_tree, port, proc, marks) in zip(names, servers, strict=True):
-                while not proved(port):
-                    if proc.poll() is not None or time.perf_counter() - t0 > args.timeout:
-                        print("".join(marks["log"][-30:]))
-                        raise RuntimeError(f"server of {name} was not proved")
-                    time.sleep(0.05)
-                print(
-                    f"[{name}] start -> proved (/liveness 200) {time.perf_counter() - t0:7.1f} s"
-                    f"   ({load()})"
-                )
-        launch: dict = {"args": ARGS}
-        if Path(CHROMIUM).exists():
-            launch["executable_path"] = CHROMIUM
-        out: dict[str, list[float]] = {name: [] for name in names}
-        cpu: dict[str, list[float]] = {name: [] for name in names}
-        with sync_playwright() as p:
-            browser = p.chromium.launch(**launch)
-            for k in range(args.samples):
-                order = list(zip(names, servers, strict=True))
-                if k % 2:  # alternate which tree goes first
+    launch: dict = {"args": ARGS}
+    if Path(CHROMIUM).exists():
+        launch["executable_path"] = CHROMIUM
+    figures: dict[str, dict[str, list[float]]] = {
+        name: {"listening": [], "proved": [], "first": [], "later": [], "cpu": []} for name in names
+    }
+    with sync_playwright() as p:
+        browser = p.chromium.launch(**launch)
+        try:
+            for r in range(args.starts):
+                order = list(zip(names, trees, warm, strict=True))
+                if r % 2:  # alternate which tree starts first
                     order.reverse()
-                for name, (_tree, port, proc, _marks) in order:
-                    page = browser.new_page(viewport={"width": 1600, "height": 1200})
-                    c = cpu_s(proc.pid)
-                    t = time.perf_counter()
-                    page.goto(
-                        f"http://127.0.0.1:{port}/main",
-                        timeout=args.timeout * 1e3,
-                        wait_until="commit",
-                    )
-                    page.wait_for_function(
-                        JS_READY, arg="mobility.truncated", timeout=args.timeout * 1e3, polling=20
-                    )
-                    dt = time.perf_counter() - t
-                    out[name].append(dt)
-                    cpu[name].append(cpu_s(proc.pid) - c)
-                    print(
-                        f"[{name}] page {k + 1}: request -> first plot {dt:6.2f} s, "
-                        f"server CPU {cpu[name][-1]:5.2f} s   ({load()})"
-                    )
-                    page.close()
+                for name, tree, w in order:
+                    one_start(browser, name, tree, w, args, figures[name])
+        finally:
             browser.close()
-        print("page request -> first plot, per tree:")
-        for name in names:
-            a = np.asarray(out[name])
+    print("per tree (medians over the starts; 'later': the pages after each start's first):")
+    for name in names:
+        f = {k: np.asarray(v) for k, v in figures[name].items()}
+
+        def med(a: np.ndarray) -> str:
+            return f"{np.median(a):6.2f} s (max {a.max():5.2f})" if a.size else "     -"
+
+        print(
+            f"[{name}] start -> listening {med(f['listening'])}; proved {med(f['proved'])}; "
+            f"first page {med(f['first'])}; later pages {med(f['later'])} (n={f['later'].size}); "
+            f"server CPU per page {np.median(f['cpu']):5.2f} s"
+        )
+    if len(names) > 1:
+        base = figures[names[0]]
+        for name in names[1:]:
             print(
-                f"[{name}] median {np.median(a):6.2f} s   min {a.min():6.2f}   "
-                f"max {a.max():6.2f}   (n={a.size}); server CPU median "
-                f"{np.median(cpu[name]):5.2f} s"
+                f"ratio {name} / {names[0]} (medians): first page "
+                f"{np.median(figures[name]['first']) / np.median(base['first']):.2f}, "
+                f"start -> listening "
+                f"{np.median(figures[name]['listening']) / np.median(base['listening']):.2f}"
             )
-        if len(names) > 1:
-            base = np.median(out[names[0]])
-            cbase = np.median(cpu[names[0]])
-            for name in names[1:]:
-                print(
-                    f"ratio {name} / {names[0]} (medians): wall "
-                    f"{np.median(out[name]) / base:.2f}, server CPU "
-                    f"{np.median(cpu[name]) / cbase:.2f}"
-                )
+
+
+def one_start(browser, name: str, tree: Path, warm: bool, args, fig: dict) -> None:
+    """Start the server of ``tree`` alone, note start -> listening (and -> proved), open
+    ``args.samples`` pages one after the other, each until its first plot; stop it."""
+    port = free_port()
+    t0 = time.perf_counter()
+    proc, marks = start(tree, port, args.panel, args.threads, warm)
+    try:
+        while not listening(port):  # polled every 50 ms
+            if proc.poll() is not None or time.perf_counter() - t0 > args.timeout:
+                print("".join(marks["log"][-30:]))
+                raise RuntimeError(f"server of {name} did not listen")
+            time.sleep(0.05)
+        fig["listening"].append(time.perf_counter() - t0)
+        print(f"[{name}] start -> listening      {fig['listening'][-1]:7.1f} s   ({load()})")
+        if args.first == "proved" and not args.panel:
+            while not proved(port):
+                if proc.poll() is not None or time.perf_counter() - t0 > args.timeout:
+                    print("".join(marks["log"][-30:]))
+                    raise RuntimeError(f"server of {name} was not proved")
+                time.sleep(0.05)
+            fig["proved"].append(time.perf_counter() - t0)
+            print(f"[{name}] start -> proved (/liveness 200) {fig['proved'][-1]:7.1f} s")
+        for k in range(args.samples):
+            page = browser.new_page(viewport={"width": 1600, "height": 1200})
+            c = cpu_s(proc.pid)
+            t = time.perf_counter()
+            page.goto(
+                f"http://127.0.0.1:{port}/main", timeout=args.timeout * 1e3, wait_until="commit"
+            )
+            page.wait_for_function(
+                JS_READY, arg="mobility.truncated", timeout=args.timeout * 1e3, polling=20
+            )
+            dt = time.perf_counter() - t
+            fig["first" if k == 0 else "later"].append(dt)
+            fig["cpu"].append(cpu_s(proc.pid) - c)
+            print(
+                f"[{name}] page {k + 1}: request -> first plot {dt:6.2f} s, "
+                f"server CPU {fig['cpu'][-1]:5.2f} s   ({load()})"
+            )
+            page.close()
     finally:
-        for _tree, _port, proc, _marks in servers:
-            proc.terminate()
-        for _tree, _port, proc, _marks in servers:
-            try:
-                proc.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                proc.kill()
+        proc.terminate()
+        try:
+            proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
 
 
 if __name__ == "__main__":
