@@ -110,17 +110,18 @@ def test_a_failing_task_is_logged_not_raised_and_the_worker_goes_on(caplog):
 
 
 def test_the_reference_studies_are_warmed_once(monkeypatch):
-    """Once per process, each harmonic's map after a quiet moment (issue 33)."""
+    """Once per process, each harmonic's map and the freeze after a quiet moment (issue 33)."""
     asked = []
     monkeypatch.setattr(compute, "error_map", lambda h, c: asked.append((h, c)))
     monkeypatch.setattr(collector, "wait_quiet", lambda: asked.append("quiet"))
-    monkeypatch.setattr(background, "freeze_long_lived", lambda: 0)
+    monkeypatch.setattr(background, "freeze_long_lived", lambda: asked.append("freeze"))
     monkeypatch.setattr(background, "_warmed", threading.Event())
     t = background.warm_reference_studies()
     assert t is not None
     t.join(60)
     assert background.warm_reference_studies() is None  # once per process
-    assert asked == [x for h in range(1, 8) for x in ("quiet", (h, "6dof"))]
+    maps = [x for h in range(1, 8) for x in ("quiet", (h, "6dof"))]
+    assert asked == [*maps, "quiet", "freeze"]  # the full collection in a quiet moment too
 
 
 def test_a_session_never_waits_for_a_background_thread_computing_the_same_result():

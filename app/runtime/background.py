@@ -138,10 +138,10 @@ def warm_reference_studies(coupling: str = "6dof") -> threading.Thread | None:
     """Once per process, on a thread of its own at a lower priority: the reference error
     maps of all seven harmonics (each holds the coupled responses of every N of the
     selector), so that the first change to another harmonic finds them computed; then the
-    long-lived objects are frozen (:func:`freeze_long_lived`). Each map waits for a quiet
-    moment (:func:`app.runtime.collector.wait_quiet`): started by the first page, the
-    warm-up ran beside that page and the next ones opened (issue 33). Returns the thread,
-    or None if the warm-up was already started."""
+    long-lived objects are frozen (:func:`freeze_long_lived`). Each map, and the freeze,
+    waits for a quiet moment (:func:`app.runtime.collector.wait_quiet`): started by the
+    first page, the warm-up ran beside that page and the next ones opened (issue 33).
+    Returns the thread, or None if the warm-up was already started."""
     with _warm_lock:
         if _warmed.is_set():
             return None
@@ -154,6 +154,8 @@ def warm_reference_studies(coupling: str = "6dof") -> threading.Thread | None:
             for h in range(1, 8):
                 collector.wait_quiet()
                 compute.error_map(h, coupling)
+            # a full collection holds the interpreter (0.24 s seen while a page opened)
+            collector.wait_quiet()
             freeze_long_lived()
         except Exception:  # optional: log, never kill the server
             log.exception("warming the reference studies failed")
