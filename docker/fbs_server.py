@@ -224,23 +224,35 @@ def preload_imports(files: list[str]) -> float:
     Run before the port opens (1.5-2 s for the dashboard: its libraries, the reference
     models' code and what its pages import on first use, ``app/runtime/libraries.py``), so
     that the first page requested does not wait for them (issue 33). A module that fails
-    to import is left to the proof, which reports the script's error.
+    to import is left to the proof, which reports the script's error. Then a preloaded
+    module's ``warm_before_serving()``, if it has one, is called: what the app's first
+    page computes, computed before the port opens (the dashboard's default results).
     """
     import importlib
 
     t0 = time.perf_counter()
+    loaded = []
     for path in files:
         subs = [n for n in script_submodules(path) if n not in sys.modules]
         for name in script_imports(path) + subs:
             if name in subs and not _is_submodule(name):
                 continue  # a function or class of the package, or the package failed
             try:
-                importlib.import_module(name)
+                loaded.append(importlib.import_module(name))
             except Exception as exc:  # noqa: BLE001 (the proof reports the script's error)
                 log.warning("preloading %s for %s failed: %s", name, path, exc)
     dt = time.perf_counter() - t0
     log.info("the apps' imports preloaded (%.1f s)", dt)
-    return dt
+    for module in loaded:
+        warm = getattr(module, "warm_before_serving", None)
+        if callable(warm):
+            t1 = time.perf_counter()
+            try:
+                warm()
+            except Exception as exc:  # noqa: BLE001 (the proof reports the script's error)
+                log.warning("%s.warm_before_serving failed: %s", module.__name__, exc)
+            log.info("%s.warm_before_serving (%.1f s)", module.__name__, time.perf_counter() - t1)
+    return time.perf_counter() - t0
 
 
 def prove_applications(apps: dict, proved: dict[str, float] | None = None) -> dict[str, float]:

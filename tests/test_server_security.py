@@ -230,6 +230,38 @@ def test_the_apps_imports_are_loaded_before_the_port_opens(tmp_path):
         srv.stop()
 
 
+def test_a_preloaded_modules_warm_up_runs_before_the_port_opens(tmp_path):
+    """Issue 33: a module the script imports may define ``warm_before_serving()`` (the
+    dashboard computes its default page's results there); the server calls it on its main
+    thread after preloading and before its port opens; one that fails is logged, and the
+    server goes on (the proof reports a broken app)."""
+    (tmp_path / "warm_mod.py").write_text(
+        "import os, pathlib, socket, threading\n"
+        "def warm_before_serving():\n"
+        "    with socket.socket() as s:\n"
+        "        port_open = s.connect_ex(('127.0.0.1', int(os.environ['FBS_PORT']))) == 0\n"
+        f"    pathlib.Path({str(tmp_path)!r}, 'warm.txt').write_text(\n"
+        "        f'{threading.current_thread().name} port open: {port_open}')\n"
+    )
+    (tmp_path / "broken_warm.py").write_text(
+        "def warm_before_serving():\n    raise RuntimeError('warm-marker')\n"
+    )
+    app = (
+        "import warm_mod, broken_warm\nimport panel as pn\npn.pane.Markdown('a page').servable()\n"
+    )
+    env = {"PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    srv = Server(tmp_path, app, env)
+    try:
+        srv.started(120)
+        assert (tmp_path / "warm.txt").read_text() == "MainThread port open: False"
+        log = srv.log()
+        assert "warm_mod.warm_before_serving (" in log
+        assert "broken_warm.warm_before_serving failed: warm-marker" in log
+        assert log.index("warm_mod.warm_before_serving (") < log.index("Bokeh app running")
+    finally:
+        srv.stop()
+
+
 def test_script_imports_reads_the_top_level_imports(tmp_path):
     script = tmp_path / "s.py"
     script.write_text(

@@ -38,3 +38,17 @@ for _name in PANEL_LAZY:
 # containers, ...) when its first kernel is compiled or loaded from its cache: 0.3 s of
 # imports, paid by the first page's first study (holding the GIL) unless done here
 cpu_target.target_context.refresh()
+
+
+def warm_before_serving() -> None:
+    """What a first page computes, computed before the server's port opens (the server
+    calls this after preloading the app's imports, ``docker/fbs_server.py``): the default
+    page's results - the reference models loaded, their first error map and responses,
+    the kernels loaded from numba's cache. A page requested the moment the port opened
+    computed them itself (0.5-0.7 s of CPU more than a later page: 2.1-2.5 s to its first
+    plot instead of 1.6-1.8 s; issue 33). They are the shared results every page reads
+    (``app.compute``), so computing them here changes no number."""
+    from app.state import DashboardState
+    from app.store import Results
+
+    Results(DashboardState()).close()
