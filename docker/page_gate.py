@@ -8,7 +8,9 @@ its first plot instead of 1.65 s once the app was proved (``bench/bench_first_pa
 :class:`PageGate` knows the pages being opened: a page opens when its session starts
 (Bokeh's session-created callbacks, before the app's script builds it) and is open when its
 browser says it shows it (Bokeh's "document ready" event, sent once the first screen is
-drawn) or its session ends.
+drawn) and the on-load callbacks the page registered have run (the dashboard builds what
+is below the first screen there: a page requested the moment the previous one showed
+shared the machine with that and with the proof), or when its session ends.
 
 The proof steps aside at safe points only: before it builds a page, before it loads it, and
 where the app's script says so. A thread that builds a page nobody waits for carries a
@@ -93,19 +95,28 @@ class PageGate:
 
     def watch_session(self, session_context: Any) -> None:
         """Session-created callback (``pn.state.on_session_created``; Panel runs it with the
-        session's document current): the page of this session opens until its browser
-        sends "document ready" or the session ends."""
+        session's document current): the page of this session opens until its on-load
+        callbacks have run (see :meth:`watch`) or the session ends."""
         import panel as pn
 
         self.watch(str(session_context.id), pn.state.curdoc)
 
     def watch(self, key: str, doc: Any) -> None:
-        """The page of ``doc`` opens now, until its "document ready" event or its
-        session's end."""
+        """The page of ``doc`` opens now, until its browser says it shows it ("document
+        ready") and the on-load callbacks the page registered have run after it (the
+        dashboard builds what is below its first screen there), or its session ends."""
         if self._retired or doc is None:
             return
         self.opened(key)
-        doc.on_event("document_ready", lambda _event: self.shown(key))
+
+        def ready(_event: Any) -> None:  # after the page's own on-load callbacks
+            import panel as pn
+            from panel.io.state import set_curdoc
+
+            with set_curdoc(doc):
+                pn.state.onload(lambda: self.shown(key))
+
+        doc.on_event("document_ready", ready)
         doc.on_session_destroyed(lambda _ctx: self.shown(key))
 
     # ---- the proof ---------------------------------------------------------------------

@@ -104,8 +104,10 @@ def test_a_session_opens_until_document_ready_or_its_end():
         with set_curdoc(doc):  # as Panel runs session-created callbacks
             gate.watch_session(Context(key))
     assert gate.opening() == 2
+    # shown, then its on-load callbacks (here, outside a server, at once; with a server
+    # after the page's own: test_the_server_proof_steps_aside_for_a_page_opened_meanwhile)
     shown.callbacks.trigger_event(DocumentReady())
-    assert gate.opening() == 1
+    wait_for(lambda: gate.opening() == 1, 30, what="the shown page's on-load callbacks")
     for callback in closed.session_destroyed_callbacks:
         callback(None)
     assert gate.opening() == 0
@@ -113,9 +115,10 @@ def test_a_session_opens_until_document_ready_or_its_end():
 
 def test_the_server_proof_steps_aside_for_a_page_opened_meanwhile(tmp_path):
     """A real server: its proof builds the app's page; a user's page opens meanwhile; the
-    proof, at the app's next safe point, waits until that page is shown, then goes on and
-    the app is reported proved."""
+    proof, at the app's next safe point, waits until that page is shown and its own on-load
+    work done, then goes on and the app is reported proved."""
     notes, gate_file = tmp_path / "notes.txt", tmp_path / "gate"
+    onload_gate = tmp_path / "onload-gate"
     app = (
         "import pathlib, threading, time\n"
         "import panel as pn\n"
@@ -137,6 +140,14 @@ def test_the_server_proof_steps_aside_for_a_page_opened_meanwhile(tmp_path):
         "    note('proof goes on')\n"
         "else:\n"
         "    note('page builds')\n"
+        "    def below():  # the page's own on-load work (the dashboard: below the screen)\n"
+        "        note('page on-load starts')\n"
+        f"        more = pathlib.Path({str(onload_gate)!r})\n"
+        "        t0 = time.monotonic()\n"
+        "        while not more.exists() and time.monotonic() - t0 < 300:\n"
+        "            time.sleep(0.02)\n"
+        "        note('page on-load ends')\n"
+        "    pn.state.onload(below)\n"
         "pn.pane.Markdown('a page').servable()\n"
     )
     srv = Server(tmp_path, app, {}, name="gateapp")
@@ -158,10 +169,17 @@ def test_the_server_proof_steps_aside_for_a_page_opened_meanwhile(tmp_path):
             doc = await client.pull(60)  # a user's page opened (built, sent)
             loop = asyncio.get_running_loop()
             await loop.run_in_executor(None, while_the_page_opens)
-            await client.ready(doc)  # the browser shows the page
+            await client.ready(doc)  # the browser shows the page: its on-load work starts
+            await loop.run_in_executor(
+                None, lambda: wait_for(lambda: "page on-load starts" in notes.read_text(), 60)
+            )
+            onload_gate.write_text("open")
             await loop.run_in_executor(
                 None, lambda: wait_for(lambda: "proof goes on" in notes.read_text(), 60)
             )
+            # the page stayed first until its own on-load work was done
+            lines = notes.read_text().splitlines()
+            assert lines.index("page on-load ends") < lines.index("proof goes on")
         finally:
             client.close()
 
