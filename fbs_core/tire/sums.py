@@ -891,33 +891,13 @@ def _tile(
         for ib in range(n_blk):  # into this block's accumulator, or to wait for a later one
             bj = blocks[ib]
             for ps_ in range(n_pass):
-                if bj == b:
-                    _fold(
-                        acc,
-                        ps_,
-                        lines,
-                        nt,
-                        w,
-                        nn,
-                        kc,
-                        H,
-                        ib,
-                        ps_,
-                        z_all,
-                        members,
-                        cc,
-                        n0,
-                        Zr,
-                        Zi,
-                        p0,
-                        cr,
-                        ci,
-                    )
-                    continue
-                acc[2, :, :nt] = 0.0  # the part of a later block, alone first
+                later = bj != b  # a later block's part: alone first, in the spare slot 2
+                slot = 2 if later else ps_
+                if later:
+                    acc[2, :, :nt] = 0.0
                 _fold(
                     acc,
-                    2,
+                    slot,
                     lines,
                     nt,
                     w,
@@ -936,6 +916,8 @@ def _tile(
                     cr,
                     ci,
                 )
+                if not later:
+                    continue
                 if not has_pend[ps_, bj]:
                     pend[ps_, bj, :, :nt] = 0.0
                     has_pend[ps_, bj] = True
