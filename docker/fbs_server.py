@@ -352,19 +352,14 @@ def load_as_browser(doc, path: str, timeout_s: float = ONLOAD_TIMEOUT_S) -> None
         ) from exc
 
 
-def prove_in_background(
-    apps: dict, proved: dict[str, float], gate: PageGate | None = None
-) -> threading.Thread:
+def prove_in_background(apps: dict, proved: dict[str, float], gate: PageGate) -> threading.Thread:
     """:func:`prove_applications` on a thread of its own, once the server listens; an app
-    that cannot build a page stops the server (as a failed start would). With ``gate``, the
-    proof steps aside while users' pages open (:class:`page_gate.PageGate`)."""
+    that cannot build a page stops the server (as a failed start would). The proof steps
+    aside while users' pages open (``gate``, :class:`page_gate.PageGate`)."""
 
     def work() -> None:
         try:
-            if gate is None:
-                prove_applications(apps, proved)
-            else:
-                gate.run(lambda: prove_applications(apps, proved))
+            gate.run(lambda: prove_applications(apps, proved))
         except Exception as exc:  # noqa: BLE001 (any failure of the app: stop with it)
             log.error("the server stopped: %s", exc)
             print(f"tire-fbs: the server stopped: {exc}", file=sys.stderr, flush=True)
