@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from .candidates import Candidate
     from .studies import SuggestedModes
 
-__all__ = ["Delivery", "delivery"]
+__all__ = ["Delivery", "assess_delivery"]
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,7 @@ class Delivery:
         return self.converged and self.enough_modes and not self.uncovered
 
 
-def delivery(
+def assess_delivery(
     candidate: Candidate,
     suggested: SuggestedModes | None = None,
     *,

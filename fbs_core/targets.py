@@ -261,12 +261,11 @@ class Target:
                     f"cannot convert the target of {self.dof} from {self.quantity} to {q} at "
                     "0 Hz (division by j omega)"
                 )
-            with np.errstate(divide="ignore"):
-                out = out + 20.0 * p * np.log10(w)
+            out = out + p * magnitude_db(w, floor=None)  # 20 p log10(omega)
         if ref is not None:
             if not (np.isfinite(ref) and ref > 0):
                 raise FBSError(f"the dB reference must be a positive number, got {ref!r}")
-            out = out + 20.0 * np.log10(self.ref / float(ref))
+            out = out + magnitude_db(self.ref / float(ref))
         return out
 
     def level_at(self, freq: ArrayLike, quantity: str | None = None) -> FloatArray:

@@ -409,7 +409,7 @@ def verdict(
     candidates : CandidateSet, optional
         Resolves names and digests and gives the candidates' order.
     deliveries : iterable of Delivery
-        Delivery adequacy to report beside the rows (:func:`fbs_core.delivery.delivery`).
+        Delivery adequacy to report beside the rows (:func:`fbs_core.delivery.assess_delivery`).
 
     Returns
     -------

@@ -20,7 +20,7 @@ from fbs_core.candidates import (
     CandidateSet,
     file_digest,
 )
-from fbs_core.delivery import delivery
+from fbs_core.delivery import assess_delivery
 from fbs_core.errors import FBSError
 from fbs_core.studies import SuggestedModes
 from fbs_core.tire import TireModel
@@ -118,17 +118,17 @@ def _table(hs, n, threshold=0.2, f_max=160.0) -> SuggestedModes:
 
 def test_delivery_modes_against_table_5_1(tire):
     c = Candidate.reference()
-    ok = delivery(c, _table((1, 4), (120, 200)))
+    ok = assess_delivery(c, _table((1, 4), (120, 200)))
     assert ok.converged and ok.enough_modes and ok.adequate and ok.uncovered == ()
     assert ok.n_modes == 400 and ok.speeds == (20.0, 120.0)
-    short = delivery(c, _table((1, 4), (120, 400)))
+    short = assess_delivery(c, _table((1, 4), (120, 400)))
     assert not short.converged and not short.adequate
     assert any("harmonic(s) 4" in w for w in short.warnings)
-    need = delivery(c, _table((1, 4), (120, 200)), required=_table((1, 4), (100, 420)))
+    need = assess_delivery(c, _table((1, 4), (120, 200)), required=_table((1, 4), (100, 420)))
     assert need.converged and not need.enough_modes
     assert any("asks for 420" in w for w in need.warnings)
     with pytest.raises(FBSError, match="one meeting"):
-        delivery(c, _table((1,), (100,)), required=_table((1,), (100,), threshold=0.1))
+        assess_delivery(c, _table((1,), (100,)), required=_table((1,), (100,), threshold=0.1))
 
 
 def test_delivery_speeds_must_cover_every_harmonic(tire):
@@ -141,6 +141,6 @@ def test_delivery_speeds_must_cover_every_harmonic(tire):
         tire.wavelengths,
         tire.participation[keep],
     )
-    d = delivery(Candidate("slow", "abc", part), _table((2, 5), (100, 100)))
+    d = assess_delivery(Candidate("slow", "abc", part), _table((2, 5), (100, 100)))
     assert d.uncovered == (2, 5) and not d.adequate and d.converged
     assert any("30-120 km/h needed, the delivery covers 40-120" in w for w in d.warnings)
