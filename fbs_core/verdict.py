@@ -446,20 +446,22 @@ def verdict(
                 f"{', '.join(order)}"
             )
     rows: list[VerdictRow] = []
+    resolved: dict[int, dict[str, Target]] = {}  # the incumbent's targets per harmonic
     for name in order:
         digest = candidates.get(name).digest if candidates is not None else ""
         for k in sorted(h for n, h in resp if n == name):
             frf = resp[(name, k)]
             inc_targets: dict[str, Target] = {}
             if incumbent is not None and inc_name is not None:
-                base = resp.get((inc_name, k))
-                if base is None:
-                    raise FBSError(
-                        f"the incumbent {inc_name!r} has no response to harmonic {k}; the "
-                        f"target 'incumbent + {incumbent.margin_db:g} dB' needs it"
-                    )
-                dofs = [d for d in (incumbent.dofs or base.outputs) if d in frf.outputs]
-                inc_targets = {t.dof: t for t in incumbent.resolve(base.sel(outputs=dofs), k)}
+                if k not in resolved:
+                    base = resp.get((inc_name, k))
+                    if base is None:
+                        raise FBSError(
+                            f"the incumbent {inc_name!r} has no response to harmonic {k}; the "
+                            f"target 'incumbent + {incumbent.margin_db:g} dB' needs it"
+                        )
+                    resolved[k] = {t.dof: t for t in incumbent.resolve(base, k)}
+                inc_targets = resolved[k]
             rows += _judge(name, digest, k, frf, explicit, inc_targets, edges.get((name, k)))
     return Verdict(tuple(rows), _ranking(rows, order, candidates), tuple(deliveries))
 
