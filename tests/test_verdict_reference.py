@@ -137,3 +137,30 @@ def test_a_band_percentile_it_does_not_hold_is_refused(review):
     with pytest.raises(FBSError, match="percentiles 5, 95 %"):
         NoiseEdge.of_band(band, q=50.0)
     assert NoiseEdge.of_band(band, q=100.0).upper.max() == pytest.approx(band.maximum.max())
+
+
+def test_vehicle_scope_response_points_are_judged(review):
+    """The car's seat and bushing points (outputs ``point:dir``) with uncorrelated track
+    components (here anti-phase and in phase at a partial coherence) judged like the
+    bushing: the level is the root of the summed squares over the components."""
+    cands, _, _ = review
+    f = fc.harmonic(4).frequencies(4.0)
+    pts = ("seat_fl:z", "bushing_rl:z")
+    resp = {
+        (c.name, 4): fc.vehicle_response(
+            4, N_MODES, f, tracks=0.5, outputs=("seat_fl", "bushing_rl"), tire=c.model
+        ).response.sel(outputs=pts)
+        for c in cands
+    }
+    targets = [fc.Target.segments(p, [(30.0, -5.0), (150.0, 5.0)]) for p in pts]
+    v = verdict(resp, targets, candidates=cands)
+    assert [r.point for r in v.rows[:2]] == ["seat_fl", "bushing_rl"]
+    for (name, _), frf in resp.items():
+        assert len(frf.inputs) == 2  # two uncorrelated components
+        for o, p in enumerate(pts):
+            level = 10 * np.log10(np.sum(np.abs(frf.data[:, o, :]) ** 2, axis=1))
+            target = np.interp(np.log10(f), np.log10([30.0, 150.0]), [-5.0, 5.0])
+            d = level - target
+            r = v.row(name, 4, p)
+            assert r.worst_db == pytest.approx(d.max(), abs=1e-9)
+            assert r.freq == f[np.argmax(d)]
