@@ -224,3 +224,18 @@ def test_csv_export_has_a_metadata_header_and_the_rows():
     assert rows[1]["status"] == "pass" and float(rows[1]["margin_db"]) == pytest.approx(6.5)
     ranking = list(csv.DictReader(io.StringIO(blocks[2].split("\n", 1)[1])))
     assert [r["candidate"] for r in ranking] == ["B", "'=cmd"]
+
+
+def test_a_candidate_with_nothing_judged_ranks_last():
+    f5 = np.arange(52.0, 200.0, 2.0)  # harmonic 5's lines
+    resp = {
+        ("A", 4): response({"bushing:z": np.full(F.size, -10.0)}),  # fails by 10 dB
+        ("B", 5): response({"bushing:z": np.full(f5.size, -30.0)}, f5),
+    }
+    v = verdict(resp, [flat("bushing:z", -20.0, harmonic=4)])
+    assert [(s.candidate, s.status) for s in v.ranking] == [("A", FAIL), ("B", NOT_JUDGED)]
+    assert math.isnan(v.ranking[1].worst_db)
+    # B's harmonic has no target: B has no row at all
+    assert {r.candidate for r in v.rows} == {"A"}
+    with pytest.raises(FBSError, match="no verdict row for 'B', harmonic 5"):
+        v.row("B", 5, "bushing:z")
