@@ -373,8 +373,12 @@ def test_the_ranking_shown_to_a_supplier_names_only_its_own_candidate(meeting):
     ]
 
 
-def test_the_digest_is_the_dashboards_upload_key():
+def test_the_digest_and_size_limit_are_the_dashboards():
     from app.datasource import _digest
+    from app.projects.service import DEFAULT_MAX_BYTES
+    from fbs_core.io.checks import DEFAULT_MAX_BYTES as core_limit
+
+    assert DEFAULT_MAX_BYTES == core_limit
 
     for data in (b"", b"abc", X_FILE):
         assert upload_digest(data) == _digest(data)

@@ -22,8 +22,6 @@ import sqlite3
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
-from fbs_core.io.checks import DEFAULT_MAX_BYTES
-
 from . import access as policy
 from .config import AccessConfig, data_dir, load_access_config
 from .errors import AccessDenied, Conflict, NotFound, ProjectError
@@ -44,6 +42,10 @@ from .storage import Problem, ProjectDB, ProjectStore, now_text
 
 __all__ = ["MAX_QUERY_CHARS", "Projects", "upload_digest"]
 
+#: Largest file kept (bytes): the limit of the files ``fbs_core.io`` reads (100 MiB), so
+#: that a project holds no file the dashboard would refuse. Not imported from there: the
+#: store starts without loading the numerical libraries.
+DEFAULT_MAX_BYTES = 100 * 1024 * 1024
 #: Longest text of a title, name, supplier, size, version or file name.
 MAX_TEXT = 120
 #: Longest note.
