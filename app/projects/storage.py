@@ -636,6 +636,9 @@ class ProjectStore:
                     shutil.rmtree(p, ignore_errors=True)
                     problems.append(Problem(str(p), "an unfinished project creation; removed"))
                 continue
+            if p.name.startswith(".old-"):
+                problems.append(Problem(str(p), "left by an interrupted restore; left alone"))
+                continue
             if p.name.startswith("."):
                 continue
             if not p.is_dir() or not is_project_id(p.name):
