@@ -12,11 +12,13 @@ file present with its digest), copies it beside the live ones under a temporary 
 renames it into place: a running server sees the old project or the restored one, never a
 mix. An existing project is replaced only when asked (``replace=True``).
 
-``scripts/projects_backup.py`` is the command line of this module (docs/projects.md).
+Command line: ``python -m app.projects.backup backup|verify|restore BACKUP_DIR [--data DIR]
+[--project ID ...] [--replace]`` (also ``scripts/projects_backup.py``; docs/projects.md).
 """
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import fcntl
 import hashlib
@@ -25,10 +27,12 @@ import os
 import secrets
 import shutil
 import sqlite3
+import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+from .config import data_dir
 from .errors import ProjectError, StorageError
 from .storage import (
     DB_NAME,
@@ -41,7 +45,7 @@ from .storage import (
     now_text,
 )
 
-__all__ = ["ATTEMPTS", "BackupReport", "backup", "restore", "verify"]
+__all__ = ["ATTEMPTS", "BackupReport", "backup", "main", "restore", "verify"]
 
 #: Attempts to copy one project whose files changed during its copy.
 ATTEMPTS = 5
@@ -247,3 +251,47 @@ def restore(
             os.close(lock)
         copied.append(pid)
     return BackupReport(tuple(copied), ())
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line (exit status 0 all copied, 1 a project skipped or damaged, 2 refused)."""
+    ap = argparse.ArgumentParser(
+        prog="projects_backup",
+        description="Back up, verify and restore the projects of a data directory.",
+    )
+    sub = ap.add_subparsers(dest="command", required=True)
+    for name in ("backup", "verify", "restore"):
+        p = sub.add_parser(name)
+        p.add_argument("backup_dir", type=Path)
+        if name != "verify":
+            p.add_argument("--data", type=Path, default=None, help="data directory")
+            p.add_argument("--project", action="append", default=[], help="project id")
+        if name == "restore":
+            p.add_argument("--replace", action="store_true", help="overwrite existing projects")
+    args = ap.parse_args(argv)
+    data = getattr(args, "data", None) or data_dir()
+    try:
+        if args.command == "backup":
+            report = backup(data, args.backup_dir, args.project)
+            for pid in report.copied:
+                print(f"backed up {pid}")
+            for pid, why in report.skipped:
+                print(f"SKIPPED {pid}: {why}", file=sys.stderr)
+            print(f"{len(report.copied)} projects in {args.backup_dir}")
+            return 1 if report.skipped else 0
+        if args.command == "verify":
+            checks = verify(args.backup_dir)
+            for pid, result in checks.items():
+                print(f"{pid}: {result}")
+            return 0 if all(r == "ok" for r in checks.values()) else 1
+        report = restore(args.backup_dir, data, args.project, replace=args.replace)
+        for pid in report.copied:
+            print(f"restored {pid}")
+        return 0
+    except ProjectError as exc:
+        print(f"refused: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
