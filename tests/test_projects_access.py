@@ -274,6 +274,20 @@ def test_changing_access_takes_effect_and_keeps_an_administrator(meeting):
     assert [i.id for i in p.list_projects("dave")] == []
 
 
+def test_a_name_used_by_a_hidden_candidate_tells_the_supplier_nothing(meeting):
+    p, pid = meeting["p"], meeting["pid"]
+    # dave (supplier Y) names his new delivery like X's candidate he cannot see: it lands
+    c = p.add_candidate(
+        "dave", pid, "y_v2.h5", b"Y v2 bytes", {"name": "Xylo Grip", "supplier": "Supplier Y"}
+    )
+    assert [x.name for x in p.open_project("dave", pid).candidates] == ["Yonder Comfort", c.name]
+    assert len([x for x in p.open_project("alice", pid).candidates if x.name == "Xylo Grip"]) == 2
+    # and a file identical to a hidden candidate's is refused without naming it
+    with pytest.raises(Conflict, match="holds this file already") as err:
+        p.add_candidate("dave", pid, "copy.h5", X_FILE, {"name": "copy", "supplier": "Supplier Y"})
+    assert "Xylo" not in str(err.value)
+
+
 def test_a_removed_candidates_view_still_opens_and_names_it(meeting):
     p, pid = meeting["p"], meeting["pid"]
     p.remove_candidate("carol", pid, meeting["cx"].id)
@@ -444,7 +458,7 @@ def test_bad_input_names_the_problem_and_changes_nothing(meeting):
             lambda: p.add_candidate(
                 "alice", pid, "n.h5", b"new", {"name": "xylo grip", "supplier": "Supplier X"}
             ),
-            "candidate of that name",
+            "Supplier X has a candidate of that name",
         ),
         (lambda: p.save_view("alice", pid, "v", "a=1\nb=2"), "control characters"),
         (lambda: p.save_view("alice", pid, "v", "a" * 9000), "at most 8000"),

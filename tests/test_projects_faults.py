@@ -254,6 +254,9 @@ def test_damaged_projects_at_start_are_reported_and_the_others_open(tmp_path):
     ids = [p.create_project("alice", f"project {k}", {"oem": None}).id for k in range(4)]
     for pid in ids:
         p.add_candidate("alice", pid, "a.h5", payload(pid, 1, 5000), {"name": f"tire {pid}"})
+    from app.projects.backup import backup, restore
+
+    backup(tmp_path, tmp_path / "backup", [ids[0]])
     root = tmp_path / "projects"
     # 0: garbage over the header; 1: cut to its first page; 2: database file missing
     db0 = root / ids[0] / "project.sqlite3"
@@ -278,3 +281,7 @@ def test_damaged_projects_at_start_are_reported_and_the_others_open(tmp_path):
     for pid in ids[:3]:
         with pytest.raises(NotFound):
             again.open_project("alice", pid)
+    # the damaged project restored from its backup opens again, without a restart
+    restore(tmp_path / "backup", tmp_path, [ids[0]], replace=True)
+    assert sorted(i.id for i in again.list_projects("alice")) == sorted([ids[0], ids[3]])
+    assert [c.name for c in again.open_project("alice", ids[0]).candidates] == [f"tire {ids[0]}"]

@@ -313,13 +313,21 @@ class Projects:
         what = f"project {pid}: adding candidate {name!r}"
 
         def insert(conn: sqlite3.Connection, sha: str) -> Candidate:
+            now = ProjectDB._info(conn)  # the access list as of this transaction
+            if not policy.may_add_candidate(who, now, supplier):
+                raise AccessDenied(f"{what}: your access to the project has changed")
             for other in ProjectDB._candidates(conn):
                 if other.removed:
                     continue
-                if other.sha256 == sha and policy.candidate_visible(who, info, other):
-                    raise Conflict(f"{what}: the same file is candidate {other.name!r}")
-                if other.sha256 == sha or other.name.casefold() == name.casefold():
-                    raise Conflict(f"{what}: the project has a candidate of that name or file")
+                if other.sha256 == sha:
+                    if policy.candidate_visible(who, now, other):
+                        raise Conflict(f"{what}: the same file is candidate {other.name!r}")
+                    raise Conflict(f"{what}: the project holds this file already")
+                same_supplier = policy.supplier_key(other.supplier) == policy.supplier_key(supplier)
+                if same_supplier and other.name.casefold() == name.casefold():
+                    raise Conflict(
+                        f"{what}: {supplier or 'no supplier'} has a candidate of that name"
+                    )
             at = now_text()
             cur = conn.execute(
                 "INSERT INTO candidates (name, supplier, size, version, filename, sha256, "

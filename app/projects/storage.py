@@ -101,8 +101,8 @@ CREATE TABLE candidates (
     size TEXT NOT NULL, version TEXT NOT NULL, filename TEXT NOT NULL, sha256 TEXT NOT NULL,
     digest TEXT NOT NULL, n_bytes INTEGER NOT NULL, added_by TEXT NOT NULL,
     added_at TEXT NOT NULL, removed_by TEXT, removed_at TEXT);
-CREATE UNIQUE INDEX candidates_name ON candidates (name COLLATE NOCASE)
-    WHERE removed_at IS NULL;
+CREATE UNIQUE INDEX candidates_name
+    ON candidates (supplier COLLATE NOCASE, name COLLATE NOCASE) WHERE removed_at IS NULL;
 CREATE UNIQUE INDEX candidates_file ON candidates (sha256) WHERE removed_at IS NULL;
 CREATE TABLE targets (
     id INTEGER PRIMARY KEY AUTOINCREMENT, name TEXT NOT NULL, filename TEXT NOT NULL,
@@ -499,13 +499,14 @@ class ProjectDB:
             staged = _Staged(self.files, data)
         except OSError as exc:
             raise _storage_error(exc, what) from None
-        existed = False
+        ours = False  # the final file is this call's (it did not exist before the rename)
         try:
 
             def body(conn: sqlite3.Connection) -> Any:
-                nonlocal existed
+                nonlocal ours
                 existed = final.exists()
                 os.replace(staged.tmp, final)
+                ours = not existed
                 fsync_dir(self.files)
                 HOOKS.checkpoint("file-renamed")
                 return insert(conn, sha)
@@ -513,7 +514,7 @@ class ProjectDB:
             try:
                 return self.write(what, body)
             except BaseException:
-                if not existed:
+                if ours:
                     with contextlib.suppress(OSError):
                         final.unlink()
                 raise
@@ -666,11 +667,25 @@ class ProjectStore:
         return tuple(
             p.name
             for p in sorted(self.projects.iterdir())
-            if is_project_id(p.name) and p.name not in self._broken and p.is_dir()
+            if is_project_id(p.name)
+            and p.is_dir()
+            and (p.name not in self._broken or self._recovered(p.name))
         )
 
+    def _recovered(self, pid: str) -> bool:
+        """Whether a project damaged at the last scan checks out now (restored since)."""
+        try:
+            ProjectDB(self.projects / pid).check()
+        except StorageError:
+            return False
+        self._broken.discard(pid)
+        return True
+
     def project(self, pid: str) -> ProjectDB:
-        if not is_project_id(pid) or pid in self._broken or not (self.projects / pid).is_dir():
+        """The project ``pid`` (NotFound for an unknown or damaged one)."""
+        if not is_project_id(pid) or not (self.projects / pid).is_dir():
+            raise NotFound(f"no project {pid!r}")
+        if pid in self._broken and not self._recovered(pid):
             raise NotFound(f"no project {pid!r}")
         return ProjectDB(self.projects / pid)
 
