@@ -200,7 +200,7 @@ def test_a_full_disk_during_an_upload_writes_nothing(project, hooks):
     p.add_candidate("alice", pid, "a.h5", payload("A", 1, SIZE), {"name": "A-1"})
     written = []
 
-    def full_after_one_chunk(fd: int, chunk: bytes) -> int:
+    def full_after_one_chunk(fd: int, chunk: memoryview) -> int:
         if written:
             raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
         written.append(len(chunk))

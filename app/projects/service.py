@@ -59,9 +59,15 @@ _CANDIDATE_KEYS = {"name", "supplier", "size", "version"}
 def upload_digest(data: bytes) -> str:
     """The key the dashboard gives an uploaded tire file (``app.datasource``): 24 hex
     characters of SHA-256 over the bytes and the (empty) import settings."""
+    return _digests(data)[1]
+
+
+def _digests(data: bytes) -> tuple[str, str]:
+    """``(sha256 hex of the bytes, upload_digest)`` in one pass over the bytes."""
     h = hashlib.sha256(data)
+    full = h.hexdigest()
     h.update(repr(sorted({}.items())).encode())
-    return h.hexdigest()[:24]
+    return full, h.hexdigest()[:24]
 
 
 def _text(value: object, what: str, required: bool = False, limit: int = MAX_TEXT) -> str:
@@ -309,7 +315,7 @@ class Projects:
                 f"{', '.join(sorted(mine or ())) or 'no supplier'} only"
             )
         fname, raw = _file(filename, data, f"candidate {name!r}")
-        digest = upload_digest(raw)
+        sha256, digest = _digests(raw)
         what = f"project {pid}: adding candidate {name!r}"
 
         def insert(conn: sqlite3.Connection, sha: str) -> Candidate:
@@ -340,7 +346,7 @@ class Projects:
                 cid, name, supplier, size, version, fname, sha, digest, len(raw), who.name, at
             )
 
-        result: Candidate = db.add_file_record(what, raw, insert)
+        result: Candidate = db.add_file_record(what, raw, insert, sha256)
         return result
 
     def _candidate(self, who: User, db: ProjectDB, info: ProjectInfo, cid: int) -> Candidate:

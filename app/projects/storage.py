@@ -137,7 +137,7 @@ class Hooks:
     """
 
     checkpoint: Callable[[str], None] = field(default=lambda point: None)
-    write: Callable[[int, bytes], int] = field(default=os.write)
+    write: Callable[[int, memoryview], int] = field(default=os.write)
 
 
 #: The hooks in use (see :class:`Hooks`).
@@ -219,7 +219,7 @@ class _Staged:
             view = memoryview(data)
             pos = 0
             while pos < len(view):
-                pos += HOOKS.write(self.fd, bytes(view[pos : pos + _CHUNK]))
+                pos += HOOKS.write(self.fd, view[pos : pos + _CHUNK])
                 if pos < len(view):
                     HOOKS.checkpoint("file-partial")
             os.fsync(self.fd)
@@ -487,13 +487,15 @@ class ProjectDB:
         what: str,
         data: bytes,
         insert: Callable[[sqlite3.Connection, str], Any],
+        sha256: str | None = None,
     ) -> Any:
         """Store ``data`` under its digest and its record in one step (module notes).
 
         ``insert(conn, sha256)`` inserts the record (and its audit line) inside the write
-        transaction and returns what the caller gets back.
+        transaction and returns what the caller gets back; ``sha256`` is the digest of
+        ``data`` when the caller has it already.
         """
-        sha = sha256_hex(data)
+        sha = sha256 or sha256_hex(data)
         final = self.files / sha
         try:
             staged = _Staged(self.files, data)
