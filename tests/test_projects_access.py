@@ -476,3 +476,20 @@ def test_bad_input_names_the_problem_and_changes_nothing(meeting):
         before.views,
         before.notes,
     )
+
+
+def test_the_server_start_turns_projects_on_only_with_groups(tmp_path, caplog):
+    from app.projects import AccessConfigError, projects_at_start
+
+    assert projects_at_start({"FBS_DATA_DIR": str(tmp_path)}) is None
+    assert not (tmp_path / "projects").exists()  # nothing written when off
+    env = {"FBS_DATA_DIR": str(tmp_path), "FBS_GROUPS": "oem:alice,bob"}
+    p = projects_at_start(env, logins=["alice"])
+    assert p is not None and p.list_projects("alice") == ()
+    assert "group members without a login: bob" in caplog.text
+    with pytest.raises(AccessConfigError, match="FBS_GROUPS entry 1"):
+        projects_at_start({**env, "FBS_GROUPS": "oem alice"})
+    blocked = tmp_path / "file"
+    blocked.write_text("not a directory")
+    with pytest.raises(ProjectError, match="set FBS_DATA_DIR to a writable directory"):
+        projects_at_start({**env, "FBS_DATA_DIR": str(blocked)})

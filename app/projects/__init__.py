@@ -38,6 +38,7 @@ from .records import (
     View,
 )
 from .service import Projects, upload_digest
+from .startup import projects_at_start
 
 __all__ = [
     "ANOTHER_CANDIDATE",
@@ -66,6 +67,7 @@ __all__ = [
     "load_access_config",
     "parse_access_file",
     "parse_groups",
+    "projects_at_start",
     "redact_ranking",
     "upload_digest",
     "visible_candidates",
