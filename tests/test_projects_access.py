@@ -304,6 +304,12 @@ def test_a_removed_candidates_view_still_opens_and_names_it(meeting):
     names = {f.name for f in files.iterdir()}
     assert hashlib.sha256(X_FILE).hexdigest() not in names
     assert hashlib.sha256(Y_FILE).hexdigest() in names
+    # a removed target: gone from the page and the data directory, its file refused
+    t = p.remove_target("alice", pid, meeting["target"].id)
+    assert t.removed and p.open_project("carol", pid).targets == ()
+    with pytest.raises(NotFound, match="removed"):
+        p.target_file("carol", pid, t.id)
+    assert hashlib.sha256(TARGET_FILE).hexdigest() not in {f.name for f in files.iterdir()}
     # the same file may be added again as a new candidate
     again = p.add_candidate(
         "carol", pid, "x_v2.h5", X_FILE, {"name": "Xylo Grip", "supplier": "Supplier X"}

@@ -13,6 +13,7 @@ problem and nothing the user may not see: :class:`AccessDenied`, :class:`NotFoun
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -380,7 +381,7 @@ class Projects:
 
         db.write(f"project {pid}: removing candidate {c.name!r}", body)
         db.remove_file_if_unused(c.sha256)
-        return Candidate(**{**c.__dict__, "removed_by": who.name, "removed_at": at})
+        return dataclasses.replace(c, removed_by=who.name, removed_at=at)
 
     def candidate_file(self, user: str | User, pid: str, cid: int) -> tuple[Candidate, bytes]:
         """A candidate's record and its file as uploaded (audited as exported)."""
@@ -444,7 +445,7 @@ class Projects:
 
         db.write(f"project {pid}: removing target {t.name!r}", body)
         db.remove_file_if_unused(t.sha256)
-        return Target(**{**t.__dict__, "removed_by": who.name, "removed_at": at})
+        return dataclasses.replace(t, removed_by=who.name, removed_at=at)
 
     def target_file(self, user: str | User, pid: str, tid: int) -> tuple[Target, bytes]:
         who = self.user(user)
