@@ -18,6 +18,7 @@ from .analysis import (
     speed_map,
     wave_campbell,
 )
+from .candidates import MAX_CANDIDATES, Candidate, CandidateSet
 from .chassis import ChassisModel, FRFChassis, reference_chassis
 from .chassis_modal import ModalChassis
 from .coupling import (
@@ -28,6 +29,7 @@ from .coupling import (
     couple_response,
     interface_condition,
 )
+from .delivery import Delivery, assess_delivery
 from .direct import SecondOrderSystem, assemble
 from .dofs import DIRECTIONS, node_labels, parse_label
 from .errors import (
@@ -66,8 +68,10 @@ from .studies import (
     suggest_modes,
     truncation_map,
 )
+from .targets import IncumbentTarget, Target, read_targets
 from .tire import TireModel, reference_tire
 from .vehicle import random_road_response, reference_vehicle, vehicle_response
+from .verdict import NoiseEdge, Verdict
 from .vocabulary import COUPLINGS, EIGEN_SPEEDS, magnitude_db, readonly
 
 __version__ = "0.1.0"
@@ -140,4 +144,14 @@ __all__ = [
     "reference_vehicle",
     "vehicle_response",
     "random_road_response",
+    "MAX_CANDIDATES",
+    "Candidate",
+    "CandidateSet",
+    "Target",
+    "IncumbentTarget",
+    "read_targets",
+    "NoiseEdge",
+    "Verdict",
+    "Delivery",
+    "assess_delivery",
 ]
