@@ -54,6 +54,9 @@ LABEL org.opencontainers.image.title="tire-fbs dashboard" \
       org.opencontainers.image.description="Frequency Based Substructuring of a rolling tire and a chassis: Panel dashboard" \
       org.opencontainers.image.licenses="BSD-3-Clause"
 RUN useradd --system --create-home --home-dir /home/fbs --uid 10001 --user-group fbs
+# The projects' data directory (FBS_DATA_DIR, docs/projects.md): owned by fbs so that a named
+# volume mounted on it (docker run -v tire-fbs-data:/data) starts writable by the server.
+RUN mkdir -p /data && chown fbs:fbs /data
 COPY --from=build /opt/venv /opt/venv
 COPY docker/entrypoint.py docker/fbs_server.py docker/fbs_auth.py docker/page_gate.py \
      docker/server_private.py docker/prepare.py /opt/fbs/
