@@ -9,6 +9,7 @@ from . import io as io
 from . import variants as variants
 from . import vehicle as vehicle
 from . import vocabulary as vocabulary
+from . import vpt as vpt
 from .analysis import (
     bushing_contributions,
     campbell,
@@ -38,6 +39,7 @@ from .errors import (
     DOFError,
     FBSError,
     FrequencyGridError,
+    GeometryError,
     HarmonicError,
     ModalError,
     ModeCountError,
@@ -69,6 +71,7 @@ from .studies import (
 from .tire import TireModel, reference_tire
 from .vehicle import random_road_response, reference_vehicle, vehicle_response
 from .vocabulary import COUPLINGS, EIGEN_SPEEDS, magnitude_db, readonly
+from .vpt import Layout, VirtualPoint, virtual_point
 
 __version__ = "0.1.0"
 
@@ -101,6 +104,7 @@ __all__ = [
     "ModeCountError",
     "OperatingPointError",
     "ParameterError",
+    "GeometryError",
     "StudyCancelled",
     "COUPLINGS",
     "EIGEN_SPEEDS",
@@ -140,4 +144,7 @@ __all__ = [
     "reference_vehicle",
     "vehicle_response",
     "random_road_response",
+    "Layout",
+    "VirtualPoint",
+    "virtual_point",
 ]
