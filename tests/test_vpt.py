@@ -76,28 +76,16 @@ def test_knuckle_agrees_with_exact_spindle_frfs_within_1_percent(meas) -> None:
 
 def test_consistency_points_at_a_flipped_direction(meas) -> None:
     good = virtual_point(meas.measured, meas.layout)
-    for ch in ("sa:x", "sc:z"):
+    assert min(good.consistency.sensor_table().values()) > 0.99
+    for ch in meas.layout.sensors.labels:  # each of the 9, mislabelled in turn
         k = meas.layout.sensors.labels.index(ch)
         d = meas.measured.data.copy()
         d[:, k] *= -1
         r = virtual_point(meas.measured.replace(data=d), meas.layout)
         worst, value = r.consistency.worst()
         assert worst == ch
-        assert value < 0.3 < 0.9 < min(good.consistency.sensor_table().values())
-        assert r.consistency.overall()[0] < good.consistency.overall()[0] - 0.05
-
-
-def test_a_channel_without_redundancy_cannot_be_checked(meas) -> None:
-    # sa:y alone sees one rigid-body combination (leverage 1): its error goes unseen, and
-    # the result says so (docs/vpt.md: every channel should have leverage < 0.9)
-    r = virtual_point(meas.measured, meas.layout)
-    assert r.sensor_leverage["sa:y"] > 0.99
-    assert sum(r.sensor_leverage.values()) == pytest.approx(6.0)
-    k = meas.layout.sensors.labels.index("sa:y")
-    d = meas.measured.data.copy()
-    d[:, k] *= -1
-    bad = virtual_point(meas.measured.replace(data=d), meas.layout)
-    assert bad.consistency.sensor_table()["sa:y"] > 0.9
+        assert value < 0.75
+        assert r.consistency.overall()[0] < good.consistency.overall()[0] - 0.01
 
 
 def test_consistency_points_at_a_loose_sensor(meas) -> None:
@@ -107,16 +95,40 @@ def test_consistency_points_at_a_loose_sensor(meas) -> None:
     t = (1 + 1j * eta) / (1 - (F / fr) ** 2 + 1j * eta)
     good = virtual_point(meas.measured, meas.layout).consistency
     assert good.overall(100.0, 250.0)[0] > 0.999
-    for ch in ("sa:x", "sb:z"):
+    for ch in ("sa:x", "sb:z", "sc:z"):
         d = meas.measured.data.copy()
         d[:, meas.layout.sensors.labels.index(ch)] *= t[:, None]
         r = virtual_point(meas.measured.replace(data=d), meas.layout)
         band = r.consistency.sensor_table(100.0, 250.0)
         assert min(band, key=band.__getitem__) == ch
         assert band[ch] < 0.5
-        assert r.consistency.overall(100.0, 250.0)[0] < 0.92
+        assert r.consistency.overall(100.0, 250.0)[0] < 0.95
         # below the mount resonance the sensor still follows its point
         assert r.consistency.sensor_table(2.0, 40.0)[ch] > 0.95
+
+
+def test_a_channel_without_redundancy_cannot_be_checked() -> None:
+    # sensor a along the vehicle axes: sa:y alone sees one rigid-body combination (leverage
+    # ~1), so its error goes unseen; the result says so (docs/vpt.md: leverage < 0.9)
+    lay = val.knuckle_layout()
+    d = lay.sensors.directions.copy()
+    d[:3] = np.eye(3)
+    lay = Layout(Channels(lay.sensors.labels, lay.sensors.positions, d), lay.impacts, lay.origin)
+    m = val.knuckle_measurement(F[:20], "mobility", layout=lay)
+    r = virtual_point(m.measured, m.layout)
+    assert r.sensor_leverage["sa:y"] > 0.99
+    assert sum(r.sensor_leverage.values()) == pytest.approx(6.0)
+    assert max(virtual_point(*_nominal()).sensor_leverage.values()) < 0.9
+    k = lay.sensors.labels.index("sa:y")
+    data = m.measured.data.copy()
+    data[:, k] *= -1
+    bad = virtual_point(m.measured.replace(data=data), m.layout)
+    assert bad.consistency.sensor_table()["sa:y"] > 0.9
+
+
+def _nominal() -> tuple[fc.FRF, Layout]:
+    m = val.knuckle_measurement(F[:5], "mobility")
+    return m.measured, m.layout
 
 
 def test_collinear_sensors_are_refused_naming_the_blind_dof() -> None:
@@ -159,3 +171,36 @@ def test_channels_missing_from_the_frf_or_of_the_wrong_kind(meas) -> None:
     Yr = meas.measured.sel(outputs=list(lay.sensors.labels)).replace(outputs=tuple(labels))
     with pytest.raises(QuantityError, match="'sa:rx' is a rotation"):
         virtual_point(Yr, rot)
+
+
+def test_a_real_tests_errors_lower_the_indicators_and_stay_in_tolerance() -> None:
+    # 2 mm, 2 degrees, 1 % noise (scripts/print_vpt_validation.py, docs/vpt.md): the
+    # indicators fall below the noise-free ones; the coupled bushing response of harmonic 4
+    # stays within the documented tolerance (median level error < 3 dB per DOF, largest
+    # error < 75 % of the DOF's peak), the noise-free one within 1 % of its peak
+    f = fc.harmonic(4).frequencies()
+    m = val.knuckle_measurement(f, quantity="accelerance")
+    v_ex = fc.bushing_response(4, chassis=fc.FRFChassis(m.exact.to("mobility")))
+    clean = virtual_point(m.measured, m.layout)
+    v0 = fc.bushing_response(4, chassis=fc.FRFChassis(clean.frf.to("mobility")))
+    peak = np.abs(v_ex.data).max(0)
+    assert (np.abs(v0.data - v_ex.data).max(0) / peak).max() < 0.01
+    for seed in range(3):
+        lay = val.perturbed_layout(m.layout, 0.002, 2.0, seed=seed)
+        r = virtual_point(val.noisy(m.measured, 0.01, seed=seed), lay)
+        assert r.consistency.overall()[0] < clean.consistency.overall()[0]
+        assert r.consistency.overall()[1] < clean.consistency.overall()[1]
+        assert r.consistency.worst()[1] < clean.consistency.worst()[1]
+        v = fc.bushing_response(4, chassis=fc.FRFChassis(r.frf.to("mobility")))
+        db = np.abs(20 * np.log10(np.abs(v.data) / np.abs(v_ex.data)))
+        assert np.median(db, axis=0).max() < 3.0
+        assert (np.abs(v.data - v_ex.data).max(0) / peak).max() < 0.75
+
+
+def test_perturbed_layout_moves_points_and_turns_directions_by_the_amounts() -> None:
+    lay = val.knuckle_layout()
+    p = val.perturbed_layout(lay, 0.002, 2.0, seed=3)
+    moved = np.linalg.norm(p.sensors.positions - lay.sensors.positions, axis=1)
+    np.testing.assert_allclose(moved, 0.002, rtol=1e-9)
+    cos = np.sum(p.impacts.directions * lay.impacts.directions, axis=1)
+    np.testing.assert_allclose(np.degrees(np.arccos(np.clip(cos, -1, 1))), 2.0, rtol=1e-6)

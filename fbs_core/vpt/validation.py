@@ -57,14 +57,14 @@ ARMS: dict[str, tuple[float, float, float]] = {
 }
 #: Rotation of each sensor's frame (degrees about x, y, z of the vehicle, applied in that order).
 SENSOR_FRAMES: dict[str, tuple[float, float, float]] = {
-    "a": (0.0, 0.0, 0.0),
+    "a": (30.0, 30.0, -30.0),
     "b": (0.0, 0.0, 30.0),
-    "c": (20.0, 15.0, 0.0),
+    "c": (30.0, 0.0, 30.0),
 }
 #: Skew impact direction on each tip (unit vectors after normalisation).
 TIP_IMPACTS: dict[str, tuple[float, float, float]] = {
-    "a": (0.6, 0.0, 0.8),
-    "b": (-0.5, 0.5, 0.7),
+    "a": (0.0, 0.6, 0.8),
+    "b": (0.7, 0.7, 0.0),
     "c": (0.3, -0.8, -0.5),
 }
 #: Outer diameter and wall of the knuckle arms' steel tube (m).
