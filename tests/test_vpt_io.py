@@ -1,0 +1,181 @@
+"""Geometry files for the virtual point transformation: UFF 15/2411, CSV and HDF5 tables.
+
+Truth: files written by independent writers (pyuff for UFF, h5py for HDF5, plain text for
+CSV) with known coordinates; the whole path file -> load_frf / load_geometry ->
+virtual_point gives the same FRF as the layout in memory. Bad input is refused by name.
+"""
+
+from __future__ import annotations
+
+import io
+
+import h5py
+import numpy as np
+import pytest
+import pyuff
+
+import fbs_core as fc
+from fbs_core.errors import DataFormatError, DOFError, GeometryError
+from fbs_core.io.geometry import geometry_csv, load_geometry
+from fbs_core.vpt import validation as val
+from fbs_core.vpt import virtual_point
+
+F = np.arange(5.0, 200.0, 15.0)
+
+
+def _uff(tmp_path, sets) -> str:
+    p = tmp_path / "geometry.unv"
+    u = pyuff.UFF(str(p))
+    for s in sets:
+        u.write_sets(s, "add")
+    return str(p)
+
+
+def test_uff_15_and_2411_in_mm_with_dataset_164(tmp_path) -> None:
+    path = _uff(
+        tmp_path,
+        [
+            pyuff.prepare_164(
+                units_code=5,
+                units_description="mm",
+                temp_mode=1,
+                length=1000.0,
+                force=1.0,
+                temp=1.0,
+                temp_offset=273.15,
+            ),
+            pyuff.prepare_15(
+                node_nums=[1, 2],
+                def_cs=[0, 0],
+                disp_cs=[0, 0],
+                color=[1, 1],
+                x=[90.0, -90.0],
+                y=[720.0, 720.0],
+                z=[120.0, 130.0],
+            ),
+            pyuff.prepare_2411(
+                node_nums=[3, 4],
+                def_cs=[1, 1],
+                disp_cs=[1, 1],
+                color=[1, 1],
+                x=[15.0, 0.0],
+                y=[710.0, 750.0],
+                z=[-25.0, 80.0],
+            ),
+        ],
+    )
+    g = load_geometry(path, nodes={4: "spindle"})
+    np.testing.assert_allclose(g.points["1"], [0.09, 0.72, 0.12])
+    np.testing.assert_allclose(g.points["3"], [0.015, 0.71, -0.025])
+    np.testing.assert_allclose(g.points["spindle"], [0.0, 0.75, 0.08])
+    pos, d = g.channel("2:y")
+    np.testing.assert_allclose(pos, [-0.09, 0.72, 0.13])
+    assert d.tolist() == [0.0, 1.0, 0.0]
+
+
+def test_uff_node_in_a_local_system_is_refused_by_name(tmp_path) -> None:
+    path = _uff(
+        tmp_path,
+        [
+            pyuff.prepare_15(
+                node_nums=[7], def_cs=[0], disp_cs=[3], color=[1], x=[0.0], y=[0.0], z=[0.0]
+            )
+        ],
+    )
+    with pytest.raises(
+        GeometryError, match="node 7 gives its displacements in coordinate system 3"
+    ):
+        load_geometry(path)
+
+
+def test_csv_and_hdf5_tables_give_the_same_virtual_point_as_memory(tmp_path) -> None:
+    m = val.knuckle_measurement(F, quantity="accelerance")
+    lay = m.layout
+    direct = virtual_point(m.measured, lay).frf
+    # the measured set through a file, as today
+    frf, _ = fc.load_frf(fc.save_frf(m.measured, format="csv"), filename="meas.csv")
+    sensors = [o for o in frf.outputs if not o.startswith("bushing")]
+    # CSV in mm
+    g = load_geometry(geometry_csv(lay, "mm"), filename="geometry.csv")
+    r = virtual_point(frf, g.layout(sensors, frf.inputs))
+    assert r.frf.outputs == direct.outputs
+    np.testing.assert_allclose(
+        r.frf.data, direct.data, rtol=0, atol=1e-9 * np.abs(direct.data).max()
+    )
+    # HDF5 written by h5py in metres
+    buf = io.BytesIO()
+    labels = list(lay.sensors.labels) + list(lay.impacts.labels) + ["spindle"]
+    roles = ["sensor"] * len(lay.sensors) + ["impact"] * len(lay.impacts) + ["point"]
+    pos = np.vstack([lay.sensors.positions, lay.impacts.positions, lay.origin])
+    dirs = np.vstack([lay.sensors.directions, lay.impacts.directions, np.full(3, np.nan)])
+    with h5py.File(buf, "w") as h:
+        grp = h.create_group("geometry")
+        grp.attrs["length_unit"] = "m"
+        grp.create_dataset(
+            "channel", data=np.array(labels, dtype=object), dtype=h5py.string_dtype()
+        )
+        grp.create_dataset("role", data=np.array(roles, dtype=object), dtype=h5py.string_dtype())
+        grp.create_dataset("position", data=pos)
+        grp.create_dataset("direction", data=dirs)
+    g5 = load_geometry(buf.getvalue(), filename="geometry.h5")
+    l5 = g5.layout(lay.sensors.labels, lay.impacts.labels)
+    np.testing.assert_allclose(l5.sensors.positions, lay.sensors.positions, atol=1e-12)
+    np.testing.assert_allclose(l5.impacts.directions, lay.impacts.directions, atol=1e-12)
+    np.testing.assert_allclose(l5.origin, lay.origin)
+
+
+HEAD = "channel,role,x,y,z,dx,dy,dz,unit\n"
+
+
+@pytest.mark.parametrize(
+    ("rows", "error", "match"),
+    [
+        ("sa:x,sensor,0.1,0,0,,,,m\n", GeometryError, r"channel 'sa:x' has no direction"),
+        (
+            "sa:x,sensor,0.1,0,0,1,0,0,m\nsa:y,sensor,100,0,0,0,1,0,mm\n",
+            GeometryError,
+            r"channel 'sa:y' is in 'mm', the rows before it in 'm'",
+        ),
+        ("sa:x,sensor,0.1,0,0,1,0,0,inch\n", GeometryError, r"'sa:x': unknown length unit 'inch'"),
+        ("sa:x,sensor,,0,0,1,0,0,m\n", GeometryError, r"channel 'sa:x', column x is empty"),
+        (
+            "sa:x,sensor,0.1,0,0,2,0,0,m\n",
+            GeometryError,
+            r"'sa:x': direction cosines .* not a unit",
+        ),
+        ("sa:x,hammer,0.1,0,0,1,0,0,m\n", DataFormatError, r"'sa:x': role 'hammer'"),
+        ("sa:x,sensor,0.1,0,0,1,0,0,m\nsa:x,sensor,0.1,0,0,1,0,0,m\n", DOFError, "listed twice"),
+    ],
+)
+def test_bad_tables_are_refused_naming_the_channel(rows, error, match) -> None:
+    with pytest.raises(error, match=match):
+        load_geometry((HEAD + rows).encode(), filename="g.csv")
+
+
+def test_missing_coordinates_rotations_and_a_flat_layout_are_refused() -> None:
+    text = HEAD + "spindle,point,0,0.75,0.08,,,,m\nk1,point,0.1,0.7,0.1,,,,m\n"
+    g = load_geometry(text.encode(), filename="g.csv")
+    with pytest.raises(GeometryError, match=r"sensor channel 'k2:x': node 'k2' has no coordinates"):
+        g.layout(["k1:x", "k2:x"], ["k1:y"])
+    with pytest.raises(GeometryError, match=r"sensor channel 'k1:rx' has no direction: a rotation"):
+        g.layout(["k1:rx"], ["k1:y"])
+    with pytest.raises(GeometryError, match=r"virtual point 'hub' is not a point"):
+        g.layout(["k1:x"], ["k1:y"], origin="hub")
+    # one tri-axial point and the spindle's own axes: all on one line -> six DOFs unseen
+    lay = g.layout(
+        ["k1:x", "k1:y", "k1:z", "spindle:x", "spindle:y", "spindle:z"],
+        ["k1:x", "k1:y", "k1:z", "spindle:x", "spindle:y", "spindle:z"],
+    )
+    Y = fc.FRF([1.0], np.ones((1, 6, 6)), lay.sensors.labels, lay.impacts.labels, "mobility")
+    with pytest.raises(GeometryError, match=r"do not observe .* one line"):
+        virtual_point(Y, lay)
+
+
+def test_files_without_geometry_are_refused(tmp_path) -> None:
+    Y = fc.FRF([1.0, 2.0], np.ones((2, 1, 1)), ["1:z"], ["1:z"], "mobility")
+    with pytest.raises(DataFormatError, match="holds no node coordinates"):
+        load_geometry(fc.save_frf(Y, format="uff"), filename="frf.unv")
+    with pytest.raises(DataFormatError, match="needs the columns"):
+        load_geometry(b"a,b\n1,2\n", filename="g.csv")
+    with pytest.raises(DataFormatError, match="/geometry/channel"):
+        load_geometry(fc.save_frf(Y, format="hdf5"), filename="frf.h5")
