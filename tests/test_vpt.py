@@ -204,3 +204,44 @@ def test_perturbed_layout_moves_points_and_turns_directions_by_the_amounts() -> 
     np.testing.assert_allclose(moved, 0.002, rtol=1e-9)
     cos = np.sum(p.impacts.directions * lay.impacts.directions, axis=1)
     np.testing.assert_allclose(np.degrees(np.arccos(np.clip(cos, -1, 1))), 2.0, rtol=1e-6)
+
+
+def test_extra_flexible_idm_is_recovered_with_the_rigid_ones() -> None:
+    # channels that move as 6 rigid modes plus one known flexible pattern: with the pattern
+    # as a 7th IDM the 7 x 7 virtual FRF comes back exactly; the 6 x 6 part as well
+    rng = np.random.default_rng(4)
+    lay = val.knuckle_layout()
+    Eu = rng.normal(size=(len(lay.sensors), 1))
+    Ef = rng.normal(size=(len(lay.impacts), 1))
+    Ru = np.hstack([lay.modes("sensors"), Eu])
+    Rf = np.hstack([lay.modes("impacts"), Ef])
+    Yq = rng.normal(size=(4, 7, 7)) + 1j * rng.normal(size=(4, 7, 7))
+    Y = fc.FRF(F[:4], Ru @ Yq @ Rf.T, lay.sensors.labels, lay.impacts.labels, "mobility")
+    r = virtual_point(Y, lay, extra_sensor_modes=Eu, extra_impact_modes=Ef)
+    assert r.extra is not None and r.extra.shape == (4, 7, 7)
+    np.testing.assert_allclose(r.extra.data, Yq, atol=1e-11 * np.abs(Yq).max())
+    np.testing.assert_allclose(r.frf.data, Yq[:, :6, :6], atol=1e-11 * np.abs(Yq).max())
+    # without it, the flexible part leaks into the rigid DOFs and the consistency shows it
+    plain = virtual_point(Y, lay)
+    assert np.abs(plain.frf.data - Yq[:, :6, :6]).max() > 0.01 * np.abs(Yq).max()
+    assert plain.consistency.overall()[0] < 0.99
+    with pytest.raises(GeometryError, match="both the sensors and the impacts"):
+        virtual_point(Y, lay, extra_sensor_modes=Eu)
+
+
+def test_weights_take_a_bad_channel_out(meas) -> None:
+    # a flipped channel with weight 1e-8 no longer spoils the result: weighted least squares
+    k = meas.layout.sensors.labels.index("sc:z")
+    d = meas.measured.data.copy()
+    d[:, k] *= -1
+    bad = meas.measured.replace(data=d)
+    w = np.ones(len(meas.layout.sensors))
+    w[k] = 1e-8
+    E = meas.exact.data
+    err_plain = rel_err(virtual_point(bad, meas.layout).frf.data, E)
+    err_w = rel_err(virtual_point(bad, meas.layout, sensor_weights=w).frf.data, E)
+    assert err_plain > 0.2 and err_w < 0.02
+
+
+def rel_err(a: np.ndarray, b: np.ndarray) -> float:
+    return float((np.abs(a - b).max(0) / np.abs(b).max(0))[:6].max())
