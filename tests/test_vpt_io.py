@@ -179,3 +179,32 @@ def test_files_without_geometry_are_refused(tmp_path) -> None:
         load_geometry(b"a,b\n1,2\n", filename="g.csv")
     with pytest.raises(DataFormatError, match="/geometry/channel"):
         load_geometry(fc.save_frf(Y, format="hdf5"), filename="frf.h5")
+
+
+def test_measured_chassis_from_two_files_couples_like_the_exact_one() -> None:
+    from fbs_core.vpt import load_measured_chassis
+
+    f = fc.harmonic(4).frequencies()
+    m = val.knuckle_measurement(f, quantity="accelerance")
+    raw = fc.save_frf(m.measured, format="hdf5")
+    geo = geometry_csv(m.layout, "mm")
+    mc = load_measured_chassis(
+        raw, geo, frf_filename="knuckle.h5", geometry_filename="geometry.csv"
+    )
+    assert "lowest channel" in mc.summary and "geometry.csv" in mc.summary
+    v = fc.bushing_response(4, chassis=mc.chassis)
+    v_ex = fc.bushing_response(4, chassis=fc.FRFChassis(m.exact.to("mobility")))
+    assert (np.abs(v.data - v_ex.data).max(0) / np.abs(v_ex.data).max(0)).max() < 0.01
+    # a geometry that misses one impact: refused by name
+    rows = [r for r in geo.decode().splitlines() if not r.startswith("tb:z")]
+    with pytest.raises(GeometryError, match="impact channel 'tb:z': node 'tb' has no coord"):
+        load_measured_chassis(
+            raw,
+            "\n".join(rows).encode(),
+            frf_filename="knuckle.h5",
+            geometry_filename="geometry.csv",
+        )
+    with pytest.raises(DOFError, match="no outputs at the bushing node 'hub'"):
+        load_measured_chassis(
+            raw, geo, frf_filename="knuckle.h5", geometry_filename="geometry.csv", bushing="hub"
+        )
