@@ -172,7 +172,9 @@ class UploadView(Viewer):
             self._run("tire", self.data.load_tire, event.new, self.tire_file.filename)
 
     # -- display -----------------------------------------------------------------------
-    @param.depends("data.models", "data.tire_summary", "data.chassis_summary")
+    @param.depends(
+        "data.models", "data.tire_summary", "data.chassis_summary", "data.geometry_summary"
+    )
     def _summary(self):
         ds = self.data
         parts = [f"<b>In use: {_text(ds.describe())}</b>"]
