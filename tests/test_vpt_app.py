@@ -8,7 +8,9 @@ import pytest
 
 import fbs_core as fc
 from app.datasource import REFERENCE, DataSource
-from app.views.vpt_consistency import consistency_plot, table_html
+from app.report.data import Provenance
+from app.report.session import provenance_of
+from app.views.vpt_consistency import consistency_plot, report_notes, table_html
 from fbs_core.io.geometry import geometry_csv
 from fbs_core.vpt import validation as val
 
@@ -38,6 +40,10 @@ def test_geometry_then_measured_set_becomes_the_sessions_chassis(files) -> None:
     html = table_html(ds.vpt)
     assert "sa:x" in html and "tc:z" in html and "leverage" in html
     assert consistency_plot(ds.vpt).visible
+    (note,) = report_notes(ds)
+    assert "virtual point 'spindle'" in note and "lowest channel" in note
+    prov = provenance_of(ds.models, report_notes(ds))
+    assert isinstance(prov, Provenance) and prov.notes == (note,)
     # a geometry that misses a channel is refused, and the chassis stays as it was
     key = ds.models.key
     bad = "\n".join(r for r in geo.decode().splitlines() if not r.startswith("sb:"))
@@ -46,6 +52,7 @@ def test_geometry_then_measured_set_becomes_the_sessions_chassis(files) -> None:
     assert ds.models.key == key
     ds.reset()
     assert ds.models is REFERENCE and ds.vpt is None and not consistency_plot(None).visible
+    assert report_notes(ds) == ()
 
 
 def test_a_refused_geometry_file_changes_nothing() -> None:

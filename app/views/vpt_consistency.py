@@ -85,3 +85,20 @@ def consistency_plot(vpt):
         sizing_mode="stretch_width",
         css_classes=["vpt-consistency-card"],
     )
+
+
+def report_notes(data) -> tuple[str, ...]:
+    """The report's note on a measured chassis in use (its "Data in use" table), else ()."""
+    vpt = getattr(data, "vpt", None)
+    if vpt is None:
+        return ()
+    c = vpt.consistency
+    so, io = c.overall()
+    worst, wv = c.worst()
+    lev = max({**vpt.sensor_leverage, **vpt.impact_leverage}.items(), key=lambda kv: kv[1])
+    return (
+        f"chassis measured at the knuckle, transformed to the virtual point "
+        f"'{vpt.layout.node}' ({len(c.sensors)} sensor channels, {len(c.impacts)} impacts): "
+        f"consistency sensors {so:.4f}, impacts {io:.4f}; lowest channel {worst} {wv:.3f}; "
+        f"highest leverage {lev[0]} {lev[1]:.2f}",
+    )
