@@ -208,3 +208,65 @@ def test_measured_chassis_from_two_files_couples_like_the_exact_one() -> None:
         load_measured_chassis(
             raw, geo, frf_filename="knuckle.h5", geometry_filename="geometry.csv", bushing="hub"
         )
+
+
+def test_one_universal_file_with_geometry_and_frfs(tmp_path) -> None:
+    # the test lab's usual file: nodes (dataset 15, mm, dataset 164) and FRFs (58) together;
+    # channels along the vehicle's axes (the UFF 58 direction codes)
+    lay0 = val.knuckle_layout()
+    S = lay0.origin
+    pts = {n: S + np.asarray(o) for n, o in val.ARMS.items()}
+    s_lab = [f"s{n}:{d}" for n in "abc" for d in "xyz"]
+    i_lab = [f"m{n}:{d}" for n in "abc" for d in "xyz"] + ["ta:x", "tb:y", "tc:z"]
+
+    def where(lab: str) -> np.ndarray:
+        node, d = lab.split(":")
+        p = pts[node[1]] if node[0] in "st" else S + 0.5 * np.asarray(val.ARMS[node[1]])
+        return p
+
+    def axis(lab: str) -> np.ndarray:
+        return np.eye(3)["xyz".index(lab.split(":")[1])]
+
+    lay = fc.vpt.Layout(
+        fc.vpt.Channels(s_lab, [where(s) for s in s_lab], [axis(s) for s in s_lab]),
+        fc.vpt.Channels(i_lab, [where(s) for s in i_lab], [axis(s) for s in i_lab], "impact"),
+        S,
+    )
+    m = val.knuckle_measurement(F, quantity="accelerance", layout=lay)
+    names = ["sa", "sb", "sc", "ma", "mb", "mc", "ta", "tb", "tc", "spindle", "bushing"]
+    number = {n: 101 + k for k, n in enumerate(names)}
+    xyz = {n: where(f"{n}:x") for n in names[:9]} | {"spindle": S}
+    nodes15 = pyuff.prepare_15(
+        node_nums=[number[n] for n in xyz],
+        def_cs=[0] * len(xyz),
+        disp_cs=[0] * len(xyz),
+        color=[1] * len(xyz),
+        x=[1000 * xyz[n][0] for n in xyz],
+        y=[1000 * xyz[n][1] for n in xyz],
+        z=[1000 * xyz[n][2] for n in xyz],
+    )
+    u164 = pyuff.prepare_164(
+        units_code=5,
+        units_description="mm",
+        temp_mode=1,
+        length=1000.0,
+        force=1.0,
+        temp=1.0,
+        temp_offset=273.15,
+    )
+    head = tmp_path / "head.unv"
+    u = pyuff.UFF(str(head))
+    u.write_sets(u164, "add")
+    u.write_sets(nodes15, "add")
+    by_number = {v: k for k, v in number.items()}
+    frf_raw = fc.save_frf(m.measured, format="uff", nodes=by_number)
+    path = tmp_path / "knuckle.unv"
+    path.write_bytes(head.read_bytes() + frf_raw)
+
+    frf, _ = fc.load_frf(path, nodes=by_number)
+    geo = load_geometry(path, nodes=by_number)
+    sensors = [o for o in frf.outputs if not o.startswith("bushing")]
+    r = virtual_point(frf, geo.layout(sensors, frf.inputs))
+    direct = virtual_point(m.measured, lay).frf
+    err = np.abs(r.frf.data - direct.data).max(0) / np.abs(direct.data).max(0)
+    assert err.max() < 1e-4  # the file's single-precision numbers
