@@ -69,6 +69,9 @@ def test_knuckle_agrees_with_exact_spindle_frfs_within_1_percent(meas) -> None:
     assert r.frf.outputs == SPINDLE + BUSHING
     err = np.abs(r.frf.data - meas.exact.data).max(0) / np.abs(meas.exact.data).max(0)
     assert err.max() < 0.01, err.max()
+    # receptance too (each FRF peaks elsewhere: same VPT, another normalisation)
+    Yr, Er = r.frf.to("receptance").data, meas.exact.to("receptance").data
+    assert (np.abs(Yr - Er).max(0) / np.abs(Er).max(0)).max() < 0.01
     # the chassis coupling takes it as it is
     ch = fc.FRFChassis(r.frf)
     assert ch.mobility(F[:3]).outputs == SPINDLE + BUSHING
