@@ -59,7 +59,7 @@ ROLES = ("sensor", "impact", "point")
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Geometry:
     """Points and channels of a measurement, SI units, vehicle axes (immutable).
 

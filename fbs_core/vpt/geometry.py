@@ -67,7 +67,7 @@ def _unit_rows(d: FloatArray, labels: Sequence[str], what: str) -> FloatArray:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Channels:
     """Measured channels: labels, positions (m) and unit directions, vehicle axes.
 
@@ -133,7 +133,7 @@ class Channels:
         return Channels(want, self.positions[idx], self.directions[idx])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Layout:
     """Sensors and impacts of one virtual point measurement (immutable).
 
@@ -173,6 +173,8 @@ class Layout:
 
     def modes(self, kind: str) -> FloatArray:
         """``R_u`` (``kind="sensors"``) or ``R_f`` (``"impacts"``), shape (n, 6)."""
+        if kind not in ("sensors", "impacts"):
+            raise DataFormatError(f"modes of {kind!r}; allowed: 'sensors', 'impacts'")
         ch = self.sensors if kind == "sensors" else self.impacts
         return displacement_modes(ch.positions, ch.directions, self.origin)
 

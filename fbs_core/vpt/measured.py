@@ -26,7 +26,7 @@ __all__ = ["MeasuredChassis", "load_measured_chassis"]
 Source = str | os.PathLike[str] | bytes | bytearray | memoryview
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MeasuredChassis:
     """A chassis measured at the knuckle and transformed to the spindle.
 

@@ -79,7 +79,7 @@ def specific_consistency(filtered: ArrayLike, measured: ArrayLike, axis: int) ->
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Consistency:
     """Sensor and impact consistency of a virtual point measurement, per line.
 

@@ -108,7 +108,7 @@ def vpt_kernel(Y: ArrayLike, Tu: ArrayLike, Tf: ArrayLike) -> ComplexArray:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class VirtualPoint:
     """A transformed measurement: the virtual point's FRF and how consistent it was.
 

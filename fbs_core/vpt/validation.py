@@ -165,7 +165,7 @@ def _fe_node(label: str) -> str:
     return f"k{node[1]}" if node[0] in "st" else f"m{node[1]}_1"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class KnuckleMeasurement:
     """A simulated VPT measurement and its exact answer.
 
