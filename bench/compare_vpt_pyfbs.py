@@ -61,7 +61,12 @@ imp = table(z["i_pos"], z["i_dir"], [f"i{k}" for k in range(ni)], [1] * ni, "For
 o = np.tile(z["origin"], (6, 1))
 vp_chn = table(o, np.zeros((6, 3)), ["ux", "uy", "uz", "rx", "ry", "rz"], [1] * 6, "Acceleration")
 vp_imp = table(o, np.zeros((6, 3)), ["fx", "fy", "fz", "mx", "my", "mz"], [1] * 6, "Force")
-out = {"version": np.array([ord(c) for c in pyFBS.__version__])}
+try:  # the distribution's release (the package's own __version__ may lag behind it)
+    from importlib.metadata import version
+    release = version("pyFBS")
+except Exception:
+    release = getattr(pyFBS, "__version__", "?")
+out = {"version": np.array([ord(c) for c in release])}
 for case in ("equal", "weighted"):
     wu = z["wu"] if case == "weighted" else None
     wf = z["wf_pyfbs"] if case == "weighted" else None
