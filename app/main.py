@@ -451,7 +451,11 @@ def create_app(
     step_aside()
 
     def report():  # the page's published results, as they are when the button is clicked
-        return report_data(results, url=page_url(), n_axis=page.n_axis)
+        from .views.vpt_consistency import report_notes
+
+        return report_data(
+            results, url=page_url(), n_axis=page.n_axis, notes=report_notes(state.data)
+        )
 
     # the modal's own close control (Panel's public close_modal); a button in the page is
     # reachable by keyboard and by tests, unlike the template's icon or the Escape key

@@ -19,7 +19,7 @@ import panel as pn
 import param
 from panel.viewable import Viewer
 
-from ..datasource import CHASSIS_ACCEPT, TIRE_ACCEPT, DataSource
+from ..datasource import CHASSIS_ACCEPT, GEOMETRY_ACCEPT, TIRE_ACCEPT, DataSource
 from ..runtime.bands import served
 from ..runtime.uploads import UPLOADS
 
@@ -27,8 +27,11 @@ HELP = (
     "Chassis FRF: UFF 58 (.uff/.unv), MATLAB (.mat), CSV or HDF5 (.h5), layouts in "
     "docs/file-formats.md; it must hold the six spindle DOFs (outputs and inputs) and the "
     "six bushing outputs. Name the spindle and bushing nodes (a node name, or a UFF node "
-    "number). Modal tire model: the project's .h5 format or MATLAB .mat. Uploads stay in "
-    "this browser session."
+    "number). A measured set (sensors and impacts around the knuckle): upload its geometry "
+    "first (UFF 15/2411, CSV or HDF5 table, docs/vpt.md); the chassis file is then "
+    "transformed to the virtual point named as the spindle node, with its consistency "
+    "per channel. Modal tire model: the project's .h5 format or MATLAB .mat. Uploads stay "
+    "in this browser session."
 )
 
 
@@ -83,6 +86,9 @@ class UploadView(Viewer):
         self.tire_file = W.FileInput(
             accept=TIRE_ACCEPT, multiple=False, css_classes=["upload-tire"], width=260
         )
+        self.geometry_file = W.FileInput(
+            accept=GEOMETRY_ACCEPT, multiple=False, css_classes=["upload-geometry"], width=260
+        )
         self.spindle = W.TextInput.from_param(
             ds.param.spindle, name="Spindle node", width=120, css_classes=["upload-spindle"]
         )
@@ -111,6 +117,7 @@ class UploadView(Viewer):
         )
         self.chassis_file.param.watch(self._on_chassis, "value")
         self.tire_file.param.watch(self._on_tire, "value")
+        self.geometry_file.param.watch(self._on_geometry, "value")
         self.reread.on_click(lambda _: self._run("chassis", ds.load_chassis))
         # a new node name or the interpolation choice re-reads the chassis file at once;
         # this also settles a click on "Read chassis again" that overtook the change
@@ -148,7 +155,7 @@ class UploadView(Viewer):
         self.data.reset()
 
     def _busy(self, on: bool):
-        for w in (self.chassis_file, self.tire_file, self.reread, self.reset):
+        for w in (self.chassis_file, self.tire_file, self.geometry_file, self.reread, self.reset):
             w.disabled = on
 
     # an empty file (b"") is read too: the page says it is empty instead of ignoring it
@@ -156,15 +163,23 @@ class UploadView(Viewer):
         if event.new is not None:
             self._run("chassis", self.data.load_chassis, event.new, self.chassis_file.filename)
 
+    def _on_geometry(self, event):
+        if event.new is not None:
+            self._run("chassis", self.data.load_geometry, event.new, self.geometry_file.filename)
+
     def _on_tire(self, event):
         if event.new is not None:
             self._run("tire", self.data.load_tire, event.new, self.tire_file.filename)
 
     # -- display -----------------------------------------------------------------------
-    @param.depends("data.models", "data.tire_summary", "data.chassis_summary")
+    @param.depends(
+        "data.models", "data.tire_summary", "data.chassis_summary", "data.geometry_summary"
+    )
     def _summary(self):
         ds = self.data
         parts = [f"<b>In use: {_text(ds.describe())}</b>"]
+        if ds.geometry_summary:
+            parts.append(f"Measured set:<pre>{_text(ds.geometry_summary)}</pre>")
         for title, text in (("Chassis", ds.chassis_summary), ("Tire", ds.tire_summary)):
             if text and (
                 (title == "Chassis" and ds.models.chassis is not None)
@@ -183,6 +198,12 @@ class UploadView(Viewer):
             visible=bool(self.data.error),
         )
 
+    @param.depends("data.vpt")
+    def _consistency(self):
+        from .vpt_consistency import consistency_plot
+
+        return consistency_plot(self.data.vpt)
+
     def __panel__(self):
         label = pn.pane.Markdown
         return pn.Column(
@@ -196,10 +217,15 @@ class UploadView(Viewer):
                     self.interpolate,
                     self.reread,
                 ),
+                pn.Column(
+                    label("**Knuckle geometry** (measured set)", margin=(0, 5)),
+                    self.geometry_file,
+                ),
                 pn.Column(label("**Modal tire model**", margin=(0, 5)), self.tire_file),
                 pn.Column(label("&nbsp;", margin=(0, 5)), self.reset),
             ),
             self._error,
             self._summary,
+            self._consistency,
             sizing_mode="stretch_width",
         )
