@@ -94,6 +94,8 @@ def literal_text(fig: Figure) -> Figure:
         if t.get_gid() != MATH_GID and id(t) not in own:
             t.set_parse_math(False)
     return fig
+
+
 #: Font sizes (pt) of tick labels, axis labels and legends.
 TICK_PT, LABEL_PT, LEGEND_PT = 9.0, 10.0, 9.0
 _DASH: dict[str, Any] = {"solid": "-", "dashed": (0, (6, 3)), "dotted": (0, (1.5, 2.5))}
