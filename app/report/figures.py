@@ -70,8 +70,11 @@ _RENDER_LOCK = threading.Lock()
 #: report figure is shown as written (see :func:`literal_text`).
 MATH_GID = "mathtext"
 
-#: Settings under which every report figure is drawn: no LaTeX run on any text.
-RC = {"text.usetex": False, "svg.fonttype": "path", "pdf.fonttype": 42}
+
+def drawing_settings() -> Any:
+    """matplotlib's settings under which every report figure is saved: no LaTeX run on
+    any text, glyphs as paths in SVG, fonts embedded as TrueType in PDF."""
+    return matplotlib.rc_context({"text.usetex": False, "svg.fonttype": "path", "pdf.fonttype": 42})
 
 
 def literal_text(fig: Figure) -> Figure:
@@ -441,6 +444,6 @@ def render(fig: Figure, fmt: str, dpi: float = 110) -> bytes:
         raise ValueError(f"unknown figure format {fmt!r}; allowed: svg, png, pdf")
     buf = io.BytesIO()
     meta = {"svg": {"Date": None}, "png": {}, "pdf": {"CreationDate": None}}[fmt]
-    with _RENDER_LOCK, matplotlib.rc_context(RC):
+    with _RENDER_LOCK, drawing_settings():
         literal_text(fig).savefig(buf, format=fmt, dpi=dpi, metadata=meta)
     return buf.getvalue()

@@ -11,7 +11,6 @@ import io
 import textwrap
 from typing import Any
 
-import matplotlib
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
@@ -134,7 +133,7 @@ def render_pdf(rep: Report) -> bytes:
     buf = io.BytesIO()
     with (
         figures._RENDER_LOCK,
-        matplotlib.rc_context(figures.RC),
+        figures.drawing_settings(),
         PdfPages(buf, metadata={"Title": rep.title, "Creator": "tire-fbs"}) as pdf,
     ):
         pages = _Pages(pdf, rep.stem)
