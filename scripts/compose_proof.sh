@@ -59,7 +59,7 @@ cleanup() {
             log "logs of the services:"
             dc logs --no-color --tail 30 2>&1 | sed 's/^/    /'
         fi
-        dc down --remove-orphans -t 10 >/dev/null 2>&1 && log "removed project $project"
+        dc down --volumes --remove-orphans -t 10 >/dev/null 2>&1 && log "removed project $project (and its volume dask-tls)"
     fi
     if [[ -n "$dockerd_pid" ]]; then
         kill "$dockerd_pid" 2>/dev/null
