@@ -251,13 +251,29 @@ def fetch(url: str, *, data=None, headers=None, timeout=60):
         return None, {}, str(e).encode(), time.perf_counter() - t0
 
 
+def login_form(base: str, user: str, password: str, headers=None) -> tuple[bytes, dict]:
+    """``(body, headers)`` of a login POST as a browser sends it: the login form fetched
+    first for its CSRF token (hidden field ``_csrf`` and cookie ``fbs_csrf``)."""
+    import re
+
+    status, h, body, _ = fetch(base + "/login", headers=headers)
+    m = re.search(rb'name="_csrf" value="([^"]+)"', body or b"")
+    token = m.group(1).decode() if m else ""
+    cookie = "; ".join(
+        v.split(";", 1)[0] for v in (h.get_all("Set-Cookie") or []) if v.startswith("fbs_csrf=")
+    ) if status else ""  # fmt: skip
+    form = {"username": user, "password": password, "_csrf": token}
+    return urllib.parse.urlencode(form).encode(), {**(headers or {}), "Cookie": cookie}
+
+
 def login(base: str, user: str, password: str) -> str | None:
     """The login cookie header value, or None."""
     jar = urllib.request.HTTPCookieProcessor()
     opener = urllib.request.build_opener(jar)
-    data = urllib.parse.urlencode({"username": user, "password": password}).encode()
+    data, headers = login_form(base, user, password)
     try:
-        opener.open(base + "/login", data=data, timeout=60).read()
+        req = urllib.request.Request(base + "/login", data=data, headers=headers)
+        opener.open(req, timeout=60).read()
     except urllib.error.HTTPError:
         return None
     cookies = {c.name: c.value for c in jar.cookiejar}
@@ -1204,8 +1220,8 @@ def attack_logins(rep: Report, base: str, user: str, password: str | None, serve
     log0 = len(server.log()) if server else 0
 
     def attempt(k):
-        data = urllib.parse.urlencode({"username": user, "password": f"wrong-{k}"}).encode()
-        return fetch(base + "/login", data=data, headers={"X-Real-IP": client}, timeout=120)
+        data, headers = login_form(base, user, f"wrong-{k}", {"X-Real-IP": client})
+        return fetch(base + "/login", data=data, headers=headers, timeout=120)
 
     t0 = time.perf_counter()
     with concurrent.futures.ThreadPoolExecutor(20) as pool:
@@ -1220,8 +1236,8 @@ def attack_logins(rep: Report, base: str, user: str, password: str | None, serve
         statuses.get(429, 0) > 0,
     )
     if password:
-        data = urllib.parse.urlencode({"username": user, "password": password}).encode()
-        status = fetch(base + "/login", data=data, headers={"X-Real-IP": client})[0]
+        data, headers = login_form(base, user, password, {"X-Real-IP": client})
+        status = fetch(base + "/login", data=data, headers=headers)[0]
         rep.line(
             "then the right password from the same client",
             f"HTTP {status} ({'refused while locked' if status == 429 else 'let in'})",

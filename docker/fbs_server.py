@@ -465,7 +465,19 @@ def _on_stop_signal(signum: int, deadline_s: float) -> None:
     threading.Thread(target=watchdog, name="shutdown-watchdog", daemon=True).start()
     STOPPING.set()
     cancel_queued_panel_work()
+    stop_reports()
     IOLoop.current().stop()
+
+
+def stop_reports() -> None:
+    """End the app's report drawing (queued reports cancelled, the report process ended, no
+    new one started): a report process started after :func:`stop_children` listed the
+    children would outlive the server. Only when the app has loaded it."""
+    reports = sys.modules.get("app.runtime.reports")
+    if reports is not None:
+        n = reports.stop()
+        if n:
+            log.info("stopped %d report process(es)", n)
 
 
 def _install_stop_signals(deadline_s: float) -> None:

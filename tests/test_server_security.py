@@ -31,7 +31,9 @@ import pytest
 from server_util import (
     NoRedirect,
     Server,
+    form_token,
     get,
+    login_post,
     process_tree,
     run_async,
     wait_for,
@@ -291,8 +293,7 @@ def _read(path: str) -> bytes:
 def test_secrets_are_not_on_any_command_line_or_environment(server):
     # a page load starts a child process (as an upload starts the parser sandbox)
     opener = urllib.request.build_opener(urllib.request.HTTPCookieProcessor())
-    data = urllib.parse.urlencode({"username": USER, "password": PASSWORD}).encode()
-    assert get(opener, server.base + "/login", data=data)[0] == 200
+    assert login_post(opener, server.base, USER, PASSWORD)[0] == 200
     builds = _builds(server)
     assert builds >= 2  # the proof at start and this page: a child each
 
@@ -373,9 +374,10 @@ def test_a_websocket_from_another_origin_is_refused(server):
 def _login(server, client_ip: str, username: str, password: str, header="X-Forwarded-For"):
     """(status, headers, seconds) of a login POST from ``client_ip`` (as the proxy says)."""
     opener = urllib.request.build_opener(NoRedirect)
-    data = urllib.parse.urlencode({"username": username, "password": password}).encode()
     t0 = time.monotonic()
-    status, headers, _ = get(opener, server.base + "/login", data=data, headers={header: client_ip})
+    status, headers, _ = login_post(
+        opener, server.base, username, password, headers={header: client_ip}
+    )
     return status, headers, time.monotonic() - t0
 
 
@@ -528,8 +530,7 @@ def _form_login(base: str, user: str, password: str) -> str:
 
     jar = http.cookiejar.CookieJar()
     opener = urllib.request.build_opener(NoRedirect, urllib.request.HTTPCookieProcessor(jar))
-    data = urllib.parse.urlencode({"username": user, "password": password}).encode()
-    assert get(opener, base + "/login", data=data)[0] == 302
+    assert login_post(opener, base, user, password)[0] == 302
     return "; ".join(f"{c.name}={c.value}" for c in jar)
 
 
@@ -557,7 +558,12 @@ def test_logout_revokes_the_login_cookie(server):
     cookie = _form_login(server.base, OTHER_USER, OTHER_PASSWORD)
     assert _logged_in(server.base, cookie)
     opener = urllib.request.build_opener(NoRedirect)
-    assert get(opener, server.base + "/logout", headers={"Cookie": cookie})[0] == 200
+    token, csrf = form_token(server.base, "/logout", headers={"Cookie": cookie})
+    data = urllib.parse.urlencode({"_csrf": token}).encode()
+    status = get(
+        opener, server.base + "/logout", data=data, headers={"Cookie": f"{cookie}; {csrf}"}
+    )
+    assert status[0] == 200
     # the same cookie, kept (stolen) after the logout, is no login any more
     assert not _logged_in(server.base, cookie)
     with pytest.raises(Exception, match="403"):
@@ -600,6 +606,32 @@ def test_a_direct_client_cannot_pick_its_address_with_forwarding_headers(direct_
     # every guess counted against the real address: refused after MAX_FAILURES
     assert statuses[:MAX_FAILURES] == [302] * MAX_FAILURES and statuses[-1] == 429, statuses
     assert "from 127.0.0.1" in srv.log() and "from 10.77.0." not in srv.log()
+
+
+def _cookie_lines(headers) -> dict[str, set[str]]:
+    """name -> attributes (lower case) of a response's Set-Cookie headers."""
+    out = {}
+    for v in headers.get_all("Set-Cookie") or []:
+        name, _, rest = v.partition("=")
+        out[name] = {a.strip().lower() for a in rest.split(";")[1:]}
+    return out
+
+
+def test_cookies_are_secure_when_a_trusted_proxy_says_https(server, direct_server):
+    """Behind a TLS-terminating proxy (X-Forwarded-Proto: https from a trusted proxy) the
+    login and form cookies are Secure; a direct client's header is ignored (the cookies stay
+    usable over its plain HTTP)."""
+    https = {"X-Forwarded-Proto": "https"}
+    for srv, secure in ((server, True), (direct_server, False)):
+        opener = urllib.request.build_opener(NoRedirect)
+        status, headers, _ = login_post(opener, srv.base, OTHER_USER, OTHER_PASSWORD, https)
+        assert status == 302
+        got = _cookie_lines(headers)
+        for name in ("user", "fbs_login"):
+            assert {"httponly", "samesite=lax"} <= got[name], got
+            assert ("secure" in got[name]) is secure, (srv.base, got)
+        status, headers, _ = get(opener, srv.base + "/login", headers=https)
+        assert ("secure" in _cookie_lines(headers)["fbs_csrf"]) is secure
 
 
 def test_removing_a_user_or_changing_the_password_revokes_the_cookies(direct_server):

@@ -84,7 +84,9 @@ def report_buttons(report: Callable[[], ReportData]) -> pn.Row:
                         pn.state.curdoc = None
                     return reports.draw_apart(kind, data)
 
-                making[:] = [asyncio.wrap_future(reports.REPORTS.submit(in_session))]
+                # cancelled when the tab closes before its turn: report() would then run
+                # on a page whose names Bokeh has cleared (NameError)
+                making[:] = [reports.submit_for_session(doc, in_session)]
             btn.loading = True
             try:
                 name, content = await asyncio.shield(making[0])

@@ -86,15 +86,17 @@ def _stamp(p: Path) -> tuple[int, int]:
 
 def _is_campaign(p: Path) -> bool:
     """Whether ``p``'s root says it is a campaign result (read again only when it changed)."""
-    import h5py
+    from fbs_core.hdf5_guard import ForeignDataError, open_h5
 
     stamp = _stamp(p)
     known = _IS_CAMPAIGN.get(p)
     if known is not None and known[0] == stamp:
         return known[1]
     try:
-        with h5py.File(p, "r") as h:
+        with open_h5(p) as h:
             ok = h.attrs.get("content") == "campaign"
+    except ForeignDataError:  # listed: opening it says why it is refused
+        ok = True
     except (OSError, ValueError, TypeError, KeyError, RuntimeError):  # not (readable) HDF5
         ok = False
     _IS_CAMPAIGN[p] = (stamp, ok)
@@ -594,11 +596,13 @@ class CampaignBrowser(pn.viewable.Viewer):
                 self.shown = truncation_case_result(self._result, self.case, dof)
         except CampaignError as exc:  # incomplete, stored without these outputs, malformed
             self.shown = None
-            self.message = str(exc)
+            self.message = relative_names(str(exc), self.directory)
         except Exception as exc:  # noqa: BLE001 (a file's problem: said in the card)
             log.exception("campaign case %s of %s", self.case, self.file)
             self.shown = None
-            self.message = f"{self.file}: case {self.case!r} cannot be shown ({exc})"
+            self.message = relative_names(
+                f"{self.file}: case {self.case!r} cannot be shown ({exc})", self.directory
+            )
 
     # -- page ------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -883,12 +887,22 @@ def _text_html(text: str) -> str:
     return f"<p>{html.escape(text)}</p>"
 
 
+def relative_names(text: str, directory: Path | None) -> str:
+    """``text`` with the campaign folder's path left out of the file names it quotes: a
+    user sees ``run.h5`` or ``run.h5.parts/0001.h5``, never the server's absolute paths."""
+    if directory is None:
+        return text
+    folder = str(directory).rstrip(os.sep)
+    return text.replace(folder + os.sep, "").replace(folder, ".")
+
+
 def _read(path: Path) -> tuple[Opened | None, str]:
-    """(the opened file, "") or (None, the message of its CampaignError)."""
+    """(the opened file, "") or (None, the message of its CampaignError, its file names
+    relative to the campaign folder)."""
     try:
         return open_cached(path), ""
     except CampaignError as exc:
-        return None, str(exc)
+        return None, relative_names(str(exc), path.parent)
 
 
 def _frame(cols: dict[str, list]):

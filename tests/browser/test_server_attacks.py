@@ -35,7 +35,7 @@ from pathlib import Path
 import h5py
 import pytest
 from playwright.sync_api import expect
-from server_util import NoRedirect, Server, get, run_async
+from server_util import NoRedirect, Server, get, login_post, run_async
 from url_fuzz import ELEMENTS, FUZZ, model_html
 
 pytestmark = [pytest.mark.browser]
@@ -109,8 +109,7 @@ def image_server(tmp_path_factory):
 def login_cookie(server: Server, user: str = USER, password: str = PASSWORD) -> str:
     jar = http.cookiejar.CookieJar()
     opener = urllib.request.build_opener(NoRedirect, urllib.request.HTTPCookieProcessor(jar))
-    data = urllib.parse.urlencode({"username": user, "password": password}).encode()
-    status, _, _ = get(opener, server.base + "/login", data=data)
+    status, _, _ = login_post(opener, server.base, user, password)
     assert status == 302
     return "; ".join(f"{c.name}={c.value}" for c in jar)
 
