@@ -10,7 +10,14 @@ checks that each private name still exists and does what is relied on (and its s
 
 from __future__ import annotations
 
-__all__ = ["cancel_queued_panel_work", "cleanup_document", "peer_address"]
+__all__ = [
+    "accept_connections",
+    "bound_bokeh_messages",
+    "cancel_queued_panel_work",
+    "cleanup_document",
+    "peer_address",
+    "report_refused_websocket_frames",
+]
 
 
 def cleanup_document(doc) -> None:
@@ -43,3 +50,114 @@ def peer_address(request) -> str:
     if isinstance(address, tuple) and address and isinstance(address[0], str):
         return address[0]
     return str(request.remote_ip or "unknown")
+
+
+def report_refused_websocket_frames(report) -> None:
+    """Call ``report(handler, reason)`` when Tornado refuses a websocket frame for its size.
+
+    Tornado checks the length a frame declares in its header against the handler's
+    ``max_message_size`` before it reads the payload, and then closes the connection with
+    code 1009 ("message too big") without a log line (``WebSocketProtocol13._receive_frame``
+    calls the protocol's ``close(1009, ...)``); this wraps that ``close`` of the server's
+    protocol class so that the refusal is logged with the client's address.
+    """
+    from tornado.websocket import WebSocketProtocol13
+
+    if getattr(WebSocketProtocol13.close, "fbs_reports", False):
+        return
+    original = WebSocketProtocol13.close
+
+    def close(self, code=None, reason=None):
+        if code == 1009 and not self.mask_outgoing:  # (a server does not mask)
+            try:
+                report(self.handler, reason)
+            except Exception:  # noqa: BLE001, S110 (a log line must not break the close)
+                pass
+        return original(self, code, reason)
+
+    close.fbs_reports = True  # type: ignore[attr-defined]
+    WebSocketProtocol13.close = close  # type: ignore[method-assign]
+
+
+def bound_bokeh_messages(max_bytes: int, refused) -> None:
+    """Close a websocket whose Bokeh message (header, metadata, content and the buffers
+    its header announces, each a websocket message of its own) exceeds ``max_bytes``
+    in all; ``refused(handler, text)`` is called first (the log line).
+
+    Tornado bounds each websocket message by its declared size; a Bokeh message may have
+    any number of buffers, so many messages under that size, each kept in memory until
+    the Bokeh message is whole, would add up. Panel's websocket handler (``panel.io.server.
+    WSHandler``, the ``/ws`` route of every app) gets this count in front of its
+    ``on_message``; a fragment's size is counted before Bokeh decodes it, plus 64 bytes
+    per fragment (so that empty buffers cannot pile up either).
+    """
+    import json
+
+    from panel.io.server import WSHandler
+
+    if getattr(WSHandler.on_message, "fbs_bounded", False):
+        return
+    original = WSHandler.on_message
+
+    async def on_message(self, fragment):
+        if getattr(self, "fbs_refused", False):
+            return None  # closing: nothing more of this connection is read
+        left = getattr(self, "fbs_frames_left", 0)
+        if left <= 0:  # a Bokeh message begins: its header says how many buffers follow
+            count = 0
+            try:
+                header = json.loads(fragment) if len(fragment) < 65536 else {}
+                count = max(0, int(header.get("num_buffers", 0) or 0))
+            except (ValueError, TypeError, AttributeError):
+                count = 0  # Bokeh refuses it with its own protocol error
+            left, size = 3 + 2 * count, 0
+        else:
+            size = getattr(self, "fbs_message_bytes", 0)
+        size += len(fragment) + 64
+        self.fbs_frames_left, self.fbs_message_bytes = left - 1, size
+        if size > max_bytes:
+            self.fbs_refused = True
+            refused(self, f"a Bokeh message of more than {size:,} bytes (limit {max_bytes:,})")
+            self.close(1009, "message too big")
+            return None
+        return await original(self, fragment)
+
+    on_message.fbs_bounded = True  # type: ignore[attr-defined]
+    WSHandler.on_message = on_message  # type: ignore[method-assign]
+
+
+def accept_connections(bokeh_server, limits) -> int:
+    """Put the server's own accept loop (``conn_limits.accept_loop``: connection caps, a
+    pause instead of a busy loop when file descriptors run out) in front of the Bokeh
+    server's HTTP server; the number of listening sockets it took over.
+
+    Tornado's ``TCPServer`` accepts in a handler it registers per listening socket
+    (``_sockets``, ``_handlers``: the remover ``stop()`` calls) and serves each connection
+    with ``_handle_connection``; an ``accept()`` that fails with EMFILE escapes its handler,
+    and the event loop calls it again at once (the busy loop). Bokeh keeps its HTTP server
+    in ``Server._http``. Called before the event loop runs.
+    """
+    from conn_limits import accept_loop
+    from tornado.ioloop import IOLoop
+
+    http = bokeh_server._http
+    io_loop = bokeh_server.io_loop
+    n = 0
+    for fd, sock in list(http._sockets.items()):
+        http._handlers.pop(fd)()  # Tornado's accept handler
+
+        def ready(_fd, _events, sock=sock):
+            accept_loop(sock, http._handle_connection, limits, pause)
+
+        def resume(sock=sock):
+            if sock.fileno() != -1:  # not closed by a stop meanwhile
+                io_loop.add_handler(sock, ready, IOLoop.READ)
+
+        def pause(seconds: float, sock=sock, resume=resume):
+            io_loop.remove_handler(sock)
+            io_loop.call_later(seconds, resume)
+
+        io_loop.add_handler(sock, ready, IOLoop.READ)
+        http._handlers[fd] = lambda sock=sock: io_loop.remove_handler(sock)
+        n += 1
+    return n
