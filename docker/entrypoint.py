@@ -62,6 +62,12 @@ Variables (all optional; the table with examples is in docs/deployment.md):
 ``FBS_HEADER_TIMEOUT_S``, ``FBS_BODY_TIMEOUT_S``
     Seconds a request's headers (from the connection's start, or the previous request on
     it) and its body may take, default 10 and 30; then the connection is closed.
+``FBS_PAGE_BUILD_SHARE``, ``FBS_PAGE_BUILD_SHARE_PER_USER``
+    Share of the server's event loop that page builds may take, of all users (default
+    0.5) and of one user (a login, or a client address without login; default 0.2);
+    beyond, a page request gets 503 or 429 with ``Retry-After`` and a page that reloads
+    itself. ``FBS_PAGE_BUILD_BURST_S`` and ``FBS_PAGE_BUILD_BURST_S_PER_USER``: seconds
+    of page builds at once (default 8 and 4: several tabs opened together).
 ``FBS_LOG_LEVEL``
     ``debug``, ``info`` (default), ``warning``, ``error`` or ``critical``.
 ``FBS_APP``
@@ -144,6 +150,20 @@ def _positive_int(env: dict[str, str], name: str, default: int | None) -> int | 
         value = 0
     if value < 1:
         raise SettingError(f"{name}={raw!r}: must be an integer >= 1")
+    return value
+
+
+def _share(env: dict[str, str], name: str, default: float) -> float:
+    """A fraction in (0, 1] from ``env[name]``; ``default`` when unset."""
+    raw = env.get(name, "").strip()
+    if not raw:
+        return default
+    try:
+        value = float(raw)
+    except ValueError:
+        value = -1.0
+    if not 0 < value <= 1:
+        raise SettingError(f"{name}={raw!r}: must be a number in (0, 1], e.g. 0.5")
     return value
 
 
@@ -295,6 +315,10 @@ def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
         "max_connections_per_client": _positive_int(env, "FBS_MAX_CONNECTIONS_PER_CLIENT", 64),
         "header_timeout_s": _positive_int(env, "FBS_HEADER_TIMEOUT_S", 10),
         "body_timeout_s": _positive_int(env, "FBS_BODY_TIMEOUT_S", 30),
+        "page_build_share": _share(env, "FBS_PAGE_BUILD_SHARE", 0.5),
+        "page_build_share_per_user": _share(env, "FBS_PAGE_BUILD_SHARE_PER_USER", 0.2),
+        "page_build_burst_s": _positive_int(env, "FBS_PAGE_BUILD_BURST_S", 8),
+        "page_build_burst_s_per_user": _positive_int(env, "FBS_PAGE_BUILD_BURST_S_PER_USER", 4),
     }
 
     secret = _cookie_secret(env)

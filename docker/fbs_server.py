@@ -79,6 +79,7 @@ from conn_limits import (
     MAX_CONNECTIONS,
     MAX_CONNECTIONS_PER_CLIENT,
     ConnectionLimits,
+    QuietLog,
 )
 from fbs_auth import (  # noqa: F401  (re-exported: the server's login in one import)
     LOGIN_FREE_FAILURES,
@@ -86,12 +87,15 @@ from fbs_auth import (  # noqa: F401  (re-exported: the server's login in one im
     GuardedBasicAuth,
     LoginThrottle,
     check_password,
+    client_address,
     parse_networks,
 )
 from page_gate import PageGate
+from page_limits import TOTAL_BURST_S, TOTAL_SHARE, USER_BURST_S, USER_SHARE, PageBuilds
 from server_private import (
     accept_connections,
     bound_bokeh_messages,
+    bound_page_builds,
     cancel_queued_panel_work,
     cleanup_document,
     peer_address,
@@ -175,6 +179,30 @@ def bound_websocket_messages(max_bytes: int) -> None:
     frames add up to more (:func:`server_private.bound_bokeh_messages`)."""
     report_refused_websocket_frames(_websocket_refused)
     bound_bokeh_messages(int(max_bytes), _websocket_refused)
+
+
+# ---- page builds ---------------------------------------------------------------------------
+
+
+def limit_page_builds(builds: PageBuilds, by_login: bool, proxies, quiet: QuietLog) -> None:
+    """Page builds draw on ``builds``' budgets (:mod:`page_limits`), owned by the login
+    (``by_login``) or else by the client address; refusals logged once per interval."""
+
+    def key_of(handler) -> str:
+        if by_login:
+            user = handler.current_user
+            return "user " + (user.decode() if isinstance(user, bytes) else str(user))
+        request = handler.request
+        return "client " + client_address(peer_address(request), request.headers, proxies)
+
+    def refused(handler, key: str, kind: str, wait_s: float) -> None:
+        quiet.note(
+            f"pages {kind}",
+            f"page builds refused: {key[:80]!r} ({'its' if kind == 'user' else 'all users'}"
+            f"' budget spent, retry in {wait_s:.0f} s)",
+        )
+
+    bound_page_builds(builds, key_of, refused)
 
 
 # ---- health check ------------------------------------------------------------------------
@@ -576,6 +604,10 @@ def _serve_class():
         max_connections_per_client = MAX_CONNECTIONS_PER_CLIENT
         header_timeout_s = HEADER_TIMEOUT_S
         body_timeout_s = BODY_TIMEOUT_S
+        page_build_share = TOTAL_SHARE
+        page_build_burst_s = TOTAL_BURST_S
+        page_build_share_per_user = USER_SHARE
+        page_build_burst_s_per_user = USER_BURST_S
         users: dict | str | None = None  # the basic-auth users (set by serve)
         limits: ConnectionLimits | None = None
 
@@ -617,6 +649,20 @@ def _serve_class():
                 int(self.max_connections_per_client),
                 int(self.max_connections),
                 exempt=proxies,
+            )
+            builds = PageBuilds(
+                float(self.page_build_share_per_user),
+                float(self.page_build_burst_s_per_user),
+                float(self.page_build_share),
+                float(self.page_build_burst_s),
+            )
+            by_login = bool(config.basic_auth) or bool(config.oauth_provider)
+            limit_page_builds(builds, by_login, proxies, self.limits.quiet)
+            log.info(
+                "page builds: %.0f %% of the event loop per %s, %.0f %% in all",
+                100 * builds.user_share,
+                "login" if by_login else "client",
+                100 * builds.total.rate,
             )
             log.info(
                 "connections: at most %d per client, %d in all; headers within %g s, "

@@ -13,6 +13,7 @@ from __future__ import annotations
 __all__ = [
     "accept_connections",
     "bound_bokeh_messages",
+    "bound_page_builds",
     "cancel_queued_panel_work",
     "cleanup_document",
     "peer_address",
@@ -161,3 +162,70 @@ def accept_connections(bokeh_server, limits) -> int:
         http._handlers[fd] = lambda sock=sock: io_loop.remove_handler(sock)
         n += 1
     return n
+
+
+def bound_page_builds(builds, key_of, refused) -> None:
+    """Put the page-build budgets (``page_limits.PageBuilds``) in front of the routes that
+    build a page for an HTTP request: Panel's page (``DocHandler.get``) and autoload
+    (``AutoloadJsHandler.get``) routes; the websocket route (``WSHandler.prepare``) gives
+    the charge back when it opens a session built by such a request (the page is in use;
+    Bokeh's ``ApplicationContext.get_session`` tells).
+
+    ``key_of(handler)`` names the budget's owner (a login or a client address);
+    ``refused(handler, key, kind, wait_s)`` is called for a refused request, which gets
+    the status, ``Retry-After`` and light page of ``builds.wait_page``. A request without a
+    login is left to the route (which sends it to the login). A build is charged the time
+    its handler took.
+    """
+    import time
+
+    from bokeh.util.token import get_session_id
+    from panel.io.server import AutoloadJsHandler, DocHandler, WSHandler
+
+    def refuse(handler, key: str, refusal) -> None:
+        status, retry, page = builds.wait_page(*refusal)
+        refused(handler, key, *refusal)
+        handler.set_status(status)
+        handler.set_header("Retry-After", str(retry))
+        handler.set_header("Cache-Control", "no-store")
+        handler.set_header("Content-Type", "text/html; charset=utf-8")
+        handler.finish(page)
+
+    for cls in (DocHandler, AutoloadJsHandler):
+        if getattr(cls.get, "fbs_bounded", False):
+            continue
+
+        async def get(self, *args, _original=cls.get, **kwargs):
+            if self.current_user is None:
+                return await _original(self, *args, **kwargs)
+            key = key_of(self)
+            refusal = builds.check(key)
+            if refusal is not None:
+                return refuse(self, key, refusal)
+            t0 = time.perf_counter()
+            try:
+                return await _original(self, *args, **kwargs)
+            finally:
+                builds.charge(key, time.perf_counter() - t0)
+
+        get.fbs_bounded = True  # type: ignore[attr-defined]
+        cls.get = get  # type: ignore[method-assign]
+
+    if getattr(WSHandler.prepare, "fbs_bounded", False):
+        return
+    original_prepare = WSHandler.prepare
+
+    async def prepare(self):
+        await original_prepare(self)
+        if self.current_user is None or self.get_status() != 200:
+            return  # refused by Panel already
+        header = self.request.headers.get("Sec-WebSocket-Protocol", "")
+        protocols = [p.strip() for p in header.split(",")]
+        try:
+            self.application_context.get_session(get_session_id(protocols[1]))
+        except Exception:  # noqa: BLE001 (no such session, or a token Bokeh refuses)
+            return
+        builds.refund(key_of(self))
+
+    prepare.fbs_bounded = True  # type: ignore[attr-defined]
+    WSHandler.prepare = prepare  # type: ignore[method-assign]

@@ -196,3 +196,15 @@ def test_the_accept_loop_the_server_takes_over_is_still_tornados():
     assert "self._handle_connection" in src
     assert "self._handlers.pop(fd)()" in inspect.getsource(tornado.tcpserver.TCPServer.stop)
     assert "self._http = http_server" in inspect.getsource(BaseServer.__init__)
+
+
+def test_the_routes_whose_page_builds_are_bounded_are_still_panels():
+    """``server_private.bound_page_builds`` wraps the coroutines of Panel's page, autoload
+    and websocket routes (the per-app routes Bokeh builds its application's handlers from)."""
+    from bokeh.server.urls import per_app_patterns
+    from panel.io.server import AutoloadJsHandler, DocHandler, WSHandler
+
+    assert {DocHandler, AutoloadJsHandler, WSHandler} <= {h for _, h in per_app_patterns}
+    for method in (DocHandler.get, AutoloadJsHandler.get, WSHandler.prepare):
+        # (a login decorator may wrap it: awaited all the same)
+        assert inspect.iscoroutinefunction(inspect.unwrap(method)), method

@@ -878,3 +878,103 @@ def test_out_of_file_descriptors_the_server_pauses_accepting_quietly(tmp_path):
         )
     finally:
         srv.stop()
+
+
+# ---- issue 42: page builds without a websocket ----------------------------------------------
+
+#: A page that takes 0.3 s of the event loop to build (as a page of the dashboard does
+#: more) and counts its builds.
+SLOW_PAGE = """
+import time
+from pathlib import Path
+import panel as pn
+
+count = Path(__file__).with_name("builds.txt")
+count.write_text(str(int(count.read_text() or 0) + 1) if count.exists() else "1")
+time.sleep(0.3)
+pn.pane.Markdown("# slow-page-marker").servable()
+"""
+
+
+def test_page_builds_are_bounded_per_user(tmp_path):
+    """A logged-in user reloading the page in a loop (no websocket) built a page on the
+    event loop each time. Now each login has a budget of event-loop time for page builds
+    (FBS_PAGE_BUILD_BURST_S_PER_USER at once, FBS_PAGE_BUILD_SHARE_PER_USER per second):
+    beyond, 429 with Retry-After and a page that reloads itself; another user still gets
+    pages, and opening the pages one asks for (their websockets) gives the charge back;
+    one log line per interval."""
+    srv = Server(
+        tmp_path,
+        SLOW_PAGE,
+        {
+            "FBS_BASIC_AUTH": f"{USER}:{PASSWORD},{OTHER_USER}:{OTHER_PASSWORD}",
+            "FBS_COOKIE_SECRET": SECRET,
+            "FBS_PAGE_BUILD_SHARE_PER_USER": "0.1",
+            "FBS_PAGE_BUILD_BURST_S_PER_USER": "1",
+        },
+    )
+    try:
+        srv.started(120)
+        log0 = len(srv.log())
+        cookie = _login_cookies()
+        opener = urllib.request.build_opener(NoRedirect)
+        builds0 = _builds(srv)
+        statuses, retry, t0 = [], [], time.monotonic()
+        while time.monotonic() - t0 < 6.0:
+            status, headers, body = get(opener, srv.base + "/fbsapp", headers={"Cookie": cookie})
+            statuses.append(status)
+            if status == 429:
+                retry.append(int(headers["Retry-After"]))
+                assert "opens by itself" in body and "render_items" not in body
+        secs = time.monotonic() - t0
+        built = _builds(srv) - builds0
+        # at most the burst (1 s) and 0.1 s per second of 0.3 s builds, and one more (the
+        # build that spends the budget is charged after it)
+        assert built <= (1 + 0.1 * secs) / 0.3 + 1, (built, statuses)
+        assert 429 in statuses and min(retry) >= 1, statuses
+        assert statuses.count(200) == built
+        # another user is not held back
+        other = _login_cookies(user=OTHER_USER, password=OTHER_PASSWORD)
+        status, _, body = get(opener, srv.base + "/fbsapp", headers={"Cookie": other})
+        assert status == 200 and "render_items" in body
+        # nor a user who opens the pages it asks for (their websockets): the budget bounds
+        # pages built and never used
+        for _ in range(8):
+            status, _, body = get(opener, srv.base + "/fbsapp", headers={"Cookie": other})
+            token = re.search(r'"token":\s*"([^"]+)"', body)
+            assert status == 200 and token, status
+            _, document = run_async(websocket_session(srv.port, "fbsapp", other, token[1]))
+            assert "slow-page-marker" in document
+        new = srv.log()[log0:]
+        assert new.count(f"page builds refused: 'user {USER}'") == 1, new[-3000:]
+        assert "Traceback" not in new
+    finally:
+        srv.stop()
+
+
+def test_page_build_budgets_per_user_and_in_all():
+    """The budgets on their own (a clock of the test's): a user's burst, its refill, and the
+    budget of all users refusing a user whose own budget is left."""
+    import page_limits
+
+    clock = _Clock()
+    builds = page_limits.PageBuilds(
+        user_share=0.2, user_burst_s=2.0, total_share=0.5, total_burst_s=3.0, clock=clock
+    )
+    assert builds.check("a") is None
+    builds.charge("a", 1.5)
+    assert builds.check("a") is None  # 0.5 s left
+    builds.charge("a", 1.0)  # -0.5 s: refilled to above 0 in 2.5 s
+    kind, wait = builds.check("a")
+    assert kind == "user" and wait == pytest.approx(2.5, abs=0.01)
+    assert builds.check("b") is None  # the total: 3 - 2.5 = 0.5 s left
+    builds.charge("b", 1.0)  # total -0.5 s: above 0 again in 1 s
+    kind, wait = builds.check("c")
+    assert kind == "all" and wait == pytest.approx(1.0, abs=0.01)
+    clock.t += 1.01
+    assert builds.check("c") is None
+    builds.refund("a")  # a's page opened: the mean cost of a build back
+    assert builds.users["a"].level > 0 and builds.check("a") is None
+    status, retry, page = builds.wait_page("user", 2.2)
+    assert (status, retry) == (429, 3) and 'content="3"' in page
+    assert builds.wait_page("all", 0.2)[:2] == (503, 1)
