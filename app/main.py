@@ -576,8 +576,8 @@ def unreadable_link() -> pn.viewable.Viewable | None:
     None for a link the dashboard can open.
 
     Checked on the request's raw query before anything asks for the page's location: Panel
-    reads every value when it makes the location, and a value it cannot read stopped the
-    page build with a traceback and left the page blank.
+    reads every value when it makes the location, and a value it cannot read would stop the
+    page build with a traceback and leave the page blank.
     """
     from app.page.query import kept_query, shown_key, unreadable_keys, unreadable_link_page
 

@@ -1,10 +1,10 @@
 """Connections the server keeps open: bounded per client and in all, refused quietly.
 
-A client that opens connections and never finishes their headers (slowloris) held them
-for ever: 3,500 such connections took the server's file descriptors from 13 to 3,512 and
-``/liveness`` from milliseconds to 4.6-6 s; near the process's open-file limit
-``accept()`` failed with EMFILE in a busy loop that wrote 90,424 tracebacks in 25 s.
-Now:
+Without limits, a client that opens connections and never finishes their headers
+(slowloris) holds them for ever: 3,500 such connections take the server's file
+descriptors from 13 to 3,512 and ``/liveness`` from milliseconds to 4.6-6 s, and near the
+process's open-file limit Tornado's ``accept()`` fails with EMFILE in a busy loop (90,424
+tracebacks in 25 s). So:
 
 - a request's headers must arrive within ``FBS_HEADER_TIMEOUT_S`` of the connection's
   start or of the previous request on it (Tornado's ``idle_connection_timeout``, which is

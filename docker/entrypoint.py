@@ -348,8 +348,8 @@ def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
         args += ["--use-xheaders"]
     # an uploaded file travels base64-encoded in one message: 135 MiB carries fbs_core's
     # largest file (100 MiB), which gets the app's clear answer; a larger message is refused
-    # by the size its frame declares before any of it is read (a 147 MB message took the
-    # server from 0.98 to 2.2 GB with the former 200 MB), and its websocket is closed
+    # by the size its frame declares before any of it is read (read and decoded, a 147 MB
+    # message takes the server from 0.98 to 2.2 GB), and its websocket is closed
     size = _positive_int(env, "FBS_WEBSOCKET_MAX_MESSAGE_MB", WEBSOCKET_MAX_MESSAGE_MB)
     args += ["--websocket-max-message-size", str(size * 1024 * 1024)]
     level = env.get("FBS_LOG_LEVEL", "info").strip().lower()

@@ -45,14 +45,16 @@ Small HTTP bodies, large websocket messages
     websocket message is refused by the size its frame declares, before any of it is read,
     and a Bokeh message whose frames (content and buffers) add up to more is refused as
     its frames arrive; either closes that websocket with a log line naming the client
-    (:func:`bound_websocket_messages`: a 147 MB message took the server from 0.98 to
-    2.2 GB).
+    (:func:`bound_websocket_messages`: read and decoded, a 147 MB message takes the
+    server from 0.98 to 2.2 GB).
 Connections bounded
     A request's headers and body must arrive within deadlines, and open connections are
     capped per client and in all; a connection beyond a cap gets a 503 and is closed, and
     ``accept()`` out of file descriptors pauses accepting instead of spinning, each logged
-    once per interval (:mod:`conn_limits`: 3,500 connections that never finished their
-    headers stayed open for ever and slowed ``/liveness`` to 4.6-6 s).
+    once per interval (:mod:`conn_limits`: unbounded, 3,500 connections that never finish
+    their headers stay open for ever and slow ``/liveness`` to 4.6-6 s). Page builds
+    never used (page requests without their websocket) draw on budgets of event-loop time
+    per user and in all (:mod:`page_limits`).
 Prompt shutdown
     On SIGTERM or SIGINT the server stops listening and exits within seconds, whatever
     computations are running or queued: queued work is cancelled, worker threads are not

@@ -1,10 +1,10 @@
 """Page builds bounded per user and in all, so that other sessions keep their latency.
 
 A page of the dashboard is built on the server's event loop when it is requested (the app
-script runs for ``GET /main``, or for a websocket that names a new session). A logged-in
-user who reloads ``/main`` in a loop without ever opening its websocket made the loop
-build pages back to back: with two such loops another user's changes took p50 5.7 s /
-p95 17.9 s. Page builds now draw on budgets of event-loop time (token buckets of
+script runs for ``GET /main``, or for a websocket that names a new session). Unbounded, a
+logged-in user who reloads ``/main`` in a loop without ever opening its websocket makes
+the loop build pages back to back: with two such loops another user's changes took p50
+5.7 s / p95 17.9 s. So page builds draw on budgets of event-loop time (token buckets of
 seconds): each user (one login, or one client address without a login) has
 :data:`USER_BURST_S` seconds refilled at :data:`USER_SHARE` seconds per second, all users
 together :data:`TOTAL_BURST_S` refilled at :data:`TOTAL_SHARE` (the rest of the loop stays

@@ -3,8 +3,8 @@
 Panel reads every value of a served page's query the first time the page asks for its
 location (``pn.state.location``), before the dashboard can look at it: a value of digits is
 read with ``int()``, which refuses more than ``sys.get_int_max_str_digits()`` digits (4,300)
-with a ``ValueError``. The page then stayed blank and the server logged a traceback. So
-the raw query of the request is checked first (:func:`unreadable_keys`), and a link with a
+with a ``ValueError``, which would leave the page blank and a traceback in the server's
+log. So the raw query of the request is checked first (:func:`unreadable_keys`), and a link with a
 value that cannot be read opens :func:`unreadable_link_page` instead of the dashboard: a
 message naming each such key and why, and a link to the same page without those keys.
 
