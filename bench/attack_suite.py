@@ -468,9 +468,15 @@ def _doc_text(sess: BokehSession) -> str:
 async def _open(base: str, path: str, cookie: str | None, timeout_s: float = 120):
     """A session as a browser opens it: the page (with its URL query), then its websocket."""
     headers = {"Cookie": cookie} if cookie else {}
-    status, _, body, _ = await asyncio.to_thread(
-        fetch, base + path, headers=headers, timeout=timeout_s
-    )
+    t0 = time.monotonic()
+    while True:
+        status, answer, body, _ = await asyncio.to_thread(
+            fetch, base + path, headers=headers, timeout=timeout_s
+        )
+        if status not in (429, 503) or time.monotonic() - t0 > timeout_s:
+            break
+        # the page-build budget is spent: wait as the page that reloads itself does
+        await asyncio.sleep(float(answer.get("Retry-After", 1)))
     match = re.search(rb'"token":\s*"([^"]+)"', body)
     if status != 200 or match is None:
         raise RuntimeError(f"the page answered HTTP {status} without a session token")

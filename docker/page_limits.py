@@ -8,8 +8,8 @@ the loop build pages back to back: with two such loops another user's changes to
 seconds): each user (one login, or one client address without a login) has
 :data:`USER_BURST_S` seconds refilled at :data:`USER_SHARE` seconds per second, all users
 together :data:`TOTAL_BURST_S` refilled at :data:`TOTAL_SHARE` (the rest of the loop stays
-for the open sessions). A build is charged what it took, and the charge (the mean cost of
-a build) is given back when the page's websocket opens: what is bounded is pages built and
+for the open sessions). A build is charged what it took, and the charge is given back when
+the page's websocket opens: what is bounded is pages built and
 never used, so a user opening and using pages (a browser, the test and load clients) is not
 held back. A request while its budget is spent gets ``429`` (the user's) or ``503`` (all
 users') with ``Retry-After`` and a light page that reloads itself then.
@@ -36,6 +36,8 @@ TOTAL_SHARE = 0.5
 TOTAL_BURST_S = 8.0
 #: Users (or addresses) whose budgets are kept; the oldest are forgotten beyond.
 MAX_USERS = 10_000
+#: Charges of a user's builds kept for giving back (the pages it may still open).
+PENDING_PER_USER = 16
 
 WAIT_PAGE = """<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta http-equiv="refresh" content="{s}">
@@ -93,7 +95,7 @@ class PageBuilds:
         self.total = Bucket(total_share, total_burst_s, clock())
         self.users: dict[str, Bucket] = {}
         self.lock = threading.Lock()
-        self.mean_s = 1.0  # mean cost of a build (given back when a page is opened)
+        self.pending: dict[str, list[float]] = {}  # charges not given back, oldest first
         self.refused = {"user": 0, "all": 0}
 
     def _user(self, key: str, now: float) -> Bucket:
@@ -128,16 +130,26 @@ class PageBuilds:
             self.total.update(now)
             self.users[key].level -= seconds
             self.total.level -= seconds
-            self.mean_s = 0.8 * self.mean_s + 0.2 * max(0.0, seconds)
+            charges = self.pending.setdefault(key, [])
+            charges.append(seconds)
+            del charges[:-PENDING_PER_USER]
+            while len(self.pending) > MAX_USERS:
+                self.pending.pop(next(iter(self.pending)))
 
-    def refund(self, key: str) -> None:
-        """A page built for ``key`` is in use (its websocket opened): the mean cost of a
-        build back to both budgets (at most up to their capacity)."""
+    def refund(self, key: str) -> float:
+        """A page built for ``key`` is in use (its websocket opened): the charge of the
+        oldest of its builds not yet given back returns to both budgets (at most up to
+        their capacity); the seconds given back."""
         with self.lock:
+            charges = self.pending.get(key)
+            if not charges:
+                return 0.0
+            seconds = charges.pop(0)
             now = self.clock()
             for b in (self._user(key, now), self.total):
                 b.update(now)
-                b.level = min(b.burst, b.level + self.mean_s)
+                b.level = min(b.burst, b.level + seconds)
+            return seconds
 
     @staticmethod
     def wait_page(kind: str, wait_s: float) -> tuple[int, int, str]:

@@ -973,8 +973,10 @@ def test_page_build_budgets_per_user_and_in_all():
     assert kind == "all" and wait == pytest.approx(1.0, abs=0.01)
     clock.t += 1.01
     assert builds.check("c") is None
-    builds.refund("a")  # a's page opened: the mean cost of a build back
-    assert builds.users["a"].level > 0 and builds.check("a") is None
+    level = builds.users["a"].update(clock.t)
+    assert builds.refund("a") == 1.5  # a's first page opened: its charge back
+    assert builds.users["a"].level == pytest.approx(level + 1.5)
+    assert builds.refund("a") == 1.0 and builds.refund("a") == 0.0  # nothing more pending
     status, retry, page = builds.wait_page("user", 2.2)
     assert (status, retry) == (429, 3) and 'content="3"' in page
     assert builds.wait_page("all", 0.2)[:2] == (503, 1)
