@@ -261,12 +261,14 @@ def fetch(url: str, *, data=None, headers=None, timeout=60):
 def login(base: str, user: str, password: str) -> str | None:
     """The login cookie header value, or None."""
     jar = urllib.request.HTTPCookieProcessor()
-    opener = urllib.request.build_opener(jar)
+    # the answer's redirect is not followed: it would build a page never opened
+    opener = urllib.request.build_opener(jar, _NoRedirect)
     data = urllib.parse.urlencode({"username": user, "password": password}).encode()
     try:
         opener.open(base + "/login", data=data, timeout=60).read()
-    except urllib.error.HTTPError:
-        return None
+    except urllib.error.HTTPError as e:
+        if e.code not in (301, 302, 303):
+            return None
     cookies = {c.name: c.value for c in jar.cookiejar}
     if "user" not in cookies:
         return None
