@@ -748,6 +748,14 @@ def _model(sess: BokehSession, title: str):
     raise LookupError(f"no control titled {title!r} in the page")
 
 
+def _has(sess: BokehSession, title: str) -> bool:
+    try:
+        _model(sess, title)
+    except LookupError:
+        return False
+    return True
+
+
 def _n_slider(sess: BokehSession):
     """The "Retained tire modes N" slider (a discrete slider: its value is the index)."""
     for m in sess.doc.models:
@@ -828,7 +836,10 @@ async def _timed_changes(sess: BokehSession, n: int, timeout_s: float, seed0: in
             f, s = await _timed_change(sess, {}, timeout_s, raw=raw)
         elif kind == "harmonic":
             current = current % 7 + 1
-            f, s = await _timed_change(sess, {"Seed": seed0 + k, "Harmonic": current}, timeout_s)
+            changes = {"Harmonic": current}
+            if _has(sess, "Seed"):  # (a typed field the page may build later)
+                changes["Seed"] = seed0 + k
+            f, s = await _timed_change(sess, changes, timeout_s)
         else:  # z -> x -> y -> z
             idx = {2: 0, 0: 1}.get(int(dof.active), 2)
             f, s = await _timed_change(sess, {}, timeout_s, raw=[(dof, "active", idx)])

@@ -200,8 +200,9 @@ def limit_page_builds(builds: PageBuilds, by_login: bool, proxies, quiet: QuietL
     def refused(handler, key: str, kind: str, wait_s: float) -> None:
         quiet.note(
             f"pages {kind}",
-            f"page builds refused: {key[:80]!r} ({'its' if kind == 'user' else 'all users'}"
-            f"' budget spent, retry in {wait_s:.0f} s)",
+            f"page builds refused: {key[:80]!r} "
+            f"({'its budget' if kind == 'user' else 'the budget of all users'} spent, "
+            f"retry in {wait_s:.0f} s)",
         )
 
     bound_page_builds(builds, key_of, refused)
