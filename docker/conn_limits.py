@@ -97,7 +97,7 @@ class ConnectionLimits:
     ----------
     per_client, total
         Caps (connections). ``total`` is lowered to what the open-file limit leaves
-        (``open_file_limit() - FD_RESERVE``, at least 16).
+        (``open_file_limit() - FD_RESERVE``, but not below 16).
     exempt
         Networks whose connections count in the total only (trusted reverse proxies:
         every client behind them shares their address).
@@ -117,7 +117,7 @@ class ConnectionLimits:
             raise ValueError("connection caps must be >= 1")
         limit = open_file_limit() if fd_limit is None else fd_limit
         self.per_client = int(per_client)
-        self.total = max(16, min(int(total), limit - FD_RESERVE))
+        self.total = min(int(total), max(16, limit - FD_RESERVE))
         self.exempt = tuple(exempt)
         self.quiet = quiet or QuietLog()
         self._open: dict[str, list[socket.socket]] = {}

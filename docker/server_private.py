@@ -143,23 +143,26 @@ def accept_connections(bokeh_server, limits) -> int:
 
     http = bokeh_server._http
     io_loop = bokeh_server.io_loop
-    n = 0
-    for fd, sock in list(http._sockets.items()):
-        http._handlers.pop(fd)()  # Tornado's accept handler
 
-        def ready(_fd, _events, sock=sock):
+    def take_over(sock) -> None:
+        def ready(_fd, _events) -> None:
             accept_loop(sock, http._handle_connection, limits, pause)
 
-        def resume(sock=sock):
+        def resume() -> None:
             if sock.fileno() != -1:  # not closed by a stop meanwhile
                 io_loop.add_handler(sock, ready, IOLoop.READ)
 
-        def pause(seconds: float, sock=sock, resume=resume):
+        def pause(seconds: float) -> None:
             io_loop.remove_handler(sock)
             io_loop.call_later(seconds, resume)
 
         io_loop.add_handler(sock, ready, IOLoop.READ)
-        http._handlers[fd] = lambda sock=sock: io_loop.remove_handler(sock)
+        http._handlers[sock.fileno()] = lambda: io_loop.remove_handler(sock)
+
+    n = 0
+    for fd, sock in list(http._sockets.items()):
+        http._handlers.pop(fd)()  # Tornado's accept handler
+        take_over(sock)
         n += 1
     return n
 

@@ -980,3 +980,39 @@ def test_page_build_budgets_per_user_and_in_all():
     status, retry, page = builds.wait_page("user", 2.2)
     assert (status, retry) == (429, 3) and 'content="3"' in page
     assert builds.wait_page("all", 0.2)[:2] == (503, 1)
+
+
+def test_connection_limits_count_open_sockets_per_client_and_in_all():
+    """The caps on their own: a closed socket no longer counts, a trusted proxy counts in
+    the total only, the total stays below the open-file limit, and the refusals of one
+    kind are logged once per interval with their count."""
+    import socket
+
+    import conn_limits
+
+    clock = _Clock()
+    quiet = conn_limits.QuietLog(10.0, clock=clock)
+    proxies = fbs_auth.parse_networks("10.0.0.9")
+    limits = conn_limits.ConnectionLimits(2, 4, exempt=proxies, fd_limit=10_000, quiet=quiet)
+    assert conn_limits.ConnectionLimits(2, 4000, fd_limit=1000).total == 1000 - 256
+    pairs = [socket.socketpair() for _ in range(8)]
+    try:
+        a, b, c, d, e, f, g, h = (p[0] for p in pairs)
+        assert limits.admit(a, ("10.0.0.1", 1)) and limits.admit(b, ("10.0.0.1", 2))
+        assert not limits.admit(c, ("10.0.0.1", 3)) and c.fileno() == -1  # refused, closed
+        assert pairs[2][1].recv(100).startswith(b"HTTP/1.1 503")
+        a.close()  # the server closed one: room again
+        assert limits.admit(d, ("10.0.0.1", 4)) and limits.open_count("10.0.0.1") == 2
+        assert limits.admit(e, ("10.0.0.9", 5)) and limits.admit(f, ("10.0.0.9", 6))
+        assert limits.open_count() == 4
+        assert not limits.admit(g, ("10.0.0.9", 7))  # the proxy: the total (4) is reached
+        clock.t += 11
+        assert not limits.admit(h, ("10.0.0.2", 8))
+        assert limits.refused == 3
+    finally:
+        for p in pairs:
+            p[0].close()
+            p[1].close()
+    assert quiet.note("k", "x") and not quiet.note("k", "x") and not quiet.note("k", "x")
+    clock.t += 10
+    assert quiet.note("k", "x")
