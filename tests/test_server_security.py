@@ -867,16 +867,16 @@ def test_out_of_file_descriptors_the_server_pauses_accepting_quietly(tmp_path):
         new = srv.log()[log0:]
         assert "Traceback" not in new and new.count("\n") < 20, new[-3000:]
         assert "no file descriptor left" in new
-    finally:
         for s in held:
             s.close()
-    try:
         wait_for(
             lambda: get(urllib.request.build_opener(), srv.base + "/liveness")[0] == 200,
             60,
             what="the server answering again",
         )
     finally:
+        for s in held:
+            s.close()
         srv.stop()
 
 
