@@ -59,7 +59,8 @@ RUN useradd --system --create-home --home-dir /home/fbs --uid 10001 --user-group
 RUN mkdir -p /data && chown fbs:fbs /data
 COPY --from=build /opt/venv /opt/venv
 COPY docker/entrypoint.py docker/fbs_server.py docker/fbs_auth.py docker/page_gate.py \
-     docker/server_private.py docker/prepare.py /opt/fbs/
+     docker/conn_limits.py docker/page_limits.py docker/server_private.py docker/prepare.py \
+     /opt/fbs/
 ENV PATH=/opt/venv/bin:$PATH \
     PYTHONUNBUFFERED=1 \
     NUMBA_CACHE_DIR=/home/fbs/.cache/numba \

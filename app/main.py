@@ -575,11 +575,38 @@ def close_page(page: pn.template.BootstrapTemplate, log: logging.Logger = log) -
                 obj.param.watchers = {}
 
 
+def unreadable_link() -> pn.viewable.Viewable | None:
+    """The page of a served link whose query cannot be read (:mod:`app.page.query`), or
+    None for a link the dashboard can open.
+
+    Checked on the request's raw query before anything asks for the page's location: Panel
+    reads every value when it makes the location, and a value it cannot read would stop the
+    page build with a traceback and leave the page blank.
+    """
+    from app.page.query import kept_query, shown_key, unreadable_keys, unreadable_link_page
+
+    args = pn.state.session_args
+    bad = unreadable_keys(args)
+    if not bad:
+        return None
+    request = pn.state.curdoc.session_context.request
+    path = str(getattr(request, "path", "") or "")
+    log.info(
+        "a link with unreadable query values opened a message page: %s",
+        "; ".join(f"{shown_key(k)} {why}" for k, why in bad.items()),
+    )
+    return unreadable_link_page(bad, kept_query(args, list(bad)), path)
+
+
 if pn.state.served:
-    # One recomputation of the document's model graph instead of one per added root
-    # (Bokeh recomputes it on every change of the graph): about a fifth of the server's
-    # CPU time for a new session (bench/load_test.py)
-    with pn.state.curdoc.models.freeze():
-        _page = create_app()
-        step_aside()
-        _page.servable(title="tire-fbs dashboard")
+    _message = unreadable_link()
+    if _message is not None:  # no location: Panel would read the unreadable values
+        _message.servable(title="tire-fbs dashboard", location=False)
+    else:
+        # One recomputation of the document's model graph instead of one per added root
+        # (Bokeh recomputes it on every change of the graph): about a fifth of the server's
+        # CPU time for a new session (bench/load_test.py)
+        with pn.state.curdoc.models.freeze():
+            _page = create_app()
+            step_aside()
+            _page.servable(title="tire-fbs dashboard")

@@ -44,7 +44,7 @@ fi
 # uploads travel base64-encoded in one websocket message: 200 MB carries files up to
 # 150 MB, so a file above fbs_core's 100 MiB limit is refused with a message (Bokeh's
 # default of 20 MB would close the connection on files above 15 MB)
-WS_MAX_MB=${WS_MAX_MB:-200}
+WS_MAX_MB=${WS_MAX_MB:-135}
 FBS_APP=app/main.py FBS_PORT=$PORT FBS_ADDRESS=$ADDRESS FBS_NUM_THREADS=$NUM_THREADS \
   FBS_WEBSOCKET_MAX_MESSAGE_MB=$WS_MAX_MB \
   .venv/bin/python docker/entrypoint.py "${SHOW_ARG[@]}" "$@" &
