@@ -208,3 +208,17 @@ def test_the_routes_whose_page_builds_are_bounded_are_still_panels():
     for method in (DocHandler.get, AutoloadJsHandler.get, WSHandler.prepare):
         # (a login decorator may wrap it: awaited all the same)
         assert inspect.iscoroutinefunction(inspect.unwrap(method)), method
+
+
+def test_the_process_pools_worker_list_is_still_there():
+    """``panel_private.pool_processes`` reads CPython's ``ProcessPoolExecutor._processes``:
+    the report drawer's processes, ended when the server stops."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from app.runtime.panel_private import pool_processes
+
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        assert pool.submit(abs, -1).result(timeout=120) == 1
+        procs = pool_processes(pool)
+        assert len(procs) == 1 and procs[0].is_alive()

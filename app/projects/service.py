@@ -222,12 +222,12 @@ class Projects:
             raise Conflict(f"project {pid}: the new access list would shut you out")
 
         def body(conn: sqlite3.Connection) -> None:
-            ProjectDB._put_access(conn, entries)
+            ProjectDB.put_access(conn, entries)
             text = "; ".join(
                 f"{a.group}: {'all' if a.suppliers is None else ', '.join(sorted(a.suppliers))}"
                 for a in entries
             )
-            ProjectDB._audit(conn, now_text(), who.name, "access", text, (), FULL_ONLY)
+            ProjectDB.write_audit(conn, now_text(), who.name, "access", text, (), FULL_ONLY)
 
         db.write(f"project {pid}: changing access", body)
         return db.info()
@@ -278,7 +278,7 @@ class Projects:
         ids = tuple(candidates)
 
         def body(conn: sqlite3.Connection) -> None:
-            ProjectDB._audit(conn, now_text(), who.name, action, what, ids, audience)
+            ProjectDB.write_audit(conn, now_text(), who.name, action, what, ids, audience)
 
         db.write(f"project {db.id}: audit log", body)
 
@@ -342,7 +342,7 @@ class Projects:
                 (name, supplier, size, version, fname, sha, digest, len(raw), who.name, at),
             )
             cid = int(cur.lastrowid or 0)
-            ProjectDB._audit(conn, at, who.name, "added", f"candidate {name!r}", (cid,), None)
+            ProjectDB.write_audit(conn, at, who.name, "added", f"candidate {name!r}", (cid,), None)
             return Candidate(
                 cid, name, supplier, size, version, fname, sha, digest, len(raw), who.name, at
             )
@@ -377,7 +377,9 @@ class Projects:
             ).rowcount
             if n != 1:
                 raise Conflict(f"project {pid}: candidate {c.name!r} was removed already")
-            ProjectDB._audit(conn, at, who.name, "removed", f"candidate {c.name!r}", (cid,), None)
+            ProjectDB.write_audit(
+                conn, at, who.name, "removed", f"candidate {c.name!r}", (cid,), None
+            )
 
         db.write(f"project {pid}: removing candidate {c.name!r}", body)
         db.remove_file_if_unused(c.sha256)
@@ -412,7 +414,7 @@ class Projects:
                 "VALUES (?, ?, ?, ?, ?, ?)",
                 (name, fname, sha, len(raw), who.name, at),
             )
-            ProjectDB._audit(conn, at, who.name, "added", f"target {name!r}", (), None)
+            ProjectDB.write_audit(conn, at, who.name, "added", f"target {name!r}", (), None)
             return Target(int(cur.lastrowid or 0), name, fname, sha, len(raw), who.name, at)
 
         try:
@@ -441,7 +443,7 @@ class Projects:
             ).rowcount
             if n != 1:
                 raise Conflict(f"project {pid}: target {t.name!r} was removed already")
-            ProjectDB._audit(conn, at, who.name, "removed", f"target {t.name!r}", (), None)
+            ProjectDB.write_audit(conn, at, who.name, "removed", f"target {t.name!r}", (), None)
 
         db.write(f"project {pid}: removing target {t.name!r}", body)
         db.remove_file_if_unused(t.sha256)
@@ -511,7 +513,7 @@ class Projects:
                 "INSERT INTO views VALUES (?, ?, ?, ?, ?, ?)",
                 (view_id, name, query, json.dumps(list(ids)), who.name, at),
             )
-            ProjectDB._audit(conn, at, who.name, "saved view", f"view {name!r}", ids, None)
+            ProjectDB.write_audit(conn, at, who.name, "saved view", f"view {name!r}", ids, None)
 
         db.write(f"project {pid}: saving view {name!r}", body)
         return view_id
@@ -564,7 +566,7 @@ class Projects:
                 (text, None if audience is None else json.dumps(sorted(audience)), who.name, at),
             )
             short = text if len(text) <= 60 else text[:57] + "..."
-            ProjectDB._audit(conn, at, who.name, "noted", repr(short), (), audience)
+            ProjectDB.write_audit(conn, at, who.name, "noted", repr(short), (), audience)
             return int(cur.lastrowid or 0)
 
         nid: int = db.write(f"project {pid}: adding a note", body)

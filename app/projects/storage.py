@@ -347,8 +347,8 @@ class ProjectDB:
                 conn.execute("BEGIN IMMEDIATE")
                 at = now_text()
                 conn.execute("INSERT INTO project VALUES (?, ?, ?, ?)", (pid, title, user, at))
-                ProjectDB._put_access(conn, access)
-                ProjectDB._audit(conn, at, user, "created", f"project {title!r}", (), audience)
+                ProjectDB.put_access(conn, access)
+                ProjectDB.write_audit(conn, at, user, "created", f"project {title!r}", (), audience)
                 conn.execute(f"PRAGMA user_version={SCHEMA_VERSION}")
                 conn.execute("COMMIT")
                 conn.execute("PRAGMA wal_checkpoint(TRUNCATE)")
@@ -370,7 +370,7 @@ class ProjectDB:
         return ProjectDB(final)
 
     @staticmethod
-    def _put_access(conn: sqlite3.Connection, access: Sequence[GroupAccess]) -> None:
+    def put_access(conn: sqlite3.Connection, access: Sequence[GroupAccess]) -> None:
         conn.execute("DELETE FROM access")
         for a in access:
             suppliers = None if a.suppliers is None else json.dumps(sorted(a.suppliers))
@@ -467,7 +467,7 @@ class ProjectDB:
     # ---- writing -----------------------------------------------------------------------------
 
     @staticmethod
-    def _audit(
+    def write_audit(
         conn: sqlite3.Connection,
         at: str,
         user: str,

@@ -41,6 +41,7 @@ __all__ = [
     "html_model",
     "html_text",
     "panel_writes_pending",
+    "pool_processes",
     "respond_at_once",
 ]
 
@@ -73,3 +74,11 @@ def panel_writes_pending(doc) -> bool:
     from panel.io import document as pdoc
 
     return doc in pdoc._WRITE_BLOCK or bool(pdoc._WRITE_MSGS.get(doc))
+
+
+def pool_processes(pool) -> list:
+    """The worker processes of a ``concurrent.futures.ProcessPoolExecutor`` (CPython keeps
+    them in ``_processes``; the executor has no public list). The report drawer's are ended
+    and reaped when the server stops, also one started after the server listed its children.
+    """
+    return list((getattr(pool, "_processes", None) or {}).values())

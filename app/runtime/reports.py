@@ -25,6 +25,7 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
 from ..report import ReportData, build_html, build_pdf
+from .panel_private import pool_processes
 
 T = TypeVar("T")
 
@@ -129,7 +130,7 @@ def stop(grace_s: float = STOP_GRACE_S) -> int:
         pools, _drawer[:] = list(_drawer), []
     procs = []
     for pool in pools:
-        procs += list((getattr(pool, "_processes", None) or {}).values())  # CPython's own
+        procs += pool_processes(pool)
         pool.shutdown(wait=False, cancel_futures=True)
     for p in procs:
         if p.is_alive():
