@@ -40,6 +40,7 @@ from fbs_core.vocabulary import magnitude_db, percent
 from .. import compute
 from ..analysis_state import PinSettings, decode_pins
 from ..datasource import REFERENCE
+from ..report.titles import NOISE_WHERE
 from .base import Band, Result, Snapshot, csv_name
 from .main import res_part, response_result
 
@@ -169,7 +170,8 @@ def _describe_settings(s: Snapshot | PinSettings) -> str:
     res = " + residual" if s.residual else ""
     return (
         f"h{s.harmonic} N={s.n_modes}{res} bushing:{s.dof} {s.coupling} noise {s.noise:g} % "
-        f"on the {s.target}{' (every line)' if s.frequency_dependent else ''} R={s.rounds} "
+        f"in {NOISE_WHERE[s.target]}{' (every line)' if s.frequency_dependent else ''} "
+        f"R={s.rounds} "
         f"seed {s.seed}"
     )
 
