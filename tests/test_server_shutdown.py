@@ -144,7 +144,8 @@ if ctx is not None and ctx.server_context is not None and not (here / "started")
                     frequency_dependent=False, rounds=300, seed=3, single_round=7,
                     percentile=90)
 
-    def reports_in_a_loop():
+    # the loop outlives the page's session, whose end clears this module's globals
+    def reports_in_a_loop(here=here, reports=reports, ReportData=ReportData, SETTINGS=SETTINGS):
         k = 0
         while True:
             try:
