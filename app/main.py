@@ -455,7 +455,7 @@ def create_app(
     step_aside()
     state = results.state
     page = PageState()
-    sync_url(state, page=page)  # the layout is kept in the link too
+    link = sync_url(state, page=page)  # the layout is kept in the link too
     if served_document() is not None:
         PAGES[served_document()] = page  # (title blocks' links name the page's N axis)
     # one frequency axis range for all spectra of the session: zoom and pan are linked;
@@ -548,6 +548,10 @@ def create_app(
         # the first screen is sent and shown first (issue 33: a page of ~1,000 Bokeh models
         # took 2.5 s to its first plot); the rest follows once the browser shows it
         pn.state.onload(complete)
+        if link is not None:
+            # the browser reports its own URL when the page loads (a view id's, or one the
+            # page read differently): the page's URL is the state's from then on
+            pn.state.onload(link.write_again)
         pn.state.onload(results.request_band)
         # once per process, after the first page: the other harmonics' reference studies
         pn.state.onload(background.warm_reference_studies)

@@ -442,10 +442,20 @@ class PageLink:
             self._pending = True
         on_document(self._doc, self.write)
 
-    def write(self) -> None:
-        """Set the URL to the settings in force (where the page's models may change)."""
+    def write(self, force: bool = False) -> None:
+        """Set the URL to the settings in force (where the page's models may change);
+        ``force``: send it to the browser even when the server's copy holds it already (the
+        browser showed another, e.g. a view id's link)."""
         with self._lock:
             self._pending = False
         text = self.query()
+        if force and (self.loc.search or "") == text:
+            self.loc.search = text + "&" if text else "?"  # a change the browser is sent
         if (self.loc.search or "") != text:
             self.loc.search = text
+
+    def write_again(self) -> None:
+        """:meth:`write` with ``force`` (where the page's models may change)."""
+        from ..runtime.draw import on_document
+
+        on_document(self._doc, lambda: self.write(force=True))
