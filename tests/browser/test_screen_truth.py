@@ -327,14 +327,19 @@ TYPED = {
     "ctl-truncation-f_max": ["140", "200", "1,000", "x", "120.5"],
 }
 TABS = ["Compare", "Phase and peaks", "Contributions"]
+#: A click as a person's: where the element is, without waiting for the page to settle.
+CLICK = {"force": True, "timeout": 20_000, "no_wait_after": True}
+#: Whether the page shows the presentation view (its switch's model).
+JS_PRESENT = """() => [...Bokeh.documents[0].all_models].some(
+    m => m.css_classes && m.css_classes.includes('ctl-page-view') && m.active === 1)"""
 
 
 def _act(page, rng: random.Random, log) -> None:
     kind = rng.choices(
         ["keys", "radio", "check", "overlay", "drag", "type", "tab", "present"],
-        weights=[30, 20, 8, 8, 10, 8, 6, 4],
+        weights=[34, 20, 8, 8, 10, 8, 4, 4],
     )[0]
-    present = "Presentation" in (page.locator(".ctl-page-view .bk-active").first.inner_text())
+    present = page.evaluate(JS_PRESENT)
     if present and kind not in ("tab", "present"):
         kind = "present"  # the controls are hidden in the presentation view: back to normal
     if kind == "keys":
@@ -347,15 +352,17 @@ def _act(page, rng: random.Random, log) -> None:
         cls = rng.choice(list(RADIOS))
         label = rng.choice(RADIOS[cls])
         log(f"click {cls} {label}")
-        page.locator(f".{cls}").get_by_role("button", name=label, exact=True).click()
+        page.locator(f".{cls}").get_by_role("button", name=label, exact=True).click(**CLICK)
     elif kind == "check":
         cls = rng.choice(CHECKS)
         log(f"toggle {cls}")
-        page.locator(f".{cls} input").first.click()
+        page.locator(f".{cls} input").first.click(**CLICK)
     elif kind == "overlay":
         label = rng.choice(["x", "y", "z", "rx", "ry", "rz"])
         log(f"overlay {label}")
-        page.locator(".ctl-plot-overlay").get_by_role("button", name=label, exact=True).click()
+        page.locator(".ctl-plot-overlay").get_by_role("button", name=label, exact=True).click(
+            **CLICK
+        )
     elif kind == "drag":
         cls = rng.choice(DRAGS)
         dx = rng.randint(-120, 120)
@@ -380,16 +387,13 @@ def _act(page, rng: random.Random, log) -> None:
         name = rng.choice(TABS)
         log(f"analysis tab {name}")
         card = page.locator(".analysis-card").first
-        if (
-            card.locator(".analysis-tabs").count() == 0
-            or not card.locator(".analysis-tabs").first.is_visible()
-        ):
-            card.locator(".card-button").first.click()
-        page.locator(".analysis-tabs").get_by_text(name, exact=True).first.click(timeout=60_000)
+        if card.locator(".analysis-tabs").count() == 0:
+            card.locator(".card-button").first.click(**CLICK)  # opened once: tabs built
+            page.locator(".analysis-tabs").first.wait_for(timeout=120_000)
+        page.locator(".analysis-tabs").get_by_text(name, exact=True).first.click(**CLICK)
     else:
-        label = "Normal view" if present else "Presentation"
-        log(f"view {label}")
-        page.locator(".ctl-page-view").get_by_role("button", name=label, exact=True).click()
+        log("view " + ("Normal view" if present else "Presentation"))
+        page.locator(".ctl-page-view button").nth(0 if present else 1).click(**CLICK)
     if rng.random() < 0.5:
         page.wait_for_timeout(rng.choice([0, 20, 80, 200, 400]))
 
