@@ -340,8 +340,14 @@ def _act(page, rng: random.Random, log) -> None:
         weights=[34, 20, 8, 8, 10, 8, 4, 4],
     )[0]
     present = page.evaluate(JS_PRESENT)
-    if present and kind not in ("tab", "present"):
-        kind = "present"  # the controls are hidden in the presentation view: back to normal
+    hidden = not page.locator(".ctl-case-dof").first.is_visible()
+    if (present or hidden) and kind not in ("tab", "present"):
+        # the controls are hidden (presentation view, or the sidebar still closing/opening)
+        kind = "present" if present else "wait"
+    if kind == "wait":
+        log("controls hidden: wait")
+        page.wait_for_timeout(300)
+        return
     if kind == "keys":
         cls = rng.choice(["ctl-case-n_modes", "ctl-case-n_modes", "ctl-case-harmonic"])
         key = rng.choice(["ArrowRight", "ArrowLeft"])
