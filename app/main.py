@@ -38,7 +38,7 @@ from app.page.layout import (
     PageState,
     present_css,
 )
-from app.page.titles import page_url
+from app.page.titles import PAGES, PageLink, page_url, read_link, resolve_view_id
 from app.public_url import public_base
 from app.report.session import provenance_of, report_data
 from app.runtime import background, closed_pages, libraries  # noqa: F401 (libraries: preloaded)
@@ -59,6 +59,7 @@ from app.views import (
     UploadView,
 )
 from app.views.analysis_base import analysis_card
+from app.views.bind import control
 from app.views.campaign import campaign_card
 from app.views.landmarks import landmarks_card
 from app.views.layout import (
@@ -140,15 +141,26 @@ def drop_unreadable_numbers(loc) -> list[str]:
     return bad
 
 
-def sync_url(state: DashboardState, location=None) -> None:
-    """Keep the state in the URL query (only when served, or with a given ``location``)."""
+def sync_url(state: DashboardState, location=None, page: PageState | None = None):
+    """Open the page on its link's settings, then keep the state (and the layout ``page``)
+    in the URL query (only when served, or with a given ``location``); returns the
+    :class:`~app.page.titles.PageLink` writing the URL (None: no location)."""
     loc = pn.state.location if location is None else location
     if loc is None:
-        return
+        return None
+    unknown = resolve_view_id(loc)
+    if unknown:
+        log.info("a link's view id %r is unknown to this server (made before a restart)", unknown)
     drop_unreadable_numbers(loc)
     for group, keys in URL_KEYS.items():
         obj = getattr(state, group)
-        loc.sync(obj, keys, on_error=functools.partial(apply_valid, obj))
+        read_link(loc, obj, keys, on_error=functools.partial(apply_valid, obj))
+    if page is not None:
+        read_link(loc, page, PAGE_URL_KEYS, on_error=functools.partial(apply_valid, page))
+    link = PageLink(loc, state, page)
+    link.watch()
+    link.write()
+    return link
 
 
 @dataclass
@@ -383,7 +395,8 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
         label="Help", button_type="light", css_classes=["help-button"], width=70
     )
     help_button.on_click(lambda _e: open_help())
-    view_switch = pn.widgets.RadioButtonGroup.from_param(
+    view_switch = control(
+        pn.widgets.RadioButtonGroup,
         page.param.view,
         name="Page",
         options={"Normal view": "normal", "Presentation": "present"},
@@ -393,7 +406,8 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
     # the page's type (page.py) and the sidebar at once
     view_switch.jscallback(value=VIEW_SWITCH_JS + VIEW_SIDEBAR_JS)
     reports = report_buttons(report)
-    n_axis = pn.widgets.RadioButtonGroup.from_param(
+    n_axis = control(
+        pn.widgets.RadioButtonGroup,
         page.param.n_axis,
         name="N axis",
         options={"N linear": "linear", "N log": "log"},
@@ -440,10 +454,10 @@ def create_app(
     results = results if results is not None else Results(state)
     step_aside()
     state = results.state
-    sync_url(state)
     page = PageState()
-    if pn.state.location is not None:  # the layout is kept in the link too
-        pn.state.location.sync(page, PAGE_URL_KEYS, on_error=functools.partial(apply_valid, page))
+    link = sync_url(state, page=page)  # the layout is kept in the link too
+    if served_document() is not None:
+        PAGES[served_document()] = page  # (title blocks' links name the page's N axis)
     # one frequency axis range for all spectra of the session: zoom and pan are linked;
     # one N range for the error map and the eigenfrequency plot
     parts = PageParts(results=results, page=page, freq=frequency_range(), modes=modes_range())
@@ -538,6 +552,10 @@ def create_app(
         # the first screen is sent and shown first (issue 33: a page of ~1,000 Bokeh models
         # took 2.5 s to its first plot); the rest follows once the browser shows it
         pn.state.onload(complete)
+        if link is not None:
+            # the browser reports its own URL when the page loads (a view id's, or one the
+            # page read differently): the page's URL is the state's from then on
+            pn.state.onload(link.write_again)
         pn.state.onload(results.request_band)
         # once per process, after the first page: the other harmonics' reference studies
         pn.state.onload(background.warm_reference_studies)

@@ -464,6 +464,15 @@ def _done_status(band: Band) -> BandStatus:
     return BandStatus(False, bands.done_text(band.result, band.seconds, band.settings.band_key()))
 
 
+def _same_value(a: Any, b: Any) -> bool:
+    a = tuple(a) if isinstance(a, list) else a
+    b = tuple(b) if isinstance(b, list) else b
+    try:
+        return bool(a == b)
+    except Exception:
+        return False
+
+
 #: Every :class:`Results` not yet freed (a page's store lives as long as its page).
 LIVE: weakref.WeakSet[Results] = weakref.WeakSet()
 
@@ -482,6 +491,11 @@ class Results(param.Parameterized):
         "Result; the report shows each as a section of its own.",
     )
     closed = param.Boolean(default=False, doc="The session has ended: nothing is drawn.")
+    published = param.Parameter(
+        default=None,
+        doc="The settings (a Snapshot without band and pins) of the last pass: the state "
+        "the page's results are of, whose link every title block carries.",
+    )
     background = param.Boolean(
         default=None,
         allow_None=True,
@@ -542,6 +556,21 @@ class Results(param.Parameterized):
                         s = s.replace(band=self.band)  # published meanwhile without a server
                     continue
                 s = self._publish(row, s)
+            now = self.snapshot().settings()
+            if now != self.published:
+                self.published = now
+
+    def link_snapshot(self, name: str, r: Result) -> Snapshot | None:
+        """The settings whose link the title block of result ``r`` (of row ``name``)
+        carries: the published state's when ``r`` is of its values (every field it depends
+        on), else ``r``'s own (a band still computing shows the one it was made of)."""
+        pub, own = self.published, r.snapshot
+        if own is None or pub is None or name not in ROWS:
+            return own
+        fields = depends(name)
+        if all(_same_value(getattr(own, f), getattr(pub, f)) for f in fields):
+            return pub
+        return own
 
     def _current(self, row: Row, s: Snapshot) -> bool:
         """False when a field of ``row`` changed again since ``s`` was read: the pass of

@@ -38,10 +38,12 @@ import panel as pn
 
 __all__ = [
     "DEBOUNCE_MS",
+    "browser_change_pending",
     "html_model",
     "html_text",
     "panel_writes_pending",
     "pool_processes",
+    "resend_value",
     "respond_at_once",
 ]
 
@@ -82,3 +84,24 @@ def pool_processes(pool) -> list:
     and reaped when the server stops, also one started after the server listed its children.
     """
     return list((getattr(pool, "_processes", None) or {}).values())
+
+
+def resend_value(widget: pn.widgets.Widget, doc) -> None:
+    """Send the browser of ``doc`` the properties of ``widget``'s models that show its
+    value (a slider's ``value``, a button group's ``active``...), even when the server's
+    copy already holds them: a message the server wrote earlier may have crossed the
+    browser's own change (:mod:`app.views.bind`). Runs where ``doc`` may change."""
+    props = widget._process_param_change({"value": widget.value})
+    for model, _ in list(widget._models.values()):
+        if model.document is not doc:
+            continue
+        for attr in props:
+            if attr in model.properties():
+                value = getattr(model, attr)
+                doc.callbacks.notify_change(model, attr, value, value)
+
+
+def browser_change_pending(widget: pn.widgets.Widget) -> bool:
+    """Whether Panel holds a change of ``widget`` from the browser that it has not yet
+    handed to the widget (waiting for its debounce or for a free worker thread)."""
+    return bool(widget._events)

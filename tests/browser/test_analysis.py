@@ -240,7 +240,7 @@ def test_compare_pin_change_and_difference(page, dashboard):
     fp_main = fingerprint(page, "mobility.truncated")
     from .conftest import set_model_value
 
-    set_model_value(page, "ctl-case-n_modes", 14, "Slider")  # N = 150
+    set_model_value(page, "ctl-case-n_modes", 150, "Slider")
     page.wait_for_function("() => window.location.search.includes('N=150')")
     wait_changed(page, "compare.diff1", fp)
     # the shown analysis view is drawn before the main views: wait for the main curve too
