@@ -77,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     study = fv.run_variants(
         design, settings, cache=cache, progress=progress, client=client, processes=a.processes
     )
-    where = f"Dask at {addr}" if client is not None else f"{a.processes} process(es)"
+    where = f"Dask at {addr}" if client is not None else f"up to {a.processes} process(es)"
     print(
         f"computed in {time.perf_counter() - t0:.1f} s on {where} "
         f"({len(set(study.tire_keys))} distinct tires)"
