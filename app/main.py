@@ -29,7 +29,14 @@ from typing import Any
 import panel as pn
 import param
 
-from app.page.chrome import data_key, help_page, link_notice, link_notice_html, report_buttons
+from app.page.chrome import (
+    busy_indicator,
+    data_key,
+    help_page,
+    link_notice,
+    link_notice_html,
+    report_buttons,
+)
 from app.page.layout import (
     CARD_CSS,
     PAGE_CSS,
@@ -207,7 +214,7 @@ EXTRA_CARDS.append(wheels_card)  # issue 31: per-wheel contributions (vehicle sc
 EXTRA_CARDS.append(  # issue 18: compare, phase and peaks, across speed, contributions
     lambda parts: analysis_card(parts.results, parts.freq, page=parts.page)
 )
-EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (when set)
+EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (unset: how to)
 EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to this tire's
 
 
@@ -392,7 +399,7 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
     )
     # the page's type (page.py) and the sidebar at once
     view_switch.jscallback(value=VIEW_SWITCH_JS + VIEW_SIDEBAR_JS)
-    reports = report_buttons(report)
+    reports = report_buttons(report, parts.results)
     n_axis = pn.widgets.RadioButtonGroup.from_param(
         page.param.n_axis,
         name="N axis",
@@ -417,6 +424,7 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
         help_button,
         view_switch,
         n_axis,
+        busy_indicator(parts.results),  # what long work runs (hidden otherwise)
         css_classes=["page-bar"],
         sizing_mode="stretch_width",
         margin=(2, 4),
