@@ -29,6 +29,7 @@ from typing import Any
 import panel as pn
 import param
 
+from app.page import scripts as page_scripts
 from app.page.chrome import (
     busy_indicator,
     data_key,
@@ -522,6 +523,7 @@ def create_app(
     template.results = results
     template.views = views
     doc = pn.state.curdoc
+    page_scripts.install(doc)  # checkbox labels toggle, tooltips stay inside the window
     if doc is not None:  # a served session, or a document built without one
         # bound now: Bokeh may clear the session's module namespace before its
         # session-destroyed callbacks run ("name 'close_page' is not defined", seen under load)
