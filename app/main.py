@@ -29,7 +29,15 @@ from typing import Any
 import panel as pn
 import param
 
-from app.page.chrome import data_key, help_page, link_notice, link_notice_html, report_buttons
+from app.page import scripts as page_scripts
+from app.page.chrome import (
+    busy_indicator,
+    data_key,
+    help_page,
+    link_notice,
+    link_notice_html,
+    report_buttons,
+)
 from app.page.layout import (
     CARD_CSS,
     PAGE_CSS,
@@ -219,7 +227,7 @@ EXTRA_CARDS.append(wheels_card)  # issue 31: per-wheel contributions (vehicle sc
 EXTRA_CARDS.append(  # issue 18: compare, phase and peaks, across speed, contributions
     lambda parts: analysis_card(parts.results, parts.freq, page=parts.page)
 )
-EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (when set)
+EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (unset: how to)
 EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to this tire's
 
 
@@ -405,7 +413,7 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
     )
     # the page's type (page.py) and the sidebar at once
     view_switch.jscallback(value=VIEW_SWITCH_JS + VIEW_SIDEBAR_JS)
-    reports = report_buttons(report)
+    reports = report_buttons(report, parts.results)
     n_axis = control(
         pn.widgets.RadioButtonGroup,
         page.param.n_axis,
@@ -431,6 +439,7 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
         help_button,
         view_switch,
         n_axis,
+        busy_indicator(parts.results),  # what long work runs (hidden otherwise)
         css_classes=["page-bar"],
         sizing_mode="stretch_width",
         margin=(2, 4),
@@ -532,6 +541,7 @@ def create_app(
     template.results = results
     template.views = views
     doc = pn.state.curdoc
+    page_scripts.install(doc)  # checkbox labels toggle, tooltips stay inside the window
     if doc is not None:  # a served session, or a document built without one
         # bound now: Bokeh may clear the session's module namespace before its
         # session-destroyed callbacks run ("name 'close_page' is not defined", seen under load)

@@ -4,8 +4,9 @@ snapshot.
 Which tire modes matter (:func:`participation_result`: the ranking of the tire's stored
 mode pairs for the harmonic, the bushing DOF and the band), what the chosen one looks like
 (:func:`mode_shape_result`: the deformed belt over one period), the Campbell diagram that
-follows the belt waves (:func:`waves_result`, solved on the background worker the first
-time), the modes a case needs chosen by importance beside table 5.1's lowest ``N``
+follows the belt waves (:func:`waves_result`, solved once per tire for every session on
+a thread of its own, each waiting session told how it moves: :func:`waves_wait`), the
+modes a case needs chosen by importance beside table 5.1's lowest ``N``
 (:func:`selected_modes_result`) and the truncation of the chassis side
 (:func:`chassis_truncation_result`). The numbers are the core's (:mod:`app.modes_compute`);
 docs/modes.md derives them.
@@ -13,6 +14,7 @@ docs/modes.md derives them.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 
 import numpy as np
@@ -38,7 +40,7 @@ __all__ = [
     "participation_result",
     "selected_modes_result",
     "waves_result",
-    "waves_work",
+    "waves_wait",
 ]
 
 #: What each ranking measure is (CSV header, axis label).
@@ -380,19 +382,31 @@ def _no_vibration(s: Snapshot, view: str, mode: int, t) -> Result:
 DIRECTION_COLORS = {"forward": "#e03131", "backward": "#1971c2", "standing": "#868e96"}
 
 
+#: What the waves' view says while the tire is solved.
+WAVES_WORK = "solving the tire's modes at its operating points"
+
+
 def waves_result(s: Snapshot) -> Result:
     view = "Campbell diagram of the belt waves (branches tracked by shape)"
-    if not mc.waves_known(s.models):
+    st = mc.waves_status(s.models)
+    if st is None or not st.finished:
         why = (
-            "solving the tire at its operating points (about 20 s the first time, then "
-            "shared by every session) ..."
+            f"{WAVES_WORK} (computed once for every session) ..."
+            if st is None
+            else st.describe(WAVES_WORK) + " ..."
         )
         r = _unavailable(s, view, "waves", why)
-        return Result(r.columns, r.meta, r.filename, why, {"ready": False, "message": why})
-    try:
-        cb = mc.waves(s.models)
-    except (FBSError, AttributeError, TypeError) as e:
-        return _unavailable(s, view, "waves", f"the tire's matrices are needed: {e}")
+        draw = {"ready": False, "pending": True, "message": why, "late": bool(st and st.late)}
+        return Result(r.columns, r.meta, r.filename, why, draw)
+    if st.state == "failed":
+        if st.message.startswith("the tire's matrices are needed"):
+            return _unavailable(s, view, "waves", st.message)
+        r = _unavailable(
+            s, view, "waves", st.describe(WAVES_WORK) + "; open the tab again to try again"
+        )
+        # pending: a later visit of the tab makes it again and asks again (a retry)
+        return dataclasses.replace(r, draw={**r.draw, "pending": True})
+    cb = st.value
     h = fbs_core.harmonic(s.harmonic)
     default = cb.selection(s.harmonic)
     shown = np.arange(cb.order.size) if s.waves_all else default
@@ -455,19 +469,17 @@ def waves_result(s: Snapshot) -> Result:
     )
 
 
-def waves_work(s: Snapshot) -> Callable[[], None] | None:
-    """The waves of the session's tire when not yet known (one call of about 20 s on an
-    idle core; a model without the tire's matrices fails at once and is remembered)."""
-    if mc.waves_known(s.models):
-        return None
-
-    def work() -> None:
+def waves_wait(s: Snapshot, listener_key=None, told=None) -> None:
+    """Ask for the waves of the session's tire, computed once for every session
+    (:data:`app.modes_compute.WAVES`); ``told(status)`` as it moves on. Without a page to
+    be told on (``told`` None: tests, exports) it is computed here."""
+    if told is None:
         try:
             mc.waves(s.models)
-        except (FBSError, AttributeError, TypeError):
-            pass  # remembered by mc.waves: the result says why
-
-    return work
+        except FBSError:
+            pass  # the result says why (mc.waves_status)
+        return
+    mc.request_waves(s.models, listener_key, told)
 
 
 def nearest_branch(draw: dict, speed: float, freq: float, tol: float = 0.05):

@@ -71,6 +71,21 @@ def _alert(body: str, kind: str, css: str, visible: bool = True) -> pn.pane.HTML
     )
 
 
+def _uploaded(widget: pn.widgets.FileInput, events) -> tuple[bytes, str] | None:
+    """The file a browser upload gave ``widget`` (its bytes and name), or None when the
+    events are not an upload (the input cleared). An empty file is ``b""``: Panel gives its
+    value as None. The input is then cleared here without telling the browser, so that the
+    same file uploaded again (an empty one too) is an upload again."""
+    value, name = widget.value, widget.filename
+    if value is None and not name:
+        return None
+    if isinstance(value, list) or isinstance(name, list):  # (single-file inputs only)
+        return None
+    with param.parameterized.discard_events(widget):
+        widget.param.update(value=None, filename=None)
+    return (b"" if value is None else bytes(value)), str(name or "upload")
+
+
 class UploadView(Viewer):
     """File inputs for a chassis FRF and a tire model, the import summary or the error."""
 
@@ -115,9 +130,11 @@ class UploadView(Viewer):
             width=160,
             css_classes=["upload-reset"],
         )
-        self.chassis_file.param.watch(self._on_chassis, "value")
-        self.tire_file.param.watch(self._on_tire, "value")
-        self.geometry_file.param.watch(self._on_geometry, "value")
+        # the file name too: Panel gives an empty file's value as None (no value event when
+        # the last one was None), and the upload was ignored with the earlier error on screen
+        self.chassis_file.param.watch(self._on_chassis, ["value", "filename"])
+        self.tire_file.param.watch(self._on_tire, ["value", "filename"])
+        self.geometry_file.param.watch(self._on_geometry, ["value", "filename"])
         self.reread.on_click(lambda _: self._run("chassis", ds.load_chassis))
         # a new node name or the interpolation choice re-reads the chassis file at once;
         # this also settles a click on "Read chassis again" that overtook the change
@@ -142,6 +159,7 @@ class UploadView(Viewer):
                 self._busy(False)
 
         self._busy(True)
+        self.data.error = ""  # the earlier file's error is stale: this one is being read
         if not served():  # a notebook or a test: no other sessions, read here
             job()
         elif UPLOADS.submit(self.data, slot, job, self._refused) is None:
@@ -158,18 +176,21 @@ class UploadView(Viewer):
         for w in (self.chassis_file, self.tire_file, self.geometry_file, self.reread, self.reset):
             w.disabled = on
 
-    # an empty file (b"") is read too: the page says it is empty instead of ignoring it
-    def _on_chassis(self, event):
-        if event.new is not None:
-            self._run("chassis", self.data.load_chassis, event.new, self.chassis_file.filename)
+    # an empty file is read too (as b""): the page says it is empty instead of ignoring it
+    def _on_chassis(self, *events):
+        got = _uploaded(self.chassis_file, events)
+        if got is not None:
+            self._run("chassis", self.data.load_chassis, *got)
 
-    def _on_geometry(self, event):
-        if event.new is not None:
-            self._run("chassis", self.data.load_geometry, event.new, self.geometry_file.filename)
+    def _on_geometry(self, *events):
+        got = _uploaded(self.geometry_file, events)
+        if got is not None:
+            self._run("chassis", self.data.load_geometry, *got)
 
-    def _on_tire(self, event):
-        if event.new is not None:
-            self._run("tire", self.data.load_tire, event.new, self.tire_file.filename)
+    def _on_tire(self, *events):
+        got = _uploaded(self.tire_file, events)
+        if got is not None:
+            self._run("tire", self.data.load_tire, *got)
 
     # -- display -----------------------------------------------------------------------
     @param.depends(
