@@ -162,3 +162,38 @@ def test_the_servers_isolated_private_uses_still_exist():
     assert "self.address = address" in src
     src = inspect.getsource(tornado.httpserver.HTTPServer.handle_stream)
     assert "HTTP1ServerConnection(stream, self.conn_params, context)" in src
+
+
+def test_the_app_script_lock_is_released_while_the_proof_steps_aside():
+    """Bokeh runs app scripts under one process-wide re-entrant lock; the proof, stepping
+    aside inside its script, releases it (``server_private.app_scripts_unlocked``) so a
+    user's script runs meanwhile, and holds it again as before afterwards."""
+    import sys
+    import threading
+
+    from bokeh.application.handlers import code_runner
+    from panel.io import handlers
+
+    sys.path.insert(0, str(ROOT / "docker"))
+    from server_private import app_scripts_unlocked
+
+    lock = code_runner._PROCESS_GLOBALS_LOCK
+    # Bokeh's and Panel's script runners both take it
+    assert "_hold_process_globals()" in inspect.getsource(code_runner.CodeRunner.run)
+    assert "_hold_process_globals()" in inspect.getsource(handlers)
+    ran = threading.Event()
+
+    def other_script() -> None:
+        with code_runner._hold_process_globals():
+            ran.set()
+
+    with code_runner._hold_process_globals(), code_runner._hold_process_globals():
+        with app_scripts_unlocked():
+            t = threading.Thread(target=other_script)
+            t.start()
+            assert ran.wait(60), "another thread's script could not run while this one waited"
+            t.join(60)
+        assert lock._is_owned()  # held again, twice: released twice below
+    assert not lock._is_owned()
+    with app_scripts_unlocked():  # a thread that does not hold it: nothing changes
+        assert not lock._is_owned()
