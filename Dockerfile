@@ -10,7 +10,7 @@
 # Only Dockerfile instructions of the classic builder are used, so it builds with BuildKit and
 # with DOCKER_BUILDKIT=0 alike.
 
-ARG PYTHON_IMAGE=python:3.11-slim-bookworm
+ARG PYTHON_IMAGE=python:3.12-slim-bookworm
 
 # ---- build stage: a virtual environment with the project and its dependencies ---------------
 FROM ${PYTHON_IMAGE} AS build

@@ -10,8 +10,12 @@ checks that each private name still exists and does what is relied on (and its s
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+
 __all__ = [
     "accept_connections",
+    "app_scripts_unlocked",
     "bound_bokeh_messages",
     "bound_page_builds",
     "cancel_queued_panel_work",
@@ -19,6 +23,35 @@ __all__ = [
     "peer_address",
     "report_refused_websocket_frames",
 ]
+
+
+@contextlib.contextmanager
+def app_scripts_unlocked() -> Iterator[None]:
+    """Let other threads run app scripts while this one waits inside its own.
+
+    Bokeh runs every app script under one process-wide re-entrant lock
+    (``code_runner._PROCESS_GLOBALS_LOCK``: a script patches the process's working
+    directory, ``sys.path``, ``sys.argv`` and the current document). The server's start-up
+    proof builds a page on a thread of its own and steps aside inside the app's script
+    while users' pages open; holding the lock there would hold every user's page build,
+    and the event loop that runs it, back until the proof goes on. The lock is released as
+    many times as this thread holds it and taken again as before (the ``Condition``
+    protocol of the re-entrant lock); a user's script restores what it patched before the
+    proof takes the lock back. A thread that does not hold it is left as it is.
+    """
+    try:
+        from bokeh.application.handlers.code_runner import _PROCESS_GLOBALS_LOCK as lock
+    except ImportError:  # a Bokeh without the lock: nothing to release
+        yield
+        return
+    if not lock._is_owned():
+        yield
+        return
+    saved = lock._release_save()
+    try:
+        yield
+    finally:
+        lock._acquire_restore(saved)
 
 
 def cleanup_document(doc) -> None:

@@ -7,7 +7,7 @@
 #
 # Environment: PORT (5006), ADDRESS (localhost; 0.0.0.0 to listen on all interfaces),
 # NUM_THREADS (4: one session's long computation does not block the others),
-# PYTHON (python3), SHOW=1 to open a browser (only where there is a display), WS_MAX_MB
+# PYTHON (an interpreter of Python 3.12+; found on PATH or among pyenv's versions), SHOW=1 to open a browser (only where there is a display), WS_MAX_MB
 # (200: largest websocket message, i.e. upload, in MB).
 # Serving to other machines: ADDRESS=0.0.0.0 and BOKEH_ALLOW_WS_ORIGIN=<host>:<port> (the
 # address the browsers use), or pass --allow-websocket-origin <host>:<port>.
@@ -15,7 +15,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PY=${PYTHON:-python3}
+. scripts/find_python.sh
 PORT=${PORT:-5006}
 ADDRESS=${ADDRESS:-localhost}
 NUM_THREADS=${NUM_THREADS:-4}

@@ -222,3 +222,38 @@ def test_the_process_pools_worker_list_is_still_there():
         assert pool.submit(abs, -1).result(timeout=120) == 1
         procs = pool_processes(pool)
         assert len(procs) == 1 and procs[0].is_alive()
+
+
+def test_the_app_script_lock_is_released_while_the_proof_steps_aside():
+    """Bokeh runs app scripts under one process-wide re-entrant lock; the proof, stepping
+    aside inside its script, releases it (``server_private.app_scripts_unlocked``) so a
+    user's script runs meanwhile, and holds it again as before afterwards."""
+    import sys
+    import threading
+
+    from bokeh.application.handlers import code_runner
+    from panel.io import handlers
+
+    sys.path.insert(0, str(ROOT / "docker"))
+    from server_private import app_scripts_unlocked
+
+    lock = code_runner._PROCESS_GLOBALS_LOCK
+    # Bokeh's and Panel's script runners both take it
+    assert "_hold_process_globals()" in inspect.getsource(code_runner.CodeRunner.run)
+    assert "_hold_process_globals()" in inspect.getsource(handlers)
+    ran = threading.Event()
+
+    def other_script() -> None:
+        with code_runner._hold_process_globals():
+            ran.set()
+
+    with code_runner._hold_process_globals(), code_runner._hold_process_globals():
+        with app_scripts_unlocked():
+            t = threading.Thread(target=other_script)
+            t.start()
+            assert ran.wait(60), "another thread's script could not run while this one waited"
+            t.join(60)
+        assert lock._is_owned()  # held again, twice: released twice below
+    assert not lock._is_owned()
+    with app_scripts_unlocked():  # a thread that does not hold it: nothing changes
+        assert not lock._is_owned()

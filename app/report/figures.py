@@ -15,7 +15,7 @@ from __future__ import annotations
 import io
 import threading
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any, TypeAlias
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import numpy as np
@@ -38,9 +38,9 @@ if TYPE_CHECKING:
     from .content import FigureBlock
 
 #: A plot's region of a figure: ``(left, bottom, width, height)`` in figure fraction.
-Rect: TypeAlias = tuple[float, float, float, float]
+type Rect = tuple[float, float, float, float]
 #: What every ``draw_*`` returns: ``draw(fig, rect)`` adds the plot's axes inside ``rect``.
-Draw: TypeAlias = Callable[[Figure, Rect], None]
+type Draw = Callable[[Figure, Rect], None]
 
 __all__ = [
     "COLORS",

@@ -19,15 +19,15 @@ out the whole page on every text change (~36 ms each in the page, against 0.2-0.
 Panel's HTML model). The text is sent escaped once, as the pane sends it (the page decodes
 it once); ``tests/test_app_views.py`` fails if the pane's convention changes.
 
-Panel writes some of a page's changes later than it serializes them: when a layout changes
+Panel writes some of a page's changes later than it schedules them: when a layout changes
 (e.g. a dynamic tab's views are rendered when the tab is clicked) while the page's socket is
-busy writing, Panel turns the changes into messages at once and writes them from a task that
-polls the socket's write lock every 10 ms (``panel.io.document.schedule_write_events``).
-A draw of the app's own (:class:`app.runtime.draw.DrawQueue`) queues on that lock and so
-overtook those messages: its patches reached the page before the models they change, which
-the page dropped, and the models then arrived as serialized before the draw (the phase
-view's plots stayed empty after a click on its tab). :func:`panel_writes_pending` tells the
-draw queue to wait for them.
+busy writing, Panel queues the change events and writes them from a task that polls the
+socket's write lock every 10 ms (``panel.io.document.schedule_write_events``; Panel records
+such a page in ``_WRITE_BLOCK`` and its queued batches in ``_WRITE_EVENTS``). A draw of the
+app's own (:class:`app.runtime.draw.DrawQueue`) queues on that lock and could overtake those
+changes: the page would see a draw's patches before the layout change that holds the models
+they change (the phase view's plots stayed empty after a click on its tab).
+:func:`panel_writes_pending` tells the draw queue to wait until Panel's queue is written.
 """
 
 from __future__ import annotations
@@ -71,11 +71,11 @@ def html_model(html_source: str = "", **props):
 
 
 def panel_writes_pending(doc) -> bool:
-    """Whether Panel holds messages for ``doc``'s page that it serialized but has not
-    written yet (see the module docstring)."""
+    """Whether Panel holds changes for ``doc``'s page that it queued but has not written
+    yet (see the module docstring)."""
     from panel.io import document as pdoc
 
-    return doc in pdoc._WRITE_BLOCK or bool(pdoc._WRITE_MSGS.get(doc))
+    return doc in pdoc._WRITE_BLOCK or bool(pdoc._WRITE_EVENTS.get(doc))
 
 
 def pool_processes(pool) -> list:

@@ -22,12 +22,10 @@ import weakref
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any, TypeVar
+from typing import Any
 
 from ..report import ReportData, build_html, build_pdf
 from .panel_private import pool_processes
-
-T = TypeVar("T")
 
 __all__ = [
     "REPORT_THREADS",
@@ -184,7 +182,7 @@ def _retrieved(f: asyncio.Future[Any]) -> None:
         log.debug("a report ended with %s: %s", type(exc).__name__, exc)
 
 
-def submit_for_session(doc: Any, fn: Callable[[], T]) -> asyncio.Future[T]:
+def submit_for_session[T](doc: Any, fn: Callable[[], T]) -> asyncio.Future[T]:
     """``fn()`` on the report thread for the session of Bokeh document ``doc``, as an
     asyncio future of the running loop.
 

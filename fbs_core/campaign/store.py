@@ -42,7 +42,7 @@ import time
 from collections.abc import Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeAlias
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -53,11 +53,11 @@ if TYPE_CHECKING:
     from .spec import Campaign
 
 #: An h5py File, Group or Dataset (h5py ships no type stubs).
-H5: TypeAlias = Any
+type H5 = Any
 
 #: A finished unit to write: ``(path, data, attrs, parents)``, see
 #: :meth:`CampaignStore.write_unit`.
-Unit: TypeAlias = tuple[str, dict[str, Any], dict[str, Any], dict[str, dict[str, Any]] | None]
+type Unit = tuple[str, dict[str, Any], dict[str, Any], dict[str, dict[str, Any]] | None]
 
 __all__ = ["CampaignStore", "FORMAT_VERSION"]
 

@@ -36,7 +36,7 @@ import os
 import warnings
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeAlias, overload
+from typing import TYPE_CHECKING, Any, overload
 
 from ..errors import DataFormatError
 from ..frf import FRF
@@ -60,9 +60,9 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
 #: A file path, or the content of an upload.
-SourceLike: TypeAlias = "str | os.PathLike[str] | bytes | bytearray | memoryview"
+type SourceLike = str | os.PathLike[str] | bytes | bytearray | memoryview
 #: Where to write; None returns the content as bytes.
-PathLike: TypeAlias = "str | os.PathLike[str]"
+type PathLike = str | os.PathLike[str]
 
 __all__ = [
     "DEFAULT_MAX_BYTES",
