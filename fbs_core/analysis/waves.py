@@ -392,10 +392,10 @@ def _track(
         if i:
             mac[i - 1] = m
     cf = np.full((n_v, n_c), np.nan)
-    for b in range(n_c):
-        if fam[b] == "ip" and order[b] >= 2:
-            fw = [ring_closed_form(order[b], float(v), params) for v in speeds]
-            cf[:, b] = [x[0] if direction[b] == "forward" else x[1] for x in fw]
+    for br in range(n_c):
+        if fam[br] == "ip" and order[br] >= 2:
+            fw = [ring_closed_form(order[br], float(v), params) for v in speeds]
+            cf[:, br] = [x[0] if direction[br] == "forward" else x[1] for x in fw]
     exists = np.isfinite(freq).any(axis=0)
     keep = np.flatnonzero(exists)
     return _subset(
