@@ -131,7 +131,10 @@ class CampbellView(AnalysisView):
             out_y.append(d["lines"][:, j])
         self._orders.data = {"xs": xs, "ys": ys, "harmonic": hs, "width": ws}
         set_data(self._order_out, {"xs": out_x, "ys": out_y})
-        self._fig.y_range.end = 460  # branches up to 450 Hz: the seven lines' band
+        # the axes span the speeds and the seven lines' band (branches up to 450 Hz), set
+        # here: the branches' gaps (NaN) are no data a range should be computed from
+        self._fig.x_range.start, self._fig.x_range.end = float(v.min()), float(v.max())
+        self._fig.y_range.start, self._fig.y_range.end = 0.0, 460.0
 
     def _draw_pick(self, pick):
         _show_pick(self._spans, pick)
