@@ -229,7 +229,9 @@ class UploadView(Viewer):
         label = pn.pane.Markdown
         return pn.Column(
             label(HELP, margin=(0, 10), styles={"color": "#495057", "font-size": "0.9em"}),
-            pn.Row(
+            # the inputs wrap onto a second line where the card is narrower than all of
+            # them (1280 px: the geometry input made the row overflow the page)
+            pn.FlexBox(
                 pn.Column(
                     label("**Chassis FRF**", margin=(0, 5)),
                     self.chassis_file,
@@ -244,6 +246,8 @@ class UploadView(Viewer):
                 ),
                 pn.Column(label("**Modal tire model**", margin=(0, 5)), self.tire_file),
                 pn.Column(label("&nbsp;", margin=(0, 5)), self.reset),
+                flex_wrap="wrap",
+                sizing_mode="stretch_width",
             ),
             self._error,
             self._summary,
