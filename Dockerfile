@@ -10,7 +10,7 @@
 # Only Dockerfile instructions of the classic builder are used, so it builds with BuildKit and
 # with DOCKER_BUILDKIT=0 alike.
 
-ARG PYTHON_IMAGE=python:3.11-slim-bookworm
+ARG PYTHON_IMAGE=python:3.12-slim-bookworm
 
 # ---- build stage: a virtual environment with the project and its dependencies ---------------
 FROM ${PYTHON_IMAGE} AS build
@@ -59,7 +59,8 @@ RUN useradd --system --create-home --home-dir /home/fbs --uid 10001 --user-group
 RUN mkdir -p /data && chown fbs:fbs /data
 COPY --from=build /opt/venv /opt/venv
 COPY docker/entrypoint.py docker/fbs_server.py docker/fbs_auth.py docker/page_gate.py \
-     docker/server_private.py docker/prepare.py /opt/fbs/
+     docker/conn_limits.py docker/page_limits.py docker/server_private.py docker/prepare.py \
+     /opt/fbs/
 ENV PATH=/opt/venv/bin:$PATH \
     PYTHONUNBUFFERED=1 \
     NUMBA_CACHE_DIR=/home/fbs/.cache/numba \

@@ -96,13 +96,46 @@ def clear_shared_caches() -> None:
         wrapper.cache_clear()
 
 
+#: Longest a thread waits for another thread's computation of the same entry (s); then it
+#: computes the entry itself (the owner may be stuck: a wait never lasts forever).
+SHARED_WAIT_S = 90.0
+
+#: How often a waiting thread looks whether the owner of the computation is still alive (s).
+_OWNER_POLL_S = 0.5
+
+
+class _Entry:
+    """A computation of one cache entry under way: who computes it, and how it ended."""
+
+    __slots__ = ("done", "background", "owner", "error")
+
+    def __init__(self, background: bool) -> None:
+        self.done = threading.Event()
+        self.background = background
+        self.owner = threading.current_thread()
+        self.error: BaseException | None = None
+
+    def wait(self, deadline_s: float) -> bool:
+        """Wait until the owner finished (True), or its thread ended without finishing or
+        ``deadline_s`` passed (False: the caller computes it itself)."""
+        t_end = time.monotonic() + deadline_s
+        while not self.done.wait(min(_OWNER_POLL_S, max(t_end - time.monotonic(), 0.0))):
+            if not self.owner.is_alive() or time.monotonic() >= t_end:
+                return self.done.is_set()
+        return True
+
+
 def shared_cache(maxsize: int):
     """``functools.lru_cache`` that computes a missing entry once for all threads.
 
     Sessions run their callbacks on a thread pool; when several of them ask for the same
     missing result at once (a review meeting opening the same link, many tabs loading the
     default view), the first computes it and the others wait for it instead of computing
-    it again beside it on the same cores.
+    it again beside it on the same cores. A wait has a deadline: the waiting thread
+    computes the entry itself when the owner's thread ended without finishing it or after
+    :data:`SHARED_WAIT_S` (a stuck or very slow owner never holds a session for ever).
+    When the owner's computation raises, every thread that waited for it gets the same
+    error (it is not computed again by each of them); the next call tries again.
     """
 
     def decorate(fn):
@@ -116,24 +149,36 @@ def shared_cache(maxsize: int):
             with guard:
                 found = running.get(args)
                 mine = found is None
-                entry = running[args] = (threading.Event(), me) if found is None else found
-            done, by_background = entry
+                entry = running[args] = _Entry(me) if found is None else found
             if not mine:
-                if by_background and not me:
+                if entry.background and not me:
                     # never wait for a low-priority thread (app/runtime/background.py): on a busy
                     # machine it runs at a fraction of a core; compute it here instead
                     return cached(*args)
-                done.wait()
-                return cached(*args)  # a hit (recomputed only if the first call failed)
+                if entry.wait(wrapper.wait_s):
+                    if entry.error is not None:
+                        raise entry.error  # the owner's failure, reported to every waiter
+                    return cached(*args)  # a hit
+                if not entry.owner.is_alive():  # lost: the next callers need not wait for it
+                    with guard:
+                        if running.get(args) is entry:
+                            del running[args]
+                return cached(*args)  # computed here (owner gone or too slow)
             try:
                 return cached(*args)
+            except BaseException as e:
+                entry.error = e
+                raise
             finally:
                 with guard:
-                    del running[args]
-                done.set()
+                    if running.get(args) is entry:
+                        del running[args]
+                entry.done.set()
 
         wrapper.cache_clear = cached.cache_clear
         wrapper.cache_info = cached.cache_info
+        wrapper.wait_s = SHARED_WAIT_S
+        wrapper.running = running  # the computations under way (tests)
         _SHARED_CACHES.append(wrapper)
         return wrapper
 

@@ -19,6 +19,10 @@ The checks are the core's (every view must run on the models):
   (:class:`fbs_core.FRFChassis`: linear in real and imaginary part, never extrapolated);
 - tire: :func:`fbs_core.io.checks.check_tire` (hub DOFs, at least 20 complex modes, the
   operating points of all seven harmonic cases and of the eigenfrequency view);
+- a measured chassis (sensors and impacts around the knuckle, with a geometry upload):
+  :func:`fbs_core.vpt.load_measured_chassis` (the channels' positions and directions, six
+  DOFs observable) turns it into the spindle chassis above, with its consistency
+  (docs/vpt.md);
 - the pair: :func:`fbs_core.io.checks.check_pair` (the interface matrix
   ``Y_jj^A + Y_jj^E``, eq. 2.44, well conditioned on every harmonic's grid).
 
@@ -41,6 +45,7 @@ from fbs_core.vocabulary import DIRECTIONS, EIGEN_SPEEDS, HARMONIC_CASES
 
 __all__ = [
     "CHASSIS_ACCEPT",
+    "GEOMETRY_ACCEPT",
     "EIGEN_SPEEDS",
     "HARMONICS",
     "TIRE_ACCEPT",
@@ -55,6 +60,7 @@ BUSHING = tuple(f"bushing:{d}" for d in DIRECTIONS)
 HARMONICS = HARMONIC_CASES
 #: File endings offered by the upload widgets.
 CHASSIS_ACCEPT = ".uff,.unv,.uf,.58,.mat,.csv,.txt,.h5,.hdf5,.hdf"
+GEOMETRY_ACCEPT = ".uff,.unv,.uf,.csv,.txt,.h5,.hdf5,.hdf"
 TIRE_ACCEPT = ".h5,.hdf5,.hdf,.mat"
 
 
@@ -187,6 +193,14 @@ class DataSource(param.Parameterized):
     )
     tire_summary = param.String(default="", doc="What was read from the tire upload.")
     chassis_summary = param.String(default="", doc="What was read from the chassis upload.")
+    geometry_summary = param.String(
+        default="", doc="What was read from the geometry upload (a measured chassis)."
+    )
+    vpt = param.Parameter(
+        default=None,
+        doc="The virtual point transformation of a measured chassis in use "
+        "(fbs_core.vpt.VirtualPoint), else None.",
+    )
     error = param.String(default="", doc="Why the last upload was refused ('' if it was not).")
     spindle = param.String(
         default="spindle", doc="Spindle node of the chassis file (name, or node number)."
@@ -210,6 +224,7 @@ class DataSource(param.Parameterized):
         super().__init__(**params)
         self._tire_key = self._chassis_key = ""
         self._last_chassis: tuple[bytes, str] | None = None
+        self._geometry: tuple[bytes, str] | None = None
         self._last_settings: tuple[str, str, bool, str] | None = None
         # uploads of one session are read one at a time (a click and a settings change
         # arrive on different worker threads: the last read must see the last settings)
@@ -241,6 +256,36 @@ class DataSource(param.Parameterized):
                 return None
             return self._load_chassis(None, None, None, None, None)
 
+    def load_geometry(self, data: bytes, filename: str | None = None) -> bool:
+        """Read a geometry upload (positions and directions of a measured set's channels).
+
+        From then on a chassis upload is a measured set around the knuckle, transformed to
+        the spindle (the virtual point, named by the spindle field); the last chassis
+        upload is read again that way. A refused geometry changes nothing.
+        """
+        from fbs_core.io import load_geometry
+
+        with self._lock:
+            name = filename or "upload"
+            try:
+                geo = load_geometry(bytes(data), filename=name)
+            except FBSError as e:
+                self.error = f"{name}: {e}"
+                return False
+            old = self._geometry
+            self._geometry = (bytes(data), name)
+            if self._last_chassis is not None and not self._load_chassis(
+                None, None, None, None, None
+            ):
+                self._geometry = old  # the chassis as it was: nothing changed
+                return False
+            self.param.update(
+                error="",
+                geometry_summary=f"geometry {name!r}: {len(geo.channels)} channels, "
+                f"{len(geo.points)} points ({', '.join(sorted(geo.points)[:6])})",
+            )
+            return True
+
     def _settings(self) -> tuple[str, str, bool, str]:
         return (self.spindle, self.bushing, bool(self.interpolate), self.quantity)
 
@@ -258,7 +303,13 @@ class DataSource(param.Parameterized):
         self._last_settings = (sp, bu, interp, self.quantity)
         q = None if self.quantity == FROM_FILE else self.quantity
         try:
-            chassis, summary, key = self._read_chassis(bytes(data), name, sp, bu, interp, q)
+            if self._geometry is None:
+                chassis, summary, key = self._read_chassis(bytes(data), name, sp, bu, interp, q)
+                vpt = None
+            else:
+                chassis, summary, key, vpt = self._read_measured(
+                    bytes(data), name, sp, bu, interp, q
+                )
             check_pair(self.models.tire, chassis)
         except FBSError as e:
             self.error = quantity_hint(f"{name}: {e}")
@@ -267,7 +318,12 @@ class DataSource(param.Parameterized):
         m = self.models
         with param.parameterized.batch_call_watchers(self):
             self.param.update(
-                spindle=sp, bushing=bu, interpolate=interp, error="", chassis_summary=summary
+                spindle=sp,
+                bushing=bu,
+                interpolate=interp,
+                error="",
+                chassis_summary=summary,
+                vpt=vpt,
             )
             self.models = _models(m.tire, self._tire_key, m.tire_name, chassis, key, name)
         return True
@@ -313,6 +369,47 @@ class DataSource(param.Parameterized):
         key = _digest(data, spindle=spindle, bushing=bushing, interpolate=interpolate, **chosen)
         return chassis, summary, key
 
+    def _read_measured(self, data, name, spindle, bushing, interpolate, quantity=None):
+        """A measured set and the geometry upload -> the spindle chassis (docs/vpt.md)."""
+        from fbs_core.vpt import load_measured_chassis
+
+        assert self._geometry is not None
+        geo, geo_name = self._geometry
+        sp_name, _ = parse_node(spindle, "spindle (the virtual point of the geometry)")
+        bu_name, bu_num = parse_node(bushing, "bushing")
+        nodes = {bu_num: "bushing"} if bu_num is not None else None
+        mc = load_measured_chassis(
+            data,
+            geo,
+            frf_filename=name,
+            geometry_filename=geo_name,
+            nodes=nodes,
+            origin=sp_name,
+            bushing="bushing" if bu_num is not None else bu_name,
+            quantity=quantity,
+            interpolate=interpolate,
+        )
+        chassis = mc.chassis
+        used = []
+        for k in HARMONICS:
+            f = harmonic(k).frequencies()
+            chassis.on_grid(f)  # FrequencyGridError unless present / interpolated
+            used.append(chassis.needs_interpolation(f))
+        summary = mc.summary
+        if any(used):
+            summary += "\nchassis: interpolated onto the analysis grids of harmonics " + ", ".join(
+                str(k) for k, u in zip(HARMONICS, used, strict=True) if u
+            )
+        chosen = {"quantity": quantity} if quantity else {}
+        key = _digest(
+            data + b"\0geometry\0" + geo,
+            spindle=spindle,
+            bushing=bushing,
+            interpolate=interpolate,
+            **chosen,
+        )
+        return chassis, summary, key, mc.vpt
+
     def load_tire(self, data: bytes, filename: str | None = None) -> bool:
         """Read a modal tire model upload (project HDF5 format or MATLAB).
 
@@ -348,9 +445,12 @@ class DataSource(param.Parameterized):
         """Back to the shipped reference tire and chassis."""
         with self._lock:
             self._last_chassis = self._last_settings = None
+            self._geometry = None
             self._tire_key = self._chassis_key = ""
             with param.parameterized.batch_call_watchers(self):
-                self.param.update(error="", tire_summary="", chassis_summary="")
+                self.param.update(
+                    error="", tire_summary="", chassis_summary="", geometry_summary="", vpt=None
+                )
                 self.models = REFERENCE
 
     def describe(self) -> str:

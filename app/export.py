@@ -168,9 +168,10 @@ def _case(s: Any) -> dict[str, object]:
 def to_uff(result: Any, meta: Mapping[str, object] | None = None) -> bytes:
     """A view's data over frequency as UFF dataset-58 records.
 
-    The FRFs the result holds (``result.core``) are FRF records (function type 4; a
-    second FRF of the same output/input pair, e.g. the all-modes reference beside the
-    N-mode response, a general function record named in ID line 1); without FRFs, the
+    The FRFs the result holds (``result.core``) are FRF records (function type 4, their
+    nodes, directions and units; several FRFs, e.g. the N-mode response and the
+    all-modes reference beside it, are function ids 1 and 2 of record 6, named in ID
+    line 1; a reader takes function id 1); without FRFs, the
     view's complex columns over ``freq_Hz`` (or, for levels only such as the scatter
     band's, its real ones) as general function records. ID lines 3-4 hold the case
     of the snapshot the result was made of (harmonic, N, residual compensation, coupling,
@@ -195,19 +196,12 @@ def to_uff(result: Any, meta: Mapping[str, object] | None = None) -> bytes:
         )
     frfs: dict[str, Any] = {}
     arrays: dict[str, Any] = {}
-    pairs = set()
-    # the N-mode response is the view's FRF record, the all-modes reference beside it
+    # the N-mode response first (function id 1: what a reader takes), the all-modes
+    # reference beside it (function id 2), each a whole FRF record
     for name in sorted(result.core, key=lambda k: k != "truncated"):
         v = result.core[name]
         if isinstance(v, FRF):
-            pair = (tuple(v.outputs), tuple(v.inputs))
-            if pair in pairs:
-                for o, out in enumerate(v.outputs):
-                    for i, inp in enumerate(v.inputs):
-                        arrays[f"{name} {out} / {inp}"] = (("freq",), v.data[:, o, i])
-            else:
-                pairs.add(pair)
-                frfs[name] = v
+            frfs[name] = v
     if not frfs:  # the complex curves, or (a band: levels only) the real ones
         curves = {
             k: np.asarray(v)

@@ -29,7 +29,15 @@ from typing import Any
 import panel as pn
 import param
 
-from app.page.chrome import data_key, help_page, link_notice, link_notice_html, report_buttons
+from app.page import scripts as page_scripts
+from app.page.chrome import (
+    busy_indicator,
+    data_key,
+    help_page,
+    link_notice,
+    link_notice_html,
+    report_buttons,
+)
 from app.page.layout import (
     CARD_CSS,
     PAGE_CSS,
@@ -38,7 +46,7 @@ from app.page.layout import (
     PageState,
     present_css,
 )
-from app.page.titles import page_url
+from app.page.titles import PAGES, PageLink, page_url, read_link, resolve_view_id
 from app.public_url import public_base
 from app.report.session import provenance_of, report_data
 from app.runtime import background, closed_pages, libraries  # noqa: F401 (libraries: preloaded)
@@ -59,6 +67,7 @@ from app.views import (
     UploadView,
 )
 from app.views.analysis_base import analysis_card
+from app.views.bind import control
 from app.views.campaign import campaign_card
 from app.views.landmarks import landmarks_card
 from app.views.layout import (
@@ -140,15 +149,26 @@ def drop_unreadable_numbers(loc) -> list[str]:
     return bad
 
 
-def sync_url(state: DashboardState, location=None) -> None:
-    """Keep the state in the URL query (only when served, or with a given ``location``)."""
+def sync_url(state: DashboardState, location=None, page: PageState | None = None):
+    """Open the page on its link's settings, then keep the state (and the layout ``page``)
+    in the URL query (only when served, or with a given ``location``); returns the
+    :class:`~app.page.titles.PageLink` writing the URL (None: no location)."""
     loc = pn.state.location if location is None else location
     if loc is None:
-        return
+        return None
+    unknown = resolve_view_id(loc)
+    if unknown:
+        log.info("a link's view id %r is unknown to this server (made before a restart)", unknown)
     drop_unreadable_numbers(loc)
     for group, keys in URL_KEYS.items():
         obj = getattr(state, group)
-        loc.sync(obj, keys, on_error=functools.partial(apply_valid, obj))
+        read_link(loc, obj, keys, on_error=functools.partial(apply_valid, obj))
+    if page is not None:
+        read_link(loc, page, PAGE_URL_KEYS, on_error=functools.partial(apply_valid, page))
+    link = PageLink(loc, state, page)
+    link.watch()
+    link.write()
+    return link
 
 
 @dataclass
@@ -207,7 +227,7 @@ EXTRA_CARDS.append(wheels_card)  # issue 31: per-wheel contributions (vehicle sc
 EXTRA_CARDS.append(  # issue 18: compare, phase and peaks, across speed, contributions
     lambda parts: analysis_card(parts.results, parts.freq, page=parts.page)
 )
-EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (when set)
+EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (unset: how to)
 EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to this tire's
 
 
@@ -383,7 +403,8 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
         label="Help", button_type="light", css_classes=["help-button"], width=70
     )
     help_button.on_click(lambda _e: open_help())
-    view_switch = pn.widgets.RadioButtonGroup.from_param(
+    view_switch = control(
+        pn.widgets.RadioButtonGroup,
         page.param.view,
         name="Page",
         options={"Normal view": "normal", "Presentation": "present"},
@@ -392,8 +413,9 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
     )
     # the page's type (page.py) and the sidebar at once
     view_switch.jscallback(value=VIEW_SWITCH_JS + VIEW_SIDEBAR_JS)
-    reports = report_buttons(report)
-    n_axis = pn.widgets.RadioButtonGroup.from_param(
+    reports = report_buttons(report, parts.results)
+    n_axis = control(
+        pn.widgets.RadioButtonGroup,
         page.param.n_axis,
         name="N axis",
         options={"N linear": "linear", "N log": "log"},
@@ -417,6 +439,7 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
         help_button,
         view_switch,
         n_axis,
+        busy_indicator(parts.results),  # what long work runs (hidden otherwise)
         css_classes=["page-bar"],
         sizing_mode="stretch_width",
         margin=(2, 4),
@@ -440,10 +463,10 @@ def create_app(
     results = results if results is not None else Results(state)
     step_aside()
     state = results.state
-    sync_url(state)
     page = PageState()
-    if pn.state.location is not None:  # the layout is kept in the link too
-        pn.state.location.sync(page, PAGE_URL_KEYS, on_error=functools.partial(apply_valid, page))
+    link = sync_url(state, page=page)  # the layout is kept in the link too
+    if served_document() is not None:
+        PAGES[served_document()] = page  # (title blocks' links name the page's N axis)
     # one frequency axis range for all spectra of the session: zoom and pan are linked;
     # one N range for the error map and the eigenfrequency plot
     parts = PageParts(results=results, page=page, freq=frequency_range(), modes=modes_range())
@@ -451,7 +474,11 @@ def create_app(
     step_aside()
 
     def report():  # the page's published results, as they are when the button is clicked
-        return report_data(results, url=page_url(), n_axis=page.n_axis)
+        from .views.vpt_consistency import report_notes
+
+        return report_data(
+            results, url=page_url(), n_axis=page.n_axis, notes=report_notes(state.data)
+        )
 
     # the modal's own close control (Panel's public close_modal); a button in the page is
     # reachable by keyboard and by tests, unlike the template's icon or the Escape key
@@ -514,6 +541,7 @@ def create_app(
     template.results = results
     template.views = views
     doc = pn.state.curdoc
+    page_scripts.install(doc)  # checkbox labels toggle, tooltips stay inside the window
     if doc is not None:  # a served session, or a document built without one
         # bound now: Bokeh may clear the session's module namespace before its
         # session-destroyed callbacks run ("name 'close_page' is not defined", seen under load)
@@ -534,6 +562,10 @@ def create_app(
         # the first screen is sent and shown first (issue 33: a page of ~1,000 Bokeh models
         # took 2.5 s to its first plot); the rest follows once the browser shows it
         pn.state.onload(complete)
+        if link is not None:
+            # the browser reports its own URL when the page loads (a view id's, or one the
+            # page read differently): the page's URL is the state's from then on
+            pn.state.onload(link.write_again)
         pn.state.onload(results.request_band)
         # once per process, after the first page: the other harmonics' reference studies
         pn.state.onload(background.warm_reference_studies)
@@ -571,11 +603,38 @@ def close_page(page: pn.template.BootstrapTemplate, log: logging.Logger = log) -
                 obj.param.watchers = {}
 
 
+def unreadable_link() -> pn.viewable.Viewable | None:
+    """The page of a served link whose query cannot be read (:mod:`app.page.query`), or
+    None for a link the dashboard can open.
+
+    Checked on the request's raw query before anything asks for the page's location: Panel
+    reads every value when it makes the location, and a value it cannot read would stop the
+    page build with a traceback and leave the page blank.
+    """
+    from app.page.query import kept_query, shown_key, unreadable_keys, unreadable_link_page
+
+    args = pn.state.session_args
+    bad = unreadable_keys(args)
+    if not bad:
+        return None
+    request = pn.state.curdoc.session_context.request
+    path = str(getattr(request, "path", "") or "")
+    log.info(
+        "a link with unreadable query values opened a message page: %s",
+        "; ".join(f"{shown_key(k)} {why}" for k, why in bad.items()),
+    )
+    return unreadable_link_page(bad, kept_query(args, list(bad)), path)
+
+
 if pn.state.served:
-    # One recomputation of the document's model graph instead of one per added root
-    # (Bokeh recomputes it on every change of the graph): about a fifth of the server's
-    # CPU time for a new session (bench/load_test.py)
-    with pn.state.curdoc.models.freeze():
-        _page = create_app()
-        step_aside()
-        _page.servable(title="tire-fbs dashboard")
+    _message = unreadable_link()
+    if _message is not None:  # no location: Panel would read the unreadable values
+        _message.servable(title="tire-fbs dashboard", location=False)
+    else:
+        # One recomputation of the document's model graph instead of one per added root
+        # (Bokeh recomputes it on every change of the graph): about a fifth of the server's
+        # CPU time for a new session (bench/load_test.py)
+        with pn.state.curdoc.models.freeze():
+            _page = create_app()
+            step_aside()
+            _page.servable(title="tire-fbs dashboard")

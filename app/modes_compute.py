@@ -4,22 +4,23 @@ Like :mod:`app.compute` (whose caches and model tokens it shares): process-wide 
 keyed by the session's ``Models`` token, so reference results are shared by all sessions
 and uploads never mix. Every function is asked for only while its tab is shown
 (:mod:`app.store`); the Campbell diagram of the waves (one dense complex-mode solve per
-operating point, about 20 s the first time) is computed on the background worker and
-looked up here without solving (:func:`waves_known`). No numerics here beyond choosing
+operating point; the reference tire's is stored) is computed once per tire for every
+session on a thread of its own (:data:`WAVES`), asked for with :func:`request_waves` and
+looked up without solving with :func:`waves_status`. No numerics here beyond choosing
 the band: everything comes from :mod:`fbs_core`.
 """
 
 from __future__ import annotations
 
-import threading
-
 import numpy as np
 
 import fbs_core
 from fbs_core.analysis import mode_participation, select_modes, tire_mode_shape, wave_campbell
+from fbs_core.errors import FBSError
 from fbs_core.studies import chassis_truncation_map
 
 from .compute import _key, _models_kw, _tire, shared_cache
+from .runtime.shared_jobs import JobStatus, SharedJobs
 
 __all__ = [
     "chassis_map",
@@ -27,8 +28,9 @@ __all__ = [
     "participation_band",
     "selection",
     "shape",
+    "request_waves",
     "waves",
-    "waves_known",
+    "waves_status",
 ]
 
 #: Fewest lines a participation band holds (the core needs 3).
@@ -71,38 +73,69 @@ def _shape(mode, speed, models):
     return tire_mode_shape(mode, speed, None if models is None else models.tire)
 
 
-_WAVES_DONE: set = set()  # models whose waves are computed, or failed at once
-_WAVES_LOCK = threading.Lock()
+#: How long the waves' diagram of a tire may take before its waiters are told why (s): the
+#: reference tire's is stored (well under a second); an uploaded tire's takes about 12 s of
+#: dense solves on an idle core, minutes on a busy one.
+WAVES_DEADLINE_S = 45.0
+
+#: The waves' diagrams of the sessions' tires: one computation per tire for every session,
+#: on a thread of its own at the server's priority, each waiter told how it moves.
+WAVES = SharedJobs("fbs-waves", threads=1, deadline_s=WAVES_DEADLINE_S)
 
 
-def waves(models=None):
+def _waves_job(models):
+    tire = None if models is None else models.tire
+
+    def work(progress):
+        return wave_campbell(tire, progress=progress)
+
+    return work
+
+
+def _no_matrices(models) -> JobStatus | None:
+    """A failed status at once for a tire without its matrices (an uploaded modal model),
+    else None."""
+    tire = _tire(models)
+    if getattr(tire, "params", None) is not None:
+        return None
+    try:
+        wave_campbell(tire)  # raises at once, before any solve
+    except (FBSError, AttributeError, TypeError) as e:
+        return JobStatus("failed", message=f"the tire's matrices are needed: {e}")
+    return None  # (not reached: a tire without parameters has no matrices)
+
+
+def waves_status(models=None) -> JobStatus | None:
+    """Where the waves' diagram of the session's tire stands (a look-up: nothing is
+    computed): None when nobody asked for it yet, else a :class:`JobStatus` (its ``value``
+    the :class:`~fbs_core.analysis.WaveCampbell` once done)."""
+    return _no_matrices(models) or WAVES.status(("waves", _key(models)))
+
+
+def request_waves(models=None, listener_key=None, listener=None) -> JobStatus:
+    """Ask for the waves' diagram of the session's tire (see :data:`WAVES`); ``listener``
+    is told of its progress, its end or its failure."""
+    return _no_matrices(models) or WAVES.request(
+        ("waves", _key(models)), _waves_job(_key(models)), listener_key, listener
+    )
+
+
+def waves(models=None, timeout: float = 600.0):
     """:func:`fbs_core.analysis.wave_campbell` of the session's tire (its operating
-    points, hub free), cached; the first call solves the tire at every operating point.
+    points, hub free), computed here or waited for (no page to be told on: tests, exports).
 
     Raises
     ------
     FBSError
-        For a tire without its matrices (an uploaded modal model); remembered, so that
-        :func:`waves_known` says it is known (it fails at once again).
+        For a tire without its matrices (an uploaded modal model), or when the computation
+        failed or did not end within ``timeout`` seconds (the message says which).
     """
-    key = _key(models)
-    try:
-        return _waves(key)
-    finally:
-        with _WAVES_LOCK:
-            _WAVES_DONE.add(key)
-
-
-def waves_known(models=None) -> bool:
-    """True when :func:`waves` has been called for these models (a look-up: computed,
-    or failed at once for a tire without matrices)."""
-    with _WAVES_LOCK:
-        return _key(models) in _WAVES_DONE
-
-
-@shared_cache(maxsize=4)
-def _waves(models):
-    return wave_campbell(None if models is None else models.tire)
+    st = _no_matrices(models) or WAVES.run_here(
+        ("waves", _key(models)), _waves_job(_key(models)), timeout
+    )
+    if st.state == "done":
+        return st.value
+    raise FBSError(st.describe("solving the tire's modes at its operating points"))
 
 
 #: The orderings of the selected-modes table: by the leave-one-out error as the criterion

@@ -266,12 +266,12 @@ class DashboardState(param.Parameterized):
     noise = param.ClassSelector(class_=NoiseState, instantiate=False)
     truncation = param.ClassSelector(class_=TruncationState, instantiate=False)
     analysis = param.ClassSelector(
-        class_=AnalysisState, instantiate=False, doc="The Analysis card (issue 18)."
+        class_=AnalysisState, instantiate=False, doc="The Analysis card."
     )
     plot = param.ClassSelector(
         class_=ResponsePlotState,
         instantiate=False,
-        doc="The coupled-response plot's overlays, level axis and cursors (issue 29).",
+        doc="The coupled-response plot's overlays, level axis and cursors.",
     )
     data = param.ClassSelector(
         class_=DataSource,

@@ -55,6 +55,7 @@ from fbs_core.analysis import add_pin, pin_state, remove_pin
 from fbs_core.errors import FBSError
 
 from . import compute
+from . import modes_compute as mc
 from .analysis_state import check_pin_name, encode_pins
 from .results import (
     FIELDS,
@@ -70,7 +71,8 @@ from .results import (
     vehicle,
 )
 from .results.base import VEHICLE_FIELDS, progress_status
-from .runtime import background, bands
+from .runtime import background, bands, uploads
+from .runtime.activity import ACTIVITIES
 from .runtime.draw import served
 from .state import MODE_COUNTS, DashboardState
 
@@ -120,6 +122,13 @@ class Row:
     ahead : callable, optional
         ``ahead(previous, snapshot) -> work | None``: computed ahead of the next change
         (``previous``: the snapshot of the value published before, None the first time).
+    wait : callable, optional
+        ``wait(snapshot, listener_key, told)``: asks for work shared by the sessions that
+        the value waits for (:mod:`app.runtime.shared_jobs`); ``told(status)`` is called as
+        it moves on, and the row is published again each time (its progress, its end or
+        its failure). ``told`` None: computed in place (no server). While the published
+        value is pending (``draw["pending"]``) every pass that looks at the row makes it
+        again and asks again (a lost job is started again: a tab switch is a retry).
     kind : type
         The published value's type (:class:`~app.results.Result`, a tuple of them, ...).
     problem : bool
@@ -138,6 +147,7 @@ class Row:
     problem: bool = False
     doc: str = ""
     vehicle_only: tuple[str, ...] = ()
+    wait: Callable[..., None] | None = None
 
     @property
     def tab(self) -> str | None:
@@ -380,8 +390,8 @@ TABLE: tuple[Row, ...] = (
         ("harmonic", "models", "waves_all"),
         modes.waves_result,
         when=while_tab("modes"),
-        slow=modes.waves_work,
-        doc="Campbell diagram of the belt waves (solved in the background the first time).",
+        wait=modes.waves_wait,
+        doc="Campbell diagram of the belt waves (solved once per tire for every session).",
     ),
     Row(
         "selected_modes",
@@ -464,6 +474,15 @@ def _done_status(band: Band) -> BandStatus:
     return BandStatus(False, bands.done_text(band.result, band.seconds, band.settings.band_key()))
 
 
+def _same_value(a: Any, b: Any) -> bool:
+    a = tuple(a) if isinstance(a, list) else a
+    b = tuple(b) if isinstance(b, list) else b
+    try:
+        return bool(a == b)
+    except Exception:
+        return False
+
+
 #: Every :class:`Results` not yet freed (a page's store lives as long as its page).
 LIVE: weakref.WeakSet[Results] = weakref.WeakSet()
 
@@ -482,6 +501,16 @@ class Results(param.Parameterized):
         "Result; the report shows each as a section of its own.",
     )
     closed = param.Boolean(default=False, doc="The session has ended: nothing is drawn.")
+    published = param.Parameter(
+        default=None,
+        doc="The settings (a Snapshot without band and pins) of the last pass: the state "
+        "the page's results are of, whose link every title block carries.",
+    )
+    working = param.String(
+        default="",
+        doc="What the session computes now when it takes long, and for how long ('' when "
+        "nothing long runs): the page's busy indicator (app.runtime.activity).",
+    )
     background = param.Boolean(
         default=None,
         allow_None=True,
@@ -527,7 +556,20 @@ class Results(param.Parameterized):
 
     # -- publishing ------------------------------------------------------------------------
     def _changed(self, fields: set[str]) -> None:
-        self._update(_affected(fields))
+        names = _affected(fields)
+        if uploads.on_upload_thread():  # an upload's reading thread only reads
+            doc = pn.state.curdoc
+
+            def run() -> None:
+                pn.state.curdoc = doc  # drawn by the session's loop, as from the upload
+                try:
+                    self._update(names)
+                finally:
+                    pn.state.curdoc = None
+
+            threading.Thread(target=run, name="fbs-upload-pass", daemon=True).start()
+            return
+        self._update(names)
 
     def _update(self, names: frozenset[str]) -> None:
         """One pass: the rows ``names`` from one snapshot, under the session's lock."""
@@ -535,13 +577,33 @@ class Results(param.Parameterized):
             if self.closed:
                 return
             s = self.snapshot()
-            for row in _order(names, s):
-                if row.when == OWN_THREAD:
-                    if self._current(row, s):
-                        self._start_band(s)
-                        s = s.replace(band=self.band)  # published meanwhile without a server
-                    continue
-                s = self._publish(row, s)
+            token = ACTIVITIES.begin(self, "Updating the views")
+            try:
+                for row in _order(names, s):
+                    if row.when == OWN_THREAD:
+                        if self._current(row, s):
+                            self._start_band(s)
+                            s = s.replace(band=self.band)  # published meanwhile without a server
+                        continue
+                    ACTIVITIES.update(token, _working_text(row, s))
+                    s = self._publish(row, s)
+            finally:
+                ACTIVITIES.end(token)
+            now = self.snapshot().settings()
+            if now != self.published:
+                self.published = now
+
+    def link_snapshot(self, name: str, r: Result) -> Snapshot | None:
+        """The settings whose link the title block of result ``r`` (of row ``name``)
+        carries: the published state's when ``r`` is of its values (every field it depends
+        on), else ``r``'s own (a band still computing shows the one it was made of)."""
+        pub, own = self.published, r.snapshot
+        if own is None or pub is None or name not in ROWS:
+            return own
+        fields = depends(name)
+        if all(_same_value(getattr(own, f), getattr(pub, f)) for f in fields):
+            return pub
+        return own
 
     def _current(self, row: Row, s: Snapshot) -> bool:
         """False when a field of ``row`` changed again since ``s`` was read: the pass of
@@ -556,15 +618,25 @@ class Results(param.Parameterized):
                 return False
         return True
 
-    def _publish(self, row: Row, s: Snapshot, force: bool = False) -> Snapshot:
+    def _publish(self, row: Row, s: Snapshot, force: bool = False, told: bool = False) -> Snapshot:
         """Publish ``row`` made of ``s`` (when shown, current and not published for the same
         key already); the snapshot with the new value when it is an input of other rows."""
         if not row.shown(s) or not self._current(row, s):
             return s
         key = row.key(s)
-        if not force and self._keys.get(row.name, None) == key and row.name in self._made:
+        if (
+            not force
+            and self._keys.get(row.name, None) == key
+            and row.name in self._made
+            and not self._pending(row)
+        ):
             return s
         assert row.make is not None
+        if row.wait is not None and not told:
+            if self.threaded:
+                row.wait(s, (self, row.name), lambda _st, row=row, key=key: self._told(row, key))
+            else:
+                row.wait(s)  # no server: computed here
         work = row.slow(s) if row.slow is not None else None
         if work is not None and not self.threaded:  # no server: all of it now
             _drain(work())
@@ -591,6 +663,33 @@ class Results(param.Parameterized):
             if ahead is not None:
                 self._ahead(row, key, ahead)
         return s.replace(**{row.name: value}) if row.name in ("pins", "band") else s
+
+    def _pending(self, row: Row) -> bool:
+        """Whether ``row`` waits for shared work and its published value is pending."""
+        if row.wait is None:
+            return False
+        value = getattr(self, row.name)
+        return isinstance(value, Result) and bool(value.draw.get("pending"))
+
+    #: Longest a note of shared work waits for the session's lock before it is tried again
+    #: later (s): the notifier's threads serve every session.
+    TOLD_LOCK_S = 2.0
+
+    def _told(self, row: Row, key: tuple) -> None:
+        """Shared work ``row`` waits for moved on (progress, end, failure): publish the row
+        again (on the notifier's thread; a busy lock is tried again a moment later)."""
+        if self._stale(row, key):
+            return
+        if not self._lock.acquire(timeout=self.TOLD_LOCK_S):
+            t = threading.Timer(self.TOLD_LOCK_S, self._told, (row, key))
+            t.daemon = True
+            t.start()
+            return
+        try:
+            if not self._stale(row, key):
+                self._publish(row, self.snapshot(), force=True, told=True)
+        finally:
+            self._lock.release()
 
     def _stale(self, row: Row, key: tuple) -> bool:
         return self.closed or self._keys.get(row.name) != key
@@ -822,10 +921,47 @@ class Results(param.Parameterized):
                 self._band_job = None
         background.BACKGROUND.cancel(self)
         background.AHEAD.cancel(self)
+        mc.WAVES.cancel_listeners(self)
 
 
 for _row in TABLE:  # one parameter per row of the table
     Results.param.add_parameter(_row.name, _row.parameter())
+
+
+#: What the busy indicator says while a row is made (its name when missing here).
+WORKING_WORDS = {
+    "pins": "reading the pins",
+    "response": "computing the coupled response",
+    "response_plot": "drawing the response plot",
+    "error_map": "computing the truncation error map",
+    "suggested": "computing the suggested modes",
+    "eigen": "computing the eigenfrequencies",
+    "tire_quality": "checking the tire model",
+    "uncoupled": "computing the uncoupled tire and chassis",
+    "band_curves": "reading the scatter band",
+    "wheel_contributions": "computing each wheel's contribution",
+    "first_order": "computing the first-order band",
+    "pinned": "comparing the pins",
+    "pick": "reading the picked point",
+    "contributions": "computing the contributions",
+    "phase": "computing the phase view",
+    "peak_modes": "finding the peaks' modes",
+    "speed_map": "computing the speed map",
+    "campbell": "computing the Campbell diagram",
+    "compare": "comparing with the pins",
+    "participation": "ranking the tire modes",
+    "mode_shape": "computing the mode shape",
+    "waves": "looking up the belt waves",
+    "selected_modes": "selecting the modes",
+    "chassis_truncation": "computing the chassis truncation",
+}
+
+
+def _working_text(row: Row, s: Snapshot) -> str:
+    """What the busy indicator says while ``row`` is made."""
+    what = WORKING_WORDS.get(row.name, f"computing {row.name}")
+    where = " of the whole car" if s.vehicle and "scope" in row.triggers else ""
+    return what[:1].upper() + what[1:] + where
 
 
 def _drain(steps: Any) -> None:

@@ -19,7 +19,11 @@ websocket protocol (``bench/load_clients.py``'s protocol client: no browser need
    time to its first plot update and to its settled plots, side by side with the same
    changes without the flood;
 7. a login flood: 200 wrong logins at once from one client;
-8. SIGTERM after all this: how long the server takes to end (only with ``--serve``).
+8. SIGTERM after all this: how long the server takes to end (only with ``--serve``);
+9. connections that never finish their headers (slowloris, 3,500 from 50 loopback
+   addresses), 2 and 4 loops of page requests that never open their websocket, each while
+   another session's changes are timed (alone vs under attack, side by side), and one
+   websocket frame declaring 147 MB (the server's memory, and a session after it).
 
 Every line is ``[ok]``, ``[FINDING]`` (a property the deployment promises does not hold) or
 ``[info]``; the exit status is 1 if there was a finding.
@@ -80,6 +84,9 @@ SECTIONS = (
     "reports",
     "bodies",
     "logins",
+    "slowloris",
+    "reloads",
+    "giant",
     "sigterm",
 )
 
@@ -251,15 +258,33 @@ def fetch(url: str, *, data=None, headers=None, timeout=60):
         return None, {}, str(e).encode(), time.perf_counter() - t0
 
 
+def login_form(base: str, user: str, password: str, headers=None) -> tuple[bytes, dict]:
+    """``(body, headers)`` of a login POST as a browser sends it: the login form fetched
+    first for its CSRF token (hidden field ``_csrf`` and cookie ``fbs_csrf``)."""
+    import re
+
+    status, h, body, _ = fetch(base + "/login", headers=headers)
+    m = re.search(rb'name="_csrf" value="([^"]+)"', body or b"")
+    token = m.group(1).decode() if m else ""
+    cookie = "; ".join(
+        v.split(";", 1)[0] for v in (h.get_all("Set-Cookie") or []) if v.startswith("fbs_csrf=")
+    ) if status else ""  # fmt: skip
+    form = {"username": user, "password": password, "_csrf": token}
+    return urllib.parse.urlencode(form).encode(), {**(headers or {}), "Cookie": cookie}
+
+
 def login(base: str, user: str, password: str) -> str | None:
     """The login cookie header value, or None."""
     jar = urllib.request.HTTPCookieProcessor()
-    opener = urllib.request.build_opener(jar)
-    data = urllib.parse.urlencode({"username": user, "password": password}).encode()
+    # the answer's redirect is not followed: it would build a page never opened
+    opener = urllib.request.build_opener(jar, _NoRedirect)
+    data, headers = login_form(base, user, password)
     try:
-        opener.open(base + "/login", data=data, timeout=60).read()
-    except urllib.error.HTTPError:
-        return None
+        req = urllib.request.Request(base + "/login", data=data, headers=headers)
+        opener.open(req, timeout=60).read()
+    except urllib.error.HTTPError as e:
+        if e.code not in (301, 302, 303):
+            return None
     cookies = {c.name: c.value for c in jar.cookiejar}
     if "user" not in cookies:
         return None
@@ -461,9 +486,15 @@ def _doc_text(sess: BokehSession) -> str:
 async def _open(base: str, path: str, cookie: str | None, timeout_s: float = 120):
     """A session as a browser opens it: the page (with its URL query), then its websocket."""
     headers = {"Cookie": cookie} if cookie else {}
-    status, _, body, _ = await asyncio.to_thread(
-        fetch, base + path, headers=headers, timeout=timeout_s
-    )
+    t0 = time.monotonic()
+    while True:
+        status, answer, body, _ = await asyncio.to_thread(
+            fetch, base + path, headers=headers, timeout=timeout_s
+        )
+        if status not in (429, 503) or time.monotonic() - t0 > timeout_s:
+            break
+        # the page-build budget is spent: wait as the page that reloads itself does
+        await asyncio.sleep(float(answer.get("Retry-After", 1)))
     match = re.search(rb'"token":\s*"([^"]+)"', body)
     if status != 200 or match is None:
         raise RuntimeError(f"the page answered HTTP {status} without a session token")
@@ -733,6 +764,14 @@ def _model(sess: BokehSession, title: str):
     raise LookupError(f"no control titled {title!r} in the page")
 
 
+def _has(sess: BokehSession, title: str) -> bool:
+    try:
+        _model(sess, title)
+    except LookupError:
+        return False
+    return True
+
+
 def _n_slider(sess: BokehSession):
     """The "Retained tire modes N" slider (a discrete slider: its value is the index)."""
     for m in sess.doc.models:
@@ -813,7 +852,10 @@ async def _timed_changes(sess: BokehSession, n: int, timeout_s: float, seed0: in
             f, s = await _timed_change(sess, {}, timeout_s, raw=raw)
         elif kind == "harmonic":
             current = current % 7 + 1
-            f, s = await _timed_change(sess, {"Seed": seed0 + k, "Harmonic": current}, timeout_s)
+            changes = {"Harmonic": current}
+            if _has(sess, "Seed"):  # (a typed field the page may build later)
+                changes["Seed"] = seed0 + k
+            f, s = await _timed_change(sess, changes, timeout_s)
         else:  # z -> x -> y -> z
             idx = {2: 0, 0: 1}.get(int(dof.active), 2)
             f, s = await _timed_change(sess, {}, timeout_s, raw=[(dof, "active", idx)])
@@ -1191,8 +1233,196 @@ def attack_bodies(rep: Report, base: str, app: str, cookie: str, args, server=No
     )
 
 
+# ---- 9. connections held open, page builds without a websocket, giant messages ---------------
+
+#: The start of a request whose headers never end (slowloris).
+PARTIAL_HEAD = b"GET /liveness HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: "
+
+
+async def _slowloris_attack(base, app, cookie, args, stop) -> str:
+    """Up to ``--slow-connections`` connections (from 50 loopback addresses) that never
+    finish their headers, topped up as the server closes them, until ``stop``."""
+    import resource
+    import select
+
+    port = int(urllib.parse.urlparse(base).port or 80)
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    try:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (hard, hard))
+    except (ValueError, OSError):
+        hard = soft
+    n = max(1, min(args.slow_connections, hard - 200))
+    flag = threading.Event()
+    held: dict[int, socket.socket] = {}
+    counts = Counter()
+    most = 0
+
+    def run() -> None:
+        nonlocal most
+        poll = select.poll()
+        k = 0
+        t0 = time.monotonic()
+        while not flag.is_set() and time.monotonic() - t0 < args.slow_seconds:
+            while len(held) < n and not flag.is_set():
+                s = socket.socket()
+                try:
+                    s.bind((f"127.0.0.{2 + k % 50}", 0))
+                    k += 1
+                    s.settimeout(5)
+                    s.connect(("127.0.0.1", port))
+                    s.sendall(PARTIAL_HEAD)
+                except OSError:
+                    s.close()
+                    counts["connect failed"] += 1
+                    break
+                held[s.fileno()] = s
+                poll.register(s, select.POLLIN | select.POLLHUP)
+            most = max(most, len(held))
+            for fd, _ in poll.poll(200):
+                s = held.pop(fd)
+                poll.unregister(fd)
+                try:
+                    data = s.recv(64)
+                except OSError:
+                    data = b""
+                counts["refused 503" if data.startswith(b"HTTP/1.1 503") else "closed"] += 1
+                s.close()
+            flag.wait(0.5)  # a slowloris, not a connection flood: top up twice a second
+        for s in held.values():
+            s.close()
+
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+    while thread.is_alive() and not stop.is_set():
+        await asyncio.sleep(0.2)
+    flag.set()
+    await asyncio.to_thread(thread.join, 30)
+    return f"{n} connections that never finish their headers: at most {most} held; {dict(counts)}"
+
+
+def attack_slowloris(rep: Report, base: str, app: str, cookie: str, args, server=None) -> None:
+    fds = ""
+    if server is not None:
+        fds = f" (server file descriptors before: {len(os.listdir(f'/proc/{server.proc.pid}/fd'))})"
+    side_by_side(
+        rep,
+        base,
+        app,
+        cookie,
+        args,
+        f"9a. slowloris: {args.slow_connections} connections that never finish their headers "
+        f"while a logged-in session changes N, harmonic, DOF{fds}",
+        "slowloris",
+        server,
+    )
+    if server is not None:
+        t0 = time.perf_counter()
+        status = fetch(base + "/liveness", timeout=30)[0]
+        rep.line(
+            "after the attack: server file descriptors; /liveness",
+            f"{len(os.listdir(f'/proc/{server.proc.pid}/fd'))}; HTTP {status} in "
+            f"{(time.perf_counter() - t0) * 1000:.0f} ms",
+            status == 200,
+        )
+
+
+async def _reloads_attack(base, app, cookie, args, stop) -> str:
+    """``--reload-loops`` loops of ``GET app`` with the login, never opening the websocket."""
+    counts = Counter()
+
+    async def loop() -> None:
+        while not stop.is_set():
+            status = (
+                await asyncio.to_thread(fetch, base + app, headers={"Cookie": cookie}, timeout=60)
+            )[0]
+            counts[status] += 1
+            if status != 200:  # refused: what a browser's reload would do after Retry-After
+                await asyncio.sleep(0.2)
+
+    await asyncio.gather(*(loop() for _ in range(args.reload_loops)))
+    return f"{args.reload_loops} loops of GET {app} without a websocket: answers {dict(counts)}"
+
+
+def attack_reloads(rep: Report, base: str, app: str, cookie: str, args, server=None) -> None:
+    import copy
+
+    for loops in (2, 4):
+        a = copy.copy(args)
+        a.reload_loops = loops
+        side_by_side(
+            rep,
+            base,
+            app,
+            cookie,
+            a,
+            f"9b. {loops} loops of GET {app} by a logged-in user (pages built, never opened) "
+            "while another session changes N, harmonic, DOF",
+            "reloads",
+            server,
+        )
+
+
+def attack_giant(rep: Report, base: str, app: str, cookie: str, server=None, mb: int = 147):
+    """One websocket frame declaring ``mb`` MB (a fake upload), sent until the server closes
+    the connection: bytes it took, its memory, and whether a session opens after."""
+    import struct
+
+    rep.section(f"9c. one websocket message declaring {mb} MB (a fake upload)")
+    from bokeh.util.token import generate_jwt_token, generate_session_id
+
+    port = int(urllib.parse.urlparse(base).port or 80)
+    token = generate_jwt_token(generate_session_id(), signed=False)
+    key = base64.b64encode(os.urandom(16)).decode()
+    size, chunk = mb * 1_000_000, 1 << 20
+    mask = os.urandom(4)
+    block = np.frombuffer(b"a" * chunk, np.uint8) ^ np.frombuffer(mask * (chunk // 4), np.uint8)
+    block = block.tobytes()
+    sent = 0
+    with MemoryPeak(server) as mem:
+        t0 = time.perf_counter()
+        with socket.create_connection(("127.0.0.1", port), timeout=30) as s:
+            s.sendall(
+                (
+                    f"GET {app}/ws HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
+                    "Upgrade: websocket\r\nConnection: Upgrade\r\n"
+                    f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n"
+                    f"Sec-WebSocket-Protocol: bokeh, {token}\r\nOrigin: {base}\r\n"
+                    f"Cookie: {cookie}\r\n\r\n"
+                ).encode()
+            )
+            head = s.recv(4096)
+            if not head.startswith(b"HTTP/1.1 101"):
+                rep.line("websocket handshake", head[:80].decode("latin-1"), False)
+                return
+            try:
+                s.sendall(struct.pack("!BBQ", 0x81, 0x80 | 127, size) + mask)
+                while sent < size:
+                    s.sendall(block[: min(chunk, size - sent)])
+                    sent += min(chunk, size - sent)
+            except OSError:
+                pass
+        secs = time.perf_counter() - t0
+        time.sleep(1.0)  # what the server does with what it read
+    closed = sent < size
+    grew = None if server is None else mem.peak - mem.start
+    rep.line(
+        f"a frame declaring {mb} MB, sent until the server closes the connection",
+        f"{sent / 1e6:.1f} MB sent in {secs:.1f} s "
+        f"({'closed by the server' if closed else 'ALL READ'}); {mem.text()}",
+        closed and (grew is None or grew < 100),
+    )
+    ws = run(ws_status(base, app, cookie))
+    rep.line("then another session of the same user", ws, ws.startswith("ACK"))
+
+
 #: The starvation attacks, each run in a process of its own by :func:`side_by_side`.
-ATTACKS = {"uploads": _uploads_attack, "reports": _reports_attack, "bodies": _bodies_attack}
+ATTACKS = {
+    "uploads": _uploads_attack,
+    "reports": _reports_attack,
+    "bodies": _bodies_attack,
+    "slowloris": _slowloris_attack,
+    "reloads": _reloads_attack,
+}
 
 
 # ---- 7. login flood ----------------------------------------------------------------------------
@@ -1204,8 +1434,8 @@ def attack_logins(rep: Report, base: str, user: str, password: str | None, serve
     log0 = len(server.log()) if server else 0
 
     def attempt(k):
-        data = urllib.parse.urlencode({"username": user, "password": f"wrong-{k}"}).encode()
-        return fetch(base + "/login", data=data, headers={"X-Real-IP": client}, timeout=120)
+        data, headers = login_form(base, user, f"wrong-{k}", {"X-Real-IP": client})
+        return fetch(base + "/login", data=data, headers=headers, timeout=120)
 
     t0 = time.perf_counter()
     with concurrent.futures.ThreadPoolExecutor(20) as pool:
@@ -1220,8 +1450,8 @@ def attack_logins(rep: Report, base: str, user: str, password: str | None, serve
         statuses.get(429, 0) > 0,
     )
     if password:
-        data = urllib.parse.urlencode({"username": user, "password": password}).encode()
-        status = fetch(base + "/login", data=data, headers={"X-Real-IP": client})[0]
+        data, headers = login_form(base, user, password, {"X-Real-IP": client})
+        status = fetch(base + "/login", data=data, headers=headers)[0]
         rep.line(
             "then the right password from the same client",
             f"HTTP {status} ({'refused while locked' if status == 429 else 'let in'})",
@@ -1293,6 +1523,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--upload-every", type=float, default=2.0, help="s between a tab's uploads")
     ap.add_argument("--body-mb", type=int, default=90)
     ap.add_argument("--body-connections", type=int, default=2)
+    ap.add_argument("--slow-connections", type=int, default=3500, help="slowloris sockets")
+    ap.add_argument("--slow-seconds", type=float, default=300, help="slowloris at most (s)")
+    ap.add_argument("--giant-mb", type=int, default=147, help="declared websocket message")
     args = ap.parse_args(argv)
     sections = set(args.only or SECTIONS)
     rep = Report()
@@ -1327,6 +1560,12 @@ def main(argv: list[str] | None = None) -> int:
             attack_reports(rep, base, app, cookie, args, server)
         if "bodies" in sections:
             attack_bodies(rep, base, app, cookie, args, server)
+        if cookie and "slowloris" in sections:
+            attack_slowloris(rep, base, app, cookie, args, server)
+        if cookie and "reloads" in sections:
+            attack_reloads(rep, base, app, cookie, args, server)
+        if cookie and "giant" in sections:
+            attack_giant(rep, base, app, cookie, server, args.giant_mb)
         if "logins" in sections:
             attack_logins(rep, base, user or "admin", password, server)
         if server is not None and "sigterm" in sections:

@@ -302,7 +302,7 @@ def vehicle_bench(servers, measure, n, rounds):
         "vehicle: modes N (mobility.truncated)": lambda: measure(
             "value",
             "ctl-case-n_modes",
-            [int(i) for i in np.resize(np.arange(1, 20), n)],
+            [10 * int(i) for i in np.resize(np.arange(2, 21), n)],
             "mobility.truncated",
         ),
         "vehicle: harmonic (mobility.truncated)": lambda: measure(
@@ -397,7 +397,7 @@ def main():
                 return out
 
             n = args.samples
-            modes = [int(i) for i in np.resize(np.arange(1, 20), n)]  # index: N = 20 ... 200
+            modes = [10 * int(i) for i in np.resize(np.arange(2, 21), n)]  # N = 20 ... 200
             if args.analysis or args.only_analysis:
                 only = {t.strip() for t in args.tabs.split(",") if t.strip()}
                 analysis_bench(servers, measure, modes, n, args.rounds, only)

@@ -185,11 +185,13 @@ def websocket_url(url: str, headers: dict | None = None) -> str:
     ``/main``) is followed first, as a browser would (sending ``headers``, e.g. a login
     cookie).
     """
-    if url not in _APP_URLS:
+    if url not in _APP_URLS and not urllib.parse.urlsplit(url).path.strip("/"):
+        # only a server root is followed: a request of an app's page builds a page that
+        # this client would never open (and spends the user's page-build budget)
         req = urllib.request.Request(url, headers=headers or {})
         with urllib.request.urlopen(req, timeout=60) as r:
             _APP_URLS[url] = r.geturl()
-    parts = urllib.parse.urlsplit(_APP_URLS[url])
+    parts = urllib.parse.urlsplit(_APP_URLS.get(url, url))
     scheme = {"http": "ws", "https": "wss"}.get(parts.scheme, parts.scheme)
     path = parts.path.rstrip("/") + "/ws"
     return urllib.parse.urlunsplit((scheme, parts.netloc, path, "", ""))

@@ -52,7 +52,22 @@ Variables (all optional; the table with examples is in docs/deployment.md):
     / ``X-Real-IP`` headers name the client (login throttling, logs); from anyone else
     these headers are ignored.
 ``FBS_WEBSOCKET_MAX_MESSAGE_MB``
-    Largest websocket message (file uploads travel in one, base64-encoded), default 200.
+    Largest websocket message in MiB (file uploads travel in one, base64-encoded), default
+    135: a file up to fbs_core's limit of 100 MiB. A larger message is refused by the size
+    its frame declares, before it is read, and its websocket closed (logged).
+``FBS_MAX_CONNECTIONS``, ``FBS_MAX_CONNECTIONS_PER_CLIENT``
+    Open connections the server keeps, in all (default 1000, and never more than the
+    open-file limit minus 256) and per client address (default 64; a trusted reverse
+    proxy counts in the total only); beyond, a connection gets a 503 and is closed.
+``FBS_HEADER_TIMEOUT_S``, ``FBS_BODY_TIMEOUT_S``
+    Seconds a request's headers (from the connection's start, or the previous request on
+    it) and its body may take, default 10 and 30; then the connection is closed.
+``FBS_PAGE_BUILD_SHARE``, ``FBS_PAGE_BUILD_SHARE_PER_USER``
+    Share of the server's event loop that page builds may take, of all users (default
+    0.5) and of one user (a login, or a client address without login; default 0.2);
+    beyond, a page request gets 503 or 429 with ``Retry-After`` and a page that reloads
+    itself. ``FBS_PAGE_BUILD_BURST_S`` and ``FBS_PAGE_BUILD_BURST_S_PER_USER``: seconds
+    of page builds at once (default 8 and 4: several tabs opened together).
 ``FBS_LOG_LEVEL``
     ``debug``, ``info`` (default), ``warning``, ``error`` or ``critical``.
 ``FBS_APP``
@@ -120,8 +135,9 @@ def _flag(env: dict[str, str], name: str) -> bool:
     raise SettingError(f"{name}={env[name]!r}: allowed values are {', '.join(TRUE + FALSE[1:])}")
 
 
-#: Default largest websocket message in MB (see build_launch).
-WEBSOCKET_MAX_MESSAGE_MB = 200
+#: Default largest websocket message in MiB: an upload of fbs_core's largest file (100 MiB)
+#: base64-encoded (133.4 MiB) in a Bokeh message (see build_launch).
+WEBSOCKET_MAX_MESSAGE_MB = 135
 
 
 def _positive_int(env: dict[str, str], name: str, default: int | None) -> int | None:
@@ -134,6 +150,20 @@ def _positive_int(env: dict[str, str], name: str, default: int | None) -> int | 
         value = 0
     if value < 1:
         raise SettingError(f"{name}={raw!r}: must be an integer >= 1")
+    return value
+
+
+def _share(env: dict[str, str], name: str, default: float) -> float:
+    """A fraction in (0, 1] from ``env[name]``; ``default`` when unset."""
+    raw = env.get(name, "").strip()
+    if not raw:
+        return default
+    try:
+        value = float(raw)
+    except ValueError:
+        value = -1.0
+    if not 0 < value <= 1:
+        raise SettingError(f"{name}={raw!r}: must be a number in (0, 1], e.g. 0.5")
     return value
 
 
@@ -281,6 +311,14 @@ def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
     options = {
         "login_max_failures": _positive_int(env, "FBS_LOGIN_MAX_FAILURES", 10),
         "trusted_proxies": _networks(env, "FBS_TRUSTED_PROXIES"),
+        "max_connections": _positive_int(env, "FBS_MAX_CONNECTIONS", 1000),
+        "max_connections_per_client": _positive_int(env, "FBS_MAX_CONNECTIONS_PER_CLIENT", 64),
+        "header_timeout_s": _positive_int(env, "FBS_HEADER_TIMEOUT_S", 10),
+        "body_timeout_s": _positive_int(env, "FBS_BODY_TIMEOUT_S", 30),
+        "page_build_share": _share(env, "FBS_PAGE_BUILD_SHARE", 0.5),
+        "page_build_share_per_user": _share(env, "FBS_PAGE_BUILD_SHARE_PER_USER", 0.2),
+        "page_build_burst_s": _positive_int(env, "FBS_PAGE_BUILD_BURST_S", 8),
+        "page_build_burst_s_per_user": _positive_int(env, "FBS_PAGE_BUILD_BURST_S_PER_USER", 4),
     }
 
     secret = _cookie_secret(env)
@@ -308,9 +346,10 @@ def build_launch(env: dict[str, str], extra: list[str]) -> Launch:
                 "headers from anyone else must not name the client)"
             )
         args += ["--use-xheaders"]
-    # an uploaded file travels base64-encoded in one message: 200 MB carries files up to
-    # 150 MB, so a file above fbs_core's 100 MiB limit gets its clear refusal instead of a
-    # closed websocket (Bokeh's default of 20 MB would cut files above 15 MB)
+    # an uploaded file travels base64-encoded in one message: 135 MiB carries fbs_core's
+    # largest file (100 MiB), which gets the app's clear answer; a larger message is refused
+    # by the size its frame declares before any of it is read (read and decoded, a 147 MB
+    # message takes the server from 0.98 to 2.2 GB), and its websocket is closed
     size = _positive_int(env, "FBS_WEBSOCKET_MAX_MESSAGE_MB", WEBSOCKET_MAX_MESSAGE_MB)
     args += ["--websocket-max-message-size", str(size * 1024 * 1024)]
     level = env.get("FBS_LOG_LEVEL", "info").strip().lower()

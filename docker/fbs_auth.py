@@ -28,6 +28,18 @@ Revocable login cookies
     cookie stops working on logout, when its user is removed from the users file, or when
     the password is changed (across restarts and processes, since the digest is derived
     from the password and the secret), and after ``PANEL_OAUTH_EXPIRY`` days (1).
+Cookie attributes
+    Every cookie set here is ``HttpOnly``; the login cookies are ``SameSite=Lax`` (a link
+    from elsewhere opens the dashboard logged in, a cross-site form or script request
+    carries no login), the form token's cookie ``SameSite=Strict``. ``Secure`` when the
+    request came over HTTPS: a TLS connection, or ``X-Forwarded-Proto: https`` from a
+    trusted proxy (``FBS_TRUSTED_PROXIES``; from anyone else the header is ignored).
+Forms with a CSRF token
+    The login form and the logout confirmation carry a random token in a hidden field and
+    in the ``fbs_csrf`` cookie (double submit); a POST whose field does not match its cookie
+    is refused (HTTP 403) before the password is looked at. ``GET /logout`` changes nothing
+    (a cross-site link cannot log a user out): it shows a confirmation form whose POST
+    logs out.
 """
 
 from __future__ import annotations
@@ -64,6 +76,11 @@ LOGIN_MAX_CLIENTS = 10_000
 MAX_REVOKED = 100_000
 #: Name of the revocable login cookie.
 LOGIN_COOKIE = "fbs_login"
+#: Name of the cookie holding the forms' CSRF token (double submit with the field ``_csrf``).
+CSRF_COOKIE = "fbs_csrf"
+#: SameSite of the login cookies and of the CSRF cookie.
+LOGIN_SAMESITE = "Lax"
+CSRF_SAMESITE = "Strict"
 
 
 # ---- client address ------------------------------------------------------------------------
@@ -355,20 +372,37 @@ def _login_handlers(auth: GuardedBasicAuth):
             return state.base_url or "/"
         return url
 
+    def refuse_form(handler: RequestHandler, form: str) -> bool:
+        """Answer 403 and return True when the POST's CSRF field does not match its cookie."""
+        if auth.csrf_ok(handler):
+            return False
+        log.warning("%s refused: no valid form token, from %s", form, auth.client(handler.request))
+        handler.set_status(403)
+        handler.finish(
+            f"<!DOCTYPE html><title>Form expired</title><p>The {form} form expired or was "
+            f'sent from another site. <a href=".{tornado.escape.xhtml_escape(auth.login_url)}">'
+            "Reload the login page</a> and try again.</p>"
+        )
+        return True
+
     class LoginHandler(RequestHandler):
-        """Panel's login form with throttling, logging of failures and revocable cookies."""
+        """Panel's login form with throttling, logging of failures, revocable cookies and
+        a CSRF token."""
 
         def get(self):
-            self.set_cookie("next_url", safe_next(self.get_argument("next", "")))
-            self.write(
-                BASIC_LOGIN_TEMPLATE.render(
-                    login_endpoint=auth.login_url,
-                    errormessage=self.get_argument("error", ""),
-                    PANEL_CDN=CDN_DIST,
-                )
+            self.set_cookie(
+                "next_url", safe_next(self.get_argument("next", "")), **auth.cookie_attrs(self)
             )
+            page = BASIC_LOGIN_TEMPLATE.render(
+                login_endpoint=auth.login_url,
+                errormessage=self.get_argument("error", ""),
+                PANEL_CDN=CDN_DIST,
+            )
+            self.write(with_token(page, auth.csrf_token(self)))
 
         async def post(self):
+            if refuse_form(self, "login"):
+                return
             client = auth.client(self.request)
             username = self.get_argument("username", "")
             wait = auth.throttle.retry_after(client, username)
@@ -408,18 +442,49 @@ def _login_handlers(auth: GuardedBasicAuth):
             self.redirect(self.request.path + error)
 
     class LogoutHandler(RequestHandler):
-        """Ends the login: the cookie's id is revoked, the cookies are cleared."""
+        """``GET``: a confirmation form (nothing changes); ``POST`` with the form's token: the
+        login ends, the cookie's id is revoked, the cookies are cleared."""
 
         def get(self):
+            self.write(
+                LOGOUT_CONFIRM.format(
+                    action=tornado.escape.xhtml_escape("." + auth.logout_url),
+                    token=tornado.escape.xhtml_escape(auth.csrf_token(self)),
+                )
+            )
+
+        def post(self):
+            if refuse_form(self, "logout"):
+                return
             token = auth.token(self)
             if token is not None:
                 auth.revoked.add(token["n"], token["t"] + auth.max_age_s)
                 log.info("logout: user %s", printable(token["u"]))
-            for name in ("user", "id_token", LOGIN_COOKIE, "next_url"):
+            for name in ("user", "id_token", LOGIN_COOKIE, "next_url", CSRF_COOKIE):
                 self.clear_cookie(name, path=config.cookie_path)
             self.write(LOGOUT_TEMPLATE.render(PANEL_CDN=CDN_DIST, LOGIN_ENDPOINT=auth.login_url))
 
+    def with_token(page: str, token: str) -> str:
+        """The login page with the CSRF token as a hidden field of its form."""
+        field = f'<input type="hidden" name="_csrf" value="{tornado.escape.xhtml_escape(token)}">'
+        head, sep, tail = page.partition("</form>")
+        if not sep:
+            raise RuntimeError("Panel's login page has no form to carry the CSRF token")
+        return head + field + sep + tail
+
     return LoginHandler, LogoutHandler
+
+
+#: The logout confirmation (``GET /logout``): its POST carries the CSRF token.
+LOGOUT_CONFIRM = """<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>Log out</title>
+<style>body{{font-family:sans-serif;margin:4em auto;max-width:24em}}
+button{{padding:.5em 1.5em}}</style></head>
+<body><form class="logout-form" action="{action}" method="post">
+<p>Log out of the dashboard?</p>
+<input type="hidden" name="_csrf" value="{token}">
+<button type="submit">Log out</button></form></body></html>
+"""
 
 
 def _provider_base():
@@ -465,11 +530,47 @@ class GuardedBasicAuth:
 
         return client_address(peer_address(request), request.headers, self.proxies)
 
-    def set_login_cookies(self, handler, user: str, password: str) -> None:
+    def is_https(self, request) -> bool:
+        """Whether the request came over HTTPS: ``X-Forwarded-Proto`` of a trusted proxy,
+        else the connection itself (TLS)."""
+        from server_private import peer_address
+        from tornado.iostream import SSLIOStream
+
+        if _trusted(peer_address(request), self.proxies):
+            proto = request.headers.get("X-Forwarded-Proto", "").split(",")[0].strip().lower()
+            if proto:
+                return proto == "https"
+        stream = getattr(request.connection, "stream", None)
+        return isinstance(stream, SSLIOStream)
+
+    def cookie_attrs(self, handler, samesite: str = LOGIN_SAMESITE) -> dict:
+        """The attributes of a cookie set for ``handler``'s request (module docstring)."""
         from panel.config import config
 
+        return {
+            "httponly": True,
+            "samesite": samesite,
+            "secure": self.is_https(handler.request),
+            "path": config.cookie_path,
+        }
+
+    def csrf_token(self, handler) -> str:
+        """The CSRF token of the request's browser (its cookie's, else a new one, set)."""
+        token = handler.get_cookie(CSRF_COOKIE, "")
+        if not (32 <= len(token) <= 128 and token.replace("-", "").replace("_", "").isalnum()):
+            token = secrets.token_urlsafe(32)
+            handler.set_cookie(CSRF_COOKIE, token, **self.cookie_attrs(handler, CSRF_SAMESITE))
+        return token
+
+    def csrf_ok(self, handler) -> bool:
+        """Whether a POST's ``_csrf`` field matches its ``fbs_csrf`` cookie."""
+        cookie = handler.get_cookie(CSRF_COOKIE, "")
+        field = handler.get_body_argument("_csrf", "")
+        return bool(cookie) and hmac.compare_digest(cookie.encode(), field.encode())
+
+    def set_login_cookies(self, handler, user: str, password: str) -> None:
         handler.clear_cookie("is_guest")
-        kw = {"expires_days": self.max_age_days, "httponly": True, "path": config.cookie_path}
+        kw = {"expires_days": self.max_age_days, **self.cookie_attrs(handler)}
         handler.set_secure_cookie("user", user, **kw)
         handler.set_secure_cookie(LOGIN_COOKIE, login_token(self.secret, user, password), **kw)
 

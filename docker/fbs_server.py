@@ -41,7 +41,20 @@ Small HTTP bodies, large websocket messages
     only body the app takes; uploads travel over the websocket), so no request can make the
     event loop read and parse megabytes (finding 8); the read buffer of a connection is
     as large as the largest websocket message, so a file upload up to that size reaches the
-    app and gets its refusal instead of a closed connection (finding 9).
+    app and gets its refusal instead of a closed connection (finding 9). A larger
+    websocket message is refused by the size its frame declares, before any of it is read,
+    and a Bokeh message whose frames (content and buffers) add up to more is refused as
+    its frames arrive; either closes that websocket with a log line naming the client
+    (:func:`bound_websocket_messages`: read and decoded, a 147 MB message takes the
+    server from 0.98 to 2.2 GB).
+Connections bounded
+    A request's headers and body must arrive within deadlines, and open connections are
+    capped per client and in all; a connection beyond a cap gets a 503 and is closed, and
+    ``accept()`` out of file descriptors pauses accepting instead of spinning, each logged
+    once per interval (:mod:`conn_limits`: unbounded, 3,500 connections that never finish
+    their headers stay open for ever and slow ``/liveness`` to 4.6-6 s). Page builds
+    never used (page requests without their websocket) draw on budgets of event-loop time
+    per user and in all (:mod:`page_limits`).
 Prompt shutdown
     On SIGTERM or SIGINT the server stops listening and exits within seconds, whatever
     computations are running or queued: queued work is cancelled, worker threads are not
@@ -62,16 +75,34 @@ import sys
 import threading
 import time
 
+from conn_limits import (
+    BODY_TIMEOUT_S,
+    HEADER_TIMEOUT_S,
+    MAX_CONNECTIONS,
+    MAX_CONNECTIONS_PER_CLIENT,
+    ConnectionLimits,
+    QuietLog,
+)
 from fbs_auth import (  # noqa: F401  (re-exported: the server's login in one import)
     LOGIN_FREE_FAILURES,
     LOGIN_MAX_FAILURES,
     GuardedBasicAuth,
     LoginThrottle,
     check_password,
+    client_address,
     parse_networks,
 )
 from page_gate import PageGate
-from server_private import cancel_queued_panel_work, cleanup_document
+from page_limits import TOTAL_BURST_S, TOTAL_SHARE, USER_BURST_S, USER_SHARE, PageBuilds
+from server_private import (
+    accept_connections,
+    bound_bokeh_messages,
+    bound_page_builds,
+    cancel_queued_panel_work,
+    cleanup_document,
+    peer_address,
+    report_refused_websocket_frames,
+)
 
 log = logging.getLogger("tire_fbs.server")
 #: The app's loggers, logged at the level panel serve gives Bokeh's (``--log-level``).
@@ -128,6 +159,53 @@ def guard_component_route(patterns: list) -> int:
             patterns[i] = (pattern[0], guarded, *pattern[2:])
             n += 1
     return n
+
+
+# ---- websocket messages ------------------------------------------------------------------
+
+
+def _websocket_refused(handler, reason: str | None) -> None:
+    """Log a websocket closed for the size of what its client sent (who, and why)."""
+    request = getattr(handler, "request", None)
+    who = peer_address(request) if request is not None else "unknown"
+    log.warning(
+        "websocket of %s closed: %s (FBS_WEBSOCKET_MAX_MESSAGE_MB)",
+        who,
+        reason if reason and reason != "message too big" else "a frame declared above the limit",
+    )
+
+
+def bound_websocket_messages(max_bytes: int) -> None:
+    """Refuse a websocket message above ``max_bytes`` by the size its frame declares,
+    before any of it is read (Tornado's check, logged here), and a Bokeh message whose
+    frames add up to more (:func:`server_private.bound_bokeh_messages`)."""
+    report_refused_websocket_frames(_websocket_refused)
+    bound_bokeh_messages(int(max_bytes), _websocket_refused)
+
+
+# ---- page builds ---------------------------------------------------------------------------
+
+
+def limit_page_builds(builds: PageBuilds, by_login: bool, proxies, quiet: QuietLog) -> None:
+    """Page builds draw on ``builds``' budgets (:mod:`page_limits`), owned by the login
+    (``by_login``) or else by the client address; refusals logged once per interval."""
+
+    def key_of(handler) -> str:
+        if by_login:
+            user = handler.current_user
+            return "user " + (user.decode() if isinstance(user, bytes) else str(user))
+        request = handler.request
+        return "client " + client_address(peer_address(request), request.headers, proxies)
+
+    def refused(handler, key: str, kind: str, wait_s: float) -> None:
+        quiet.note(
+            f"pages {kind}",
+            f"page builds refused: {key[:80]!r} "
+            f"({'its budget' if kind == 'user' else 'the budget of all users'} spent, "
+            f"retry in {wait_s:.0f} s)",
+        )
+
+    bound_page_builds(builds, key_of, refused)
 
 
 # ---- health check ------------------------------------------------------------------------
@@ -465,7 +543,19 @@ def _on_stop_signal(signum: int, deadline_s: float) -> None:
     threading.Thread(target=watchdog, name="shutdown-watchdog", daemon=True).start()
     STOPPING.set()
     cancel_queued_panel_work()
+    stop_reports()
     IOLoop.current().stop()
+
+
+def stop_reports() -> None:
+    """End the app's report drawing (queued reports cancelled, the report process ended, no
+    new one started): a report process started after :func:`stop_children` listed the
+    children would outlive the server. Only when the app has loaded it."""
+    reports = sys.modules.get("app.runtime.reports")
+    if reports is not None:
+        n = reports.stop()
+        if n:
+            log.info("stopped %d report process(es)", n)
 
 
 def _install_stop_signals(deadline_s: float) -> None:
@@ -525,7 +615,16 @@ def _serve_class():
         shutdown_deadline_s = SHUTDOWN_DEADLINE_S
         trusted_proxies = ""
         http_max_body_bytes = HTTP_MAX_BODY_BYTES
+        max_connections = MAX_CONNECTIONS
+        max_connections_per_client = MAX_CONNECTIONS_PER_CLIENT
+        header_timeout_s = HEADER_TIMEOUT_S
+        body_timeout_s = BODY_TIMEOUT_S
+        page_build_share = TOTAL_SHARE
+        page_build_burst_s = TOTAL_BURST_S
+        page_build_share_per_user = USER_SHARE
+        page_build_burst_s_per_user = USER_BURST_S
         users: dict | str | None = None  # the basic-auth users (set by serve)
+        limits: ConnectionLimits | None = None
 
         def customize_kwargs(self, args, server_kwargs):
             # the level panel serve gave Bokeh's loggers (--log-level)
@@ -552,11 +651,42 @@ def _serve_class():
             if guard_component_route(kwargs["extra_patterns"]) != 1:
                 raise RuntimeError("Panel's component-resource route was not found to guard")
             ws_max = getattr(args, "websocket_max_message_size", None) or 20 * 1024 * 1024
+            bound_websocket_messages(ws_max)
             kwargs["http_server_kwargs"] = {
                 **(kwargs.get("http_server_kwargs") or {}),
                 "max_body_size": int(self.http_max_body_bytes),
                 "max_buffer_size": int(ws_max) + READ_BUFFER_SLACK,
+                # the deadline of a request's headers too (Tornado's header_timeout)
+                "idle_connection_timeout": float(self.header_timeout_s),
+                "body_timeout": float(self.body_timeout_s),
             }
+            self.limits = ConnectionLimits(
+                int(self.max_connections_per_client),
+                int(self.max_connections),
+                exempt=proxies,
+            )
+            builds = PageBuilds(
+                float(self.page_build_share_per_user),
+                float(self.page_build_burst_s_per_user),
+                float(self.page_build_share),
+                float(self.page_build_burst_s),
+            )
+            by_login = bool(config.basic_auth) or bool(config.oauth_provider)
+            limit_page_builds(builds, by_login, proxies, self.limits.quiet)
+            log.info(
+                "page builds: %.0f %% of the event loop per %s, %.0f %% in all",
+                100 * builds.user_share,
+                "login" if by_login else "client",
+                100 * builds.total.rate,
+            )
+            log.info(
+                "connections: at most %d per client, %d in all; headers within %g s, "
+                "bodies within %g s",
+                self.limits.per_client,
+                self.limits.total,
+                float(self.header_timeout_s),
+                float(self.body_timeout_s),
+            )
             apps = applications(args.files, args.args or [])
             preload_imports(args.files)  # before the port opens: no page waits for them
             proved: dict[str, float] = {}
@@ -580,7 +710,10 @@ def _serve_class():
             return kwargs
 
         def customize_server(self, server):
-            return Supervised(super().customize_server(server))
+            server = super().customize_server(server)
+            if self.limits is not None and accept_connections(server, self.limits) < 1:
+                raise RuntimeError("the server's listening socket was not found to guard")
+            return Supervised(server)
 
     return HardenedServe
 
@@ -598,7 +731,8 @@ def serve(argv: list[str], private: dict, options: dict | None = None) -> int:
     options : dict, optional
         ``login_max_failures`` (int), ``shutdown_deadline_s`` (float), ``trusted_proxies``
         (str: addresses or networks, :func:`fbs_auth.parse_networks`),
-        ``http_max_body_bytes`` (int).
+        ``http_max_body_bytes`` (int), ``max_connections``, ``max_connections_per_client``
+        (int), ``header_timeout_s``, ``body_timeout_s`` (float): :mod:`conn_limits`.
     """
     from panel.config import config
 

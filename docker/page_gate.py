@@ -71,6 +71,7 @@ class PageGate:
         with self._cond:
             if not self._retired:
                 self._opening[key] = time.monotonic()
+                log.info("a page opens while the proof runs (%d opening)", len(self._opening))
 
     def shown(self, key: str) -> None:
         """The page of ``key`` is shown (document ready) or its session ended."""
@@ -151,11 +152,19 @@ class PageGate:
                 log.info("the proof goes on (%.2f s aside)", waited)
             return not self._retired and self.waited_s < self.budget_s
 
+    def _wait_unlocked(self) -> bool:
+        """:meth:`wait`, with the app-script lock this thread may hold released meanwhile
+        (it steps aside inside the app's script: ``server_private.app_scripts_unlocked``)."""
+        from server_private import app_scripts_unlocked
+
+        with app_scripts_unlocked():
+            return self.wait()
+
     def run(self, work: Callable[[], Any]) -> Any:
         """``work()`` in this thread, which carries :meth:`wait` as its ``step_aside``
         (see the module's docstring); the gate is retired after it."""
         thread = threading.current_thread()
-        thread.step_aside = self.wait  # type: ignore[attr-defined]
+        thread.step_aside = self._wait_unlocked  # type: ignore[attr-defined]
         try:
             return work()
         finally:

@@ -9,6 +9,7 @@ from . import io as io
 from . import variants as variants
 from . import vehicle as vehicle
 from . import vocabulary as vocabulary
+from . import vpt as vpt
 from .analysis import (
     bushing_contributions,
     campbell,
@@ -40,6 +41,7 @@ from .errors import (
     DOFError,
     FBSError,
     FrequencyGridError,
+    GeometryError,
     HarmonicError,
     ModalError,
     ModeCountError,
@@ -73,6 +75,7 @@ from .tire import TireModel, reference_tire
 from .vehicle import random_road_response, reference_vehicle, vehicle_response
 from .verdict import NoiseEdge, Verdict
 from .vocabulary import COUPLINGS, EIGEN_SPEEDS, magnitude_db, readonly
+from .vpt import Layout, VirtualPoint, virtual_point
 
 __version__ = "0.1.0"
 
@@ -105,6 +108,7 @@ __all__ = [
     "ModeCountError",
     "OperatingPointError",
     "ParameterError",
+    "GeometryError",
     "StudyCancelled",
     "COUPLINGS",
     "EIGEN_SPEEDS",
@@ -154,4 +158,7 @@ __all__ = [
     "Verdict",
     "Delivery",
     "assess_delivery",
+    "Layout",
+    "VirtualPoint",
+    "virtual_point",
 ]

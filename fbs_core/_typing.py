@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, TypeAlias
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -11,16 +11,16 @@ from numpy.typing import NDArray
 __all__ = ["AnyArray", "BoolArray", "ComplexArray", "FloatArray", "IndexLike", "IntArray"]
 
 #: Real array (frequencies in Hz, magnitudes, parameters).
-FloatArray: TypeAlias = NDArray[np.float64]
+type FloatArray = NDArray[np.float64]
 #: Complex array (FRF data, mode shapes; complex128 at run time). Spelled with
 #: ``complexfloating`` because numpy's stubs give that type to the results of
 #: ``linalg.solve``, ``inv`` and complex arithmetic.
-ComplexArray: TypeAlias = NDArray[np.complexfloating[Any, Any]]
+type ComplexArray = NDArray[np.complexfloating[Any, Any]]
 #: Integer array (indices, counts).
-IntArray: TypeAlias = NDArray[np.intp]
+type IntArray = NDArray[np.intp]
 #: Boolean mask.
-BoolArray: TypeAlias = NDArray[np.bool_]
+type BoolArray = NDArray[np.bool_]
 #: Array of unspecified dtype (object arrays, inputs before validation).
-AnyArray: TypeAlias = NDArray[Any]
+type AnyArray = NDArray[Any]
 #: Positions along one axis: a list of ints or an integer array.
-IndexLike: TypeAlias = "Sequence[int] | NDArray[np.integer[Any]]"
+type IndexLike = "Sequence[int] | NDArray[np.integer[Any]]"

@@ -362,9 +362,9 @@ def read_chassis_frf(path: str | os.PathLike[str]) -> FRF:
     DataFormatError
         If the file is not a chassis file of a known version.
     """
-    import h5py
+    from .hdf5_guard import open_h5
 
-    with h5py.File(path, "r") as h:
+    with open_h5(path) as h:  # refuses links and data leaving the file
         if h.attrs.get("format") != "tire-fbs" or h.attrs.get("model") != "reference chassis":
             raise DataFormatError(
                 f"{path}: not a 'tire-fbs' reference chassis file "

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, TypeAlias
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -29,7 +29,7 @@ from .frf import FRF, QUANTITIES, check_grid
 __all__ = ["SecondOrderSystem", "assemble"]
 
 #: A dense ndarray or a scipy.sparse matrix (scipy ships no type stubs, so this is Any).
-Matrix: TypeAlias = Any
+type Matrix = Any
 
 
 def _as_matrix(a: Matrix, n: int, name: str) -> Matrix:

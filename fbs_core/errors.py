@@ -24,6 +24,7 @@ __all__ = [
     "CampaignError",
     "ClusterUnavailable",
     "ParameterError",
+    "GeometryError",
     "StudyCancelled",
 ]
 
@@ -89,6 +90,11 @@ class ClusterUnavailable(CampaignError):
 
 class ParameterError(FBSError):
     """An unknown model parameter, a bad range or an unphysical value (fbs_core.variants)."""
+
+
+class GeometryError(FBSError):
+    """Positions or directions of measured channels that are missing, not unit vectors, or
+    that cannot observe the six DOFs of a virtual point (fbs_core.vpt)."""
 
 
 class StudyCancelled(Exception):  # noqa: N818  (a signal, not an error of the input)

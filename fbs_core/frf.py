@@ -9,7 +9,7 @@ method returns a new :class:`FRF`.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from typing import Any, TypeAlias
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -23,7 +23,7 @@ from .vocabulary import readonly as _frozen
 __all__ = ["FRF", "QUANTITIES", "UNITS", "check_grid"]
 
 #: A position selector of :meth:`FRF.isel`: int, slice, index list or boolean mask.
-_Index: TypeAlias = "slice | ArrayLike | None"
+type _Index = "slice | ArrayLike | None"
 
 #: FRF quantities (thesis table 2.1) and the power of ``j omega`` that turns a
 #: receptance into each of them.

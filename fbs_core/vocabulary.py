@@ -7,8 +7,6 @@ dashboard.
 
 from __future__ import annotations
 
-from typing import TypeVar
-
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
@@ -53,10 +51,8 @@ HARMONIC_CASES: tuple[int, ...] = tuple(range(1, 8))
 #: Magnitudes are floored at this value before the dB conversion (no ``-inf`` at zeros).
 DB_FLOOR = 1e-30
 
-_Ratio = TypeVar("_Ratio", float, np.ndarray)
 
-
-def percent(fraction: _Ratio) -> _Ratio:
+def percent[Ratio: (float, np.ndarray)](fraction: Ratio) -> Ratio:
     """A ratio of the core in percent, as the dashboard shows it (0.2 -> 20.0).
 
     The core takes and returns ratios as fractions: the noise level ``p`` (0.1 = +-10 %),
@@ -71,7 +67,7 @@ def percent(fraction: _Ratio) -> _Ratio:
     return fraction * 100.0
 
 
-def fraction(percent: _Ratio) -> _Ratio:
+def fraction[Ratio: (float, np.ndarray)](percent: Ratio) -> Ratio:
     """A percentage of the dashboard as the core's fraction (20.0 -> 0.2); see :func:`percent`.
 
     Examples

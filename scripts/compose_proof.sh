@@ -18,6 +18,8 @@
 #     runs a corridor study (a [variants] table of 8 variants of a small tire: one task per
 #     rebuilt tire) on the cluster and checks that every task ran on a worker and that its
 #     responses equal fbs_core.variants.run_variants of the case's seed in the container;
+#     checks that TLS is in force: the scheduler refuses a plain tcp:// client and a TLS
+#     client without a certificate, and the dashboard refuses a plain remote scheduler;
 #  6. `down` of the project and stops dockerd if it started it, also on failure or
 #     interruption, and prints the timings.
 #
@@ -57,7 +59,7 @@ cleanup() {
             log "logs of the services:"
             dc logs --no-color --tail 30 2>&1 | sed 's/^/    /'
         fi
-        dc down --remove-orphans -t 10 >/dev/null 2>&1 && log "removed project $project"
+        dc down --volumes --remove-orphans -t 10 >/dev/null 2>&1 && log "removed project $project (and its volume dask-tls)"
     fi
     if [[ -n "$dockerd_pid" ]]; then
         kill "$dockerd_pid" 2>/dev/null
@@ -136,8 +138,8 @@ compose_up() {
 wait_cluster() {  # the scheduler sees both workers (asked from the dashboard container)
     dc exec -T dashboard python - <<'PY'
 import os, time
-from distributed import Client
-c = Client(os.environ["FBS_DASK_SCHEDULER"], timeout="120s")
+from fbs_core.campaign.security import connect
+c = connect(os.environ["FBS_DASK_SCHEDULER"], "120s")
 c.wait_for_workers(2, timeout=180)
 w = c.scheduler_info()["workers"]
 print("    scheduler", c.scheduler.address, "workers:", sorted(v["name"] for v in w.values()))
@@ -181,12 +183,12 @@ TOML
 import os
 import h5py, numpy as np
 import fbs_core
-from distributed import Client
 from fbs_core.campaign import open_campaign
+from fbs_core.campaign.security import connect
 res = open_campaign("/tmp/smoke.h5")
 (case,) = res.cases
 assert case.complete, case
-c = Client(os.environ["FBS_DASK_SCHEDULER"], timeout="60s")
+c = connect(os.environ["FBS_DASK_SCHEDULER"], "60s")
 workers = set(c.scheduler_info()["workers"])
 c.close()
 with h5py.File("/tmp/smoke.h5") as h:
@@ -235,12 +237,12 @@ TOML
 import os
 import h5py, numpy as np
 import fbs_core.variants as fv
-from distributed import Client
 from fbs_core.campaign import load_campaign, open_campaign
+from fbs_core.campaign.security import connect
 (case,) = load_campaign("/tmp/variants.toml").variants_cases
 res = open_campaign("/tmp/variants.h5")
 study = res.variants(case.name)
-c = Client(os.environ["FBS_DASK_SCHEDULER"], timeout="60s")
+c = connect(os.environ["FBS_DASK_SCHEDULER"], "60s")
 workers = set(c.scheduler_info()["workers"])
 c.close()
 with h5py.File("/tmp/variants.h5") as h:
@@ -258,12 +260,44 @@ print(f"    9 tasks (8 tires + nominal) on {len(set(used))} of {len(workers)} wo
 PY
 }
 
+tls_in_force() {  # plain and certificate-less clients refused; the dashboard refuses plain
+    dc exec -T dashboard python - <<'PY'
+import os, socket, ssl
+from distributed import Client
+addr = os.environ["FBS_DASK_SCHEDULER"]
+assert addr.startswith("tls://"), addr
+plain = addr.replace("tls://", "tcp://")
+try:
+    Client(plain, timeout="10s").close()
+    raise SystemExit(f"a plain client joined {plain}")
+except (OSError, TimeoutError) as e:
+    print(f"    plain {plain}: refused ({type(e).__name__})")
+ctx = ssl.create_default_context(cafile=os.environ["FBS_DASK_TLS_DIR"] + "/ca.pem")
+ctx.check_hostname = False
+try:
+    with socket.create_connection(("scheduler", 8786), 10) as raw, ctx.wrap_socket(raw) as t:
+        t.settimeout(10)
+        t.sendall(b"\0" * 16)
+        assert t.recv(1) == b"", "the scheduler kept a client without a certificate"
+except (ssl.SSLError, ConnectionError) as e:
+    pass
+print("    TLS client without a certificate: refused")
+from fbs_core.campaign.security import InsecureScheduler, security_for
+try:
+    security_for(plain, {})
+    raise SystemExit("plain tcp to the scheduler was allowed")
+except InsecureScheduler:
+    print("    the dashboard refuses plain tcp://scheduler:8786 (FBS_DASK_ALLOW_PLAIN unset)")
+PY
+}
+
 timed "install tools (apt-get when missing)" install_tools
 timed "Docker daemon" start_dockerd
 timed "image $image" ensure_image
 port=$(free_port)
 timed "compose up" compose_up
-timed "scheduler sees 2 workers" wait_cluster
+timed "scheduler sees 2 workers (TLS)" wait_cluster
+timed "TLS in force: plain and certificate-less clients refused" tls_in_force
 timed "dashboard healthy + app document" wait_dashboard
 timed "campaign in 8 blocks on the cluster == scatter_band" smoke_campaign
 timed "campaigns/example.toml on the cluster" example_campaign

@@ -4,9 +4,9 @@
 #  1. installs docker.io and debootstrap with apt-get when missing (needs root), and
 #     chromium for the browser test;
 #  2. starts dockerd in the background when no daemon answers;
-#  3. makes sure the base image python:3.11-slim-bookworm exists: pulled when a registry is
+#  3. makes sure the base image python:3.12-slim-bookworm exists: pulled when a registry is
 #     reachable, else a local stand-in (Debian bookworm minbase made with debootstrap,
-#     `docker import`, python3 + python3-venv from docker/standin-base.Dockerfile);
+#     `docker import`, the host's CPython 3.12 in /usr/local: docker/standin-base.Dockerfile);
 #  4. makes the wheelhouse on the host (scripts/make_wheelhouse.sh) and builds the image with
 #     the offline build path (--build-arg WHEELHOUSE=wheelhouse: pip uses no index);
 #  5. runs the container on a loopback port, waits for Docker to report it healthy, checks
@@ -31,7 +31,7 @@ image=${FBS_IMAGE:-tire-fbs:proof}
 cpus=${FBS_PROOF_CPUS:-$(( $(nproc) < 2 ? $(nproc) : 2 ))}
 health_timeout=${FBS_PROOF_HEALTH_TIMEOUT:-180}
 standin=${FBS_PROOF_STANDIN:-auto}
-base_image=python:3.11-slim-bookworm
+base_image=python:3.12-slim-bookworm
 export DOCKER_BUILDKIT=0   # the classic builder: no buildx plugin needed, same Dockerfile
 export PATH="$PATH:/usr/local/sbin:/usr/sbin:/sbin"   # dockerd, debootstrap
 if [[ -x .venv/bin/python ]]; then PY=$repo/.venv/bin/python; else PY=python3; fi
@@ -120,7 +120,17 @@ build_standin() {
         || { tail -20 "$work/debootstrap.log"; fail "debootstrap failed"; }
     tar -C "$work/rootfs" -c . | docker import - local/debian:bookworm-minbase >/dev/null
     rm -rf "$work/rootfs"
-    docker build --force-rm -q -t "$base_image" - <docker/standin-base.Dockerfile >/dev/null
+    # the interpreter: the host's CPython 3.12 (the prefix behind the project's venv), without
+    # its test suite and installed packages
+    local prefix
+    prefix=$("$PY" -c 'import sys; assert sys.version_info[:2] == (3, 12), sys.version; print(sys.base_prefix)') \
+        || fail "the stand-in needs the host's Python 3.12 ($PY is $("$PY" --version 2>&1))"
+    mkdir -p "$work/standin/python"
+    tar -C "$prefix" -c --exclude=lib/python3.12/test --exclude='lib/python3.12/site-packages/*' \
+        --exclude='__pycache__' bin include lib share 2>/dev/null | tar -C "$work/standin/python" -x
+    docker build --force-rm -q -t "$base_image" -f docker/standin-base.Dockerfile "$work/standin" \
+        >"$work/standin.log" 2>&1 || { tail -20 "$work/standin.log"; fail "stand-in build failed"; }
+    rm -rf "$work/standin"
 }
 
 ensure_base() {

@@ -6,13 +6,13 @@
 #   docker build --build-arg WHEELHOUSE=wheelhouse -t tire-fbs .
 # and pip inside the build never contacts an index (`--no-index --find-links`).
 #
-# The wheels are chosen for the image's interpreter, not the host's: CPython 3.11 on
-# glibc Linux (the official python:3.11-slim-bookworm image), binary wheels only, so the
+# The wheels are chosen for the image's interpreter, not the host's: CPython 3.12 on
+# glibc Linux (the official python:3.12-slim-bookworm image), binary wheels only, so the
 # host may run another Python version. Versions are pinned to the host environment's
 # (`pip freeze` of $PYTHON) when that has the packages, so the image runs what was tested.
 #
 # Usage: scripts/make_wheelhouse.sh [OUTDIR]      (default OUTDIR: wheelhouse)
-# Environment: PYTHON (default .venv/bin/python, else python3), WHEELHOUSE_PY (3.11),
+# Environment: PYTHON (default .venv/bin/python, else python3), WHEELHOUSE_PY (3.12),
 #   WHEELHOUSE_ARCH (uname -m), WHEELHOUSE_PIN (1: pin to $PYTHON's versions; 0: newest),
 #   WHEELHOUSE_EXTRA (extra requirements, space separated, e.g. "cryptography" for OAuth).
 set -euo pipefail
@@ -22,7 +22,7 @@ out=${1:-wheelhouse}
 if [[ -z "${PYTHON:-}" ]]; then
     if [[ -x .venv/bin/python ]]; then PYTHON=.venv/bin/python; else PYTHON=python3; fi
 fi
-py=${WHEELHOUSE_PY:-3.11}
+py=${WHEELHOUSE_PY:-3.12}
 arch=${WHEELHOUSE_ARCH:-$(uname -m)}
 pin=${WHEELHOUSE_PIN:-1}
 tmp=$(mktemp -d)

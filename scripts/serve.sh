@@ -7,7 +7,7 @@
 #
 # Environment: PORT (5006), ADDRESS (localhost; 0.0.0.0 to listen on all interfaces),
 # NUM_THREADS (4: one session's long computation does not block the others),
-# PYTHON (python3), SHOW=1 to open a browser (only where there is a display), WS_MAX_MB
+# PYTHON (an interpreter of Python 3.12+; found on PATH or among pyenv's versions), SHOW=1 to open a browser (only where there is a display), WS_MAX_MB
 # (200: largest websocket message, i.e. upload, in MB).
 # Serving to other machines: ADDRESS=0.0.0.0 and BOKEH_ALLOW_WS_ORIGIN=<host>:<port> (the
 # address the browsers use), or pass --allow-websocket-origin <host>:<port>.
@@ -15,7 +15,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PY=${PYTHON:-python3}
+. scripts/find_python.sh
 PORT=${PORT:-5006}
 ADDRESS=${ADDRESS:-localhost}
 NUM_THREADS=${NUM_THREADS:-4}
@@ -44,7 +44,7 @@ fi
 # uploads travel base64-encoded in one websocket message: 200 MB carries files up to
 # 150 MB, so a file above fbs_core's 100 MiB limit is refused with a message (Bokeh's
 # default of 20 MB would close the connection on files above 15 MB)
-WS_MAX_MB=${WS_MAX_MB:-200}
+WS_MAX_MB=${WS_MAX_MB:-135}
 FBS_APP=app/main.py FBS_PORT=$PORT FBS_ADDRESS=$ADDRESS FBS_NUM_THREADS=$NUM_THREADS \
   FBS_WEBSOCKET_MAX_MESSAGE_MB=$WS_MAX_MB \
   .venv/bin/python docker/entrypoint.py "${SHOW_ARG[@]}" "$@" &

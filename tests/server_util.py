@@ -242,6 +242,38 @@ def get(opener, url, data=None, headers=None):
         return e.code, e.headers, e.read().decode()
 
 
+def form_token(base: str, path: str = "/login", headers=None) -> tuple[str, str]:
+    """``(token, cookie header)`` of a form of the server (the login form, the logout
+    confirmation) as a browser gets it: its hidden CSRF field and the cookie that goes with
+    it."""
+    import http.cookiejar
+    import re
+
+    jar = http.cookiejar.CookieJar()
+    opener = urllib.request.build_opener(NoRedirect, urllib.request.HTTPCookieProcessor(jar))
+    status, _, body = get(opener, base + path, headers=headers)
+    m = re.search(r'name="_csrf" value="([^"]+)"', body)
+    assert status == 200 and m, (status, body[:300])
+    return m.group(1), "; ".join(f"{c.name}={c.value}" for c in jar)
+
+
+def login_post(opener, base: str, user: str, password: str, headers=None):
+    """(status, headers, body) of the login form's POST as a browser sends it: the form
+    fetched first for its CSRF token (hidden field and cookie). The token's cookie goes
+    with the POST only, not with the redirects ``opener`` may follow (its own cookies do)."""
+    import urllib.parse
+
+    token, cookie = form_token(base, headers=headers)
+    data = urllib.parse.urlencode({"username": user, "password": password, "_csrf": token})
+    req = urllib.request.Request(base + "/login", data=data.encode(), headers=headers or {})
+    req.add_unredirected_header("Cookie", cookie)
+    try:
+        with opener.open(req, timeout=60) as r:
+            return r.status, r.headers, r.read().decode()
+    except urllib.error.HTTPError as e:
+        return e.code, e.headers, e.read().decode()
+
+
 def run_async(coro):
     """Run ``coro`` to completion on a fresh event loop in its own thread.
 

@@ -5,13 +5,14 @@ Truth: the rotating ring's closed form (reference-models.md sec. 2.1, Huang & So
 with the spin (forward).
 """
 
+import dataclasses
 import functools
 
 import numpy as np
 import pytest
 
 from fbs_core import reference_tire
-from fbs_core.analysis import wave_campbell
+from fbs_core.analysis import wave_campbell, waves
 from fbs_core.errors import FBSError
 from fbs_core.tire import TireParameters, ring_closed_form
 
@@ -113,3 +114,52 @@ def test_bad_input():
         wave_campbell(params=RING)
     with pytest.raises(FBSError, match="fmax"):
         wave_campbell(fmax=-1.0)
+
+
+def test_the_stored_reference_result_is_the_one_computed_now():
+    """The reference tire's diagram is read from data/reference_waves.npz (the dense solves
+    take 12 s on an idle core): it must be what the tracking computes today, field by
+    field, and be used only for the very tire, speeds, hub and veer_mac it was made of."""
+    tire = reference_tire()
+    speeds = tuple(float(v) for v in tire.speeds)
+    stored = waves.load_stored(tire, speeds, "free", 0.8)
+    assert stored is not None, "data/reference_waves.npz is missing or stale"
+    fresh = waves._track(tire, speeds, "free", 0.8)
+    for f in dataclasses.fields(fresh):
+        a, b = getattr(stored, f.name), getattr(fresh, f.name)
+        if isinstance(b, np.ndarray) and b.dtype.kind in "fc":
+            np.testing.assert_allclose(a, b, rtol=1e-7, atol=1e-9, err_msg=f.name)
+        elif isinstance(b, np.ndarray):
+            np.testing.assert_array_equal(a, b, err_msg=f.name)
+        else:
+            assert a == b, f.name
+    # what the library returns for the reference tire is that result (below 450 Hz)
+    cb = wave_campbell()
+    low = np.nanmin(np.where(np.isfinite(fresh.freq), fresh.freq, np.inf), axis=0) <= 450.0
+    np.testing.assert_allclose(cb.freq, fresh.freq[:, low], rtol=1e-9)
+    assert cb.labels() == tuple(np.asarray(fresh.labels())[low])
+    # another hub condition, veer_mac or speed grid: not the stored result
+    assert waves.load_stored(tire, speeds, "fixed", 0.8) is None
+    assert waves.load_stored(tire, speeds, "free", 0.7) is None
+    assert waves.load_stored(tire, speeds[:-1], "free", 0.8) is None
+    other = dataclasses.replace(tire.params, zeta=tire.params.zeta * 1.01)
+    assert waves.load_stored(other, speeds, "free", 0.8) is None
+
+
+def test_progress_reports_every_speed_and_can_stop_the_solve():
+    seen = []
+    speeds = [20.0, 50.0, 80.0]
+    cb = wave_campbell(
+        params=RING, speeds=speeds, hub="fixed", progress=lambda d, n: seen.append((d, n))
+    )
+    assert seen == [(0, 3), (1, 3), (2, 3), (3, 3)] and cb.freq.shape[0] == 3
+
+    class Stop(Exception):
+        pass
+
+    def stop(done, total):
+        if done == 1:
+            raise Stop
+
+    with pytest.raises(Stop):
+        wave_campbell(params=RING, speeds=[20.0, 60.0, 90.0], hub="fixed", progress=stop)

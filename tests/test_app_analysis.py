@@ -127,6 +127,29 @@ def test_phase_view_bode_real_imag_and_cursors(store):
     assert type(view._top.x_scale).__name__ == "LogScale"
 
 
+def test_the_speed_tabs_campbell_claims_no_direction_of_travel(store):
+    """The Speed tab's branches are the modal model's tracked modes, which pass between
+    forward and backward waves at the veerings: labelled by their slope, most branches
+    whose waves the belt-wave diagram follows got the wrong direction (docs/modes.md). The
+    view shows them without a direction, in one colour, and points to the wave diagram;
+    neither its legend, its CSV nor the report's plot says forward or backward."""
+    r = store
+    r.state.analysis.tab = "speed"
+    cv = CampbellView(store=r)
+    cv.__panel__()
+    res = r.campbell
+    words = ("forward", "backward")
+    legend = [i.label.value for i in cv._fig.legend[0].items]
+    assert not any(w in t for t in legend for w in words), legend
+    assert not any(w in c for c in res.columns for w in words)
+    groups = res.draw["report_plot"]["groups"]
+    assert not any(w in g for g in groups for w in words), list(groups)
+    assert "Modes" in res.caption and "wave" in res.caption
+    # every tracked branch is still drawn (the same frequencies as the core's)
+    cb = fbs_core.analysis.campbell(fbs_core.reference_tire(), fmax=450.0)
+    assert len(cv._branches["modes"].data["ys"]) == cb.branch.size
+
+
 def test_campbell_and_speed_map_views_and_picking(store):
     r = store
     r.state.analysis.tab = "speed"
@@ -135,12 +158,11 @@ def test_campbell_and_speed_map_views_and_picking(store):
     tire = fbs_core.reference_tire()
     eig = tire.eigenfrequencies(80.0)
     n = 0
-    for d in ("forward", "backward", "standing"):
-        src = cv._branches[d].data
-        for xs, ys in zip(src["xs"], src["ys"], strict=True):
-            k = int(np.argmin(np.abs(xs - 80.0)))
-            assert abs(xs[k] - 80.0) < 1e-9 and np.min(np.abs(eig - ys[k])) < 1e-6
-            n += 1
+    src = cv._branches["modes"].data
+    for xs, ys in zip(src["xs"], src["ys"], strict=True):
+        k = int(np.argmin(np.abs(xs - 80.0)))
+        assert abs(xs[k] - 80.0) < 1e-9 and np.min(np.abs(eig - ys[k])) < 1e-6
+        n += 1
     assert n > 20
     o = cv._orders.data
     for h, xs, ys in zip(o["harmonic"], o["xs"], o["ys"], strict=True):

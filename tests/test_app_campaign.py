@@ -8,6 +8,7 @@ campaign's own TOML (the case matrix).
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -270,3 +271,42 @@ def test_the_shown_variants_case_is_a_section_of_the_sessions_report(variants_di
     assert lead in rows["sensitivity leaders (total Sobol' index per band)"]
     card.browser.case = None  # nothing shown: no section
     assert all(x.key != "campaign" for x in report_data(store).extra)
+
+
+def test_without_a_directory_the_page_says_how_to_get_corridors_and_campaigns(monkeypatch):
+    """The card is on the page even when the operator set no campaign folder: it names the
+    setting, what a campaign file is and the commands, and the commands it gives work on the
+    example files it names."""
+    import subprocess
+    import sys
+    from types import SimpleNamespace
+
+    import panel as pn
+
+    from app.views.campaign import campaign_card
+
+    monkeypatch.delenv("FBS_CAMPAIGN_DIR", raising=False)
+    parts = SimpleNamespace(card=lambda title, view, height, **kw: pn.Card(view, title=title, **kw))
+    card = campaign_card(parts)
+    assert card is not None and "campaign-card" in card.css_classes
+    assert "not set up" in card.title
+    text = card.objects[0].object
+    for words in (
+        "FBS_CAMPAIGN_DIR",
+        "campaign file",
+        "TOML",
+        "python -m fbs_core.campaign run campaigns/corridor.toml",
+        "corridor",
+    ):
+        assert words in text, words
+    root = Path(__file__).resolve().parents[1]
+    for example in ("campaigns/example.toml", "campaigns/corridor.toml"):
+        assert example in text and (root / example).is_file()
+    plan = subprocess.run(
+        [sys.executable, "-m", "fbs_core.campaign", "plan", "campaigns/corridor.toml"],
+        cwd=root,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert plan.returncode == 0 and "variants" in plan.stdout, plan.stderr

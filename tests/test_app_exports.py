@@ -88,13 +88,23 @@ def test_the_uff_export_reads_back_with_the_case_of_its_snapshot_and_a_node_map(
         )
         assert _whole_pairs(st["id3"]) and _whole_pairs(st["id4"])
         assert st["id5"] == "nodes: 1=bushing 2=patch"
-    frf_rec = next(s for s in sets if s["func_type"] == 4)
-    ref_rec = next(s for s in sets if s["func_type"] != 4)
-    assert frf_rec["id1"].startswith("truncated: ") and "reference" in ref_rec["id1"]
+    # both are whole FRF records of the same pair (bushing:rx per road patch: node 1
+    # direction 4 = rx, node 2 the patch), told apart by record 6's function id
+    assert [s["func_type"] for s in sets] == [4, 4]
+    assert [s["func_id"] for s in sets] == [1, 2]
+    for st in sets:
+        assert (st["rsp_node"], st["rsp_dir"], st["ref_node"]) == (1, 4, 2), st["id1"]
+        assert st["ordinate_axis_units_lab"] == sets[0]["ordinate_axis_units_lab"] != "NONE"
+        assert st["orddenom_axis_units_lab"] == sets[0]["orddenom_axis_units_lab"] != "NONE"
+        assert st["abscissa_axis_units_lab"] == "Hz"
+    frf_rec, ref_rec = sets
+    assert frf_rec["id1"].startswith("truncated: ") and ref_rec["id1"].startswith("reference: ")
     # with the node map of line 5, fbs_core reads the FRF back under its labels
     nodes = dict(p.split("=")[::-1] for p in frf_rec["id5"][len("nodes: ") :].split())
-    got = load_frf(path, nodes={int(v): k for k, v in nodes.items()}).frf
-    assert got is not None
+    loaded = load_frf(path, nodes={int(v): k for k, v in nodes.items()})
+    got = loaded.frf
+    assert got is not None  # the file's first function: the N-mode response
+    assert any("function ids 2 (reference)" in n for n in loaded.notes), loaded.notes
     assert got.outputs == ("bushing:rx",) and got.inputs == ("patch",)
     want = r.core["truncated"]
     np.testing.assert_allclose(got.freq, want.freq, rtol=1e-5)

@@ -162,3 +162,98 @@ def test_the_servers_isolated_private_uses_still_exist():
     assert "self.address = address" in src
     src = inspect.getsource(tornado.httpserver.HTTPServer.handle_stream)
     assert "HTTP1ServerConnection(stream, self.conn_params, context)" in src
+
+
+def test_tornado_refuses_a_frame_by_its_declared_size_before_reading_it():
+    """``server_private.report_refused_websocket_frames`` relies on Tornado checking the
+    length a websocket frame declares before it reads the payload, closing with 1009 via the
+    protocol's ``close`` (which it wraps; ``mask_outgoing`` tells a server's protocol);
+    ``bound_bokeh_messages`` wraps ``on_message`` of Panel's websocket handler."""
+    import tornado.websocket
+    from panel.io.server import WSHandler
+
+    src = inspect.getsource(tornado.websocket.WebSocketProtocol13._receive_frame)
+    check = src.index("if new_len > self.params.max_message_size:")
+    assert src.index('self.close(1009, "message too big")') > check
+    assert src.index("await self._read_bytes(payloadlen)") > check
+    assert "self.mask_outgoing = mask_outgoing" in inspect.getsource(
+        tornado.websocket.WebSocketProtocol13.__init__
+    )
+    assert inspect.iscoroutinefunction(WSHandler.on_message)
+
+
+def test_the_accept_loop_the_server_takes_over_is_still_tornados():
+    """``server_private.accept_connections`` replaces the accept handler Tornado's
+    ``TCPServer.add_sockets`` registers per listening socket (kept in ``_sockets`` and
+    ``_handlers``, whose removers ``stop()`` calls) and serves connections with
+    ``_handle_connection``; Bokeh's server keeps its HTTP server in ``_http``."""
+    import tornado.tcpserver
+    from bokeh.server.server import BaseServer
+
+    src = inspect.getsource(tornado.tcpserver.TCPServer.add_sockets)
+    assert "self._sockets[sock.fileno()] = sock" in src
+    assert "self._handlers[sock.fileno()] = add_accept_handler(" in src
+    assert "self._handle_connection" in src
+    assert "self._handlers.pop(fd)()" in inspect.getsource(tornado.tcpserver.TCPServer.stop)
+    assert "self._http = http_server" in inspect.getsource(BaseServer.__init__)
+
+
+def test_the_routes_whose_page_builds_are_bounded_are_still_panels():
+    """``server_private.bound_page_builds`` wraps the coroutines of Panel's page, autoload
+    and websocket routes (the per-app routes Bokeh builds its application's handlers from)."""
+    from bokeh.server.urls import per_app_patterns
+    from panel.io.server import AutoloadJsHandler, DocHandler, WSHandler
+
+    assert {DocHandler, AutoloadJsHandler, WSHandler} <= {h for _, h in per_app_patterns}
+    for method in (DocHandler.get, AutoloadJsHandler.get, WSHandler.prepare):
+        # (a login decorator may wrap it: awaited all the same)
+        assert inspect.iscoroutinefunction(inspect.unwrap(method)), method
+
+
+def test_the_process_pools_worker_list_is_still_there():
+    """``panel_private.pool_processes`` reads CPython's ``ProcessPoolExecutor._processes``:
+    the report drawer's processes, ended when the server stops."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from app.runtime.panel_private import pool_processes
+
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        assert pool.submit(abs, -1).result(timeout=120) == 1
+        procs = pool_processes(pool)
+        assert len(procs) == 1 and procs[0].is_alive()
+
+
+def test_the_app_script_lock_is_released_while_the_proof_steps_aside():
+    """Bokeh runs app scripts under one process-wide re-entrant lock; the proof, stepping
+    aside inside its script, releases it (``server_private.app_scripts_unlocked``) so a
+    user's script runs meanwhile, and holds it again as before afterwards."""
+    import sys
+    import threading
+
+    from bokeh.application.handlers import code_runner
+    from panel.io import handlers
+
+    sys.path.insert(0, str(ROOT / "docker"))
+    from server_private import app_scripts_unlocked
+
+    lock = code_runner._PROCESS_GLOBALS_LOCK
+    # Bokeh's and Panel's script runners both take it
+    assert "_hold_process_globals()" in inspect.getsource(code_runner.CodeRunner.run)
+    assert "_hold_process_globals()" in inspect.getsource(handlers)
+    ran = threading.Event()
+
+    def other_script() -> None:
+        with code_runner._hold_process_globals():
+            ran.set()
+
+    with code_runner._hold_process_globals(), code_runner._hold_process_globals():
+        with app_scripts_unlocked():
+            t = threading.Thread(target=other_script)
+            t.start()
+            assert ran.wait(60), "another thread's script could not run while this one waited"
+            t.join(60)
+        assert lock._is_owned()  # held again, twice: released twice below
+    assert not lock._is_owned()
+    with app_scripts_unlocked():  # a thread that does not hold it: nothing changes
+        assert not lock._is_owned()

@@ -461,3 +461,29 @@ def test_an_empty_file_is_refused_with_a_message(which):
     assert err.visible and "refused" in err.object
     assert f"{name}" in err.object and "empty" in err.object
     assert ds.models is REFERENCE
+
+
+def test_an_empty_file_is_answered_and_an_earlier_error_does_not_stay():
+    """Panel hands an empty upload over as its file name with the value None (the browser's
+    empty base64 text): it is read as an empty file and the page names the problem, the
+    earlier file's error is replaced, and the same empty file uploaded again is answered
+    again."""
+    from app.views.upload import UploadView
+
+    view = UploadView(data=DataSource())
+    ds = view.data
+    view.chassis_file.param.update(value=b"junk", filename="first.csv")  # a refused file
+    assert "first.csv" in ds.error
+    seen = []
+    ds.param.watch(lambda e: seen.append(e.new), "error")
+    # an empty file, as Panel gives it
+    view.chassis_file.param.update(value=None, filename="empty.csv")
+    assert "empty.csv" in ds.error and "empty" in ds.error.split(":", 1)[1]
+    assert "first.csv" not in ds.error
+    assert seen[0] == ""  # the stale error cleared as soon as the new file was taken
+    seen.clear()
+    view.chassis_file.param.update(value=None, filename="empty.csv")  # the same again
+    assert seen and seen[-1] == ds.error and "empty.csv" in ds.error
+    # a tire file, empty
+    view.tire_file.param.update(value=None, filename="tire.h5")
+    assert "tire.h5" in ds.error and "is empty" in ds.error

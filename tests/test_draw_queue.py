@@ -156,8 +156,8 @@ def test_a_draw_waits_inside_the_lock_for_the_messages_panel_serialized_before_i
 
 
 def test_pending_panel_writes_are_read_from_panel_itself():
-    """The predicate reads Panel's own record of serialized, unwritten messages (it fails
-    here if Panel renames or drops it)."""
+    """The predicate reads Panel's own record of queued, unwritten changes (it fails here
+    if Panel renames or drops it)."""
     from panel.io import document as pdoc
 
     doc = Document()
@@ -167,9 +167,9 @@ def test_pending_panel_writes_are_read_from_panel_itself():
         assert panel_writes_pending(doc)
     finally:
         del pdoc._WRITE_BLOCK[doc]
-    pdoc._WRITE_MSGS[doc] = {"connection": ["message"]}
+    pdoc._WRITE_EVENTS[doc] = [(["connection"], ["event"])]
     try:
         assert panel_writes_pending(doc)
     finally:
-        del pdoc._WRITE_MSGS[doc]
+        del pdoc._WRITE_EVENTS[doc]
     assert not panel_writes_pending(doc)

@@ -116,7 +116,9 @@ def test_a_session_opens_until_document_ready_or_its_end():
 def test_the_server_proof_steps_aside_for_a_page_opened_meanwhile(tmp_path):
     """A real server: its proof builds the app's page; a user's page opens meanwhile; the
     proof, at the app's next safe point, waits until that page is shown and its own on-load
-    work done, then goes on and the app is reported proved."""
+    work done, then goes on and the app is reported proved. Bokeh runs one app script at a
+    time (a process-wide lock): the user's page is built once the proof, busy in its
+    script, reaches that safe point, where it lets the user's script run."""
     notes, gate_file = tmp_path / "notes.txt", tmp_path / "gate"
     onload_gate = tmp_path / "onload-gate"
     app = (
@@ -154,7 +156,6 @@ def test_the_server_proof_steps_aside_for_a_page_opened_meanwhile(tmp_path):
 
     def while_the_page_opens() -> None:
         assert "page builds" in notes.read_text()
-        gate_file.write_text("open")
         # the proof reached its safe point while the page opens: it waits there
         wait_for(lambda: "the proof steps aside: 1 page(s) opening" in srv.log(), 60)
         assert "proof at a safe point (True)" in notes.read_text()
@@ -166,8 +167,16 @@ def test_the_server_proof_steps_aside_for_a_page_opened_meanwhile(tmp_path):
     async def user() -> None:
         client = await PageClient.open(f"ws://127.0.0.1:{srv.port}/gateapp/ws")
         try:
-            doc = await client.pull(60)  # a user's page opened (built, sent)
             loop = asyncio.get_running_loop()
+            pull = asyncio.ensure_future(client.pull(120))  # a user's page is requested
+            # the server knows the page opens; the proof, busy in its script, goes on to
+            # its next safe point
+            await loop.run_in_executor(
+                None, lambda: wait_for(lambda: "a page opens while the proof" in srv.log(), 60)
+            )
+            assert "page builds" not in notes.read_text()
+            gate_file.write_text("open")
+            doc = await pull  # the user's page opened (built, sent)
             await loop.run_in_executor(None, while_the_page_opens)
             await client.ready(doc)  # the browser shows the page: its on-load work starts
             await loop.run_in_executor(

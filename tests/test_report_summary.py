@@ -79,17 +79,46 @@ def test_the_peak_table_holds_band_width_and_contributions_at_each_peak(snap):
         shares = (terms[i] * np.conj(tot)).real / abs(tot) ** 2
         k = int(np.argmax(np.abs(shares)))
         assert row[5].startswith(f"{c.interface[k]} {100 * shares[k]:.0f} %")
-    top = max(snap.peaks, key=lambda p: p.level_db)
-    i = _line(b.freq, top.freq)
+    i = int(np.argmax(np.abs(tr)))  # the highest level of the plotted curve
+    i = _line(b.freq, snap.truncated.freq[i])
     width = 20 * np.log10(b.maximum[i, j] / b.minimum[i, j])
-    assert _rows(snap)["scatter band width at the highest peak"].startswith(f"{width:.2f} dB")
+    assert _rows(snap)["scatter band width at the highest level"].startswith(f"{width:.2f} dB")
+
+
+def _edge_snap(snap, edge: int):
+    """``snap`` whose N-mode response rises at one edge line above all its peaks (the
+    review's case: a peak at 62.3 Hz, the plotted maximum at the band's edge)."""
+    tr = snap.truncated
+    data = np.array(tr.data, copy=True)
+    j = list(tr.outputs).index("bushing:z")
+    data[edge, j, 0] = 4 * np.abs(data[:, j, 0]).max()
+    return dataclasses.replace(snap, truncated=type(tr)(tr.freq, data, tr.outputs, tr.inputs))
+
+
+@pytest.mark.parametrize("edge", [0, -1])
+def test_one_rule_for_the_highest_level_corner_and_car_the_band_edge_counts(snap, edge):
+    """The summary's highest level is the plotted maximum over the whole band, the edge
+    lines included, whether the data hold peak labels (the corner) or not (the car)."""
+    s = _edge_snap(snap, edge)
+    tr = s.truncated.sel(outputs="bushing:z").data[:, 0, 0]
+    lv = 20 * np.log10(np.abs(tr))
+    i = int(np.argmax(lv))
+    assert i == (edge % lv.size)
+    f = s.truncated.freq[i]
+    side = "lower" if edge == 0 else "upper"
+    for variant in (s, dataclasses.replace(s, peaks=())):  # with and without peak labels
+        text = _rows(variant)["highest level of bushing:z"]
+        assert text.startswith(f"{lv[i]:.2f} dB at {f:.1f} Hz (the band's {side} edge)"), text
+    # the highest labelled peak, inside the band, is said beside it
+    pk = max(s.peaks, key=lambda p: p.level_db)
+    assert _rows(s)["highest labelled peak"].startswith(f"{pk.level_db:.2f} dB at {pk.freq:.1f}")
 
 
 def test_without_band_or_contributions_the_summary_says_which_view_computes_them(snap):
     bare = dataclasses.replace(snap, band=None, contributions=None)
     rows = _rows(bare)
-    assert "not computed for these settings" in rows["scatter band width at the highest peak"]
-    key = "largest contributions at the highest peak (share of the total)"
+    assert "not computed for these settings" in rows["scatter band width at the highest level"]
+    key = "largest contributions at the highest level (share of the total)"
     assert "Contributions tab" in rows[key]
     assert "band max - min" not in report_summary(bare).peak_header
 

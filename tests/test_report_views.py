@@ -88,7 +88,7 @@ def test_a_view_of_settings_left_behind_is_not_reported(store):
         assert "campbell" in keys
         assert data.contributions is None
         rows = dict(report_summary(data).rows)
-        key = "largest contributions at the highest peak (share of the total)"
+        key = "largest contributions at the highest level (share of the total)"
         assert "Contributions tab" in rows[key]
     finally:
         store.state.case.n_modes = 40

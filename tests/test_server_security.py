@@ -31,7 +31,9 @@ import pytest
 from server_util import (
     NoRedirect,
     Server,
+    form_token,
     get,
+    login_post,
     process_tree,
     run_async,
     wait_for,
@@ -291,8 +293,7 @@ def _read(path: str) -> bytes:
 def test_secrets_are_not_on_any_command_line_or_environment(server):
     # a page load starts a child process (as an upload starts the parser sandbox)
     opener = urllib.request.build_opener(urllib.request.HTTPCookieProcessor())
-    data = urllib.parse.urlencode({"username": USER, "password": PASSWORD}).encode()
-    assert get(opener, server.base + "/login", data=data)[0] == 200
+    assert login_post(opener, server.base, USER, PASSWORD)[0] == 200
     builds = _builds(server)
     assert builds >= 2  # the proof at start and this page: a child each
 
@@ -373,9 +374,10 @@ def test_a_websocket_from_another_origin_is_refused(server):
 def _login(server, client_ip: str, username: str, password: str, header="X-Forwarded-For"):
     """(status, headers, seconds) of a login POST from ``client_ip`` (as the proxy says)."""
     opener = urllib.request.build_opener(NoRedirect)
-    data = urllib.parse.urlencode({"username": username, "password": password}).encode()
     t0 = time.monotonic()
-    status, headers, _ = get(opener, server.base + "/login", data=data, headers={header: client_ip})
+    status, headers, _ = login_post(
+        opener, server.base, username, password, headers={header: client_ip}
+    )
     return status, headers, time.monotonic() - t0
 
 
@@ -528,8 +530,7 @@ def _form_login(base: str, user: str, password: str) -> str:
 
     jar = http.cookiejar.CookieJar()
     opener = urllib.request.build_opener(NoRedirect, urllib.request.HTTPCookieProcessor(jar))
-    data = urllib.parse.urlencode({"username": user, "password": password}).encode()
-    assert get(opener, base + "/login", data=data)[0] == 302
+    assert login_post(opener, base, user, password)[0] == 302
     return "; ".join(f"{c.name}={c.value}" for c in jar)
 
 
@@ -557,7 +558,12 @@ def test_logout_revokes_the_login_cookie(server):
     cookie = _form_login(server.base, OTHER_USER, OTHER_PASSWORD)
     assert _logged_in(server.base, cookie)
     opener = urllib.request.build_opener(NoRedirect)
-    assert get(opener, server.base + "/logout", headers={"Cookie": cookie})[0] == 200
+    token, csrf = form_token(server.base, "/logout", headers={"Cookie": cookie})
+    data = urllib.parse.urlencode({"_csrf": token}).encode()
+    status = get(
+        opener, server.base + "/logout", data=data, headers={"Cookie": f"{cookie}; {csrf}"}
+    )
+    assert status[0] == 200
     # the same cookie, kept (stolen) after the logout, is no login any more
     assert not _logged_in(server.base, cookie)
     with pytest.raises(Exception, match="403"):
@@ -602,6 +608,32 @@ def test_a_direct_client_cannot_pick_its_address_with_forwarding_headers(direct_
     assert "from 127.0.0.1" in srv.log() and "from 10.77.0." not in srv.log()
 
 
+def _cookie_lines(headers) -> dict[str, set[str]]:
+    """name -> attributes (lower case) of a response's Set-Cookie headers."""
+    out = {}
+    for v in headers.get_all("Set-Cookie") or []:
+        name, _, rest = v.partition("=")
+        out[name] = {a.strip().lower() for a in rest.split(";")[1:]}
+    return out
+
+
+def test_cookies_are_secure_when_a_trusted_proxy_says_https(server, direct_server):
+    """Behind a TLS-terminating proxy (X-Forwarded-Proto: https from a trusted proxy) the
+    login and form cookies are Secure; a direct client's header is ignored (the cookies stay
+    usable over its plain HTTP)."""
+    https = {"X-Forwarded-Proto": "https"}
+    for srv, secure in ((server, True), (direct_server, False)):
+        opener = urllib.request.build_opener(NoRedirect)
+        status, headers, _ = login_post(opener, srv.base, OTHER_USER, OTHER_PASSWORD, https)
+        assert status == 302
+        got = _cookie_lines(headers)
+        for name in ("user", "fbs_login"):
+            assert {"httponly", "samesite=lax"} <= got[name], got
+            assert ("secure" in got[name]) is secure, (srv.base, got)
+        status, headers, _ = get(opener, srv.base + "/login", headers=https)
+        assert ("secure" in _cookie_lines(headers)["fbs_csrf"]) is secure
+
+
 def test_removing_a_user_or_changing_the_password_revokes_the_cookies(direct_server):
     srv = direct_server
     a = _form_login(srv.base, OTHER_USER, OTHER_PASSWORD)
@@ -614,3 +646,402 @@ def test_removing_a_user_or_changing_the_password_revokes_the_cookies(direct_ser
     # the user removed
     srv.users.write_text(json.dumps({USER: PASSWORD}))
     assert not _logged_in(srv.base, b)
+
+
+# ---- issue 42: giant websocket messages ------------------------------------------------------
+
+
+def _rss_mb(pid: int) -> float:
+    for line in _read(f"/proc/{pid}/status").decode().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024
+    return float("nan")
+
+
+def _raw_websocket(server, cookie: str):
+    """A websocket of the app opened by hand (a socket: frames of any declared size)."""
+    import socket
+
+    from bokeh.util.token import generate_jwt_token, generate_session_id
+
+    token = generate_jwt_token(generate_session_id(), signed=False)
+    key = base64.b64encode(os.urandom(16)).decode()
+    s = socket.create_connection(("127.0.0.1", server.port), timeout=30)
+    s.sendall(
+        (
+            f"GET /fbsapp/ws HTTP/1.1\r\nHost: 127.0.0.1:{server.port}\r\n"
+            "Upgrade: websocket\r\nConnection: Upgrade\r\n"
+            f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n"
+            f"Sec-WebSocket-Protocol: bokeh, {token}\r\n"
+            f"Origin: http://127.0.0.1:{server.port}\r\nCookie: {cookie}\r\n\r\n"
+        ).encode()
+    )
+    head = b""
+    while b"\r\n\r\n" not in head:
+        chunk = s.recv(4096)
+        assert chunk, head
+        head += chunk
+    assert head.startswith(b"HTTP/1.1 101"), head[:200]
+    return s
+
+
+def _frame_header(opcode: int, length: int, mask: bytes) -> bytes:
+    import struct
+
+    return struct.pack("!BBQ", 0x80 | opcode, 0x80 | 127, length) + mask
+
+
+def _send_until_closed(s, chunks, deadline_s: float) -> int:
+    """Send ``chunks`` until the server closes the connection; bytes sent."""
+    sent = 0
+    t0 = time.monotonic()
+    try:
+        for chunk in chunks:
+            s.sendall(chunk)
+            sent += len(chunk)
+            if time.monotonic() - t0 > deadline_s:
+                break
+    except OSError:  # closed by the server (reset or broken pipe)
+        pass
+    return sent
+
+
+def _masked(payload: bytes, mask: bytes) -> bytes:
+    import numpy as np
+
+    m = np.frombuffer(mask * (len(payload) // 4), dtype=np.uint8)
+    return (np.frombuffer(payload, dtype=np.uint8) ^ m).tobytes()
+
+
+def test_a_frame_declaring_150_mb_is_refused_before_it_is_read(server):
+    """A websocket frame whose header declares 150 MB (a fake upload above the largest a
+    file may need) closes the connection before its payload is read: the server's memory
+    does not grow by it (it took 0.98 -> 2.2 GB), the refusal is logged with the client's
+    address, and another session works."""
+    import threading
+
+    cookie = _login_cookies()
+    size, chunk = 150_000_000, 1 << 20
+    mask = os.urandom(4)
+    payload = _masked(b"a" * chunk, mask)
+    rss0 = _rss_mb(server.proc.pid)
+    peak = [rss0]
+    stop = threading.Event()
+
+    def sample():
+        while not stop.wait(0.02):
+            peak[0] = max(peak[0], _rss_mb(server.proc.pid))
+
+    log0 = len(server.log())
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
+    s = _raw_websocket(server, cookie)
+    try:
+        chunks = [_frame_header(0x1, size, mask)] + [payload] * (size // chunk)
+        chunks.append(payload[: size % chunk])
+        sent = _send_until_closed(s, chunks, 120)
+        time.sleep(1.0)  # (the peak of what the server does with what it read)
+    finally:
+        s.close()
+        stop.set()
+        sampler.join()
+    assert peak[0] - rss0 < 100, f"server memory {rss0:.0f} -> {peak[0]:.0f} MB"
+    assert sent < 50_000_000, f"{sent:,} bytes of the frame were sent and read"
+    mark = "websocket of 127.0.0.1 closed:"
+    wait_for(lambda: mark in server.log()[log0:], 30, what="the log line")
+    line = next(ln for ln in server.log()[log0:].splitlines() if mark in ln)
+    assert "declared above the limit" in line, line
+    _, document = run_async(websocket_session(server.port, "fbsapp", cookie))
+    assert "confidential-model-marker" in document and server.alive()
+
+
+def test_a_bokeh_message_of_many_buffers_is_bounded_in_all(server):
+    """A Bokeh message is a header, metadata, content and the buffers its header announces,
+    each a websocket message of its own: buffers each under the size limit but above it in
+    all (4 x 50 MB) close the connection with a logged reason once their sum is above."""
+    import json as _json
+
+    cookie = _login_cookies()
+    mask = os.urandom(4)
+
+    def text(obj) -> bytes:
+        raw = _json.dumps(obj).encode()
+        raw += b" " * (-len(raw) % 4)
+        return _frame_header(0x1, len(raw), mask) + _masked(raw, mask)
+
+    buffer = 50_000_000
+    block = _masked(b"\0" * (1 << 20), mask)
+    chunks = [text({"msgid": "m1", "msgtype": "PATCH-DOC", "num_buffers": 4}), text({}), text({})]
+    for k in range(4):
+        chunks.append(text({"id": f"b{k}"}))
+        chunks.append(_frame_header(0x2, buffer, mask))
+        chunks += [block] * (buffer >> 20)
+        chunks.append(_masked(b"\0" * (buffer - (buffer >> 20 << 20)), mask))
+    log0 = len(server.log())
+    s = _raw_websocket(server, cookie)
+    try:
+        _send_until_closed(s, chunks, 120)
+    finally:
+        s.close()
+    wait_for(lambda: "a Bokeh message of more than" in server.log()[log0:], 60, what="the log")
+    _, document = run_async(websocket_session(server.port, "fbsapp", cookie))
+    assert "confidential-model-marker" in document and server.alive()
+
+
+# ---- issue 42: connections held open (slowloris) ---------------------------------------------
+
+#: The start of a request whose headers never end.
+PARTIAL = b"GET /liveness HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: "
+
+
+def _held(source: str, port: int, n: int) -> list:
+    """``n`` connections from the loopback address ``source``, each with a partial head."""
+    import socket
+
+    out = []
+    for _ in range(n):
+        s = socket.socket()
+        s.bind((source, 0))
+        s.settimeout(30)
+        s.connect(("127.0.0.1", port))
+        try:
+            s.sendall(PARTIAL)
+        except OSError:  # refused and closed at once
+            pass
+        out.append(s)
+    return out
+
+
+def _answer(s, timeout_s: float) -> bytes | None:
+    """What the server sent before closing ``s`` (b"" for a plain close), or None if the
+    connection is still open after ``timeout_s``."""
+    s.settimeout(timeout_s)
+    data = b""
+    try:
+        while True:
+            chunk = s.recv(4096)
+            if not chunk:
+                return data
+            data += chunk
+    except TimeoutError:
+        return None
+    except OSError:  # reset
+        return data
+
+
+def test_connections_that_never_finish_their_headers_are_capped_and_closed(tmp_path):
+    """Slowloris: connections that never finish their headers stayed open for ever. Now a
+    client holds at most FBS_MAX_CONNECTIONS_PER_CLIENT, all clients FBS_MAX_CONNECTIONS;
+    beyond, a connection is answered 503 and closed at once (logged once per interval);
+    and the server closes the held ones FBS_HEADER_TIMEOUT_S after they opened."""
+    srv = Server(
+        tmp_path,
+        "import panel as pn\npn.pane.Markdown('a page').servable()\n",
+        {
+            "FBS_MAX_CONNECTIONS_PER_CLIENT": "20",
+            "FBS_MAX_CONNECTIONS": "30",
+            "FBS_HEADER_TIMEOUT_S": "8",
+        },
+    )
+    held: list = []
+    try:
+        srv.started(120)
+        log0 = len(srv.log())
+        t0 = time.monotonic()
+        a = _held("127.0.0.2", srv.port, 25)  # 5 above the cap of a client
+        b = _held("127.0.0.3", srv.port, 15)  # 5 above the cap of all (30)
+        held = a + b
+        import select
+
+        def closed():  # the connections the server closed so far
+            return [k for k, s in enumerate(held) if select.select([s], [], [], 0)[0]]
+
+        wait_for(lambda: len(closed()) >= 10, 6, what="10 refusals")
+        refused = closed()
+        answers = {k: _answer(held[k], 5) for k in refused}
+        assert refused == [*range(20, 25), *range(35, 40)], answers
+        assert all(answers[k].startswith(b"HTTP/1.1 503") for k in refused), answers
+        # the held ones are closed by the server once their header deadline is over
+        late = [_answer(s, 60) for k, s in enumerate(held) if k not in refused]
+        assert all(x == b"" for x in late), late
+        assert time.monotonic() - t0 < 8 + 30
+        status, _, _ = get(urllib.request.build_opener(), srv.base + "/liveness")
+        assert status == 200
+        new = srv.log()[log0:]
+        assert "Traceback" not in new
+        per_client = new.count("connections refused: client 127.0.0.2 holds 20")
+        in_all = new.count("connections refused: 30 open")
+        assert per_client == 1 and in_all == 1, new[-3000:]
+    finally:
+        for s in held:
+            s.close()
+        srv.stop()
+
+
+def test_out_of_file_descriptors_the_server_pauses_accepting_quietly(tmp_path):
+    """Near the open-file limit ``accept()`` failed with EMFILE in a busy loop (90,424
+    tracebacks in 25 s). The server's limit is lowered under it here (``prlimit``), then
+    more connections come (from several addresses: no cap of a client is reached) than
+    descriptors are left: a few log lines, no traceback, and once they close the server
+    answers again."""
+    import resource
+
+    srv = Server(tmp_path, "import panel as pn\npn.pane.Markdown('a page').servable()\n", {})
+    held: list = []
+    try:
+        srv.started(120)
+        fds = len(os.listdir(f"/proc/{srv.proc.pid}/fd"))
+        resource.prlimit(srv.proc.pid, resource.RLIMIT_NOFILE, (fds + 20, fds + 20))
+        log0 = len(srv.log())
+        for k in range(4):
+            held += _held(f"127.0.0.{k + 2}", srv.port, 15)  # 60 > 20 descriptors left
+        time.sleep(3.0)  # the attack goes on (what the log gets meanwhile is the point)
+        new = srv.log()[log0:]
+        assert "Traceback" not in new and new.count("\n") < 20, new[-3000:]
+        assert "no file descriptor left" in new
+        for s in held:
+            s.close()
+        wait_for(
+            lambda: get(urllib.request.build_opener(), srv.base + "/liveness")[0] == 200,
+            60,
+            what="the server answering again",
+        )
+    finally:
+        for s in held:
+            s.close()
+        srv.stop()
+
+
+# ---- issue 42: page builds without a websocket ----------------------------------------------
+
+#: A page that takes 0.3 s of the event loop to build (as a page of the dashboard does
+#: more) and counts its builds.
+SLOW_PAGE = """
+import time
+from pathlib import Path
+import panel as pn
+
+count = Path(__file__).with_name("builds.txt")
+count.write_text(str(int(count.read_text() or 0) + 1) if count.exists() else "1")
+time.sleep(0.3)
+pn.pane.Markdown("# slow-page-marker").servable()
+"""
+
+
+def test_page_builds_are_bounded_per_user(tmp_path):
+    """A logged-in user reloading the page in a loop (no websocket) built a page on the
+    event loop each time. Now each login has a budget of event-loop time for page builds
+    (FBS_PAGE_BUILD_BURST_S_PER_USER at once, FBS_PAGE_BUILD_SHARE_PER_USER per second):
+    beyond, 429 with Retry-After and a page that reloads itself; another user still gets
+    pages, and opening the pages one asks for (their websockets) gives the charge back;
+    one log line per interval."""
+    srv = Server(
+        tmp_path,
+        SLOW_PAGE,
+        {
+            "FBS_BASIC_AUTH": f"{USER}:{PASSWORD},{OTHER_USER}:{OTHER_PASSWORD}",
+            "FBS_COOKIE_SECRET": SECRET,
+            "FBS_PAGE_BUILD_SHARE_PER_USER": "0.1",
+            "FBS_PAGE_BUILD_BURST_S_PER_USER": "1",
+        },
+    )
+    try:
+        srv.started(120)
+        log0 = len(srv.log())
+        cookie = _login_cookies()
+        opener = urllib.request.build_opener(NoRedirect)
+        builds0 = _builds(srv)
+        statuses, retry, t0 = [], [], time.monotonic()
+        while time.monotonic() - t0 < 6.0:
+            status, headers, body = get(opener, srv.base + "/fbsapp", headers={"Cookie": cookie})
+            statuses.append(status)
+            if status == 429:
+                retry.append(int(headers["Retry-After"]))
+                assert "opens by itself" in body and "render_items" not in body
+        secs = time.monotonic() - t0
+        built = _builds(srv) - builds0
+        # at most the burst (1 s) and 0.1 s per second of 0.3 s builds, and one more (the
+        # build that spends the budget is charged after it)
+        assert built <= (1 + 0.1 * secs) / 0.3 + 1, (built, statuses)
+        assert 429 in statuses and min(retry) >= 1, statuses
+        assert statuses.count(200) == built
+        # another user is not held back, even opening pages in a row: opening a page (its
+        # websocket) gives its charge back; the budget bounds pages built and never used
+        other = _login_cookies(user=OTHER_USER, password=OTHER_PASSWORD)
+        for _ in range(8):
+            status, _, body = get(opener, srv.base + "/fbsapp", headers={"Cookie": other})
+            token = re.search(r'"token":\s*"([^"]+)"', body)
+            assert status == 200 and token, status
+            _, document = run_async(websocket_session(srv.port, "fbsapp", other, token[1]))
+            assert "slow-page-marker" in document
+        new = srv.log()[log0:]
+        assert new.count(f"page builds refused: 'user {USER}'") == 1, new[-3000:]
+        assert "Traceback" not in new
+    finally:
+        srv.stop()
+
+
+def test_page_build_budgets_per_user_and_in_all():
+    """The budgets on their own (a clock of the test's): a user's burst, its refill, and the
+    budget of all users refusing a user whose own budget is left."""
+    import page_limits
+
+    clock = _Clock()
+    builds = page_limits.PageBuilds(
+        user_share=0.2, user_burst_s=2.0, total_share=0.5, total_burst_s=3.0, clock=clock
+    )
+    assert builds.check("a") is None
+    builds.charge("a", 1.5)
+    assert builds.check("a") is None  # 0.5 s left
+    builds.charge("a", 1.0)  # -0.5 s: refilled to above 0 in 2.5 s
+    kind, wait = builds.check("a")
+    assert kind == "user" and wait == pytest.approx(2.5, abs=0.01)
+    assert builds.check("b") is None  # the total: 3 - 2.5 = 0.5 s left
+    builds.charge("b", 1.0)  # total -0.5 s: above 0 again in 1 s
+    kind, wait = builds.check("c")
+    assert kind == "all" and wait == pytest.approx(1.0, abs=0.01)
+    clock.t += 1.01
+    assert builds.check("c") is None
+    level = builds.users["a"].update(clock.t)
+    assert builds.refund("a") == 1.5  # a's first page opened: its charge back
+    assert builds.users["a"].level == pytest.approx(level + 1.5)
+    assert builds.refund("a") == 1.0 and builds.refund("a") == 0.0  # nothing more pending
+    status, retry, page = builds.wait_page("user", 2.2)
+    assert (status, retry) == (429, 3) and 'content="3"' in page
+    assert builds.wait_page("all", 0.2)[:2] == (503, 1)
+
+
+def test_connection_limits_count_open_sockets_per_client_and_in_all():
+    """The caps on their own: a closed socket no longer counts, a trusted proxy counts in
+    the total only, the total stays below the open-file limit, and the refusals of one
+    kind are logged once per interval with their count."""
+    import socket
+
+    import conn_limits
+
+    clock = _Clock()
+    quiet = conn_limits.QuietLog(10.0, clock=clock)
+    proxies = fbs_auth.parse_networks("10.0.0.9")
+    limits = conn_limits.ConnectionLimits(2, 4, exempt=proxies, fd_limit=10_000, quiet=quiet)
+    assert conn_limits.ConnectionLimits(2, 4000, fd_limit=1000).total == 1000 - 256
+    pairs = [socket.socketpair() for _ in range(8)]
+    try:
+        a, b, c, d, e, f, g, h = (p[0] for p in pairs)
+        assert limits.admit(a, ("10.0.0.1", 1)) and limits.admit(b, ("10.0.0.1", 2))
+        assert not limits.admit(c, ("10.0.0.1", 3)) and c.fileno() == -1  # refused, closed
+        assert pairs[2][1].recv(100).startswith(b"HTTP/1.1 503")
+        a.close()  # the server closed one: room again
+        assert limits.admit(d, ("10.0.0.1", 4)) and limits.open_count("10.0.0.1") == 2
+        assert limits.admit(e, ("10.0.0.9", 5)) and limits.admit(f, ("10.0.0.9", 6))
+        assert limits.open_count() == 4
+        assert not limits.admit(g, ("10.0.0.9", 7))  # the proxy: the total (4) is reached
+        clock.t += 11
+        assert not limits.admit(h, ("10.0.0.2", 8))
+        assert limits.refused == 3
+    finally:
+        for p in pairs:
+            p[0].close()
+            p[1].close()
+    assert quiet.note("k", "x") and not quiet.note("k", "x") and not quiet.note("k", "x")
+    clock.t += 10
+    assert quiet.note("k", "x")

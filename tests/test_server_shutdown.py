@@ -121,3 +121,90 @@ def test_stop_signal_ends_the_process_group_of_a_child(tmp_path):
         srv.stop()
         if grandchild is not None and running(grandchild):
             os.kill(grandchild, signal.SIGKILL)
+
+
+# a page keeps the report process busy drawing PDF reports, as a tab asking for reports in a
+# loop does; its processes carry a marker in their environment (inherited by every process
+# the server starts after the page set it)
+REPORT_APP = """
+import os, threading
+from pathlib import Path
+import panel as pn
+
+here = Path(__file__).parent
+ctx = pn.state.curdoc.session_context
+if ctx is not None and ctx.server_context is not None and not (here / "started").exists():
+    (here / "started").touch()
+    os.environ["FBS_TEST_REPORT_MARK"] = str(here)
+    from app.report import ReportData
+    from app.runtime import reports
+
+    SETTINGS = dict(harmonic=1, n_modes=20, dof="z", coupling="6dof", threshold=20.0,
+                    f_max=40.0, map_mode="selected DOF", noise=10.0, target="both",
+                    frequency_dependent=False, rounds=300, seed=3, single_round=7,
+                    percentile=90)
+
+    # the loop outlives the page's session, whose end clears this module's globals
+    def reports_in_a_loop(here=here, reports=reports, ReportData=ReportData, SETTINGS=SETTINGS):
+        k = 0
+        while True:
+            try:
+                reports.draw_apart("pdf", ReportData(settings=SETTINGS))
+            except Exception as exc:  # the server stopping: no more reports
+                (here / "ended").write_text(repr(exc))
+                return
+            k += 1
+            (here / f"drawn-{k}").touch()
+
+    threading.Thread(target=reports_in_a_loop, daemon=True).start()
+pn.Column("# report page").servable()
+"""
+
+
+def _marked(mark: str) -> list[int]:
+    """PIDs of the processes whose environment holds ``FBS_TEST_REPORT_MARK=mark``."""
+    import os
+
+    want = f"FBS_TEST_REPORT_MARK={mark}".encode()
+    out = []
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open(f"/proc/{d}/environ", "rb") as f:
+                if want in f.read().split(b"\0"):
+                    out.append(int(d))
+        except OSError:
+            continue
+    return out
+
+
+def test_stop_signal_while_a_report_is_drawn_leaves_no_report_process(tmp_path):
+    """SIGTERM while the report process draws: the server ends it and starts no other
+    (before: the pool broke when its process was stopped, and the report thread started a
+    new process after the server had listed its children: an orphan)."""
+    import os
+
+    srv = Server(tmp_path, REPORT_APP, {}, name="reports").started()
+    mark = str(tmp_path)
+    try:
+        status, _, body = get(urllib.request.build_opener(), srv.base + "/reports")
+        assert status == 200 and "render_items" in body
+        wait_for(lambda: list(tmp_path.glob("drawn-*")), 180, what="a report drawn")
+        wait_for(lambda: _marked(mark), 30, what="the report process")  # drawing the next
+        srv.proc.send_signal(signal.SIGTERM)
+        srv.proc.wait(DOCKER_STOP_GRACE_S)
+        left = []
+
+        def none_left():
+            left[:] = [p for p in _marked(mark) if running(p)]
+            return not left
+
+        wait_for(none_left, 10, what="no report process left")
+    finally:
+        srv.stop()
+        for pid in _marked(mark):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass

@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+import scipy.linalg
 
 import fbs_core
 import fbs_core.variants as fv
@@ -288,7 +289,10 @@ def test_nominal_study_of_the_reference_models_is_the_shipped_prediction():
     fbs_core.bushing_response's."""
     study = fv.corridor_study(["knuckle_mass", "body_bushing_loss"], n=4, method="lhs", seed=1)
     np.testing.assert_array_equal(study.nominal[4], fbs_core.bushing_response(4).data[:, :, 0])
-    assert set(study.tire_keys) == {fv.tire_key(DEFAULT_PARAMETERS, reference_tire().speeds)}
+    # one tire for every row: the base's (the key of the points the harmonic reads)
+    speeds = fv.VariantSettings().tire_speeds()
+    assert set(study.tire_keys) == {fv.tire_key(DEFAULT_PARAMETERS, speeds)}
+    assert speeds == tuple(float(v) for v in reference_tire().speeds if v >= 27.5)
 
 
 @pytest.mark.parametrize("name", [n for n in fv.__all__ if callable(getattr(fv, n))])
@@ -311,3 +315,80 @@ def test_public_callables_are_documented(name):
         and p not in doc
     ]
     assert not missing, f"fbs_core.variants.{name}: parameters {missing} not in its docstring"
+
+
+# ---- the rebuild's cost: fewer points, real arithmetic, workers ---------------------------
+
+
+def test_left_eigenvectors_in_real_arithmetic_are_the_inverse_of_the_right_ones():
+    from fbs_core.tire.modes import _inverse_of_eigenvectors
+    from fbs_core.tire.ring import build_tire_system
+
+    rng = np.random.default_rng(3)
+    s = build_tire_system(50.0, CHEAP)
+    n = s.M.shape[0]
+    keep = np.flatnonzero(np.any(s.M != 0, axis=0))
+    nm = keep.size
+    A = np.zeros((n + nm, n + nm))
+    A[:n, n:] = np.eye(n)[:, keep]
+    A[n:, :n] = rng.standard_normal((nm, n))  # any real matrix: real and complex eigenvalues
+    A[n:, n:] = rng.standard_normal((nm, nm))
+    for B in (A, rng.standard_normal((40, 40))):
+        lam, vr = scipy.linalg.eig(B)
+        assert np.any(lam.imag == 0) and np.any(lam.imag != 0)
+        W = _inverse_of_eigenvectors(lam, vr)
+        truth = np.linalg.solve(vr, np.eye(lam.size))  # the complex inverse
+        assert np.abs(W @ vr - np.eye(lam.size)).max() < 1e-9
+        assert np.abs(W - truth).max() < 1e-9 * np.abs(truth).max()
+
+
+def test_needed_speeds_keep_the_stencils_of_the_lines():
+    sp = tuple(10.0 + 5 * i for i in range(23))  # 10 .. 120
+    assert fv.needed_speeds(sp, 30.0, 120.0) == sp[3:]  # 25 .. 120: the cubic stencil of 30
+    assert fv.needed_speeds(sp, 10.0, 120.0) == sp
+    assert fv.needed_speeds(sp, 31.0, 44.0) == sp[3:9]  # 25 .. 50
+    assert fv.needed_speeds(sp, 12.0, 118.0) == sp  # first and last interval: linear
+    assert fv.needed_speeds(sp, 116.0, 118.0) == sp[-3:]  # last interval: linear, 110 kept
+    assert fv.needed_speeds(SPEEDS, 30.0, 120.0) == SPEEDS
+
+
+def test_a_tire_rebuilt_at_the_needed_points_responds_as_one_built_at_all():
+    from fbs_core.prediction import bushing_response
+    from fbs_core.tire.build import build_modal_model
+
+    sp = tuple(10.0 + 10 * i for i in range(12))  # 10 .. 120: 10 km/h is not needed
+    s = fv.VariantSettings(harmonics=(4, 7), speeds=sp, tire=CHEAP)
+    assert s.tire_speeds() == sp[1:]
+    values = {"inflation_pressure": 2.0e5, "tread_mass": 6.0}
+    got = fv.variant_responses(values, s, fv.TireCache())
+    tp, cp = fv.apply_values(values, CHEAP, s.chassis)
+    whole = build_modal_model(tp, speeds=sp)  # all the points, as before
+    for k in s.harmonics:
+        ref = bushing_response(k, None, s.freq(k), tire=whole, chassis=ChassisModel(cp)).data[
+            :, :, 0
+        ]
+        np.testing.assert_allclose(got[k], ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max())
+
+
+def test_workers_and_a_dask_cluster_give_the_numbers_of_this_process():
+    from distributed import Client, LocalCluster
+
+    design = fv.sample_design(fv.ParameterSpace.from_names(["tread_mass", "knuckle_mass"]), 4)
+    here = fv.run_variants(design, SETTINGS, cache=fv.TireCache())
+    seen: list[tuple[int, int]] = []
+    pooled = fv.run_variants(
+        design, SETTINGS, processes=2, progress=lambda d, t: seen.append((d, t))
+    )
+    assert seen[0] == (0, design.n) and seen[-1] == (design.n, design.n)
+    assert [d for d, _ in seen] == sorted(d for d, _ in seen)
+    with (
+        LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address="127.0.0.1:0"
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        on_dask = fv.run_variants(design, SETTINGS, client=client)
+    for other in (pooled, on_dask):
+        assert other.tire_keys == here.tire_keys
+        np.testing.assert_allclose(other.responses[4], here.responses[4], rtol=1e-12, atol=0)
+        np.testing.assert_array_equal(other.nominal[4], here.nominal[4])

@@ -104,10 +104,15 @@ class Recorded:
 
 def served_location(monkeypatch, query: str) -> Recorded:
     """Make ``pn.state.location`` a Location holding ``query`` (as in a served session) and
-    record every ``Location.sync`` made while the page is built."""
+    record every object the page reads from its link while it is built (``Location.sync``
+    or the page's own reader, ``app.page.titles.read_link``)."""
+    import app.main
+    from app.page import titles
+
     loc = Location(search="?" + query if query else "")
     rec = Recorded()
     original = Location.sync
+    original_read = titles.read_link
 
     def sync(self, parameterized, parameters=None, on_error=None):
         names = parameters or [p for p in parameterized.param if p != "name"]
@@ -116,7 +121,12 @@ def served_location(monkeypatch, query: str) -> Recorded:
         rec.synced.append((parameterized, dict(names)))
         return original(self, parameterized, parameters, on_error)
 
+    def read_link(loc_, obj, keys, on_error=None):
+        rec.synced.append((obj, dict(keys)))
+        return original_read(loc_, obj, keys, on_error)
+
     monkeypatch.setattr(Location, "sync", sync)
+    monkeypatch.setattr(app.main, "read_link", read_link)
     monkeypatch.setattr(type(pn.state), "location", property(lambda self: loc))
     return rec
 

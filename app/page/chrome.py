@@ -1,5 +1,6 @@
-"""The page's chrome: the report downloads, the help page, the data badge and the notice of
-a shared link that needs uploaded data (the reports themselves: :mod:`app.report`)."""
+"""The page's chrome: the report downloads, the help page, the busy indicator, the data
+badge and the notice of a shared link that needs uploaded data (the reports themselves:
+:mod:`app.report`)."""
 
 from __future__ import annotations
 
@@ -14,9 +15,12 @@ import panel as pn
 
 from ..report import Provenance, ReportData
 from ..runtime import reports
+from ..runtime.activity import ACTIVITIES
+from ..runtime.draw import on_document, served_document
 
 __all__ = [
     "HELP_TEXT",
+    "busy_indicator",
     "help_page",
     "report_buttons",
     "data_badge",
@@ -39,13 +43,52 @@ def help_page(**kw: Any) -> pn.pane.Markdown:
     return pn.pane.Markdown(HELP_TEXT, **kw)
 
 
-def report_buttons(report: Callable[[], ReportData]) -> pn.Row:
+#: The busy indicator's spinner (its own style: the pane's shadow root has no Bootstrap).
+_SPINNER = (
+    "<style>@keyframes fbs-spin{to{transform:rotate(360deg)}}</style>"
+    '<span aria-hidden="true" style="display:inline-block;width:0.9em;height:0.9em;'
+    "border:2px solid currentColor;border-right-color:transparent;border-radius:50%;"
+    'animation:fbs-spin 0.8s linear infinite;vertical-align:-0.1em;margin-right:6px"></span>'
+)
+
+
+def busy_html(text: str) -> str:
+    """The indicator's HTML for ``text`` (escaped: never markup)."""
+    if not text:
+        return ""
+    return f'<div role="status" aria-live="polite">{_SPINNER}{html.escape(text)} ...</div>'
+
+
+def busy_indicator(results: Any) -> pn.pane.HTML:
+    """What the session is busy with while long work runs (``results.working``, written
+    by :mod:`app.runtime.activity`): a spinner and e.g. "Computing the coupled response of
+    the whole car (12 s)"; hidden otherwise."""
+    doc = served_document()
+    pane = pn.pane.HTML(
+        busy_html(results.working),
+        visible=bool(results.working),
+        css_classes=["busy-indicator"],
+        margin=(8, 10),
+        styles={"color": "#664d03", "font-weight": "600"},
+        sizing_mode="stretch_width",
+    )
+
+    def show(*_: Any) -> None:
+        text = results.working
+        on_document(doc, lambda: pane.param.update(object=busy_html(text), visible=bool(text)))
+
+    results.param.watch(show, "working")
+    return pane
+
+
+def report_buttons(report: Callable[[], ReportData], owner: Any = None) -> pn.Row:
     """Two downloads, the report as a self-contained HTML file and as PDF, each built from
     ``report()`` when clicked (the file name says what it shows).
 
     When served, a report is drawn on the report thread (:mod:`app.runtime.reports`) while the
     click waits on the session's event loop; a session has at most one report of each
-    kind in the making (a second click gets the same file).
+    kind in the making (a second click gets the same file). While it is made, ``owner``'s
+    busy indicator says so (:func:`busy_indicator`).
     """
     doc = pn.state.curdoc
     served = doc is not None and doc.session_context is not None
@@ -84,11 +127,15 @@ def report_buttons(report: Callable[[], ReportData]) -> pn.Row:
                         pn.state.curdoc = None
                     return reports.draw_apart(kind, data)
 
-                making[:] = [asyncio.wrap_future(reports.REPORTS.submit(in_session))]
+                # cancelled when the tab closes before its turn: report() would then run
+                # on a page whose names Bokeh has cleared (NameError)
+                making[:] = [reports.submit_for_session(doc, in_session)]
             btn.loading = True
+            token = ACTIVITIES.begin(owner, f"Making the {kind.upper()} report")
             try:
                 name, content = await asyncio.shield(making[0])
             finally:
+                ACTIVITIES.end(token)
                 btn.loading = False
             return deliver(name, content)
 

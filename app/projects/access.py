@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from typing import Any, TypeVar
+from typing import Any
 
 from .records import FULL_ONLY, Audience, Candidate, Note, ProjectInfo, User, View
 
@@ -45,8 +45,6 @@ ANOTHER_CANDIDATE = "another candidate"
 
 #: Digests of models every user may see by name: the shipped reference tire.
 PUBLIC_DIGESTS = frozenset({"reference"})
-
-T = TypeVar("T")
 
 
 def supplier_key(name: str) -> str:
@@ -163,7 +161,7 @@ def _blank(value: Any) -> Any:
     return None
 
 
-def redact_ranking(
+def redact_ranking[T](
     user: User,
     project: ProjectInfo,
     candidates: Iterable[Candidate],

@@ -23,6 +23,7 @@ from .data import SETTING_KEYS, ExtraSection, ReportData, ReportError, present
 from .method import EQUATIONS, METHOD_PARAGRAPHS, THESIS, Equation
 from .summary import Summary, report_summary, suggested_n
 from .titles import (
+    PLAIN_TEXT,
     TitleBlock,
     coupling_description,
     file_stem,
@@ -315,7 +316,14 @@ def _band_section(snap: ReportData) -> Section:
         f"times (eqs. 5.2-5.4). Shaded: minimum to maximum over the rounds and the {w} % "
         f"central band ({lo:g}-{hi:g} % percentiles); dark line: the unpolluted reference; "
         f"orange: round #{s['single_round']}. A large last change of a band edge means R is "
-        "too small.",
+        "too small."
+        + (
+            f" The band is the N = {s['n_modes']} model's, a {PLAIN_TEXT} (the page's "
+            "residual compensation acts on the coupled response, the error map and the "
+            "suggested N)."
+            if s.get("residual")
+            else ""
+        ),
     )
     tables = (
         Table(f"Levels at the reference peak, {f_i}", ("curve", "level"), rows),

@@ -15,7 +15,7 @@ import datetime as _dt
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, TypeVar
+from typing import Any
 
 from numpy.typing import ArrayLike
 
@@ -103,10 +103,7 @@ class ReportError(FBSError):
     """Report data that cannot be reported: missing or invalid settings, mismatched results."""
 
 
-_T = TypeVar("_T")
-
-
-def present(value: _T | None, what: str) -> _T:
+def present[T](value: T | None, what: str) -> T:
     """``value``, which a report part needs: a :class:`ReportError` naming ``what`` if None."""
     if value is None:
         raise ReportError(f"the report data hold no {what}")

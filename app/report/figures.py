@@ -15,7 +15,7 @@ from __future__ import annotations
 import io
 import threading
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any, TypeAlias
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import numpy as np
@@ -24,6 +24,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.text import Text
 from numpy.typing import ArrayLike
 
 from fbs_core.units import frf_unit, output_kind
@@ -37,9 +38,9 @@ if TYPE_CHECKING:
     from .content import FigureBlock
 
 #: A plot's region of a figure: ``(left, bottom, width, height)`` in figure fraction.
-Rect: TypeAlias = tuple[float, float, float, float]
+type Rect = tuple[float, float, float, float]
 #: What every ``draw_*`` returns: ``draw(fig, rect)`` adds the plot's axes inside ``rect``.
-Draw: TypeAlias = Callable[[Figure, Rect], None]
+type Draw = Callable[[Figure, Rect], None]
 
 __all__ = [
     "COLORS",
@@ -64,6 +65,40 @@ COLORS = {
 }
 _SPEED_COLORS = ("#74c0fc", "#1c7ed6", "#0b3d91")
 _RENDER_LOCK = threading.Lock()
+
+#: The ``gid`` of a text meant as mathtext (the method's equations). Every other text of a
+#: report figure is shown as written (see :func:`literal_text`).
+MATH_GID = "mathtext"
+
+
+def drawing_settings() -> Any:
+    """matplotlib's settings under which every report figure is saved: no LaTeX run on
+    any text, glyphs as paths in SVG, fonts embedded as TrueType in PDF."""
+    return matplotlib.rc_context({"text.usetex": False, "svg.fonttype": "path", "pdf.fonttype": 42})
+
+
+def literal_text(fig: Figure) -> Figure:
+    """Every text of ``fig`` but the equations (:data:`MATH_GID`) and the axes' own tick
+    labels shown as written (``parse_math`` off), and ``fig`` returned.
+
+    File names, DOF labels and case names come from users: matplotlib would parse a
+    ``$...$`` in them as mathtext (an unknown command raises ValueError, a deep nest a
+    RecursionError, ``$x$`` silently becomes an italic x). Tick labels and offsets are
+    written by matplotlib's formatters (no user text) and keep their mathtext (``10^2``).
+    Calling it again changes nothing.
+    """
+    own: set[int] = set()
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            own.add(id(axis.offsetText))
+            for tick in (*axis.get_major_ticks(), *axis.get_minor_ticks()):
+                own.update((id(tick.label1), id(tick.label2)))
+    for t in fig.findobj(Text):
+        if t.get_gid() != MATH_GID and id(t) not in own:
+            t.set_parse_math(False)
+    return fig
+
+
 #: Font sizes (pt) of tick labels, axis labels and legends.
 TICK_PT, LABEL_PT, LEGEND_PT = 9.0, 10.0, 9.0
 _DASH: dict[str, Any] = {"solid": "-", "dashed": (0, (6, 3)), "dotted": (0, (1.5, 2.5))}
@@ -409,6 +444,6 @@ def render(fig: Figure, fmt: str, dpi: float = 110) -> bytes:
         raise ValueError(f"unknown figure format {fmt!r}; allowed: svg, png, pdf")
     buf = io.BytesIO()
     meta = {"svg": {"Date": None}, "png": {}, "pdf": {"CreationDate": None}}[fmt]
-    with _RENDER_LOCK, matplotlib.rc_context({"svg.fonttype": "path", "pdf.fonttype": 42}):
-        fig.savefig(buf, format=fmt, dpi=dpi, metadata=meta)
+    with _RENDER_LOCK, drawing_settings():
+        literal_text(fig).savefig(buf, format=fmt, dpi=dpi, metadata=meta)
     return buf.getvalue()

@@ -61,7 +61,7 @@ def _svg(fig: Figure) -> str:
 @lru_cache(maxsize=16)
 def _equation_svg(mathtext: str) -> str:
     fig = Figure(figsize=(9.5, 0.45))
-    fig.text(0.005, 0.5, mathtext, fontsize=12, va="center")
+    fig.text(0.005, 0.5, mathtext, fontsize=12, va="center", gid=figures.MATH_GID)
     return _svg(fig)
 
 

@@ -11,7 +11,6 @@ import io
 import textwrap
 from typing import Any
 
-import matplotlib
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
@@ -57,7 +56,7 @@ class _Pages:
 
     def flush(self) -> None:
         if self.fig is not None:
-            self.pdf.savefig(self.fig, dpi=150)
+            self.pdf.savefig(figures.literal_text(self.fig), dpi=150)
             self.fig = None
 
     def need(self, h: float) -> Figure:
@@ -124,7 +123,7 @@ class _Pages:
         self.need(0.9)
         self.text(f"Eq. {eq.number}: {eq.name}", 9.0, weight="bold")
         self.y += 0.05
-        self.text(eq.mathtext, 10.5)
+        self.text(eq.mathtext, 10.5, gid=figures.MATH_GID)
         self.y += 0.06
         self.para(eq.meaning, 8.5)
 
@@ -134,7 +133,7 @@ def render_pdf(rep: Report) -> bytes:
     buf = io.BytesIO()
     with (
         figures._RENDER_LOCK,
-        matplotlib.rc_context({"pdf.fonttype": 42}),
+        figures.drawing_settings(),
         PdfPages(buf, metadata={"Title": rep.title, "Creator": "tire-fbs"}) as pdf,
     ):
         pages = _Pages(pdf, rep.stem)

@@ -105,6 +105,31 @@ def _peaks(snap: ReportData) -> list[Any]:
     return [_Line(float(tr.freq[i]), float(lv[i]), i, float(h.speed_at(tr.freq[i])))]
 
 
+def _highest(snap: ReportData) -> Any:
+    """The highest level of the N-mode response over the whole band, the band's edge lines
+    included: the maximum the plot shows, by one rule for the corner and the car (a peak
+    label is a local maximum inside the band; the highest level can sit at an edge where
+    the response still rises beyond the band)."""
+    tr = snap.truncated
+    if tr is None:
+        return None
+    lv = _level_db(tr, snap.response_dof)
+    i = int(np.argmax(lv))
+    h = snap.harmonic
+
+    @dataclass(frozen=True)
+    class _Line:
+        freq: float
+        level_db: float
+        line: int
+        speed_kmh: float | None
+        edge: str
+        freqs: Any  # the lines of the curve
+
+    edge = "lower" if i == 0 else ("upper" if i == lv.size - 1 else "")
+    return _Line(float(tr.freq[i]), float(lv[i]), i, float(h.speed_at(tr.freq[i])), edge, tr.freq)
+
+
 def _line_of(freq: np.ndarray, f: float) -> int | None:
     """The grid line at frequency ``f`` (None: not on this grid)."""
     i = int(np.argmin(np.abs(np.asarray(freq, float) - f)))
@@ -169,30 +194,41 @@ def report_summary(snap: ReportData) -> Summary:
             text = "not in the error map (N off its grid, or no centre up to f_max)"
         rows.append((f"largest eq. 5.1 error of the chosen N = {s['n_modes']}{res}", text))
     peaks = _peaks(snap)
-    top = peaks[0] if peaks else None
+    top = _highest(snap)
     if top is not None:
+        where = f" (the band's {top.edge} edge)" if top.edge else ""
         rows.append(
             (
-                f"highest peak of {snap.response_dof}",
-                f"{_f(top.level_db, 2)} dB at {_f(top.freq)} Hz"
+                f"highest level of {snap.response_dof}",
+                f"{_f(top.level_db, 2)} dB at {_f(top.freq)} Hz{where}"
                 + (f", {_f(top.speed_kmh)} km/h" if top.speed_kmh is not None else ""),
             )
         )
+        if snap.peaks:
+            pk = max(snap.peaks, key=lambda p: p.level_db)
+            if _line_of(np.asarray(top.freqs), pk.freq) != top.line:
+                rows.append(
+                    (
+                        "highest labelled peak",
+                        f"{_f(pk.level_db, 2)} dB at {_f(pk.freq)} Hz"
+                        + (f", {_f(pk.speed_kmh)} km/h" if pk.speed_kmh is not None else ""),
+                    )
+                )
         bw = _band_width(snap, top.freq)
         if snap.band is None:
             band = "not computed for these settings (scatter band view)"
         elif bw is None:
-            band = "the peak is off the band's grid"
+            band = "the line is off the band's grid"
         else:
             band = (
                 f"{_f(bw[0], 2)} dB between minimum and maximum, {_f(bw[1], 2)} dB for the "
                 f"{s['percentile']} % central band (p = {s['noise']:g} %, R = {s['rounds']:,})"
             )
-        rows.append(("scatter band width at the highest peak", band))
+        rows.append(("scatter band width at the highest level", band))
         con = _contributions(snap, top.freq)
         rows.append(
             (
-                "largest contributions at the highest peak (share of the total)",
+                "largest contributions at the highest level (share of the total)",
                 con
                 if con is not None
                 else "not computed in this session (Analysis card, Contributions tab)",

@@ -81,7 +81,13 @@ RESIDUAL_VIEWS = (
 )
 
 _NOISE_EQ = {"tire": "5.2", "chassis": "5.3", "both": "5.4"}
-_NOISE_WHERE = {"tire": "the tire", "chassis": "the chassis", "both": "tire and chassis"}
+#: Where the noise is, in words (``"noise 5 % in tire and chassis"``), by noise target.
+NOISE_WHERE = {"tire": "the tire", "chassis": "the chassis", "both": "tire and chassis"}
+_NOISE_WHERE = NOISE_WHERE
+#: Views with a chosen N that residual compensation does not change: with it on, their
+#: titles say that they are plain truncations (the page's switch acts on the others).
+PLAIN_VIEWS = ("scatter-band",)
+PLAIN_TEXT = "plain truncation (residual compensation not applied to the band)"
 
 
 @dataclass(frozen=True)
@@ -218,6 +224,8 @@ def _part(snap: ReportData, view: str, part: str) -> str | None:
     if part in ("modes", "chosen"):
         text = modes_description(s["n_modes"], snap.n_modes_total)
         text += " + residual compensation" if residual else ""
+        if s.get("residual") and view in PLAIN_VIEWS:
+            text += f", {PLAIN_TEXT}"
         return "chosen " + text if part == "chosen" else text
     if part == "residual":
         return "with residual compensation" if residual else None
@@ -327,7 +335,8 @@ def compact_title(snap: ReportData, view: str) -> TitleBlock:
     if view in ("truncation-map", "eigenfrequency"):
         n = "chosen " + n
     if view not in _NO_N_VIEWS:
-        case.append(n + (" + residual" if residual else ""))
+        plain = bool(s.get("residual")) and view in PLAIN_VIEWS
+        case.append(n + (" + residual" if residual else "") + (f", {PLAIN_TEXT}" if plain else ""))
     if view in _CRITERION_VIEWS and "threshold" in s:
         case.append(f"threshold {s['threshold']:g} % to {s['f_max']:g} Hz")
     if view == "participation" and "f_max" in s:

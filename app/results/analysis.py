@@ -308,23 +308,27 @@ def campbell_result(s: Snapshot) -> Result:
     cb = ac.campbell(s.models)
     hs = [fbs_core.harmonic(int(k)) for k in cb.harmonic]
     cols: dict[str, np.ndarray] = {"speed_kmh": np.asarray(cb.speeds, float)}
+    # the modal model's tracked branches carry no direction of travel: they pass between
+    # waves at the veerings (docs/modes.md: 1 of 14 follows its wave), so their slope says
+    # nothing known about forward or backward; the waves are the Modes tab's diagram
     for j, br in enumerate(cb.branch):
-        cols[f"branch{int(br)}_{cb.direction[j]}_Hz"] = cb.freq[:, j]
+        cols[f"branch{int(br)}_Hz"] = cb.freq[:, j]
     for k, hk in enumerate(cb.harmonic):
         cols[f"order_line_h{int(hk)}_Hz"] = cb.lines[:, k]
-    branches = {}
-    for d in ("forward", "backward", "standing"):
-        idx = [j for j in range(cb.branch.size) if cb.direction[j] == d]
-        branches[d] = {
-            "xs": [np.asarray(cb.speeds, float)] * len(idx),
-            "ys": [cb.freq[:, j] for j in idx],
-            "branch": [int(cb.branch[j]) for j in idx],
+    branches = {
+        "modes": {
+            "xs": [np.asarray(cb.speeds, float)] * cb.branch.size,
+            "ys": [cb.freq[:, j] for j in range(cb.branch.size)],
+            "branch": [int(b) for b in cb.branch],
         }
+    }
     return Result(
         columns=cols,
         meta={
             "view": "Campbell diagram: tire eigenfrequencies vs speed, order lines f = v / lambda",
-            "direction": f"{cb.method} criterion (fbs_core.analysis.campbell)",
+            "direction of travel": "not shown: the modal model's branches are tracked for "
+            "the interpolation and pass between forward and backward waves at the veerings "
+            "(docs/modes.md); the Modes tab's Campbell diagram of the belt waves has them",
             "branches": f"{cb.branch.size} vibration modes below 450 Hz somewhere in the range",
             "wavelengths_m": ", ".join(
                 f"h{int(k)}: {w:g}" for k, w in zip(cb.harmonic, cb.wavelength, strict=True)
@@ -334,10 +338,11 @@ def campbell_result(s: Snapshot) -> Result:
         },
         filename=csv_name(s, "campbell"),
         caption=(
-            f"{cb.branch.size} tire modes below 450 Hz &middot; forward / backward by the "
-            f"{cb.method} of each branch &middot; order lines of the seven cases (solid inside "
-            "their speed range) &middot; **click**: pick speed and frequency (on an order line: "
-            "that harmonic)"
+            f"{cb.branch.size} tire modes below 450 Hz, the modal model's tracked branches "
+            "(no direction of travel: they pass between waves at veerings; forward and backward "
+            "waves: the **Modes** tab's belt-wave diagram) &middot; order lines of the seven "
+            "cases (solid inside their speed range) &middot; **click**: pick speed and "
+            "frequency (on an order line: that harmonic)"
         ),
         draw={
             "branches": branches,
@@ -352,7 +357,11 @@ def campbell_result(s: Snapshot) -> Result:
                 "kind": "lines",
                 "x": np.asarray(cb.speeds, float),
                 "groups": {
-                    **{f"{d} modes": branches[d]["ys"] for d in branches if branches[d]["ys"]},
+                    **(
+                        {"tire modes (tracked branches)": branches["modes"]["ys"]}
+                        if branches["modes"]["ys"]
+                        else {}
+                    ),
                     "order lines of the other cases": [
                         cb.lines[:, i] for i, k in enumerate(cb.harmonic) if int(k) != s.harmonic
                     ],

@@ -4,8 +4,9 @@ snapshot.
 Which tire modes matter (:func:`participation_result`: the ranking of the tire's stored
 mode pairs for the harmonic, the bushing DOF and the band), what the chosen one looks like
 (:func:`mode_shape_result`: the deformed belt over one period), the Campbell diagram that
-follows the belt waves (:func:`waves_result`, solved on the background worker the first
-time), the modes a case needs chosen by importance beside table 5.1's lowest ``N``
+follows the belt waves (:func:`waves_result`, solved once per tire for every session on
+a thread of its own, each waiting session told how it moves: :func:`waves_wait`), the
+modes a case needs chosen by importance beside table 5.1's lowest ``N``
 (:func:`selected_modes_result`) and the truncation of the chassis side
 (:func:`chassis_truncation_result`). The numbers are the core's (:mod:`app.modes_compute`);
 docs/modes.md derives them.
@@ -13,11 +14,13 @@ docs/modes.md derives them.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 
 import numpy as np
 
 import fbs_core
+from fbs_core.analysis import KINDS
 from fbs_core.errors import FBSError
 from fbs_core.vocabulary import percent
 
@@ -37,7 +40,7 @@ __all__ = [
     "participation_result",
     "selected_modes_result",
     "waves_result",
-    "waves_work",
+    "waves_wait",
 ]
 
 #: What each ranking measure is (CSV header, axis label).
@@ -70,8 +73,18 @@ def _band_text(band: tuple[float, float]) -> str:
 
 
 def _mode_text(p, i: int) -> str:
-    f = "slip state" if p.first_order[i] else f"{p.mode_freq[i]:.1f} Hz"
-    return f"mode {int(p.modes[i])} ({f} at {p.mode_speed[i]:.0f} km/h)"
+    if p.first_order[i]:
+        return f"mode {int(p.modes[i])} (tread {p.kind[i]}, no vibration)"
+    return f"mode {int(p.modes[i])} ({p.mode_freq[i]:.1f} Hz at {p.mode_speed[i]:.0f} km/h)"
+
+
+def _first_order_text(p, j: int, measure: str) -> str:
+    """The first-order pairs (no vibration: not ranked) with their measure, one line."""
+    parts = []
+    for i in np.flatnonzero(np.asarray(p.first_order, bool)):
+        v = percent(float(np.asarray(getattr(p, measure), float)[i, j]))
+        parts.append(f"mode {int(p.modes[i])} tread {p.kind[i]} {measure} {v:.0f} %")
+    return "; ".join(parts)
 
 
 # -- the ranking ------------------------------------------------------------------------------
@@ -83,21 +96,29 @@ def participation_result(s: Snapshot) -> Result:
         return _unavailable(s, view, "participation", f"the tire's per-mode terms: {e}")
     out = f"bushing:{s.dof}"
     j = p.dofs.index(out)
-    order = p.ranking(s.mode_rank, out)
+    # the vibration modes are ranked; the tread's first-order states (sliding, relaxation:
+    # real poles, no oscillation, in the synthesis at every N) follow, unranked
+    vib = p.ranking(s.mode_rank, out, vibration=True)
+    first = np.flatnonzero(np.asarray(p.first_order, bool))
+    order = np.concatenate([vib, first]).astype(int)
     pct = {k: percent(np.asarray(getattr(p, k), float)[order, j]) for k in MEASURES}
+    kind_code = {"vibration": 0.0, "sliding": 1.0, "relaxation": 2.0}
     cols = {
-        "rank": np.arange(1, order.size + 1, dtype=float),
+        "rank": np.concatenate(
+            [np.arange(1, vib.size + 1, dtype=float), np.full(first.size, np.nan)]
+        ),
         "mode": p.modes[order].astype(float),
         "freq_Hz": np.where(p.first_order[order], np.nan, p.mode_freq[order]),
-        "speed_kmh": np.asarray(p.mode_speed[order], float),
-        "slip_state": p.first_order[order].astype(float),
+        "speed_kmh": np.where(p.first_order[order], np.nan, p.mode_speed[order]),
+        "slip_state": np.array([kind_code[p.kind[i]] for i in order]),
         **{f"{k}_pct": v for k, v in pct.items()},
     }
-    top = order[:TOP_BARS]
-    value = pct[s.mode_rank][:TOP_BARS]
+    top = vib[:TOP_BARS]
+    value = pct[s.mode_rank][: top.size]
     if s.mode_rank == "share":
         value = np.abs(value)
     band = _band_text(p.band)
+    unranked = _first_order_text(p, j, s.mode_rank)
     meta = {
         "view": view,
         "harmonic": s.harmonic,
@@ -107,7 +128,14 @@ def participation_result(s: Snapshot) -> Result:
         "ranked by": MEASURES[s.mode_rank],
         "mode": "stored mode pair of the tire model (members 2m and 2m + 1; docs/modes.md)",
         "share": "sum Re(c_r conj(v_e*)) / sum |v_e*|^2 over the band (adds up to 100 %)",
-        **{f"rank {r + 1}": _mode_text(p, int(i)) for r, i in enumerate(order[:8])},
+        "slip_state": "0 a vibration mode (ranked); 1 "
+        + KINDS["sliding"]
+        + "; 2 "
+        + KINDS["relaxation"]
+        + " (first-order states, in the synthesis at every N: "
+        "listed after the ranking, unranked, without frequency or speed)",
+        **{f"rank {r + 1}": _mode_text(p, int(i)) for r, i in enumerate(vib[:8])},
+        "not ranked (no vibration)": unranked or "none",
         "models": s.models.describe(),
     }
     return Result(
@@ -124,19 +152,25 @@ def participation_result(s: Snapshot) -> Result:
         ),  # fmt: skip
         caption=(
             f"**Harmonic {s.harmonic}** &middot; {out} &middot; {band} &middot; {s.coupling} "
-            f"&middot; ranked by {s.mode_rank}: first **{_mode_text(p, int(order[0]))}** "
-            "&middot; **click a bar**: its shape"
+            f"&middot; vibration modes ranked by {s.mode_rank}: first "
+            f"**{_mode_text(p, int(vib[0]))}** &middot; **click a bar**: its shape"
+            + (f" &middot; not ranked, no vibration: {unranked}" if unranked else "")
         ),
         draw={
             "ready": True,
             "mode": [int(m) for m in p.modes[top]],
             "label": [f"m{int(m)}" for m in p.modes[top]],
             "value": np.asarray(value, float),
-            "freq": ["slip" if p.first_order[i] else f"{p.mode_freq[i]:.1f} Hz" for i in top],
+            "freq": [f"{p.mode_freq[i]:.1f} Hz" for i in top],
             "speed": np.asarray(p.mode_speed[top], float),
-            "share": pct["share"][:TOP_BARS],
-            "loo": pct["loo"][:TOP_BARS],
+            "share": pct["share"][: top.size],
+            "loo": pct["loo"][: top.size],
             "y_label": f"{s.mode_rank} (%)",
+            "unranked": (
+                f"Not ranked (first-order slip states, no vibration; in every N): {unranked}"
+                if unranked
+                else ""
+            ),
         },
         core={"participation": p},
     )
@@ -155,7 +189,7 @@ def participation_ahead(old: Snapshot | None, new: Snapshot) -> Callable[[], Non
     def work() -> None:
         try:
             p = mc.participation(new.harmonic, new.f_max, new.coupling, new.models)
-            for i in p.ranking(new.mode_rank, f"bushing:{new.dof}")[:AHEAD_SHAPES]:
+            for i in p.ranking(new.mode_rank, f"bushing:{new.dof}", vibration=True)[:AHEAD_SHAPES]:
                 mc.shape(int(p.modes[i]), round(float(p.mode_speed[i]), 1), new.models)
             for k in (new.harmonic + 1, new.harmonic - 1):
                 if 1 <= k <= 7:
@@ -180,7 +214,7 @@ def _chosen(s: Snapshot) -> tuple[int, float, str]:
     if mode < 0 or speed <= 0:
         p = mc.participation(s.harmonic, s.f_max, s.coupling, s.models)
         if mode < 0:
-            i = int(p.ranking(s.mode_rank, f"bushing:{s.dof}")[0])
+            i = int(p.ranking(s.mode_rank, f"bushing:{s.dof}", vibration=True)[0])
             mode = int(p.modes[i])
             how = (
                 f"first of the ranking by {s.mode_rank} (harmonic {s.harmonic}, bushing:{s.dof}, "
@@ -210,6 +244,8 @@ def mode_shape_result(s: Snapshot) -> Result:
         t = mc.shape(mode, speed, s.models)
     except (FBSError, AttributeError, TypeError) as e:
         return _unavailable(s, view, "mode_shape", str(e))
+    if t.kind != "vibration":
+        return _no_vibration(s, view, mode, t)
     sh = t.shape
     ring = sh.ring  # (n_k, n_t, 3)
     n_k, n_t = ring.shape[:2]
@@ -304,23 +340,73 @@ def mode_shape_result(s: Snapshot) -> Result:
     )
 
 
+def _no_vibration(s: Snapshot, view: str, mode: int, t) -> Result:
+    """A first-order pair picked: what it is instead of a shape (it has no period)."""
+    lam = t.pole.real
+    if t.kind == "sliding":
+        what = (
+            f"mode {mode} is the tread sliding, no vibration: two real poles at 0 "
+            f"(x and y), the whole tire slides on its slip dampers as a rigid body (the "
+            f"belt's deformation is {t.deformation:.0e} of its motion); in the synthesis "
+            "a constant hub mobility (v / C_kappa fore-aft, v / C_alpha lateral), kept at "
+            "every N"
+        )
+    else:
+        what = (
+            f"mode {mode} is the tread's relaxation, no vibration: real poles "
+            f"({lam:.1f} 1/s at {t.speed_kmh:g} km/h, time constant "
+            f"{1e3 / abs(lam):.0f} ms = relaxation length / speed); the tread's slip "
+            "lags the belt without oscillating, kept at every N"
+        )
+    return Result(
+        columns={},
+        meta={
+            "view": view,
+            "mode": f"stored pair {mode}",
+            "not a vibration": what,
+            "models": s.models.describe(),
+        },  # fmt: skip
+        filename=csv_name(s, "mode_shape", f"m{mode}", "first_order"),
+        caption=f"**Mode {mode}**: {what}",
+        draw={
+            "ready": False,
+            "message": what,
+            "mode": mode,
+            "kind": t.kind,
+            "title": f"mode {mode}: the tread's {t.kind}, no vibration (no shape to animate)",
+        },
+    )
+
+
 # -- the Campbell diagram of the waves -----------------------------------------------------------
 DIRECTION_COLORS = {"forward": "#e03131", "backward": "#1971c2", "standing": "#868e96"}
 
 
+#: What the waves' view says while the tire is solved.
+WAVES_WORK = "solving the tire's modes at its operating points"
+
+
 def waves_result(s: Snapshot) -> Result:
     view = "Campbell diagram of the belt waves (branches tracked by shape)"
-    if not mc.waves_known(s.models):
+    st = mc.waves_status(s.models)
+    if st is None or not st.finished:
         why = (
-            "solving the tire at its operating points (about 20 s the first time, then "
-            "shared by every session) ..."
+            f"{WAVES_WORK} (computed once for every session) ..."
+            if st is None
+            else st.describe(WAVES_WORK) + " ..."
         )
         r = _unavailable(s, view, "waves", why)
-        return Result(r.columns, r.meta, r.filename, why, {"ready": False, "message": why})
-    try:
-        cb = mc.waves(s.models)
-    except (FBSError, AttributeError, TypeError) as e:
-        return _unavailable(s, view, "waves", f"the tire's matrices are needed: {e}")
+        draw = {"ready": False, "pending": True, "message": why, "late": bool(st and st.late)}
+        return Result(r.columns, r.meta, r.filename, why, draw)
+    if st.state == "failed":
+        if st.message.startswith("the tire's matrices are needed"):
+            return _unavailable(s, view, "waves", st.message)
+        r = _unavailable(
+            s, view, "waves", st.describe(WAVES_WORK) + "; open the tab again to try again"
+        )
+        # pending: a later visit of the tab makes it again and asks again (a retry)
+        return dataclasses.replace(r, draw={**r.draw, "pending": True})
+    cb = st.value
     h = fbs_core.harmonic(s.harmonic)
     default = cb.selection(s.harmonic)
     shown = np.arange(cb.order.size) if s.waves_all else default
@@ -383,19 +469,17 @@ def waves_result(s: Snapshot) -> Result:
     )
 
 
-def waves_work(s: Snapshot) -> Callable[[], None] | None:
-    """The waves of the session's tire when not yet known (one call of about 20 s on an
-    idle core; a model without the tire's matrices fails at once and is remembered)."""
-    if mc.waves_known(s.models):
-        return None
-
-    def work() -> None:
+def waves_wait(s: Snapshot, listener_key=None, told=None) -> None:
+    """Ask for the waves of the session's tire, computed once for every session
+    (:data:`app.modes_compute.WAVES`); ``told(status)`` as it moves on. Without a page to
+    be told on (``told`` None: tests, exports) it is computed here."""
+    if told is None:
         try:
             mc.waves(s.models)
-        except (FBSError, AttributeError, TypeError):
-            pass  # remembered by mc.waves: the result says why
-
-    return work
+        except FBSError:
+            pass  # the result says why (mc.waves_status)
+        return
+    mc.request_waves(s.models, listener_key, told)
 
 
 def nearest_branch(draw: dict, speed: float, freq: float, tol: float = 0.05):

@@ -17,7 +17,11 @@ coupled-response view's) and the pins', gives their difference in dB
 another harmonic has no difference curve), the band edges of each, and the error map of
 the current state minus the chosen pin's (:func:`fbs_core.analysis.
 truncation_map_difference`, same harmonic only; each map with its own residual setting) at
-the current map DOF.
+the current map DOF. The map's colours span the 95th percentile of the cells that differ
+(:func:`difference_scale`): a few cells at low N, where eq. 5.1 errors run to hundreds of
+times the response, differ by tens of thousands of percentage points and would set a range
+in which every other cell is white; the cells beyond are drawn in the end colours and
+counted in the map's title, the colour bar's end labels say ``>=`` / ``<=``.
 """
 
 from __future__ import annotations
@@ -36,10 +40,24 @@ from fbs_core.vocabulary import magnitude_db, percent
 from .. import compute
 from ..analysis_state import PinSettings, decode_pins
 from ..datasource import REFERENCE
+from ..report.titles import NOISE_WHERE
 from .base import Band, Result, Snapshot, csv_name
 from .main import res_part, response_result
 
-__all__ = ["Pin", "build_pins", "compare_result", "pin_settings", "pinned_result"]
+__all__ = [
+    "Pin",
+    "build_pins",
+    "compare_result",
+    "difference_scale",
+    "pin_settings",
+    "pinned_result",
+]
+
+#: Share of the differing cells whose colour the difference map's range covers: the rest
+#: (the largest differences) are clipped to the end colours and said so.
+SCALE_QUANTILE = 0.95
+#: Cells whose difference is below this (percentage points) are the same in both maps.
+SAME_PP = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,7 +170,8 @@ def _describe_settings(s: Snapshot | PinSettings) -> str:
     res = " + residual" if s.residual else ""
     return (
         f"h{s.harmonic} N={s.n_modes}{res} bushing:{s.dof} {s.coupling} noise {s.noise:g} % "
-        f"on the {s.target}{' (every line)' if s.frequency_dependent else ''} R={s.rounds} "
+        f"in {NOISE_WHERE[s.target]}{' (every line)' if s.frequency_dependent else ''} "
+        f"R={s.rounds} "
         f"seed {s.seed}"
     )
 
@@ -173,6 +192,24 @@ def _band_edges(data: PinnedState | None) -> tuple[np.ndarray, np.ndarray] | Non
 def _relabel(resp: FRF, like: FRF) -> FRF:
     """``resp`` with the labels of ``like`` (a pin of another DOF compares level to level)."""
     return FRF(resp.freq, resp.data, like.outputs, like.inputs, resp.quantity)
+
+
+def difference_scale(diff_pp: np.ndarray) -> tuple[float, int, float]:
+    """The colour range of a difference map: ``(limit, n_beyond, largest)``.
+
+    ``limit`` is the :data:`SCALE_QUANTILE` quantile of ``|diff|`` over the cells that differ
+    (``|diff| > SAME_PP``; NaN cells ignored), so no single cell sets the range; ``n_beyond``
+    counts the cells with ``|diff| > limit`` (drawn in the end colours), ``largest`` is the
+    largest ``|diff|``. Maps without differing cells give ``(0, 0, largest)``.
+    """
+    a = np.abs(np.asarray(diff_pp, float))
+    a = a[np.isfinite(a)]
+    largest = float(a.max()) if a.size else 0.0
+    differ = a[a > SAME_PP]
+    if differ.size == 0:
+        return 0.0, 0, largest
+    limit = float(np.quantile(differ, SCALE_QUANTILE))
+    return limit, int(np.count_nonzero(a > limit)), largest
 
 
 def compare_result(s: Snapshot) -> Result:
@@ -242,19 +279,27 @@ def compare_result(s: Snapshot) -> Result:
             )
             what = s.map_dof
             err = md.max_diff if what is None else md.diff[:, :, md.dofs.index(f"bushing:{what}")]
+            diff_pct = percent(np.asarray(err, float))
+            limit, beyond, largest = difference_scale(diff_pct)
             dmap = {
                 "n_modes": np.asarray(md.n_modes, int),
                 "centres": np.asarray(md.centres, float),
-                "diff_pct": percent(np.asarray(err, float)),
+                "diff_pct": diff_pct,
                 "pin": target.name,
                 "what": f"bushing:{what}" if what else "max over 6 DOFs",
+                "scale_pp": limit,
+                "beyond": beyond,
+                "largest_pp": largest,
             }
         except FBSError as e:
             map_note = f"no difference map against {target.name!r}: {e}"
     if dmap is not None:
         meta["difference map"] = (
             f"error (eq. 5.1) of the current state minus pin {dmap['pin']!r} in percentage "
-            f"points, {dmap['what']}; in the CSV of the error map view of each state"
+            f"points, {dmap['what']}; in the CSV of the error map view of each state; "
+            f"colours span +-{dmap['scale_pp']:.3g} pp (the {percent(SCALE_QUANTILE):g}th "
+            f"percentile of the cells that differ), {dmap['beyond']} cells beyond, up to "
+            f"{dmap['largest_pp']:.4g} pp"
         )
     elif map_note:
         meta["difference map"] = map_note

@@ -235,10 +235,10 @@ def wheels_result(s: Snapshot) -> Result:
             v = bw.data[:, e, k]
             cols[f"{w}_{comp.removeprefix('road_')}"] = v
             per[w] = per[w] + np.abs(v) ** 2
-    for w in WHEELS:
+    on = [w for w in WHEELS if w in s.wheels]
+    for w in on:  # an off wheel contributes exact zeros: no level (20 log10 0), no column
         cols[f"{w}_dB"] = magnitude_db(np.sqrt(per[w]))
     peak = int(np.argmax(level)) if level.size else 0
-    on = [w for w in WHEELS if w in s.wheels]
     top = max(on, key=lambda w: per[w][peak]) if on and level[peak] > 0 else None
     res = " + residual" if s.residual else ""
     return Result(
@@ -255,7 +255,8 @@ def wheels_result(s: Snapshot) -> Result:
             "terms": "<wheel>_<component>: complex contribution of that wheel's road to the "
             "component; the four add up to the response",
             "<wheel>_dB": "level of the wheel's contribution (root of the summed squares of "
-            "its components)",
+            "its components), for the driven wheels only (an off wheel's terms are zero: "
+            "no level)",
             "unit": compute.level_unit(s.dof),
             "models": s.models.describe(),
         },

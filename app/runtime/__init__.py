@@ -7,8 +7,12 @@
 - :mod:`~app.runtime.offload`: heavy bands on a Dask cluster when one is configured;
 - :mod:`~app.runtime.background`: work nobody waits for and work computed ahead, on a
   fixed number of threads of the process, superseded work dropped;
+- :mod:`~app.runtime.shared_jobs`: long work sessions wait for (the belt waves of a tire),
+  computed once for all of them on a thread of its own, each waiter told of its progress,
+  its end or its failure, with a deadline and a retry of a lost run;
 - :mod:`~app.runtime.uploads`: uploaded files read by parser processes side by side, off
-  Panel's worker threads, bounded per session and in all;
+  Panel's worker threads, bounded per session and in all; the pass of new models on a
+  thread of its own;
 - :mod:`~app.runtime.reports`: reports drawn one at a time in a process of their own while
   the click waits on the event loop;
 - :mod:`~app.runtime.priority`: lower CPU priority of the threads that are not interactive;

@@ -18,8 +18,11 @@ seconds, doubling up to :data:`MAX_BACKOFF_S`), it has no workers, or it or its 
 go away while the band runs (:class:`fbs_core.campaign.cluster.ClusterUnavailable`).
 
 Results come back from the workers by unpickling: whoever can talk to the scheduler's
-port can run code in this server. docs/deployment.md says how to keep the port private
-(and how to use Dask's TLS).
+port can run code in this server. The scheduler is therefore joined as
+:mod:`fbs_core.campaign.security` allows: ``tls://`` with the certificates of
+``$FBS_DASK_TLS_DIR`` (mutual authentication), plain ``tcp://`` on the loopback interface
+only, unless ``FBS_DASK_ALLOW_PLAIN=1`` says the network is private by other means. A
+refused address is logged and backed off like an unreachable one: bands are computed here.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ import time
 
 from fbs_core.campaign import SCHEDULER_ENV
 from fbs_core.campaign.cluster import ClusterUnavailable, scatter_band_on
+from fbs_core.campaign.security import InsecureScheduler, connect
 
 from .. import compute
 
@@ -95,13 +99,13 @@ def client():
     Raises
     ------
     Unavailable
-        While the scheduler is backed off after a failure, or another band is connecting.
+        While the scheduler is backed off after a failure, or another band is connecting,
+        or when its address is refused (plain TCP off the loopback, TLS without
+        certificates: :func:`fbs_core.campaign.security.security_for`).
     OSError, TimeoutError
         When the connection fails (the scheduler is then backed off).
     """
     global _client, _client_addr
-    from distributed import Client
-
     addr = scheduler()
     if not _lock.acquire(blocking=False):  # another band is connecting: do not wait for it
         raise Unavailable(f"connecting to {addr}")
@@ -115,7 +119,10 @@ def client():
             _close(_client)
             _client = None
         try:
-            _client = Client(addr, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
+            _client = connect(addr, f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
+        except InsecureScheduler as exc:  # refused before any connection is tried
+            failed(addr, f"refused: {exc}")
+            raise Unavailable(str(exc)) from None
         except (OSError, TimeoutError) as exc:
             failed(addr, f"unreachable ({exc})")
             raise

@@ -19,15 +19,15 @@ out the whole page on every text change (~36 ms each in the page, against 0.2-0.
 Panel's HTML model). The text is sent escaped once, as the pane sends it (the page decodes
 it once); ``tests/test_app_views.py`` fails if the pane's convention changes.
 
-Panel writes some of a page's changes later than it serializes them: when a layout changes
+Panel writes some of a page's changes later than it schedules them: when a layout changes
 (e.g. a dynamic tab's views are rendered when the tab is clicked) while the page's socket is
-busy writing, Panel turns the changes into messages at once and writes them from a task that
-polls the socket's write lock every 10 ms (``panel.io.document.schedule_write_events``).
-A draw of the app's own (:class:`app.runtime.draw.DrawQueue`) queues on that lock and so
-overtook those messages: its patches reached the page before the models they change, which
-the page dropped, and the models then arrived as serialized before the draw (the phase
-view's plots stayed empty after a click on its tab). :func:`panel_writes_pending` tells the
-draw queue to wait for them.
+busy writing, Panel queues the change events and writes them from a task that polls the
+socket's write lock every 10 ms (``panel.io.document.schedule_write_events``; Panel records
+such a page in ``_WRITE_BLOCK`` and its queued batches in ``_WRITE_EVENTS``). A draw of the
+app's own (:class:`app.runtime.draw.DrawQueue`) queues on that lock and could overtake those
+changes: the page would see a draw's patches before the layout change that holds the models
+they change (the phase view's plots stayed empty after a click on its tab).
+:func:`panel_writes_pending` tells the draw queue to wait until Panel's queue is written.
 """
 
 from __future__ import annotations
@@ -38,9 +38,12 @@ import panel as pn
 
 __all__ = [
     "DEBOUNCE_MS",
+    "browser_change_pending",
     "html_model",
     "html_text",
     "panel_writes_pending",
+    "pool_processes",
+    "resend_value",
     "respond_at_once",
 ]
 
@@ -68,8 +71,37 @@ def html_model(html_source: str = "", **props):
 
 
 def panel_writes_pending(doc) -> bool:
-    """Whether Panel holds messages for ``doc``'s page that it serialized but has not
-    written yet (see the module docstring)."""
+    """Whether Panel holds changes for ``doc``'s page that it queued but has not written
+    yet (see the module docstring)."""
     from panel.io import document as pdoc
 
-    return doc in pdoc._WRITE_BLOCK or bool(pdoc._WRITE_MSGS.get(doc))
+    return doc in pdoc._WRITE_BLOCK or bool(pdoc._WRITE_EVENTS.get(doc))
+
+
+def pool_processes(pool) -> list:
+    """The worker processes of a ``concurrent.futures.ProcessPoolExecutor`` (CPython keeps
+    them in ``_processes``; the executor has no public list). The report drawer's are ended
+    and reaped when the server stops, also one started after the server listed its children.
+    """
+    return list((getattr(pool, "_processes", None) or {}).values())
+
+
+def resend_value(widget: pn.widgets.Widget, doc) -> None:
+    """Send the browser of ``doc`` the properties of ``widget``'s models that show its
+    value (a slider's ``value``, a button group's ``active``...), even when the server's
+    copy already holds them: a message the server wrote earlier may have crossed the
+    browser's own change (:mod:`app.views.bind`). Runs where ``doc`` may change."""
+    props = widget._process_param_change({"value": widget.value})
+    for model, _ in list(widget._models.values()):
+        if model.document is not doc:
+            continue
+        for attr in props:
+            if attr in model.properties():
+                value = getattr(model, attr)
+                doc.callbacks.notify_change(model, attr, value, value)
+
+
+def browser_change_pending(widget: pn.widgets.Widget) -> bool:
+    """Whether Panel holds a change of ``widget`` from the browser that it has not yet
+    handed to the widget (waiting for its debounce or for a free worker thread)."""
+    return bool(widget._events)

@@ -13,7 +13,11 @@ finding 3: p95 from 0.17 s to over 60 s). Here an upload is a job of :data:`UPLO
 - at most :data:`MAX_WAITING` jobs wait in all; beyond that an upload is refused at once
   with a message (``DataSource.error``) instead of queueing without bound;
 - a closed tab cancels its jobs: a waiting one is dropped, a running one stops its parse
-  (``fbs_core.io._sandbox.cancel_scope``: the parser process is killed).
+  (``fbs_core.io._sandbox.cancel_scope``: the parser process is killed);
+- a job only reads: what the new models change (the session's pass, which may compute for
+  many seconds) runs on a thread of its own (:func:`on_upload_thread`, used by
+  :class:`app.store.Results`), so a long pass never holds a reading thread (every
+  session's later uploads waited for it) nor the data source's lock.
 
 A job runs with the session's document as Panel's current document, so what it changes
 (the data source's models, error and summaries) reaches the page through the session's
@@ -33,12 +37,19 @@ import panel as pn
 
 from fbs_core.io._sandbox import Cancelled, cancel_scope, parsers
 
-__all__ = ["MAX_WAITING", "UPLOADS", "UploadJob", "UploadQueue"]
+__all__ = ["MAX_WAITING", "UPLOADS", "UploadJob", "UploadQueue", "on_upload_thread"]
 
 log = logging.getLogger(__name__)
 
 #: Uploads waiting at most in the process (beyond: refused at once with a message).
 MAX_WAITING = 16
+
+_local = threading.local()
+
+
+def on_upload_thread() -> bool:
+    """True while a job of an :class:`UploadQueue` runs on the calling thread."""
+    return bool(getattr(_local, "reading", False))
 
 
 @dataclass(eq=False)
@@ -150,6 +161,7 @@ class UploadQueue:
         if job.cancelled.is_set():
             return
         pn.state.curdoc = job.doc  # what the job changes is drawn by its session's loop
+        _local.reading = True
         try:
             with cancel_scope(job.cancelled):
                 job.run()
@@ -158,6 +170,7 @@ class UploadQueue:
         except Exception:  # a job's own failure must not end the reading thread
             log.exception("reading an upload failed")
         finally:
+            _local.reading = False
             pn.state.curdoc = None
 
 

@@ -117,8 +117,8 @@ def analysis_card(results, x_range=None, tabs: dict | None = None, page=None) ->
             "phase": lambda r, x: made(PhaseView(store=r, x_range=x, mode=mode())),
             "speed": lambda r, x: speed_tab(r, mode(), views),
             "contributions": lambda r, x: made(ContributionsView(store=r, x_range=x, mode=mode())),
-            "modes": lambda r, x: modes_tab(r),
-            "selection": lambda r, x: selection_tab(r),
+            "modes": lambda r, x: modes_tab(r, mode(), views),
+            "selection": lambda r, x: selection_tab(r, mode(), views),
         }
     if page is not None:
 

@@ -1,8 +1,10 @@
 """Compare: pin the current state as a named baseline (up to four), change anything, and see
 the pinned coupled responses overlaid on the current one with the difference in dB, the
 scatter bands' percentile edges, and the truncation error map as a difference map (current
-minus a chosen pin, percentage points). Pins are in the URL (``pins=``), the CSV (one row
-per curve and line, each curve's settings and provenance in the header) and the report.
+minus a chosen pin, percentage points; its colours clipped at the 95th percentile of the
+cells that differ, the clipping said in its title and colour bar). Pins are in the URL
+(``pins=``), the CSV (one row per curve and line, each curve's settings and provenance in the
+header) and the report.
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import panel as pn
 from bokeh.layouts import column, row
-from bokeh.models import ColumnDataSource, HoverTool
+from bokeh.models import ColumnDataSource, FixedTicker, HoverTool
 from bokeh.palettes import RdBu11
 
 from fbs_core.analysis import MAX_PINS
@@ -114,8 +116,18 @@ class CompareView(AnalysisView):
     def _build(self):
         spectrum = self._frequency_figure
         self._lv = lv = spectrum("compare.levels", level_label("z"), 250)
-        self._df = df = spectrum("compare.diff", "Current minus pin (dB)", 200)
-        self._bd = bd = spectrum("compare.band", level_label("z", "Band level"), 250)
+        self._df = df = spectrum(
+            "compare.diff",
+            "Current minus pin (dB)",
+            200,
+            title="Difference of the levels: current minus each pin (dB)",
+        )
+        self._bd = bd = spectrum(
+            "compare.band",
+            level_label("z", "Band level"),
+            250,
+            title="Scatter band: current band and the pins' percentile edges",
+        )
         self._mp = mp = spectrum(
             "compare.map_figure", "Retained modes N", 200, title="Error map: current minus pin"
         )
@@ -264,12 +276,22 @@ class CompareView(AnalysisView):
                 "dw": [float(c[-1] - c[0] + dc)],
                 "dh": [float(n[-1] - n[0] + dn)],
             }
-            lim = float(np.nanmax(np.abs(e))) if np.isfinite(e).any() else 0.0
+            lim, beyond = float(m["scale_pp"]), int(m["beyond"])
             title = f"Error map: current minus pin {m['pin']!r} ({m['what']})"
             if lim < SAME_MAP_PP:  # a colour scale of +-1e-6 pp drew a grey box: say it
-                lim = 1.0
+                lim, beyond = 1.0, 0
                 title = f"Error map: no difference to pin {m['pin']!r} (identical maps)"
+            elif beyond:
+                title += (
+                    f"; colours clipped at \u00b1{lim:.3g} pp: {beyond} cells beyond, "
+                    f"up to \u00b1{m['largest_pp']:.4g} pp"
+                )
             self._mapper.update(low=-lim, high=lim)
+            ticks = [float(t) for t in np.linspace(-lim, lim, 5)]
+            self._bar.ticker = FixedTicker(ticks=ticks)
+            self._bar.major_label_overrides = (
+                {ticks[0]: f"\u2264 {-lim:.3g}", ticks[-1]: f"\u2265 {lim:.3g}"} if beyond else {}
+            )
             self._mp.title.text = title
             self._map_glyph.visible = self._bar.visible = True
         else:

@@ -32,6 +32,7 @@ from bokeh.models import (
     NormalHead,
     Span,
     TableColumn,
+    Title,
 )
 
 from .analysis_speed import SPEED_LABEL
@@ -140,8 +141,17 @@ class ParticipationView(LiveView):
             )
         )
         fig.xaxis.ticker = FixedTicker(ticks=[])
+        # labels across the axis: a bar's slot needs one line of type, not the label's
+        # length (20 labels along the axis ran together at 1280 px in the presentation view)
+        fig.xaxis.major_label_orientation = "vertical"
         fig.xgrid.visible = False
         fig.y_range.start = 0
+        # the tread's first-order states (no vibration, not ranked): said under the bars
+        self._unranked = Title(
+            text="", align="left", text_font_style="italic", text_font_size="11px",
+            name="participation.unranked",
+        )  # fmt: skip
+        fig.add_layout(self._unranked, "below")
         fig.on_event(Tap, self._tapped)
         return [fig]
 
@@ -153,7 +163,10 @@ class ParticipationView(LiveView):
         d = r.draw
         if not d.get("ready"):
             set_data(self._bars, {k: [] for k in self._bars.data})
+            self._unranked.text = ""
             return
+        if self._unranked.text != d.get("unranked", ""):
+            self._unranked.text = d.get("unranked", "")
         shape = self.store.mode_shape
         picked = shape.draw.get("mode") if shape is not None else None
         n = len(d["mode"])
@@ -236,6 +249,10 @@ class ModeShapeView(LiveView):
 
     def _draw(self, r):
         d = r.draw
+        # a first-order pair has no shape: its plot says what it is instead
+        note = d.get("title", "") if d.get("kind") else ""
+        if self._plane.title.text != note:
+            self._plane.title.text = note
         if not d.get("ready"):
             set_data(self._frames, {k: [] for k in self._frames.data})
             set_data(self._rest, {"x": [], "z": []})
@@ -397,26 +414,31 @@ class ChassisTruncationView(LiveView):
         self._sug.location = float(d["suggested"])
 
 
-def modes_tab(results) -> pn.Column:
+def modes_tab(results, mode: str = "normal", views: list | None = None) -> pn.Column:
     """The "Modes" tab: the two ways to pick a mode side by side (the ranking's bars, the
     branches of the waves' Campbell diagram), the picked mode's shape below them at the
     tab's full width (its two plots side by side need it: at half a card's width their
-    title lines were cut)."""
+    title lines were cut). In the type sizes of ``mode``; the views are appended to
+    ``views`` (they follow the page's view switch)."""
+    bars, waves, shape = (
+        ParticipationView(store=results, mode=mode),
+        WavesView(store=results, mode=mode),
+        ModeShapeView(store=results, mode=mode),
+    )
+    if views is not None:
+        views.extend([bars, waves, shape])
     return pn.Column(
-        pn.Row(
-            ParticipationView(store=results),
-            WavesView(store=results),
-            sizing_mode="stretch_width",
-        ),  # fmt: skip
-        ModeShapeView(store=results),
+        pn.Row(bars, waves, sizing_mode="stretch_width"),
+        shape,
         sizing_mode="stretch_width",
     )
 
 
-def selection_tab(results) -> pn.Column:
-    """The "Selected modes" tab: the selections beside table 5.1, the chassis side."""
-    return pn.Column(
-        SelectedModesView(store=results),
-        ChassisTruncationView(store=results),
-        sizing_mode="stretch_width",
-    )
+def selection_tab(results, mode: str = "normal", views: list | None = None) -> pn.Column:
+    """The "Selected modes" tab: the selections beside table 5.1, the chassis side (in the
+    type sizes of ``mode``; the views are appended to ``views``)."""
+    table = SelectedModesView(store=results, mode=mode)
+    chassis = ChassisTruncationView(store=results, mode=mode)
+    if views is not None:
+        views.extend([table, chassis])
+    return pn.Column(table, chassis, sizing_mode="stretch_width")

@@ -1,10 +1,13 @@
 """Across speed: the Campbell diagram of the tire and the bushing level over speed and
 frequency for the chosen harmonic.
 
-Campbell: every tracked tire mode pair's eigenfrequency over 20-120 km/h, coloured forward /
-backward / standing (:func:`fbs_core.analysis.campbell`, slope criterion), and the order
-lines ``f = v / lambda`` of the seven harmonic cases (solid inside the case's speed range,
-dotted outside; the chosen case thicker).
+Campbell: every tracked tire mode pair's eigenfrequency over 20-120 km/h
+(:func:`fbs_core.analysis.campbell`) in one colour, and the order lines ``f = v / lambda``
+of the seven harmonic cases (solid inside the case's speed range, dotted outside; the
+chosen case thicker). The branches carry no direction of travel: the modal model tracks
+its modes for the interpolation, and they pass between forward and backward waves at the
+veerings (docs/modes.md), so a label by slope would claim what is not known; the Modes
+tab's Campbell diagram of the belt waves follows the waves.
 
 Speed map: ``20 log10 |v_e*|`` at the chosen bushing DOF for the tire at fixed speeds under
 the chosen case's road wavelength (:func:`fbs_core.analysis.speed_map`), with the harmonic
@@ -30,7 +33,8 @@ from .plots import add_image, new_figure, set_data
 
 __all__ = ["CampbellView", "SpeedMapView", "speed_tab"]
 
-DIRECTION_COLORS = {"forward": "#e03131", "backward": "#1971c2", "standing": "#868e96"}
+#: The tracked branches' one colour (no direction of travel is known for them).
+BRANCH_COLOR = "#1971c2"
 ORDER_COLOR = "#2b2b2b"
 SPEED_LABEL = "Speed (km/h)"
 FREQ_LABEL = "Frequency (Hz)"
@@ -61,7 +65,7 @@ def _show_pick(spans, pick):
 
 
 class CampbellView(AnalysisView):
-    """Tire eigenfrequencies vs speed with forward / backward branches and order lines."""
+    """Tire eigenfrequencies vs speed (the tracked branches) and order lines."""
 
     key = "campbell"
     result_name = "campbell"
@@ -71,14 +75,13 @@ class CampbellView(AnalysisView):
         self._fig = fig = new_figure(
             x_label=SPEED_LABEL, y_label=FREQ_LABEL, name="campbell.figure", min_height=440
         )
-        self._branches = {}
-        for d, color in DIRECTION_COLORS.items():
-            src = ColumnDataSource({"xs": [], "ys": [], "branch": []}, name=f"campbell.{d}")
-            r = fig.multi_line(
-                "xs", "ys", source=src, line_color=color, line_width=1.4, legend_label=d
-            )
-            fig.add_tools(HoverTool(renderers=[r], tooltips=[("mode pair", "@branch"), ("", d)]))
-            self._branches[d] = src
+        src = ColumnDataSource({"xs": [], "ys": [], "branch": []}, name="campbell.modes")
+        r = fig.multi_line(
+            "xs", "ys", source=src, line_color=BRANCH_COLOR, line_width=1.4,
+            legend_label="tire modes (no direction of travel: see Modes, waves)",
+        )  # fmt: skip
+        fig.add_tools(HoverTool(renderers=[r], tooltips=[("mode pair", "@branch")]))
+        self._branches = {"modes": src}
         self._orders = ColumnDataSource(
             {"xs": [], "ys": [], "harmonic": [], "width": []}, name="campbell.orders"
         )
@@ -128,7 +131,10 @@ class CampbellView(AnalysisView):
             out_y.append(d["lines"][:, j])
         self._orders.data = {"xs": xs, "ys": ys, "harmonic": hs, "width": ws}
         set_data(self._order_out, {"xs": out_x, "ys": out_y})
-        self._fig.y_range.end = 460  # branches up to 450 Hz: the seven lines' band
+        # the axes span the speeds and the seven lines' band (branches up to 450 Hz), set
+        # here: the branches' gaps (NaN) are no data a range should be computed from
+        self._fig.x_range.start, self._fig.x_range.end = float(v.min()), float(v.max())
+        self._fig.y_range.start, self._fig.y_range.end = 0.0, 460.0
 
     def _draw_pick(self, pick):
         _show_pick(self._spans, pick)

@@ -51,6 +51,7 @@ from .live import download_button, inline_html
 
 __all__ = [
     "CAMPAIGN_DIR_ENV",
+    "HOW_TO",
     "CampaignBrowser",
     "campaign_dir",
     "campaign_card",
@@ -86,15 +87,17 @@ def _stamp(p: Path) -> tuple[int, int]:
 
 def _is_campaign(p: Path) -> bool:
     """Whether ``p``'s root says it is a campaign result (read again only when it changed)."""
-    import h5py
+    from fbs_core.hdf5_guard import ForeignDataError, open_h5
 
     stamp = _stamp(p)
     known = _IS_CAMPAIGN.get(p)
     if known is not None and known[0] == stamp:
         return known[1]
     try:
-        with h5py.File(p, "r") as h:
+        with open_h5(p) as h:
             ok = h.attrs.get("content") == "campaign"
+    except ForeignDataError:  # listed: opening it says why it is refused
+        ok = True
     except (OSError, ValueError, TypeError, KeyError, RuntimeError):  # not (readable) HDF5
         ok = False
     _IS_CAMPAIGN[p] = (stamp, ok)
@@ -388,7 +391,7 @@ def variants_case_result(result, name: str, dof: str, harmonic: int | None = Non
     params = ", ".join(s["parameters"])
     pct_text = ", ".join(f"{q:g}" for q in c.q)
     meta = {
-        "view": "campaign corridor of systematic errors (issue 32, docs/corridor.md)",
+        "view": "campaign corridor of systematic errors (docs/corridor.md)",
         "response DOF": label,
         "harmonic": h,
         "parameters": params,
@@ -594,11 +597,13 @@ class CampaignBrowser(pn.viewable.Viewer):
                 self.shown = truncation_case_result(self._result, self.case, dof)
         except CampaignError as exc:  # incomplete, stored without these outputs, malformed
             self.shown = None
-            self.message = str(exc)
+            self.message = relative_names(str(exc), self.directory)
         except Exception as exc:  # noqa: BLE001 (a file's problem: said in the card)
             log.exception("campaign case %s of %s", self.case, self.file)
             self.shown = None
-            self.message = f"{self.file}: case {self.case!r} cannot be shown ({exc})"
+            self.message = relative_names(
+                f"{self.file}: case {self.case!r} cannot be shown ({exc})", self.directory
+            )
 
     # -- page ------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -843,14 +848,47 @@ class CampaignBrowser(pn.viewable.Viewer):
         )
 
 
+#: What the campaign card says when the server has no campaign directory: what corridors
+#: and campaigns are, what a campaign file is, the commands that make a result file and the
+#: setting that shows it here (the examples are the repository's ``campaigns/`` files).
+HOW_TO = f"""**Corridors of systematic errors and sensitivity campaigns** (many cases: harmonics,
+noise levels, truncations, or physical parameters of the tire and chassis varied within their
+ranges) take minutes to hours, so they run outside the page and are browsed here from their
+result files. **This server has no campaign folder set**, so there is nothing to show yet.
+
+1. **A campaign file** is a TOML case matrix: the cases to compute and where to write the
+   result (one HDF5 file). Examples in the repository: `campaigns/example.toml` (scatter bands
+   and truncation maps), `campaigns/corridor.toml` (a corridor of systematic errors with
+   Sobol' sensitivity per band).
+2. **Run it** on the server's machine (or a Dask cluster, `FBS_DASK_SCHEDULER`):
+   `python -m fbs_core.campaign plan campaigns/corridor.toml` lists what it will compute,
+   `python -m fbs_core.campaign run campaigns/corridor.toml --workers 2` computes it with a
+   progress bar (stopped with Ctrl-C, the same command resumes), and
+   `python -m fbs_core.campaign corridor corridor.h5` prints the corridor's tables.
+3. **Show the results here**: the operator starts the server with `{CAMPAIGN_DIR_ENV}` set to
+   the folder of the result files (`{CAMPAIGN_DIR_ENV}=/path/to/results bash scripts/serve.sh`;
+   with Docker, mount the folder and pass `-e {CAMPAIGN_DIR_ENV}=/campaigns`). This card then
+   lists the files and draws each case's band, error map or corridor.
+
+In Python: `fbs_core.variants.corridor_study(["inflation_pressure", "knuckle_mass"], n=4)`
+(docs/corridor.md)."""
+
+
 def campaign_card(parts):
     """The page's card of the campaign browser (an entry of ``app.main.EXTRA_CARDS``):
-    collapsed, built with ``parts.card``; None when no campaign directory is configured.
+    collapsed, built with ``parts.card``. Without a campaign directory the card says how to
+    get one (:data:`HOW_TO`): corridors and campaigns must be findable from the page.
 
     The browser reads nothing until the card is expanded (then it lists the files and opens
     the first, :meth:`CampaignBrowser.activate`)."""
     if campaign_dir() is None:
-        return None
+        return parts.card(
+            "Corridors and campaigns (not set up on this server)",
+            pn.pane.Markdown(HOW_TO, sizing_mode="stretch_width", css_classes=["campaign-howto"]),
+            None,
+            collapsed=True,
+            css_classes=["campaign-card"],
+        )
     browser = CampaignBrowser(lazy=True)
     card = parts.card(
         "Campaign results (FBS_CAMPAIGN_DIR)",
@@ -883,12 +921,22 @@ def _text_html(text: str) -> str:
     return f"<p>{html.escape(text)}</p>"
 
 
+def relative_names(text: str, directory: Path | None) -> str:
+    """``text`` with the campaign folder's path left out of the file names it quotes: a
+    user sees ``run.h5`` or ``run.h5.parts/0001.h5``, never the server's absolute paths."""
+    if directory is None:
+        return text
+    folder = str(directory).rstrip(os.sep)
+    return text.replace(folder + os.sep, "").replace(folder, ".")
+
+
 def _read(path: Path) -> tuple[Opened | None, str]:
-    """(the opened file, "") or (None, the message of its CampaignError)."""
+    """(the opened file, "") or (None, the message of its CampaignError, its file names
+    relative to the campaign folder)."""
     try:
         return open_cached(path), ""
     except CampaignError as exc:
-        return None, str(exc)
+        return None, relative_names(str(exc), path.parent)
 
 
 def _frame(cols: dict[str, list]):

@@ -1,4 +1,4 @@
-"""The control panel: widgets generated from the state parameters.
+"""The control panel: widgets bound to the state parameters (:mod:`app.views.bind`).
 
 Typed numbers are plain text fields read by :func:`app.views.typed.parse_number` (``1e5``,
 ``1.5``, ``5,5``): a text that is not a number of the field's kind, or a value outside the
@@ -18,8 +18,8 @@ from panel.viewable import Viewer
 import fbs_core
 
 from ..runtime.draw import on_document, served_document
-from ..runtime.panel_private import respond_at_once
-from ..state import VEHICLE_ROUNDS, DashboardState
+from ..state import MODE_COUNTS, VEHICLE_ROUNDS, DashboardState
+from .bind import control
 from .layout import font
 from .live import LiveText
 from .typed import NumberField, refusal
@@ -104,67 +104,80 @@ class Controls(Viewer):
             p = self.state.plot
             W = pn.widgets
             self._widgets = {
-                "case.scope": W.RadioButtonGroup.from_param(
-                    c.param.scope, name="Scope", options={"Corner": "corner", "Vehicle": "vehicle"}
+                "case.scope": control(
+                    W.RadioButtonGroup,
+                    c.param.scope,
+                    name="Scope",
+                    options={"Corner": "corner", "Vehicle": "vehicle"},
                 ),
-                "case.wheels": W.CheckButtonGroup.from_param(
+                "case.wheels": control(
+                    W.CheckButtonGroup,
                     c.param.wheels,
                     name="Road input on the wheels",
                     options={"FL": "fl", "FR": "fr", "RL": "rl", "RR": "rr"},
+                    to_widget=list,
                 ),
-                "case.tracks": W.RadioButtonGroup.from_param(c.param.tracks, name="Tracks"),
-                "case.coherence": W.FloatSlider.from_param(
-                    c.param.coherence, name="Coherence of the tracks", start=-1.0, end=1.0
+                "case.tracks": control(W.RadioButtonGroup, c.param.tracks, name="Tracks"),
+                "case.coherence": control(
+                    W.FloatSlider, c.param.coherence, name="Coherence of the tracks"
                 ),
-                "case.point": W.Select.from_param(c.param.point, name="Response point"),
-                "case.harmonic": W.IntSlider.from_param(
-                    c.param.harmonic, name="Harmonic case", start=1, end=7, step=1
+                "case.point": control(W.Select, c.param.point, name="Response point"),
+                "case.harmonic": control(
+                    W.IntSlider, c.param.harmonic, name="Harmonic case", start=1, end=7, step=1
                 ),
-                "case.n_modes": W.DiscreteSlider.from_param(
-                    c.param.n_modes, name="Retained tire modes N"
+                # a plain slider over the counts (10 to 400 in steps of 10) that draws its own
+                # label in the browser: one writer of what it shows
+                "case.n_modes": control(
+                    W.IntSlider,
+                    c.param.n_modes,
+                    name="Retained tire modes N",
+                    start=MODE_COUNTS[0],
+                    end=MODE_COUNTS[-1],
+                    step=MODE_COUNTS[1] - MODE_COUNTS[0],
                 ),
-                "case.dof": W.RadioButtonGroup.from_param(
-                    c.param.dof, name="Response DOF at the bushing"
+                "case.dof": control(
+                    W.RadioButtonGroup, c.param.dof, name="Response DOF at the bushing"
                 ),
-                "case.coupling": W.RadioButtonGroup.from_param(
-                    c.param.coupling, name="Hub coupling"
+                "case.coupling": control(W.RadioButtonGroup, c.param.coupling, name="Hub coupling"),
+                "case.show_uncoupled": control(
+                    W.Checkbox, c.param.show_uncoupled, name="Show uncoupled tire and chassis FRFs"
                 ),
-                "case.show_uncoupled": W.Checkbox.from_param(
-                    c.param.show_uncoupled, name="Show uncoupled tire and chassis FRFs"
-                ),
-                "case.residual": W.Checkbox.from_param(
+                "case.residual": control(
+                    W.Checkbox,
                     c.param.residual,
                     name="Residual compensation (modes left out: quasi-static part)",
                 ),
-                "plot.overlay": W.CheckButtonGroup.from_param(
-                    p.param.overlay, name="Overlay bushing DOFs"
+                "plot.overlay": control(
+                    W.CheckButtonGroup, p.param.overlay, name="Overlay bushing DOFs", to_widget=list
                 ),
-                "plot.level_scale": W.RadioButtonGroup.from_param(
-                    p.param.level_scale, name="Level axis"
+                "plot.level_scale": control(
+                    W.RadioButtonGroup, p.param.level_scale, name="Level axis"
                 ),
                 "plot.cursor1": self._typed("plot.cursor1").text,
                 "plot.cursor2": self._typed("plot.cursor2").text,
-                "plot.snap": W.Checkbox.from_param(
-                    p.param.snap, name="Cursors snap to the nearest peak"
+                "plot.snap": control(
+                    W.Checkbox, p.param.snap, name="Cursors snap to the nearest peak"
                 ),
                 "truncation.threshold": self._typed("truncation.threshold").text,
                 "truncation.f_max": self._typed("truncation.f_max").text,
-                "truncation.map_mode": W.RadioButtonGroup.from_param(
-                    t.param.map_mode, name="Error map of"
+                "truncation.map_mode": control(
+                    W.RadioButtonGroup, t.param.map_mode, name="Error map of"
                 ),
                 "noise.noise": self._typed("noise.noise").text,
-                "noise.target": W.RadioButtonGroup.from_param(n.param.target, name="Noise in"),
-                "noise.frequency_dependent": W.Checkbox.from_param(
+                "noise.target": control(W.RadioButtonGroup, n.param.target, name="Noise in"),
+                "noise.frequency_dependent": control(
+                    W.Checkbox,
                     n.param.frequency_dependent,
                     name="Frequency-dependent noise (new S at every line)",
                 ),
                 "noise.rounds": self._typed("noise.rounds").text,
                 "noise.seed": self._typed("noise.seed").text,
                 "noise.single_round": self._typed("noise.single_round").text,
-                "noise.percentile": W.Select.from_param(
-                    n.param.percentile, name="Central percentile band (%)"
+                "noise.percentile": control(
+                    W.Select, n.param.percentile, name="Central percentile band (%)"
                 ),
-                "noise.first_order": W.Checkbox.from_param(
+                "noise.first_order": control(
+                    W.Checkbox,
                     n.param.first_order,
                     name="First-order band overlay (linearised, docs/corridor.md)",
                 ),
@@ -173,7 +186,6 @@ class Controls(Viewer):
                 if key in self._fields:  # classed and quickened by its NumberField
                     continue
                 w.css_classes = [*w.css_classes, "ctl-" + key.replace(".", "-")]
-                respond_at_once(w)
         return self._widgets
 
     def __panel__(self):

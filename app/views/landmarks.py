@@ -92,7 +92,7 @@ def landmarks_card(parts: object = None) -> pn.Card:
         text = f"The landmark table is not available ({exc})."
     return pn.Card(
         pn.pane.Markdown(text, sizing_mode="stretch_width", styles={"font-size": font("0.85em")}),
-        title="The thesis' landmarks next to the reference tire (issue 14)",
+        title="The thesis' landmarks next to the reference tire",
         collapsible=True,
         collapsed=True,
         sizing_mode="stretch_width",

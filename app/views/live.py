@@ -240,8 +240,11 @@ class LiveView(Viewer):
         self._figures: list = []
         self._titles: list[TitleBlockModels] = []
         self._fits: list[tuple] = []  # ranges to fit after a draw's data (_fit)
+        self._title_pending = False
         if self.result_name:
             self.store.param.watch(lambda _e: self.redraw(), [self.result_name, *self.also])
+            # a change the result does not depend on still changes the link it carries
+            self.store.param.watch(lambda _e: self.retitle(), "published")
 
     # -- what a subclass provides ----------------------------------------------------------
     def result(self) -> Result | None:
@@ -314,12 +317,33 @@ class LiveView(Viewer):
         self._fits.append((rng, values))
 
     # -- title block: what the plot shows, on the plot and in its saved PNG -----------------
+    def retitle(self) -> None:
+        """Draw the title block again (the published state changed)."""
+        if self._layout is None or not self._titles:
+            return
+        with self._guard:
+            if self._title_pending:
+                return
+            self._title_pending = True
+
+        def again() -> None:
+            with self._guard:
+                self._title_pending = False
+            r = None if self.store.closed else self.result()
+            if r is not None:
+                self._draw_title(r)
+
+        self._on_document(again)
+
     def _draw_title(self, r: Result) -> None:
         """The title block of ``r``'s own snapshot (the band's: the settings it was
-        computed for)."""
+        computed for), with the link of the published state when ``r`` is of its values
+        (:meth:`app.store.Results.link_snapshot`): never the page's URL of the moment,
+        which may already or still name another state."""
         if not self._titles or r.snapshot is None:
             return
-        tb, stem = view_title(self.key, r.snapshot, page_url())
+        link = self.store.link_snapshot(self.result_name, r)
+        tb, stem = view_title(self.key, r.snapshot, link=link)
         for t in self._titles:
             t.update(tb, stem)
 

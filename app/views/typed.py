@@ -19,8 +19,7 @@ import panel as pn
 import param
 from panel.viewable import Viewer
 
-from ..runtime.draw import served
-from ..runtime.panel_private import respond_at_once
+from .bind import Refused, bind
 from .layout import font
 
 __all__ = ["NumberField", "TypedInputError", "format_number", "parse_number", "refusal"]
@@ -32,10 +31,6 @@ _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 _GROUPED = re.compile(r"[+-]?\d{1,3}(,\d{3})+(\.\d*)?")
 #: Spaces a person puts between digit groups (``10 000``).
 _SPACES = re.compile(r"(?<=\d)[ \u00a0\u202f](?=\d)")
-
-
-#: Milliseconds after a refusal at which the field's value in force is sent once more.
-RESEND_MS = 400
 
 
 class TypedInputError(ValueError):
@@ -201,73 +196,42 @@ class NumberField(Viewer):
                 sizing_mode="stretch_width",
                 margin=(0, 12),
             )
-            self.bar.param.watch(self._dragged, "value")
-        self.text.param.watch(self._typed, "value")
-        obj.param.watch(self._follow, name)
-        for w in (self.text, self.bar):
-            if w is not None:
-                respond_at_once(w)
+            bind(self.bar, obj, name, to_widget=self._on_bar, to_state=self._from_bar)
+        # the field shows the value in force as plain digits; what it cannot take is refused
+        # with the message under it (app.views.bind: the one link of widgets and state)
+        bind(self.text, obj, name, to_widget=format_number, to_state=self._read, refused=self._tell)
 
-    def _typed(self, event) -> None:
-        obj, name = self.obj, self.parameter
-        if event.new == format_number(getattr(obj, name)):
-            return  # the value in force (also the field put back after a message)
-        text = self.refusal_of(event.new)
-        if text:
-            self.message.param.update(object=html.escape(text), visible=True)
-            self._show_value_in_force()
+    def _read(self, text: str) -> float | int:
+        message = self.refusal_of(text)
+        if message:
+            raise Refused(message)
+        return parse_number(text, self._integer)
+
+    def _tell(self, message: str) -> None:
+        """Show (or, with ``""``, clear) the message under the field."""
+        if message:
+            self.message.param.update(object=html.escape(message), visible=True)
             if pn.state.notifications is not None:
-                pn.state.notifications.error(text, duration=8000)
-            return
-        value = parse_number(event.new, self._integer)
-        if self.message.visible:
+                pn.state.notifications.error(message, duration=8000)
+        elif self.message.visible:
             self.message.param.update(object="", visible=False)
-        if value != getattr(obj, name):
-            setattr(obj, name, value)
-        elif event.new != format_number(value):
-            self._show_value_in_force()  # "1e1" for 10 in force: shown as 10
 
     def refusal_of(self, text: str) -> str:
         """The message for ``text`` typed in this field ("" when it is taken)."""
         return refusal(self.obj, self.parameter, text, self.label)
 
-    def _show_value_in_force(self) -> None:
-        # when served, after Panel has handled the browser's change (a change of the same
-        # property while it is handled is not sent back)
-        def put_back():
-            self.text.value = format_number(getattr(self.obj, self.parameter))
+    def _on_bar(self, value: float) -> float:
+        """The slider's position for ``value`` (its range widened to a typed value beyond it)."""
+        bar = self.bar
+        assert bar is not None
+        if value > bar.end:
+            bar.end = value
+        if value < bar.start:
+            bar.start = value
+        return value
 
-        def again():
-            # the browser's change and the put-back are handled on different threads;
-            # when Panel took the put-back for an echo of the browser's change it sent
-            # nothing: the value is sent once more, later (seen on a loaded machine)
-            self.text.param.trigger("value")
-
-        if served():
-            pn.state.execute(put_back, schedule=True)
-            doc = pn.state.curdoc
-            if doc is not None:
-                doc.add_timeout_callback(again, RESEND_MS)
-        else:
-            put_back()
-
-    def _dragged(self, event) -> None:
-        value = int(round(event.new)) if self._integer else event.new
-        if value != getattr(self.obj, self.parameter):
-            setattr(self.obj, self.parameter, value)
-
-    def _follow(self, event) -> None:
-        """The parameter changed (typed, dragged, a link, another control): the field and
-        the slider show it."""
-        shown = format_number(event.new)
-        if self.text.value != shown:
-            self.text.value = shown
-        if self.bar is not None and self.bar.value != event.new:
-            if event.new > self.bar.end:  # a typed value beyond the slider's end
-                self.bar.end = event.new
-            if event.new < self.bar.start:
-                self.bar.start = event.new
-            self.bar.value = event.new
+    def _from_bar(self, value: float) -> float | int:
+        return int(round(value)) if self._integer else value
 
     def __panel__(self):
         if self.compact:  # as wide as the label and the field: beside other controls

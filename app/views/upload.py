@@ -19,7 +19,7 @@ import panel as pn
 import param
 from panel.viewable import Viewer
 
-from ..datasource import CHASSIS_ACCEPT, TIRE_ACCEPT, DataSource
+from ..datasource import CHASSIS_ACCEPT, GEOMETRY_ACCEPT, TIRE_ACCEPT, DataSource
 from ..runtime.bands import served
 from ..runtime.uploads import UPLOADS
 
@@ -27,8 +27,11 @@ HELP = (
     "Chassis FRF: UFF 58 (.uff/.unv), MATLAB (.mat), CSV or HDF5 (.h5), layouts in "
     "docs/file-formats.md; it must hold the six spindle DOFs (outputs and inputs) and the "
     "six bushing outputs. Name the spindle and bushing nodes (a node name, or a UFF node "
-    "number). Modal tire model: the project's .h5 format or MATLAB .mat. Uploads stay in "
-    "this browser session."
+    "number). A measured set (sensors and impacts around the knuckle): upload its geometry "
+    "first (UFF 15/2411, CSV or HDF5 table, docs/vpt.md); the chassis file is then "
+    "transformed to the virtual point named as the spindle node, with its consistency "
+    "per channel. Modal tire model: the project's .h5 format or MATLAB .mat. Uploads stay "
+    "in this browser session."
 )
 
 
@@ -68,6 +71,21 @@ def _alert(body: str, kind: str, css: str, visible: bool = True) -> pn.pane.HTML
     )
 
 
+def _uploaded(widget: pn.widgets.FileInput, events) -> tuple[bytes, str] | None:
+    """The file a browser upload gave ``widget`` (its bytes and name), or None when the
+    events are not an upload (the input cleared). An empty file is ``b""``: Panel gives its
+    value as None. The input is then cleared here without telling the browser, so that the
+    same file uploaded again (an empty one too) is an upload again."""
+    value, name = widget.value, widget.filename
+    if value is None and not name:
+        return None
+    if isinstance(value, list) or isinstance(name, list):  # (single-file inputs only)
+        return None
+    with param.parameterized.discard_events(widget):
+        widget.param.update(value=None, filename=None)
+    return (b"" if value is None else bytes(value)), str(name or "upload")
+
+
 class UploadView(Viewer):
     """File inputs for a chassis FRF and a tire model, the import summary or the error."""
 
@@ -82,6 +100,9 @@ class UploadView(Viewer):
         )
         self.tire_file = W.FileInput(
             accept=TIRE_ACCEPT, multiple=False, css_classes=["upload-tire"], width=260
+        )
+        self.geometry_file = W.FileInput(
+            accept=GEOMETRY_ACCEPT, multiple=False, css_classes=["upload-geometry"], width=260
         )
         self.spindle = W.TextInput.from_param(
             ds.param.spindle, name="Spindle node", width=120, css_classes=["upload-spindle"]
@@ -109,8 +130,11 @@ class UploadView(Viewer):
             width=160,
             css_classes=["upload-reset"],
         )
-        self.chassis_file.param.watch(self._on_chassis, "value")
-        self.tire_file.param.watch(self._on_tire, "value")
+        # the file name too: Panel gives an empty file's value as None (no value event when
+        # the last one was None), and the upload was ignored with the earlier error on screen
+        self.chassis_file.param.watch(self._on_chassis, ["value", "filename"])
+        self.tire_file.param.watch(self._on_tire, ["value", "filename"])
+        self.geometry_file.param.watch(self._on_geometry, ["value", "filename"])
         self.reread.on_click(lambda _: self._run("chassis", ds.load_chassis))
         # a new node name or the interpolation choice re-reads the chassis file at once;
         # this also settles a click on "Read chassis again" that overtook the change
@@ -135,6 +159,7 @@ class UploadView(Viewer):
                 self._busy(False)
 
         self._busy(True)
+        self.data.error = ""  # the earlier file's error is stale: this one is being read
         if not served():  # a notebook or a test: no other sessions, read here
             job()
         elif UPLOADS.submit(self.data, slot, job, self._refused) is None:
@@ -148,23 +173,34 @@ class UploadView(Viewer):
         self.data.reset()
 
     def _busy(self, on: bool):
-        for w in (self.chassis_file, self.tire_file, self.reread, self.reset):
+        for w in (self.chassis_file, self.tire_file, self.geometry_file, self.reread, self.reset):
             w.disabled = on
 
-    # an empty file (b"") is read too: the page says it is empty instead of ignoring it
-    def _on_chassis(self, event):
-        if event.new is not None:
-            self._run("chassis", self.data.load_chassis, event.new, self.chassis_file.filename)
+    # an empty file is read too (as b""): the page says it is empty instead of ignoring it
+    def _on_chassis(self, *events):
+        got = _uploaded(self.chassis_file, events)
+        if got is not None:
+            self._run("chassis", self.data.load_chassis, *got)
 
-    def _on_tire(self, event):
-        if event.new is not None:
-            self._run("tire", self.data.load_tire, event.new, self.tire_file.filename)
+    def _on_geometry(self, *events):
+        got = _uploaded(self.geometry_file, events)
+        if got is not None:
+            self._run("chassis", self.data.load_geometry, *got)
+
+    def _on_tire(self, *events):
+        got = _uploaded(self.tire_file, events)
+        if got is not None:
+            self._run("tire", self.data.load_tire, *got)
 
     # -- display -----------------------------------------------------------------------
-    @param.depends("data.models", "data.tire_summary", "data.chassis_summary")
+    @param.depends(
+        "data.models", "data.tire_summary", "data.chassis_summary", "data.geometry_summary"
+    )
     def _summary(self):
         ds = self.data
         parts = [f"<b>In use: {_text(ds.describe())}</b>"]
+        if ds.geometry_summary:
+            parts.append(f"Measured set:<pre>{_text(ds.geometry_summary)}</pre>")
         for title, text in (("Chassis", ds.chassis_summary), ("Tire", ds.tire_summary)):
             if text and (
                 (title == "Chassis" and ds.models.chassis is not None)
@@ -183,11 +219,19 @@ class UploadView(Viewer):
             visible=bool(self.data.error),
         )
 
+    @param.depends("data.vpt")
+    def _consistency(self):
+        from .vpt_consistency import consistency_plot
+
+        return consistency_plot(self.data.vpt)
+
     def __panel__(self):
         label = pn.pane.Markdown
         return pn.Column(
             label(HELP, margin=(0, 10), styles={"color": "#495057", "font-size": "0.9em"}),
-            pn.Row(
+            # the inputs wrap onto a second line where the card is narrower than all of
+            # them (1280 px: the geometry input made the row overflow the page)
+            pn.FlexBox(
                 pn.Column(
                     label("**Chassis FRF**", margin=(0, 5)),
                     self.chassis_file,
@@ -196,10 +240,17 @@ class UploadView(Viewer):
                     self.interpolate,
                     self.reread,
                 ),
+                pn.Column(
+                    label("**Knuckle geometry** (measured set)", margin=(0, 5)),
+                    self.geometry_file,
+                ),
                 pn.Column(label("**Modal tire model**", margin=(0, 5)), self.tire_file),
                 pn.Column(label("&nbsp;", margin=(0, 5)), self.reset),
+                flex_wrap="wrap",
+                sizing_mode="stretch_width",
             ),
             self._error,
             self._summary,
+            self._consistency,
             sizing_mode="stretch_width",
         )

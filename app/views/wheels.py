@@ -4,7 +4,9 @@ The four lines are the levels of ``VehicleResponse.by_wheel`` at the response po
 road under each wheel, a wheelbase apart front to rear, the right track in phase, in
 anti-phase or partially coherent with the left), the thick line their sum: the coupled
 response view's truncated curve (N modes). Where two wheels' contributions are of equal
-level and opposite phase the total drops below both (wheelbase filtering).
+level and opposite phase the total drops below both (wheelbase filtering). A wheel whose
+road input is off contributes exact zeros, which have no level: its line and legend entry
+are hidden, so the axis spans the driven wheels' levels only.
 """
 
 from __future__ import annotations
@@ -65,12 +67,27 @@ class WheelContributionsView(LiveView):
             tooltips=level_tooltips("total", "total"),
             legend_location="bottom_right",
         )
+        # a wheel whose road input is off has no level: its line and legend entry are hidden
+        self._lines = {r.glyph.y: r for r in fig.renderers if r.glyph.y in WHEELS}
         return [fig]
 
     def _draw(self, r):
         c = r.columns
         f = c["freq_Hz"]
-        self._src.data = {"freq": f, **{w: c[f"{w}_dB"] for w in WHEELS}, "total": c["total_dB"]}
+        gap = np.full(np.shape(f), np.nan)  # an off wheel: no level, nothing for the axis
+        self._src.data = {
+            "freq": f,
+            **{w: c.get(f"{w}_dB", gap) for w in WHEELS},
+            "total": c["total_dB"],
+        }
+        on = set(r.draw["wheels"])
+        for w, line in self._lines.items():
+            if line.visible != (w in on):
+                line.visible = w in on
+        for item in self._fig.legend[0].items:
+            w = next((x for x, ln in self._lines.items() if ln in item.renderers), None)
+            if w is not None and item.visible != (w in on):
+                item.visible = w in on
         self._fig.yaxis.axis_label = level_label(r.draw["dof"])
         self._fit(self.x_range, f)
 

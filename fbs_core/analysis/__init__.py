@@ -92,15 +92,19 @@ __all__ += [
     "remove_pin",
 ]
 from .participation import (  # noqa: E402
+    KINDS,
     Participation,
     coupled_mode_arrays,
     mode_participation,
+    pair_kinds,
     participation_from_terms,
 )
 from .selection import ModeSelection, prefix_responses, select_modes  # noqa: E402
 
 __all__ += [
+    "KINDS",
     "Participation",
+    "pair_kinds",
     "coupled_mode_arrays",
     "mode_participation",
     "participation_from_terms",

@@ -27,6 +27,17 @@ A "mode" here is a stored (tracked) mode pair of the tire model (both members of
 conjugate pair, or a pair of real poles of the tread's first-order slip states), the
 unit the truncation keeps or drops (thesis section 5.1). Derivation and measured
 tables: docs/modes.md.
+
+Not every pair is a vibration. A pair of real poles is a first-order state of the tread's
+slip law (docs/tire-model.md, "Slip in the contact"): a pair of poles at 0 is the whole
+tire **sliding** on its slip dampers (a rigid translation in x and in y that strains no
+spring, ``K x = 0``; its term is the frequency-independent hub mobility of the dampers,
+``v / C_kappa`` and ``v / C_alpha``), a pair of negative real poles the tread's
+**relaxation** (``lambda = -v / sigma``, time constants ``sigma / v``). They have no
+eigenfrequency and no period, and they are part of the synthesis at every ``N``: their
+measures are real (without the sliding pair the tire cannot slide on the road), but they
+are no candidates of a vibration-mode ranking (:meth:`Participation.ranking` with
+``vibration=True``, :attr:`Participation.kind`).
 """
 
 from __future__ import annotations
@@ -36,8 +47,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from .._typing import ComplexArray, FloatArray, IntArray
+from .._typing import BoolArray, ComplexArray, FloatArray, IntArray
 from ..errors import DOFError, FBSError
 from ..frf import check_grid
 from ..harmonics import Harmonic
@@ -47,7 +59,9 @@ from ..tire.terms import ModeTerms, mode_terms
 from ..vocabulary import readonly as _ro
 
 __all__ = [
+    "KINDS",
     "Participation",
+    "pair_kinds",
     "mode_participation",
     "participation_from_terms",
     "coupled_mode_arrays",
@@ -56,6 +70,39 @@ __all__ = [
 
 #: Measures a ranking can be sorted by (:meth:`Participation.ranking`).
 RANKINGS = ("loo", "share", "level", "loo_direct", "loo_floating")
+#: What a stored pair is (:attr:`Participation.kind`): an oscillation (a conjugate pair),
+#: the tread sliding (two real poles at 0) or its relaxation (two negative real poles).
+KINDS = {
+    "vibration": "vibration mode (a conjugate pair of poles)",
+    "sliding": "tread sliding: the whole tire slides on its slip dampers (two real poles "
+    "at 0, x and y; no deformation, a constant hub mobility v / C)",
+    "relaxation": "tread relaxation (two real poles -v / sigma: the slip law's first-order "
+    "lag, no oscillation)",
+}
+#: A real pole slower than this (rad/s; a time constant above ~12 days) is a zero pole.
+ZERO_RATE = 1e-6
+
+
+def pair_kinds(poles: ArrayLike) -> tuple[BoolArray, BoolArray]:
+    """Which stored pairs are first-order and which of those are the sliding states.
+
+    Parameters
+    ----------
+    poles : array_like, shape (n_s, n_m)
+        The modal model's poles at its operating points, pairs ``[2 m, 2 m + 1]``.
+
+    Returns
+    -------
+    first_order, sliding : ndarray of bool, shape (n_m // 2,)
+        ``first_order``: both members real at every operating point; ``sliding``: and
+        both zero (slower than :data:`ZERO_RATE`) at every operating point.
+    """
+    lam = np.asarray(poles, complex)
+    a, b = lam[:, 0::2], lam[:, 1::2]
+    first: BoolArray = np.all((a.imag == 0) & (b.imag == 0), axis=0)
+    zero = np.all((np.abs(a) < ZERO_RATE) & (np.abs(b) < ZERO_RATE), axis=0)
+    sliding: BoolArray = first & zero
+    return first, sliding
 
 
 def coupled_mode_arrays(
@@ -144,6 +191,8 @@ class Participation:
         The response without each mode (exact, both paths).
     width : float
         Floating band width in Hz (eq. 5.1; the step is 1 Hz).
+    sliding : ndarray of bool, shape (n_p,)
+        The first-order pairs whose poles are 0: the tread sliding (:data:`KINDS`).
     """
 
     harmonic: int
@@ -165,6 +214,20 @@ class Participation:
     loo_floating: FloatArray
     loo_response: ComplexArray
     width: float
+    sliding: Any = None
+
+    def __post_init__(self) -> None:
+        if self.sliding is None:
+            object.__setattr__(self, "sliding", _ro(np.zeros(len(self.modes), bool), bool))
+
+    @property
+    def kind(self) -> tuple[str, ...]:
+        """What every pair is: ``"vibration"``, ``"sliding"`` or ``"relaxation"``
+        (:data:`KINDS`)."""
+        return tuple(
+            "sliding" if sl else ("relaxation" if fo else "vibration")
+            for fo, sl in zip(self.first_order, self.sliding, strict=True)
+        )
 
     def _dof(self, dof: str | None) -> int | None:
         if dof is None:
@@ -193,10 +256,14 @@ class Participation:
         out: FloatArray = a.max(axis=1) if i is None else a[:, i]
         return out
 
-    def ranking(self, by: str = "loo", dof: str | None = None) -> IntArray:
-        """Positions (into :attr:`modes`) from the mode that matters most, shape (n_p,)."""
+    def ranking(self, by: str = "loo", dof: str | None = None, vibration: bool = False) -> IntArray:
+        """Positions (into :attr:`modes`) from the mode that matters most, shape (n_p,);
+        ``vibration=True``: of the vibration modes only (the first-order slip states, no
+        oscillation, left out: :attr:`first_order`)."""
         m = self.measure(by, dof)
         order: IntArray = np.argsort(-m, kind="stable")
+        if vibration:
+            order = order[~np.asarray(self.first_order, bool)[order]]
         return order
 
     def table(self, dof: str | None = None, by: str = "loo", top: int = 15) -> str:
@@ -217,7 +284,11 @@ class Participation:
             else:
                 sh, lv, lo, di = (x[p, i] for x in (self.share, self.level, self.loo,
                                                      self.loo_direct))  # fmt: skip
-            f = "slip" if self.first_order[p] else f"{self.mode_freq[p]:8.1f}"
+            f = (
+                self.kind[p].replace("relaxation", "relax")
+                if self.first_order[p]
+                else f"{self.mode_freq[p]:8.1f}"
+            )
             rows.append(
                 f"{rank:4d} {int(self.modes[p]):5d} {f:>8} {self.mode_speed[p]:8.1f} "
                 f"{100 * sh:8.1f} {100 * lv:8.1f} {100 * lo:8.1f} {100 * di:8.1f}"
@@ -309,8 +380,10 @@ def mode_participation(
     speeds = np.asarray(h.speed_at(f), float)
     YjjE, YejE, resp = _models.chassis_arrays(chassis, f, dirs)
     terms = mode_terms(tire, f, speeds, tire._harmonic_index(h))
-    first = np.all(np.asarray(tire.poles)[:, 0::2].imag == 0, axis=0)
-    return participation_from_terms(h.k, terms, YjjE, YejE, resp, dirs, first, width)
+    first, sliding = pair_kinds(tire.poles)
+    return participation_from_terms(
+        h.k, terms, YjjE, YejE, resp, dirs, first, width, sliding=sliding
+    )
 
 
 def participation_from_terms(
@@ -322,6 +395,8 @@ def participation_from_terms(
     dirs: Sequence[str],
     first_order: Any,
     width: float = 12.0,
+    *,
+    sliding: Any = None,
 ) -> Participation:
     """:func:`mode_participation` from per-mode terms and chassis arrays (the kernel).
 
@@ -339,6 +414,8 @@ def participation_from_terms(
         Pairs of real poles.
     width : float
         Floating band of ``loo_floating`` in Hz.
+    sliding : ndarray of bool, shape (n_p,), optional
+        Pairs of zero poles (:func:`pair_kinds`); default none.
 
     Returns
     -------
@@ -387,4 +464,5 @@ def participation_from_terms(
         loo_floating=_ro(e_flt.max(axis=1)),
         loo_response=_ro(loo_resp),
         width=float(width),
+        sliding=_ro(np.zeros(terms.n_pairs, bool) if sliding is None else sliding, bool),
     )

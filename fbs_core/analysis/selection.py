@@ -47,7 +47,12 @@ from ..studies.metric import floating_band_error
 from ..studies.truncation import suggest_n_modes
 from ..tire.terms import ModeTerms, mode_terms
 from ..vocabulary import readonly as _ro
-from .participation import RANKINGS, coupled_mode_arrays, participation_from_terms
+from .participation import (
+    RANKINGS,
+    coupled_mode_arrays,
+    pair_kinds,
+    participation_from_terms,
+)
 
 __all__ = ["ModeSelection", "select_modes", "prefix_responses", "SELECTIONS"]
 
@@ -314,8 +319,10 @@ def select_modes(
     cen = np.arange(np.ceil(f[0] - 1e-9), np.floor(min(f_max, f[-1]) + 1e-9) + 1.0)
     Yp, vp, A, v = coupled_mode_arrays(terms, YjjE, dirs)
     ref = np.einsum("fec,fc->fe", YejE, np.linalg.solve(A, v[..., None])[..., 0])
-    first = np.all(np.asarray(tire.poles)[:, 0::2].imag == 0, axis=0)
-    part = participation_from_terms(h.k, terms, YjjE, YejE, resp, dirs, first, width)
+    first, sliding = pair_kinds(tire.poles)
+    part = participation_from_terms(
+        h.k, terms, YjjE, YejE, resp, dirs, first, width, sliding=sliding
+    )
     if by == "greedy":
         Y0, v0 = np.zeros_like(A), np.zeros_like(v)
         if residual:  # a pair not (yet) chosen is there with its static part

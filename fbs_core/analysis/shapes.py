@@ -139,6 +139,15 @@ class TireModeShape:
     hub_share : float
         Share of the mode's ``sum m |x|^2`` in the hub (rim) DOFs.
     shape : BeltShape
+    kind : str
+        ``"vibration"`` (an oscillation), ``"sliding"`` (a zero pole: the whole tire slides
+        on the tread's slip dampers) or ``"relaxation"`` (a negative real pole: the slip
+        law's first-order lag); :data:`fbs_core.analysis.KINDS`.
+    deformation : float
+        Share of the belt's displacement that is no rigid motion with the hub,
+        ``||d - (t + r x p)|| / ||d||`` over the drawn belt points ``p`` (``t``, ``r`` the
+        hub's translation and rotation): 0 for a wheel moving as a rigid body (the sliding
+        states, ``K x = 0``), of order 1 for a belt mode.
     """
 
     mode: int
@@ -153,6 +162,8 @@ class TireModeShape:
     travelling: float
     hub_share: float
     shape: BeltShape
+    kind: str = "vibration"
+    deformation: float = float("nan")
 
 
 @dataclass(frozen=True, eq=False)
@@ -368,6 +379,12 @@ def tire_mode_shape(
     fam, order, share, direction = dominant(content, trav)
     shape = _belt_shape(parts, scale * tire.params.R / parts.largest, n_frames, int(order[0]))
     e = m * np.abs(x) ** 2
+    if abs(model_pole.imag) > 0:
+        kind = "vibration"
+    else:
+        from .participation import ZERO_RATE
+
+        kind = "sliding" if abs(model_pole) < ZERO_RATE else "relaxation"
     return TireModeShape(
         mode=int(mode),
         speed_kmh=float(speed_kmh),
@@ -381,7 +398,20 @@ def tire_mode_shape(
         travelling=float(trav[0].reshape(-1)[np.argmax(content[0])]),
         hub_share=float(e[co.hub].sum() / max(e.sum(), 1e-300)),
         shape=shape,
+        kind=kind,
+        deformation=_deformation(x, parts, tire.params),
     )
+
+
+def _deformation(x: ComplexArray, parts: _Parts, params: Any) -> float:
+    """Share of the belt's displacement that is no rigid motion with the hub (wheel axes:
+    the hub's translation ``t`` and rotation ``r`` moved to every belt point ``p``)."""
+    Q = wheel_rotation(params)
+    hub = np.asarray(x)[parts.coords.hub]
+    t, r = Q.T @ hub[:3], Q.T @ hub[3:]
+    rigid = t + np.cross(r, parts.rest)  # (n_t, n_y, 3)
+    total = float(np.linalg.norm(parts.d))
+    return float(np.linalg.norm(parts.d - rigid) / total) if total > 0 else 0.0
 
 
 def _check_sizes(n_frames: int, n_theta: int, n_y: int, scale: float) -> None:

@@ -36,9 +36,12 @@ every ring order 2..8 has a forward and a backward branch near it (docs/modes.md
 
 from __future__ import annotations
 
-import functools
-from collections.abc import Sequence
-from dataclasses import dataclass
+import hashlib
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, fields
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -54,7 +57,22 @@ from ..tire.params import FAMILIES, TireParameters
 from ..tire.ring import build_tire_system, patch_load, ring_closed_form
 from ..vocabulary import DIRECTIONS
 
-__all__ = ["WaveCampbell", "wave_campbell", "HUB_CONDITIONS"]
+__all__ = ["WaveCampbell", "wave_campbell", "HUB_CONDITIONS", "STORED_FILE", "save_waves"]
+
+#: ``progress(done, total)``: the speeds solved so far (it may raise to stop the solve).
+Progress = Callable[[int, int], None]
+
+#: Tracked results kept per process (by model, speeds, hub and ``veer_mac``).
+CACHE_SIZE = 4
+
+#: The reference tire's tracked branches, stored (``scripts/build_reference_waves.py``):
+#: the 43 dense solves take 12 s on an idle core and many minutes on a busy one, and the
+#: result is the same for every session and every start of the server.
+STORED_FILE = Path(__file__).resolve().parents[2] / "data" / "reference_waves.npz"
+
+#: Version of the tracking's numbers: a stored result of another version is not used
+#: (raise it whenever a change of this module changes what :func:`_track` returns).
+TRACKING_VERSION = 1
 
 #: How the hub is held: ``"free"`` (the tire on the road, as coupled) or ``"fixed"``
 #: (the rim clamped: the "rim-fixed" belt modes of MF-Swift and the ring's closed form).
@@ -280,8 +298,15 @@ def _character_labels(n_f: int, n_o: int) -> tuple[list[str], list[int], list[st
     return fam, order, direction
 
 
-@functools.lru_cache(maxsize=4)
-def _track(source: Any, speeds: tuple[float, ...], hub: str, veer_mac: float) -> WaveCampbell:
+def _track(
+    source: Any,
+    speeds: tuple[float, ...],
+    hub: str,
+    veer_mac: float,
+    progress: Progress | None = None,
+) -> WaveCampbell:
+    """The tracked branches: one dense complex-mode solve per speed (``progress(i, n)``
+    after each), then the characters assigned; see the module notes."""
     from ..tire import complex_modes
 
     params = _params(source)
@@ -289,7 +314,9 @@ def _track(source: Any, speeds: tuple[float, ...], hub: str, veer_mac: float) ->
     loads = None
     rows = []
     prev = None
-    for v in speeds:
+    for i_v, v in enumerate(speeds):
+        if progress is not None:
+            progress(i_v, len(speeds))
         M, C, K, dofs = _system(source, float(v), hub)
         md = complex_modes(M, C, K)
         pos = np.flatnonzero(md.poles[0::2].imag > 0)  # vibration modes only
@@ -336,6 +363,8 @@ def _track(source: Any, speeds: tuple[float, ...], hub: str, veer_mac: float) ->
             mac[ok] = num / ((np.abs(a) ** 2).sum(0) * (np.abs(b) ** 2).sum(0))
         rows.append((lam, chars, trav, content, ex, stored, carrier, mac))
         prev = (psi, w, carrier)
+    if progress is not None:
+        progress(len(speeds), len(speeds))
     n_v, n_c = len(speeds), rows[0][1].shape[1]
     n_f, n_o = rows[0][3].shape[1:]
     fam, order, direction = _character_labels(n_f, n_o)
@@ -363,10 +392,10 @@ def _track(source: Any, speeds: tuple[float, ...], hub: str, veer_mac: float) ->
         if i:
             mac[i - 1] = m
     cf = np.full((n_v, n_c), np.nan)
-    for b in range(n_c):
-        if fam[b] == "ip" and order[b] >= 2:
-            fw = [ring_closed_form(order[b], float(v), params) for v in speeds]
-            cf[:, b] = [x[0] if direction[b] == "forward" else x[1] for x in fw]
+    for br in range(n_c):
+        if fam[br] == "ip" and order[br] >= 2:
+            fw = [ring_closed_form(order[br], float(v), params) for v in speeds]
+            cf[:, br] = [x[0] if direction[br] == "forward" else x[1] for x in fw]
     exists = np.isfinite(freq).any(axis=0)
     keep = np.flatnonzero(exists)
     return _subset(
@@ -403,6 +432,7 @@ def wave_campbell(
     hub: str = "free",
     fmax: float | None = 450.0,
     veer_mac: float = 0.8,
+    progress: Progress | None = None,
 ) -> WaveCampbell:
     """Campbell diagram whose branches follow the belt waves (module notes).
 
@@ -423,12 +453,17 @@ def wave_campbell(
         Keep the branches that come below ``fmax`` Hz somewhere (None: all).
     veer_mac : float
         MAC below which a tracked step is flagged as veering.
+    progress : callable, optional
+        ``progress(done, total)`` as the speeds are solved (not called for a result
+        cached or stored); an exception it raises stops the solve and is raised here.
 
     Returns
     -------
     WaveCampbell
         Cached per model, speeds, hub and ``veer_mac`` (one dense complex-mode solve per
-        speed: about 0.15 s each on an idle core).
+        speed: about 0.2 s each on an idle core); the reference tire's is read from
+        :data:`STORED_FILE` when it was stored for the same model, speeds, hub and
+        ``veer_mac`` (:func:`content_key`).
 
     Raises
     ------
@@ -456,7 +491,7 @@ def wave_campbell(
     v = np.asarray(tire.speeds if speeds is None else speeds, float).ravel()
     if v.size < 2 or np.any(np.diff(v) <= 0) or not np.all(np.isfinite(v)):
         raise FBSError(f"speeds must be >= 2 increasing values in km/h, got {v.tolist()}")
-    cb = _track(source, tuple(float(x) for x in v), hub, float(veer_mac))
+    cb = _tracked(source, tuple(float(x) for x in v), hub, float(veer_mac), progress)
     if fmax is None:
         return cb
     keep = np.flatnonzero(
@@ -485,3 +520,79 @@ def _subset(cb: WaveCampbell, keep: Sequence[int] | IntArray) -> WaveCampbell:
         stored=cb.stored[:, k],
         hub=cb.hub,
     )
+
+
+_cache: OrderedDict[tuple[Any, ...], WaveCampbell] = OrderedDict()
+_cache_lock = threading.Lock()
+
+
+def _tracked(
+    source: Any,
+    speeds: tuple[float, ...],
+    hub: str,
+    veer_mac: float,
+    progress: Progress | None,
+) -> WaveCampbell:
+    """:func:`_track` cached per process, or the stored result when it is the same."""
+    key = (source, speeds, hub, veer_mac)
+    with _cache_lock:
+        cb = _cache.get(key)
+        if cb is not None:
+            _cache.move_to_end(key)
+            return cb
+    cb = load_stored(source, speeds, hub, veer_mac)
+    if cb is None:
+        cb = _track(source, speeds, hub, veer_mac, progress)
+    with _cache_lock:
+        _cache[key] = cb
+        while len(_cache) > CACHE_SIZE:
+            _cache.popitem(last=False)
+    return cb
+
+
+def content_key(source: Any, speeds: Sequence[float], hub: str, veer_mac: float) -> str:
+    """A digest of everything :func:`_track` reads: the tire's physical parameters, its
+    stored poles (matched to the branches), the speeds, the hub condition, ``veer_mac``
+    and :data:`TRACKING_VERSION`."""
+    h = hashlib.sha256()
+    params = _params(source)
+    h.update(repr(params).encode())
+    h.update(np.asarray(speeds, float).tobytes())
+    if not isinstance(source, TireParameters):
+        h.update(np.ascontiguousarray(np.asarray(source.poles, complex)).tobytes())
+        h.update(np.asarray(source.speeds, float).tobytes())
+    h.update(f"{hub}|{float(veer_mac)!r}|{TRACKING_VERSION}".encode())
+    return h.hexdigest()
+
+
+def save_waves(cb: WaveCampbell, path: str | Path, key: str) -> None:
+    """Write a tracked result and its :func:`content_key` to ``path`` (``.npz``: plain
+    arrays, no pickles)."""
+    arrays: dict[str, Any] = {"content_key": np.array(key)}
+    for f in fields(cb):
+        arrays[f.name] = np.asarray(getattr(cb, f.name))
+    np.savez_compressed(Path(path), **arrays)
+
+
+def load_stored(
+    source: Any, speeds: Sequence[float], hub: str, veer_mac: float, path: Path | None = None
+) -> WaveCampbell | None:
+    """The stored result (:data:`STORED_FILE`) when it was made of the same content
+    (:func:`content_key`), else None."""
+    path = STORED_FILE if path is None else path
+    if not path.is_file():
+        return None
+    key = content_key(source, speeds, hub, veer_mac)
+    with np.load(path, allow_pickle=False) as z:
+        if str(z["content_key"]) != key:
+            return None
+        kw: dict[str, Any] = {}
+        for f in fields(WaveCampbell):
+            a = z[f.name]
+            if f.name == "veer_mac":
+                kw[f.name] = float(a)
+            elif f.name == "hub":
+                kw[f.name] = str(a)
+            else:
+                kw[f.name] = np.array(a)
+    return WaveCampbell(**kw)

@@ -28,7 +28,7 @@ import numpy as np
 
 from .._typing import AnyArray, FloatArray, IntArray
 from .spec import CampaignError
-from .store import CampaignStore
+from .store import CampaignStore, read_file
 
 if TYPE_CHECKING:
     from ..studies.scatter import ScatterBand
@@ -214,7 +214,6 @@ class CampaignResult:
     """A campaign result file opened for reading (see :func:`open_campaign`)."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
-        import h5py
 
         self.path = Path(path)
         self._store = CampaignStore(self.path)
@@ -226,11 +225,7 @@ class CampaignResult:
         cases: dict[str, dict[str, Any]] = {}
         self._where: dict[str, Path] = {}  # unit path -> file
         for p in files:
-            try:
-                h = h5py.File(p, "r")
-            except OSError as e:
-                raise CampaignError(f"{p}: not a readable HDF5 file ({e})") from None
-            with h, _readable(p):
+            with read_file(p) as h, _readable(p):
                 if p == self.path:
                     if h.attrs.get("content") != "campaign":
                         raise CampaignError(f"{p}: not a campaign result file")
@@ -311,12 +306,11 @@ class CampaignResult:
         )
 
     def _inputs(self, name: str) -> tuple[dict[str, AnyArray], tuple[str, ...]]:
-        import h5py
 
         p = self._where.get(f"inputs/{name}")
         if p is None:
             raise CampaignError(f"{self.path}: the subsystem arrays {name!r} are missing")
-        with _readable(p, f"subsystem arrays {name!r}"), h5py.File(p, "r") as h:
+        with _readable(p, f"subsystem arrays {name!r}"), read_file(p) as h:
             g = h["inputs"][name]
             arr = {k: g[k][()] for k in ("freq", "YjjA", "vj", "YjjE", "YejE", "reference")}
             dofs = tuple(str(x) for x in _json(g.attrs["dofs"]))
@@ -331,7 +325,6 @@ class CampaignResult:
             For an unknown, truncation or incomplete case, or one stored without its
             band edges (``[outputs] scatter``).
         """
-        import h5py
 
         from .work import BLOCK_KEYS
 
@@ -349,7 +342,7 @@ class CampaignResult:
             arr, dofs = self._inputs(str(d["attrs"]["inputs"]))
         blocks = []
         for (a, z), p in sorted(d["blocks"].items()):
-            with _readable(p, f"case {name!r} block {a}_{z}"), h5py.File(p, "r") as h:
+            with _readable(p, f"case {name!r} block {a}_{z}"), read_file(p) as h:
                 g = h["cases"][name]["blocks"][f"{a}_{z}"]
                 b = {k: (g[k][()] if k in g else None) for k in (*BLOCK_KEYS, "checkpoints")}
             blocks.append(b | {"l0": a, "l1": z})
@@ -431,11 +424,10 @@ class CampaignResult:
             return self._truncation(p, name, c)
 
     def _truncation(self, p: Path, name: str, c: CaseEntry) -> TruncationEntry:
-        import h5py
 
         from ..studies.truncation import TruncationMap
 
-        with h5py.File(p, "r") as h:
+        with read_file(p) as h:
             g = h["cases"][name]["result"]
             get = {k: g[k][()] for k in g}
             at = {k: _json(v) for k, v in g.attrs.items()}

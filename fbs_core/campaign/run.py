@@ -219,13 +219,21 @@ def group_blocks(tasks: list[Task], task_round_lines: float) -> list[list[Task]]
 def make_client(scheduler: str | None = None, workers: int | None = None) -> tuple[Any, Any]:
     """``(client, cluster)``: join ``scheduler`` (or ``$FBS_DASK_SCHEDULER``), else start a
     LocalCluster (in-process with one worker thread, or ``workers`` worker processes);
-    ``cluster`` is None when joining an existing one."""
+    ``cluster`` is None when joining an existing one.
+
+    A scheduler is joined as :mod:`fbs_core.campaign.security` allows: over TLS with the
+    certificates of ``$FBS_DASK_TLS_DIR``, or in plain TCP on the loopback interface only
+    (elsewhere with ``FBS_DASK_ALLOW_PLAIN=1``); a refused address raises
+    :class:`~fbs_core.campaign.security.InsecureScheduler` (a :class:`CampaignError`).
+    """
     from distributed import Client, LocalCluster
+
+    from .security import connect
 
     addr = scheduler or os.environ.get(SCHEDULER_ENV) or None
     if addr:
         try:
-            return Client(addr, timeout="30s"), None
+            return connect(addr, "30s"), None
         except OSError as e:
             raise CampaignError(f"cannot reach the Dask scheduler at {addr}: {e}") from None
     if workers:

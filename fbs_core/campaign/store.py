@@ -39,27 +39,47 @@ import json
 import os
 import shutil
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeAlias
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..hdf5_guard import open_h5
 from .spec import CampaignError
 
 if TYPE_CHECKING:
     from .spec import Campaign
 
 #: An h5py File, Group or Dataset (h5py ships no type stubs).
-H5: TypeAlias = Any
+type H5 = Any
 
 #: A finished unit to write: ``(path, data, attrs, parents)``, see
 #: :meth:`CampaignStore.write_unit`.
-Unit: TypeAlias = tuple[str, dict[str, Any], dict[str, Any], dict[str, dict[str, Any]] | None]
+type Unit = tuple[str, dict[str, Any], dict[str, Any], dict[str, dict[str, Any]] | None]
 
 __all__ = ["CampaignStore", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
+
+
+@contextmanager
+def read_file(path: Path) -> Iterator[H5]:
+    """A result file or part opened for reading through :func:`fbs_core.hdf5_guard.open_h5`
+    (a file linking to, or mapping data from, other files is refused).
+
+    Raises
+    ------
+    CampaignError
+        For a file that is not HDF5, or that points outside itself (naming the object).
+    """
+    with ExitStack() as stack:
+        try:
+            h = stack.enter_context(open_h5(path, error=CampaignError))
+        except OSError as e:
+            raise CampaignError(f"{path}: not a readable HDF5 file ({e})") from None
+        yield h
 
 
 def _now() -> str:
@@ -156,12 +176,11 @@ class CampaignStore:
 
     def done(self) -> set[str]:
         """Paths of all finished units (result file and parts)."""
-        import h5py
 
         out: set[str] = set()
         for p in self.files():
             try:
-                with h5py.File(p, "r") as h:
+                with open_h5(p, error=CampaignError) as h:
                     out |= _units(h)
             except OSError as e:
                 if p == self.output:
@@ -248,10 +267,9 @@ class CampaignStore:
 
     def unit_attrs(self, path: str) -> dict[str, Any] | None:
         """Attributes of a stored unit (result file or parts), None when absent."""
-        import h5py
 
         for p in self.files():
-            with h5py.File(p, "r") as h:
+            with read_file(p) as h:
                 if path in h:
                     return {k: v for k, v in h[path].attrs.items()}
         return None
@@ -259,11 +277,10 @@ class CampaignStore:
     # -- checks ------------------------------------------------------------------------------
     def case_digests(self) -> dict[str, str]:
         """``case name -> settings digest`` of the cases already in the file or parts."""
-        import h5py
 
         out: dict[str, str] = {}
         for p in self.files():
-            with h5py.File(p, "r") as h:
+            with read_file(p) as h:
                 for name, g in h.get("cases", {}).items():
                     if "digest" in g.attrs:
                         out.setdefault(name, str(g.attrs["digest"]))
@@ -278,11 +295,10 @@ class CampaignStore:
             When the file holds a case of the same name computed with other settings
             (seed, percentiles, grid ...), or is another tool's file.
         """
-        import h5py
 
         if self.output.is_file():
             try:
-                with h5py.File(self.output, "r") as h:
+                with open_h5(self.output, error=CampaignError) as h:
                     if h.attrs.get("content") != "campaign":
                         raise CampaignError(
                             f"{self.output} exists and is not a campaign result file; "
@@ -377,12 +393,11 @@ class Merging:
     def merge(self, part: Path) -> None:
         """Merge one part file into the copy; on any failure the copy is dropped and the
         error raised."""
-        import h5py
 
         if self._h is None:
             raise CampaignError(f"{self.tmp}: the copy of the result file was dropped")
         try:
-            with h5py.File(part, "r") as src:
+            with read_file(part) as src:
                 n = len(_units(src))
                 _merge(src, self._h)
         except BaseException:

@@ -425,18 +425,17 @@ def study_from_file(path: Any, name: str) -> VariantStudy:
     CampaignError
         For an unknown case, another kind of case, or one not complete.
     """
-    import h5py
 
     from ..variants import VariantStudy, tire_key
     from ..variants.parameters import apply_values
-    from .store import CampaignStore
+    from .store import CampaignStore, read_file
 
     store = CampaignStore(path)
     attrs: dict[str, Any] | None = None
     units: dict[str, dict[str, Any]] = {}
     design_unit: dict[str, Any] | None = None
     for p in store.files():
-        with h5py.File(p, "r") as h:
+        with read_file(p) as h:
             g = h.get(f"cases/{name}")
             if g is None:
                 continue

@@ -8,6 +8,8 @@ Entry points (all accept a path, or the bytes of an upload plus its file name):
 * :func:`import_tire_model` - a modal tire model from the project's format or MATLAB
   (``load_tire_model`` is its deprecated name; the package's own trusted file is read by
   :func:`fbs_core.tire.read_tire_h5`).
+* :func:`load_geometry` - positions and directions of measured channels (UFF 15/2411,
+  CSV, HDF5) for the virtual point transformation (:mod:`.geometry`, :mod:`fbs_core.vpt`).
 * :func:`export_result` - coupled and study results to CSV, UFF 58 or HDF5 with
   metadata (harmonic, N, noise, seed, fbs_core version) for traceability.
 
@@ -34,7 +36,7 @@ import os
 import warnings
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeAlias, overload
+from typing import TYPE_CHECKING, Any, overload
 
 from ..errors import DataFormatError
 from ..frf import FRF
@@ -50,6 +52,7 @@ from .checks import (
     require_dofs,
 )
 from .formats import FORMATS, REGISTRY, FileFormat, detect_format, format_of
+from .geometry import Geometry, load_geometry
 from .imported import ImportResult, frf_import, tire_import
 from .results import ResultData, as_result_data
 
@@ -57,14 +60,15 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
 #: A file path, or the content of an upload.
-SourceLike: TypeAlias = "str | os.PathLike[str] | bytes | bytearray | memoryview"
+type SourceLike = str | os.PathLike[str] | bytes | bytearray | memoryview
 #: Where to write; None returns the content as bytes.
-PathLike: TypeAlias = "str | os.PathLike[str]"
+type PathLike = str | os.PathLike[str]
 
 __all__ = [
     "DEFAULT_MAX_BYTES",
     "FORMATS",
     "FileFormat",
+    "Geometry",
     "ImportResult",
     "REGISTRY",
     "ResultData",
@@ -75,6 +79,7 @@ __all__ = [
     "import_tire_model",
     "interface_check",
     "load_frf",
+    "load_geometry",
     "load_result",
     "load_tire_model",
     "prepare_chassis",

@@ -268,11 +268,11 @@ def parse_isolated(
     mem_bytes: int | None = None,
     max_result_bytes: int | None = None,
 ) -> tuple[dict[str, Any], list[np.ndarray]]:
-    """Parse ``raw`` with handler ``kind`` ("mat5", "hdf5", "uff" or "csv") in the sandbox.
+    """Parse ``raw`` with handler ``kind`` ("mat5", "hdf5", "uff", "csv", "table") in the sandbox.
 
     Parameters
     ----------
-    kind : {"mat5", "hdf5", "uff", "csv"}
+    kind : {"mat5", "hdf5", "uff", "csv", "table"}
     raw : bytes
         File content.
     what : str

@@ -8,11 +8,13 @@ object per number of the file's data: numbers are parsed by numpy from whole blo
 * :func:`parse_uff` splits a Universal File into its datasets (a block between two
   ``-1`` lines; binary 58b blocks are skipped by their announced byte count, so bytes
   looking like ``-1`` inside them do not split them) and reads datasets 58 / 58b
-  (header records 1-11 and the data), 164 (units) and 151 (header) completely; of
-  other datasets only the type is kept. A file that ends inside a dataset is refused
-  with the line where it ends.
+  (header records 1-11 and the data), 164 (units), 151 (header) and the node
+  coordinates of 15 and 2411 completely; of other datasets only the type is kept. A
+  file that ends inside a dataset is refused with the line where it ends.
 * :func:`parse_csv` reads the ``#`` header lines and the column-header row as text
   and the data rows as one float array.
+* :func:`parse_table` reads a small CSV table whose cells are text (a geometry table:
+  channel labels beside numbers), at most :data:`MAX_TABLE_CELLS` cells.
 
 Both return ``(meta, arrays)``: JSON-compatible ``meta`` referring to ``arrays`` by
 position, as the other sandbox handlers do. Refusals raise :class:`ParseError` with
@@ -29,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ParseError", "parse_uff", "parse_csv"]
+__all__ = ["ParseError", "parse_uff", "parse_csv", "parse_table"]
 
 
 class ParseError(ValueError):
@@ -279,6 +281,15 @@ def parse_uff(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
             entry.update(d)
         elif dtype == 164:
             entry.update(_units_164(raw[body_start : e.start()].splitlines(), where))
+        elif dtype in (15, 2411):
+            ids, cs, xyz = _nodes(raw[body_start : e.start()].splitlines(), dtype, where)
+            total += 6 * len(ids)
+            if max_values is not None and total > max_values:
+                raise ParseError(
+                    "the datasets hold more numbers than this tool accepts from one file"
+                )
+            entry.update(nodes=len(arrays), cs=len(arrays) + 1, xyz=len(arrays) + 2)
+            arrays += [ids, cs, xyz]
         elif dtype == 151:
             body = raw[body_start : e.start()].splitlines()
             entry.update({f"line{i + 1}": _text(b).rstrip()[:80] for i, b in enumerate(body[:7])})
@@ -436,6 +447,33 @@ def _binary_values(
     return np.frombuffer(raw, dtype=dt, count=want, offset=a).astype(float)
 
 
+def _nodes(body: list[bytes], dtype: int, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Node numbers, (definition, displacement) coordinate systems and coordinates of a
+    dataset 15 (one line per node: I10 node, I10 def. CS, I10 disp. CS, I10 colour, 3E13.5)
+    or 2411 (two lines per node: 4I10 node, export CS, disp. CS, colour; then 3D25.16)."""
+    lines = [b for b in body if b.strip()]
+    ids, cs, xyz = [], [], []
+    step = 1 if dtype == 15 else 2
+    if len(lines) % step:
+        raise ParseError(f"{where}: a node of dataset 2411 needs two lines, the last has one")
+    for k in range(0, len(lines), step):
+        text = _text(b" ".join(lines[k : k + step])).replace("D", "E").replace("d", "e")
+        f = text.split()
+        if len(f) != 7:
+            raise ParseError(
+                f"{where}: node record {k // step + 1} has {len(f)} fields, expected 7 "
+                "(node, two coordinate systems, colour, x, y, z)"
+            )
+        ids.append(_int(f[0], where))
+        cs.append((_int(f[1], where), _int(f[2], where)))
+        xyz.append([_float(v, where) for v in f[4:7]])
+    return (
+        np.asarray(ids, dtype=np.int64),
+        np.asarray(cs, dtype=np.int64).reshape(-1, 2),
+        np.asarray(xyz, dtype=float).reshape(-1, 3),
+    )
+
+
 def _units_164(body: list[bytes], where: str) -> dict[str, Any]:
     if len(body) < 3:
         raise ParseError(f"{where}: a units dataset needs 3 lines, it has {len(body)}")
@@ -565,6 +603,76 @@ def parse_csv(raw: bytes, max_values: int | None = None) -> tuple[dict[str, Any]
         },
         [a.reshape(-1, ncol) if a.size else np.empty((0, ncol))],
     )
+
+
+#: Most cells of a text table (a geometry table has a few hundred).
+MAX_TABLE_CELLS = 200_000
+
+
+def parse_table(
+    raw: bytes, max_values: int | None = None
+) -> tuple[dict[str, Any], list[np.ndarray]]:
+    """A small CSV table of text cells: ``#`` comment lines, a header row, data rows.
+
+    Returns
+    -------
+    meta : dict
+        ``comments``, ``header``, ``rows`` (lists of stripped cells), ``lines`` (the
+        1-based line number of each row), ``delimiter``.
+    arrays : []
+
+    Raises
+    ------
+    ParseError
+        For text that is not UTF-8, NUL bytes, no header row, rows of other lengths than
+        the header, more than :data:`MAX_TABLE_CELLS` cells.
+    """
+    if raw.startswith(b"\xef\xbb\xbf"):
+        raw = raw[3:]
+    raw = _lf(raw)
+    nul = raw.find(b"\x00")
+    if nul >= 0:
+        raise ParseError(f"contains NUL bytes (line {_line_no(raw, nul)}); not a text file")
+    text = _utf8(raw, 1)
+    comments: list[str] = []
+    header: list[str] | None = None
+    delim = ","
+    rows: list[list[str]] = []
+    lines: list[int] = []
+    cells = 0
+    limit = MAX_TABLE_CELLS if max_values is None else min(MAX_TABLE_CELLS, max_values)
+    for no, line in enumerate(text.split("\n"), start=1):
+        s = line.strip()
+        if not s:
+            continue
+        if header is None:
+            if s.startswith("#"):
+                comments.append(s[1:].strip())
+                continue
+            delim = max((",", ";", "\t"), key=line.count)
+            header = [c.strip() for c in next(csv.reader([line], delimiter=delim))]
+            continue
+        if s.startswith("#"):
+            continue
+        row = [c.strip() for c in next(csv.reader([line], delimiter=delim))]
+        if len(row) != len(header):
+            raise ParseError(f"line {no}: {len(row)} fields, the header has {len(header)}")
+        cells += len(row)
+        if cells > limit:
+            raise ParseError(f"holds more than {limit:,} cells, more than a table may have")
+        rows.append(row)
+        lines.append(no)
+    if header is None:
+        raise ParseError("has no header row (after the '#' lines)")
+    meta = {
+        "format": "table",
+        "comments": comments,
+        "header": header,
+        "rows": rows,
+        "lines": lines,
+        "delimiter": delim,
+    }
+    return meta, []
 
 
 def _lf(raw: bytes) -> bytes:

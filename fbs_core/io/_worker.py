@@ -10,7 +10,8 @@ so the calling process never dies with the parser.
 
 Protocol on stdin / stdout (all integers unsigned 64-bit little endian):
 
-- request: ``kind`` (8 ASCII bytes: ``mat5``, ``hdf5``, ``uff`` or ``csv``, space padded),
+- request: ``kind`` (8 ASCII bytes: ``mat5``, ``hdf5``, ``uff``, ``csv`` or ``table``, space
+  padded),
   ``timeout_ms``, ``mem_bytes``, ``max_reply`` (largest total size of the arrays that may
   come back), ``n``, then ``n`` bytes of file content;
 - reply: ``status`` (0 ok, 1 refused, 2 crash, 3 timeout, 4 library error), ``n``, then ``n``
@@ -343,7 +344,20 @@ def parse_csv(raw: bytes, limit: int) -> tuple[dict[str, Any], list[np.ndarray]]
     return out
 
 
-HANDLERS = {"mat5": parse_mat5, "hdf5": parse_hdf5, "uff": parse_uff, "csv": parse_csv}
+def parse_table(raw: bytes, limit: int) -> tuple[dict[str, Any], list[np.ndarray]]:
+    out: tuple[dict[str, Any], list[np.ndarray]] = _textparse().parse_table(
+        raw, max_values=limit // 64
+    )
+    return out
+
+
+HANDLERS = {
+    "mat5": parse_mat5,
+    "hdf5": parse_hdf5,
+    "uff": parse_uff,
+    "csv": parse_csv,
+    "table": parse_table,
+}
 
 
 # -- process plumbing ------------------------------------------------------------------

@@ -322,7 +322,9 @@ def result_to_uff(
 ) -> bytes:
     """The functions of frequency in a result as UFF dataset-58 records.
 
-    FRFs are written as FRF records (function type 4). Every other array with a
+    FRFs are written as FRF records (function type 4; several FRFs get function
+    identification numbers 1, 2, ... in record 6, so FRFs of the same output/input pair
+    are each whole FRF records, told apart by it). Every other array with a
     frequency axis (:data:`FREQ_DIMS`) is written slice by slice as general functions
     (type 0): ID line 1 names the array and the slice, e.g. ``upper [dofs=bushing:z]``;
     when a slice has a DOF label it is the record's response DOF. ID lines 2-4 hold the
@@ -364,8 +366,13 @@ def result_to_uff(
     nodes = {n: name for name, n in numbers.items()}
     id5 = node_map_line(numbers)
     recs = []
-    for key, frf in res.frfs.items():
-        recs += frf_records(frf, nodes=nodes, id_lines=ids, round_abscissa=round_abscissa, name=key)
+    # several FRFs: function id 1, 2, ... each (FRF records of the same pairs told apart)
+    fid = len(res.frfs) > 1
+    for k, (key, frf) in enumerate(res.frfs.items()):
+        recs += frf_records(
+            frf, nodes=nodes, id_lines=ids, round_abscissa=round_abscissa, name=key,
+            function_id=k + 1 if fid else 0,
+        )  # fmt: skip
     skipped = []
     for name, (dims, values) in res.arrays.items():
         v = np.asarray(values)

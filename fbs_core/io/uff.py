@@ -269,6 +269,7 @@ def read_uff(
     notes: list[str] = []
     frf_sets = _frf_sets(sets, contents, src.name, notes)
     ent_names = {} if nodes else _entity_names(frf_sets)
+    frf_sets = _first_function(frf_sets, notes)
     records: dict[tuple[str, str], _Record] = {}
     for k, s in enumerate(frf_sets):
         r = _record(s, f"{src.name!r} FRF record {k + 1}", nodes, ent_names)
@@ -357,6 +358,36 @@ def _frf_sets(
             f"{name!r} holds no FRF records (dataset 58 with function type 4); it holds {held}"
         )
     return frf_sets
+
+
+def _first_function(frf_sets: list[dict[str, Any]], notes: list[str]) -> list[dict[str, Any]]:
+    """Records of an output/input pair that repeats under another function identification
+    number (record 6, field 2; e.g. a truncated model's FRF, function id 1, and the
+    reference beside it, function id 2): the pair's first record is read, the others are
+    skipped with a note. A pair repeated under the same function id is left to the
+    reader's error."""
+
+    def pair(s: dict[str, Any]) -> tuple[Any, ...]:
+        return tuple(int(s[k]) for k in ("rsp_node", "rsp_dir", "ref_node", "ref_dir"))
+
+    seen: dict[tuple[Any, ...], int] = {}
+    kept, skipped = [], []
+    for s in frf_sets:
+        key, fid = pair(s), int(s.get("func_id", 0) or 0)
+        if key in seen and seen[key] != fid:
+            skipped.append(s)
+            continue
+        seen.setdefault(key, fid)
+        kept.append(s)
+    if skipped:
+        ids = sorted({int(s.get("func_id", 0) or 0) for s in skipped})
+        names = sorted({str(s.get("id1", "")).split(":")[0] for s in skipped} - {""})
+        notes.append(
+            f"read the first FRF record of each output/input pair; skipped {len(skipped)} "
+            f"FRF records of the same pairs with function ids {', '.join(map(str, ids))}"
+            + (f" ({', '.join(names)})" if names else "")
+        )
+    return kept
 
 
 def _record(
@@ -544,7 +575,10 @@ def write_uff_records(records: list[dict[str, Any]], *, binary: bool = False) ->
                 for k, r in enumerate(records):
                     path = Path(d) / f"r{k}.uff"
                     r = dict(r, binary=int(binary))
-                    pyuff.UFF(str(path)).write_sets(pyuff.prepare_58(**r), mode="add")
+                    fid = int(r.pop("func_id", 0))  # record 6 field 2: not in prepare_58
+                    dset = pyuff.prepare_58(**r)
+                    dset["func_id"] = fid
+                    pyuff.UFF(str(path)).write_sets(dset, mode="add")
                     parts.append(path.read_bytes())
                     path.unlink()
         except Exception as e:  # pyuff raises bare Exceptions
@@ -559,11 +593,15 @@ def frf_records(
     id_lines: Sequence[str] = (),
     round_abscissa: bool = False,
     name: str = "",
+    function_id: int = 0,
 ) -> list[dict[str, Any]]:
     """pyuff dictionaries of one dataset 58 per output/input pair of ``frf``.
 
     ID line 1: ``name`` (when given), the quantity and the pair; lines 2-4: ``id_lines``
-    (:func:`id_lines`); line 5: the node map (:func:`node_map_line`).
+    (:func:`id_lines`); line 5: the node map (:func:`node_map_line`). ``function_id`` is
+    record 6's function identification and version number: several FRFs of the same
+    output/input pair in one file (e.g. a truncated model's and the reference) are told
+    apart by it, each record a whole FRF record (type 4, its nodes, directions, units).
     """
     even = _abscissa(frf.freq, round_abscissa)
     numbers = _node_numbers(frf.outputs + frf.inputs, nodes)
@@ -578,7 +616,8 @@ def frf_records(
             recs.append(
                 dict(
                     func_type=4,
-                    ver_num=0,
+                    func_id=int(function_id),
+                    ver_num=int(function_id),
                     load_case_id=0,
                     id1=f"{label}{frf.quantity} {out} / {inp}"[:80],
                     id2=ids[0][:80],

@@ -45,7 +45,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TypeAlias
 
 import numpy as np
 import scipy.linalg as sla
@@ -59,7 +58,7 @@ from .static import StaticState, solve_static_state
 #: Patch data of :func:`_operators`: forward and lateral position and weight of every
 #: patch point, the wheel-axes components (x, y, z) of the belt shapes there, zone areas,
 #: the static contact pressure at every point and the patch length.
-_Contact: TypeAlias = tuple[
+type _Contact = tuple[
     np.ndarray,
     np.ndarray,
     np.ndarray,

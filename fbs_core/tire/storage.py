@@ -33,6 +33,7 @@ import h5py
 import numpy as np
 
 from ..errors import DataFormatError
+from ..hdf5_guard import open_h5
 from .model import TireModel
 from .params import TireParameters
 from .ring import HUB_DOFS
@@ -142,7 +143,7 @@ def read_tire_h5(path: str | os.PathLike[str]) -> TireModel:
     if not path.is_file():
         raise DataFormatError(f"no modal tire file at {path}")
     try:
-        with h5py.File(path, "r") as f:
+        with open_h5(path) as f:  # refuses links and data leaving the file
             root = dict(f.attrs.items())
             data = {k: f[k][()] for k in f if isinstance(f[k], h5py.Dataset)}
             params = dict(f["parameters"].attrs.items()) if "parameters" in f else None

@@ -25,7 +25,14 @@ Example
 
 from .corridor import Corridor, corridor
 from .design import DESIGNS, Design, sample_design
-from .models import TIRE_CACHE, TireCache, VariantSettings, tire_key, variant_models
+from .models import (
+    TIRE_CACHE,
+    TireCache,
+    VariantSettings,
+    needed_speeds,
+    tire_key,
+    variant_models,
+)
 from .models import variant_responses as variant_responses
 from .parameters import (
     PARAMETERS,
@@ -56,6 +63,7 @@ __all__ = [
     "corridor",
     "corridor_study",
     "evaluate_rows",
+    "needed_speeds",
     "parameter",
     "run_variants",
     "sample_design",

@@ -44,13 +44,14 @@ __all__ = [
     "TIRE_CACHE",
     "TireCache",
     "VariantSettings",
+    "needed_speeds",
     "tire_key",
     "variant_models",
     "variant_responses",
 ]
 
 #: Bumped when the tire build changes its numbers for the same parameters (part of the key).
-BUILD_VERSION = 1
+BUILD_VERSION = 2
 
 
 def _reference_speeds() -> tuple[float, ...]:
@@ -75,7 +76,8 @@ class VariantSettings:
     speeds : tuple of float, optional
         Operating points (km/h) of the rebuilt tires; default (None) those of the shipped
         reference tire (20-120 km/h, 43 points), whose nominal variant is then the shipped
-        model itself.
+        model itself. A tire is rebuilt at those of them the harmonics' lines read
+        (:meth:`tire_speeds`).
     tire : TireParameters
         The base tire (default the reference); a smaller configuration (fewer orders,
         speeds) makes a rebuild cheap, e.g. in tests.
@@ -109,8 +111,20 @@ class VariantSettings:
             object.__setattr__(self, "speeds", sp)
 
     def tire_speeds(self) -> tuple[float, ...]:
-        """The operating points of the rebuilt tires (km/h)."""
-        return _reference_speeds() if self.speeds is None else self.speeds
+        """The operating points of the rebuilt tires (km/h): those the harmonics' lines use.
+
+        Of ``speeds`` (default the shipped tire's), the points that the lines of the
+        study's harmonics interpolate between (:func:`needed_speeds`), so that a rebuilt
+        tire is solved only where its response is read, with the same numbers as a tire
+        built at all the points.
+        """
+        from ..harmonics import harmonic
+
+        sp = _reference_speeds() if self.speeds is None else self.speeds
+        v = np.concatenate(
+            [np.atleast_1d(harmonic(k).speed_at(self.freq(k))) for k in self.harmonics]
+        )
+        return needed_speeds(sp, float(v.min()), float(v.max()))
 
     def freq(self, k: int) -> np.ndarray:
         """The grid of harmonic ``k`` in Hz."""
@@ -129,6 +143,45 @@ class VariantSettings:
             "tire": self.tire.to_dict(),
             "chassis": dataclasses.asdict(self.chassis),
         }
+
+
+def needed_speeds(speeds: Sequence[float], v_min: float, v_max: float) -> tuple[float, ...]:
+    """The operating points a modal tire model reads between ``v_min`` and ``v_max`` km/h.
+
+    Between the operating points the model interpolates every mode in speed, cubic on the
+    four nearest points (linear in the first and last interval;
+    :class:`~fbs_core.tire.TireModel`). The points kept are the stencils of the intervals
+    holding ``v_min`` and ``v_max`` and all points between; cut there, the model's
+    intervals of those speeds keep the stencil (cubic or linear) they had in the whole
+    model, so its responses at speeds in ``[v_min, v_max]`` are the whole model's (to
+    the order in which its modes are summed).
+
+    Parameters
+    ----------
+    speeds : sequence of float
+        Operating points in km/h, increasing (at least two).
+    v_min, v_max : float
+        The slowest and fastest speed read, within the points.
+
+    Returns
+    -------
+    tuple of float
+
+    Examples
+    --------
+    >>> needed_speeds([20, 22.5, 25, 27.5, 30, 32.5, 35], 30.0, 32.0)
+    (27.5, 30.0, 32.5, 35.0)
+    """
+    sp = tuple(float(v) for v in speeds)
+    n = len(sp)
+    if n < 4:
+        return sp
+    k0, k1 = (
+        min(max(int(np.searchsorted(sp, v, side="right")) - 1, 0), n - 2) for v in (v_min, v_max)
+    )
+    a = 0 if k0 == 0 else k0 - 1
+    b = min(n - 1, k1 + 2)
+    return sp[a : b + 1]
 
 
 def tire_key(

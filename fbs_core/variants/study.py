@@ -12,6 +12,7 @@ as tasks on a Dask cluster, with the same numbers (:func:`evaluate_rows` is the 
 
 from __future__ import annotations
 
+import concurrent.futures
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -166,6 +167,19 @@ def evaluate_rows(
     }
 
 
+def _wait_any(pending: list[Any], dask: bool, timeout: float) -> None:
+    """Block until one of the futures is done or ``timeout`` seconds passed."""
+    if dask:
+        from distributed import wait
+
+        try:
+            wait(pending, timeout=timeout, return_when="FIRST_COMPLETED")
+        except TimeoutError:
+            pass
+    else:
+        concurrent.futures.wait(pending, timeout=timeout, return_when="FIRST_COMPLETED")
+
+
 def run_variants(
     design: Design,
     settings: VariantSettings | None = None,
@@ -173,8 +187,15 @@ def run_variants(
     cache: TireCache | None = None,
     progress: Callable[[int, int], object] | None = None,
     cancel: Callable[[], bool] | None = None,
+    client: Any = None,
+    processes: int = 1,
+    poll: float = 0.2,
 ) -> VariantStudy:
-    """Compute every variant of a design in this process.
+    """Compute every variant of a design: in this process, in worker processes or on Dask.
+
+    Every tire group (:func:`tire_groups`) is one task, :func:`evaluate_rows`; the
+    responses are those of the same rows computed in this process (each task is the same
+    computation, placed by its rows).
 
     Parameters
     ----------
@@ -182,11 +203,20 @@ def run_variants(
     settings : VariantSettings, optional
         Default: the reference models, harmonic 4.
     cache : TireCache, optional
-        Default the process-wide cache (two tires in memory).
+        Default the process-wide cache (two tires in memory); used in this process only
+        (a worker uses its own process-wide cache).
     progress : callable, optional
-        ``progress(rows_done, rows_total)`` after every tire group.
+        ``progress(rows_done, rows_total)`` at the start and after every tire group.
     cancel : callable, optional
-        Asked before every tire group; True stops with :class:`~fbs_core.StudyCancelled`.
+        Asked before every tire group (with workers: every ``poll`` seconds); True stops
+        with :class:`~fbs_core.StudyCancelled` (the tasks not started are cancelled).
+    client : distributed.Client, optional
+        A Dask client: the groups run as tasks on its cluster when it has workers
+        (:func:`fbs_core.campaign.cluster.has_workers`), else in this process.
+    processes : int
+        Without a cluster: worker processes of this machine (1: this process).
+    poll : float
+        Seconds between asking ``cancel`` while tasks run elsewhere.
 
     Returns
     -------
@@ -199,10 +229,9 @@ def run_variants(
     done = 0
     if progress is not None:
         progress(0, design.n)
-    for key, rows in groups:
-        if cancel is not None and cancel():
-            raise StudyCancelled(f"variant study cancelled after {done} of {design.n} variants")
-        res = evaluate_rows([design.row(i) for i in rows], s, cache)["responses"]
+
+    def place(rows: list[int], key: str, res: dict[int, ComplexArray]) -> None:
+        nonlocal done
         for k, v in res.items():
             if k not in resp:
                 resp[k] = np.empty((design.n, *v.shape[1:]), complex)
@@ -212,6 +241,46 @@ def run_variants(
         done += len(rows)
         if progress is not None:
             progress(done, design.n)
+
+    def stop() -> None:
+        raise StudyCancelled(f"variant study cancelled after {done} of {design.n} variants")
+
+    use_dask = client is not None and _has_workers(client)
+    if use_dask or (int(processes) > 1 and len(groups) > 1):
+        pool: Any = None
+        if use_dask:
+            submit: Callable[..., Any] = lambda rows: client.submit(  # noqa: E731
+                evaluate_rows, rows, s, pure=False
+            )
+        else:
+            import multiprocessing
+
+            pool = concurrent.futures.ProcessPoolExecutor(
+                max_workers=min(int(processes), len(groups)),
+                mp_context=multiprocessing.get_context("spawn"),
+            )
+            submit = lambda rows: pool.submit(evaluate_rows, rows, s)  # noqa: E731
+        futures = {submit([design.row(i) for i in rows]): (key, rows) for key, rows in groups}
+        pending = list(futures)
+        try:
+            while pending:
+                if cancel is not None and cancel():
+                    stop()
+                _wait_any(pending, use_dask, poll)
+                for fu in [f for f in pending if f.done()]:
+                    pending.remove(fu)
+                    key, rows = futures[fu]
+                    place(rows, key, fu.result()["responses"])
+        finally:
+            for fu in pending:
+                fu.cancel()
+            if pool is not None:
+                pool.shutdown(wait=True, cancel_futures=True)
+    else:
+        for key, rows in groups:
+            if cancel is not None and cancel():
+                stop()
+            place(rows, key, evaluate_rows([design.row(i) for i in rows], s, cache)["responses"])
     nominal = variant_responses({}, s, cache)
     return VariantStudy(
         design=design,
@@ -220,6 +289,12 @@ def run_variants(
         nominal={k: _ro(v) for k, v in nominal.items()},
         tire_keys=tuple(keys),
     )
+
+
+def _has_workers(client: Any) -> bool:
+    from ..campaign.cluster import has_workers
+
+    return has_workers(client)
 
 
 def corridor_study(
@@ -233,8 +308,10 @@ def corridor_study(
     cache: TireCache | None = None,
     progress: Callable[[int, int], object] | None = None,
     cancel: Callable[[], bool] | None = None,
+    client: Any = None,
+    processes: int = 1,
 ) -> VariantStudy:
-    """Sample the named parameters and compute every variant (in this process).
+    """Sample the named parameters and compute every variant (here, in processes or on Dask).
 
     Parameters
     ----------
@@ -249,7 +326,7 @@ def corridor_study(
         Harmonics, grid, coupling, base models (default: reference models, harmonic 4).
     ranges : mapping of str to (low, high), optional
         Ranges replacing the documented defaults.
-    cache, progress, cancel
+    cache, progress, cancel, client, processes
         As :func:`run_variants`.
 
     Returns
@@ -263,4 +340,12 @@ def corridor_study(
     """
     space = ParameterSpace.from_names(parameters, ranges)
     design = sample_design(space, n, method, seed)
-    return run_variants(design, settings, cache=cache, progress=progress, cancel=cancel)
+    return run_variants(
+        design,
+        settings,
+        cache=cache,
+        progress=progress,
+        cancel=cancel,
+        client=client,
+        processes=processes,
+    )

@@ -52,7 +52,7 @@ __all__ = [
 _REFS = {
     "gillespie": "Gillespie, Fundamentals of Vehicle Dynamics, SAE 1992, ch. 5 (ride)",
     "heydinger": "Heydinger et al., Measured vehicle inertial parameters, SAE 1999-01-1336",
-    "body": "issue 31 (typical published ranges for mid-size cars); cf. Malen, Fundamentals "
+    "body": "typical published ranges for mid-size cars; cf. Malen, Fundamentals "
     "of Automobile Body Structure Design, SAE 2011",
 }
 

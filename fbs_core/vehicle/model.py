@@ -349,7 +349,7 @@ class FRFVehicle:
         track: float | tuple[float, float],
         interpolate: bool = False,
     ) -> None:
-        tr = (float(track), float(track)) if np.isscalar(track) else tuple(map(float, track))  # type: ignore[arg-type]
+        tr = (float(track), float(track)) if np.isscalar(track) else tuple(map(float, track))  # type: ignore[arg-type, unused-ignore]
         if not (np.isfinite(wheelbase) and wheelbase > 0) or len(tr) != 2 or min(tr) <= 0:
             raise DataFormatError(
                 f"wheelbase and track must be positive lengths in m, got {wheelbase!r}, {track!r}"

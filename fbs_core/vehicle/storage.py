@@ -86,9 +86,9 @@ def read_vehicle_frf(path: str | os.PathLike[str] = DATA_FILE) -> FRF:
     DataFormatError
         If the file is not a reference vehicle file.
     """
-    import h5py
+    from ..hdf5_guard import open_h5
 
-    with h5py.File(path, "r") as h:
+    with open_h5(path) as h:  # refuses links and data leaving the file
         if h.attrs.get("format") != "tire-fbs" or h.attrs.get("model") != "reference vehicle":
             raise DataFormatError(
                 f"{path}: not a 'tire-fbs' reference vehicle file "

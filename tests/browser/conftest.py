@@ -30,6 +30,9 @@ CHROMIUM_ARGS = [
 #: Script served; overridable for debugging the harness itself.
 ARTIFACTS = Path(__file__).parent / "artifacts"
 APP_SCRIPT = os.environ.get("FBS_DASHBOARD_SCRIPT", str(ROOT / "app" / "main.py"))
+#: The checkout the server runs from (its working directory, first on its path): another
+#: commit's tree shows that a test fails there (the tests themselves run from this one).
+SERVER_ROOT = Path(os.environ.get("FBS_DASHBOARD_ROOT", str(ROOT)))
 #: Names of the ColumnDataSources that every page shows (set by the views' hooks).
 SOURCES = [
     "mobility.reference",
@@ -91,7 +94,7 @@ class DashboardServer:
         ]
         self.proc = subprocess.Popen(
             cmd,
-            cwd=ROOT,
+            cwd=SERVER_ROOT,
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,

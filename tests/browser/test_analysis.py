@@ -142,7 +142,7 @@ def _phase_view_checks(page, dashboard):
 
 def test_across_speed_campbell_speed_map_and_picking(page, dashboard):
     _tab(page, "Across speed")
-    wait_loaded(page, ["campbell.forward", "campbell.orders"], timeout=180_000)
+    wait_loaded(page, ["campbell.modes", "campbell.orders"], timeout=180_000)
     page.wait_for_function(
         """() => [...Bokeh.documents[0].all_models].filter(m => m.name === 'speedmap.image')[0]
                  .data.image[0].length > 100""",
@@ -151,7 +151,7 @@ def test_across_speed_campbell_speed_map_and_picking(page, dashboard):
     tire = fbs_core.reference_tire()
     # every branch passes through the tire's eigenfrequencies at its operating points
     eig = tire.eigenfrequencies(80.0)
-    for d in ("forward", "backward", "standing"):
+    for d in ("modes",):  # one set of branches: no direction of travel is claimed
         data = page.evaluate(
             """(n) => { const m = [...Bokeh.documents[0].all_models].filter(
                  x => x.name === n)[0];
@@ -240,7 +240,7 @@ def test_compare_pin_change_and_difference(page, dashboard):
     fp_main = fingerprint(page, "mobility.truncated")
     from .conftest import set_model_value
 
-    set_model_value(page, "ctl-case-n_modes", 14, "Slider")  # N = 150
+    set_model_value(page, "ctl-case-n_modes", 150, "Slider")
     page.wait_for_function("() => window.location.search.includes('N=150')")
     wait_changed(page, "compare.diff1", fp)
     # the shown analysis view is drawn before the main views: wait for the main curve too

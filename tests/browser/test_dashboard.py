@@ -53,7 +53,7 @@ STEPS = {
         EIGEN,
     ),
     "n_modes": (
-        lambda p: set_model_value(p, "ctl-case-n_modes", 9, "Slider"),  # N = 100
+        lambda p: set_model_value(p, "ctl-case-n_modes", 100, "Slider"),
         ["mobility.truncated"] + BAND,
         ["mobility.reference"] + MAP + EIGEN,
     ),
@@ -178,7 +178,7 @@ def test_url_restores_the_state(browser, dashboard):
     page = browser.new_page()
     open_dashboard(page, dashboard.url + URL)
     assert model_value(page, "ctl-case-harmonic", "Slider") == 3
-    assert model_value(page, "ctl-case-n_modes", "Slider") == 11  # index of N = 120
+    assert model_value(page, "ctl-case-n_modes", "Slider") == 120
     # typed numbers are text fields (app/views/typed.py)
     assert model_value(page, "ctl-noise-seed") == "3"
     assert model_value(page, "ctl-noise-rounds") == "800"
@@ -199,7 +199,7 @@ def test_url_restores_the_state(browser, dashboard):
     np.testing.assert_allclose(pct["lower"], d["pct_low_db"], rtol=1e-12)
     assert 10 - 1e-9 < color_high(page) < 10  # below the threshold; 10 % is red
     # a control change goes back into the URL
-    set_model_value(page, "ctl-case-n_modes", 12, "Slider")
+    set_model_value(page, "ctl-case-n_modes", 130, "Slider")
     page.wait_for_function("() => window.location.search.includes('N=130')")
     page.close()
 
@@ -249,7 +249,7 @@ def test_long_computation_in_one_session_does_not_block_another(browser, dashboa
     a.locator(".scatter-status p", has_text="Computing").wait_for()
     # ... session B changes N and sees its plot updated while A is still computing
     before = fingerprint(b, "mobility.truncated")
-    set_model_value(b, "ctl-case-n_modes", 20, "Slider")
+    set_model_value(b, "ctl-case-n_modes", 210, "Slider")
     wait_changed(b, "mobility.truncated", before, timeout=30_000)
     assert a.locator(".scatter-status p", has_text="Computing").count() == 1
     a.close()
