@@ -23,6 +23,8 @@ __all__ = [
     "ModalError",
     "CampaignError",
     "ClusterUnavailable",
+    "InsecureScheduler",
+    "ForeignDataError",
     "ParameterError",
     "GeometryError",
     "StudyCancelled",
@@ -86,6 +88,16 @@ class ClusterUnavailable(CampaignError):
     Raised by :func:`fbs_core.campaign.cluster.scatter_band_on`; the caller computes the
     study in its own process instead.
     """
+
+
+class InsecureScheduler(CampaignError):
+    """A scheduler address this package does not join (plain TCP off the loopback, or TLS
+    without certificates); raised by :mod:`fbs_core.campaign.security`."""
+
+
+class ForeignDataError(DataFormatError):
+    """An HDF5 file that links to, or maps data from, outside itself
+    (:mod:`fbs_core.hdf5_guard`)."""
 
 
 class ParameterError(FBSError):

@@ -36,7 +36,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from .errors import DataFormatError
+from .errors import ForeignDataError
 
 __all__ = ["ForeignDataError", "check_self_contained", "open_h5"]
 
@@ -45,10 +45,6 @@ _REMEMBERED = 256
 
 _passed: OrderedDict[tuple[Any, ...], None] = OrderedDict()
 _passed_lock = threading.Lock()
-
-
-class ForeignDataError(DataFormatError):
-    """An HDF5 file that links to, or maps data from, outside itself."""
 
 
 def check_self_contained(root: Any) -> None:

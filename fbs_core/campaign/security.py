@@ -31,7 +31,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .spec import CampaignError
+from ..errors import InsecureScheduler
 
 __all__ = [
     "ALLOW_PLAIN_ENV",
@@ -53,11 +53,6 @@ ALLOW_PLAIN_ENV = "FBS_DASK_ALLOW_PLAIN"
 CA_FILE, CERT_FILE, KEY_FILE = "ca.pem", "node.pem", "node-key.pem"
 #: Life of the certificates made by :func:`make_certificates` (days).
 VALID_DAYS = 3650
-
-
-class InsecureScheduler(CampaignError):
-    """A scheduler address this package does not join (plain TCP off the loopback, or TLS
-    without certificates)."""
 
 
 def _split(addr: str) -> tuple[str, str]:
