@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import re
 import sys
 import urllib.parse
 import weakref
@@ -83,7 +84,9 @@ from app.views.plots import frequency_range, modes_range
 from app.views.quality import TireQualityView
 from app.views.wheels import wheels_card
 
-pn.extension("tabulator", notifications=True, sizing_mode="stretch_width")
+# bokeh-tables: the Selected modes tab's DataTable is built when the tab is first shown,
+# after the page loaded; Panel bundles only the scripts of the models a page starts with
+pn.extension("tabulator", "bokeh-tables", notifications=True, sizing_mode="stretch_width")
 public_base()  # a wrong FBS_PUBLIC_URL stops the server at start, naming the variable
 pn.config.param.update(**PANEL_CONFIG)  # stated sizing modes hold (app/views/layout.py)
 
@@ -142,7 +145,9 @@ def drop_unreadable_numbers(loc) -> list[str]:
     """
     limit = sys.get_int_max_str_digits()
     pairs = urllib.parse.parse_qsl((loc.search or "").lstrip("?"), keep_blank_values=True)
-    bad = [k for k, v in pairs if v.isdigit() and limit and len(v) > limit]
+    # a whole number as Panel's parse_query tells one (a sign too)
+    whole = re.compile(r"-?[0-9]+")
+    bad = [k for k, v in pairs if limit and whole.fullmatch(v) and len(v.lstrip("-")) > limit]
     if bad:
         kept = [(k, v) for k, v in pairs if k not in bad]
         loc.search = "?" + urllib.parse.urlencode(kept) if kept else ""
@@ -474,7 +479,7 @@ def create_app(
     step_aside()
 
     def report():  # the page's published results, as they are when the button is clicked
-        from .views.vpt_consistency import report_notes
+        from app.views.vpt_consistency import report_notes
 
         return report_data(
             results, url=page_url(), n_axis=page.n_axis, notes=report_notes(state.data)
