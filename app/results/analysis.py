@@ -338,11 +338,9 @@ def campbell_result(s: Snapshot) -> Result:
         },
         filename=csv_name(s, "campbell"),
         caption=(
-            f"{cb.branch.size} tire modes below 450 Hz, the modal model's tracked branches "
-            "(no direction of travel: they pass between waves at veerings; forward and backward "
-            "waves: the **Modes** tab's belt-wave diagram) &middot; order lines of the seven "
-            "cases (solid inside their speed range) &middot; **click**: pick speed and "
-            "frequency (on an order line: that harmonic)"
+            f"{cb.branch.size} tire modes below 450 Hz (no direction of travel: waves are "
+            "in the **Modes** tab) &middot; order lines of the seven cases &middot; "
+            "**click**: pick speed and frequency"
         ),
         draw={
             "branches": branches,
