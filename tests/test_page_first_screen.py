@@ -15,6 +15,7 @@ import time
 
 import pytest
 from bokeh.document import Document
+from bokeh.model import Model
 from bokeh.models import ColumnDataSource
 from server_util import PageClient, in_own_loop, served_in_process
 
@@ -35,7 +36,9 @@ def _dressing(doc: Document, name: str) -> list[tuple]:
     parents = {}
     for m in doc.models:
         for c in getattr(m, "children", None) or []:
-            parents[(c[0] if isinstance(c, tuple) else c).id] = m
+            child = c[0] if isinstance(c, tuple) else c  # (grid children: model, row, col)
+            if isinstance(child, Model):  # (some models' children are names, not models)
+                parents[child.id] = m
     out, x = [], next(m for m in doc.models if getattr(m, "name", None) == name)
     while x is not None:
         sheets = tuple(getattr(s, "url", None) or "inline" for s in x.stylesheets)

@@ -18,6 +18,7 @@ import threading
 
 import pytest
 from bokeh.document import Document
+from server_util import in_own_loop
 
 from app.runtime import reports
 
@@ -51,7 +52,7 @@ def test_a_report_queued_by_a_closed_tab_never_runs():
         with pytest.raises(reports.ReportsStopped, match="closed"):
             reports.submit_for_session(doc_b, lambda: ran.append("late"))
 
-    asyncio.run(main())
+    in_own_loop(main(), 300)
     assert ran == ["a2"]
 
 
@@ -78,7 +79,7 @@ def test_a_report_failing_after_its_tab_closed_is_not_an_unretrieved_error(caplo
         gc.collect()
 
     with caplog.at_level(logging.DEBUG):
-        asyncio.run(main())
+        in_own_loop(main(), 300)
         gc.collect()
     assert not [r for r in caplog.records if "never retrieved" in r.getMessage()]
     assert any("NameError" in r.getMessage() for r in caplog.records)
