@@ -61,7 +61,9 @@ def test_the_report_data_of_a_session_reach_the_report_process(store):
         np.testing.assert_array_equal(getattr(back, name).data, getattr(data, name).data)
     np.testing.assert_array_equal(back.truncation.error, data.truncation.error)
     np.testing.assert_array_equal(back.band.minimum, data.band.minimum)
-    np.testing.assert_array_equal(back.band.round(3), data.band.round(3))  # regenerated there
+    # regenerated there from the pickled inputs: the same numbers to rounding (the order of
+    # a compiled kernel's sums is not promised across processes and array copies)
+    np.testing.assert_allclose(back.band.round(3), data.band.round(3), rtol=1e-12, atol=0)
     assert build_html(back)[0] == build_html(data)[0]
 
 
