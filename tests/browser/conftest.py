@@ -145,6 +145,9 @@ def dashboard():
     server = DashboardServer()
     yield server
     server.stop()
+    # the whole log, for a failure seen only in the server (an error in a callback)
+    ARTIFACTS.mkdir(exist_ok=True)
+    (ARTIFACTS / "dashboard_server.log").write_text("".join(server.log))
 
 
 # -- helpers reading the Bokeh document ----------------------------------------------------
@@ -324,3 +327,8 @@ def pytest_runtest_makereport(item, call):
     server = item.funcargs.get("dashboard") if hasattr(item, "funcargs") else None
     if report.failed and isinstance(server, DashboardServer):
         report.sections.append(("dashboard server log (last 80 lines)", "".join(server.log[-80:])))
+        # every traceback whole (the last lines alone cut off where it began)
+        starts = [i for i, ln in enumerate(server.log) if "Traceback" in ln]
+        if starts:
+            whole = "".join("".join(server.log[i : i + 60]) for i in starts[-4:])
+            report.sections.append(("dashboard server tracebacks (last 4)", whole))
