@@ -55,6 +55,7 @@ from app.runtime.collector import count_alive, session_ended, session_started
 from app.runtime.collector import start as start_quiet_collections
 from app.runtime.draw import DrawQueue, on_document, served, served_document
 from app.runtime.pace import step_aside
+from app.runtime.panel_private import lock_held_only_by_its_thread
 from app.state import URL_KEYS, DashboardState
 from app.store import LIVE, Results
 from app.views import (
@@ -87,6 +88,7 @@ from app.views.wheels import wheels_card
 # bokeh-tables: the Selected modes tab's DataTable is built when the tab is first shown,
 # after the page loaded; Panel bundles only the scripts of the models a page starts with
 pn.extension("tabulator", "bokeh-tables", notifications=True, sizing_mode="stretch_width")
+lock_held_only_by_its_thread()  # Panel's worker threads change a page only under its lock
 public_base()  # a wrong FBS_PUBLIC_URL stops the server at start, naming the variable
 pn.config.param.update(**PANEL_CONFIG)  # stated sizing modes hold (app/views/layout.py)
 

@@ -33,6 +33,7 @@ they change (the phase view's plots stayed empty after a click on its tab).
 from __future__ import annotations
 
 import html
+import threading
 
 import panel as pn
 
@@ -41,6 +42,7 @@ __all__ = [
     "browser_change_pending",
     "html_model",
     "html_text",
+    "lock_held_only_by_its_thread",
     "panel_writes_pending",
     "pool_processes",
     "resend_value",
@@ -105,3 +107,47 @@ def browser_change_pending(widget: pn.widgets.Widget) -> bool:
     """Whether Panel holds a change of ``widget`` from the browser that it has not yet
     handed to the widget (waiting for its debounce or for a free worker thread)."""
     return bool(widget._events)
+
+
+_LOCKED_HERE = threading.local()
+
+
+def lock_held_only_by_its_thread() -> None:
+    """Let Panel change a served page's models off the event loop only in the thread that
+    holds the page's document lock.
+
+    Panel 1.10 handles a browser's widget change on its worker threads (``--num-threads``)
+    and changes the models at once when ``state._document_lock_held``: the session's lock
+    is held, by anyone. When another callback held it (a draw, a settle) the change raced
+    that callback's end, and Bokeh refused it ("_pending_writes should be non-None when we
+    have a document lock"; seen with the notification of a refused typed value and with
+    the design's restyling when the car's wheels card appeared). Here the lock counts only
+    in the thread running a locked callback (Bokeh's ``ServerSession.with_document_locked``
+    runs the callback in an executor thread); elsewhere Panel schedules the change on the
+    page's event loop, under the lock, as it does for any other thread. Idempotent.
+    """
+    from bokeh.server import session as bokeh_session
+    from panel.io.state import state
+
+    cls = bokeh_session.ServerSession
+    if getattr(cls.with_document_locked, "_fbs_marks_thread", False):
+        return
+    inner = cls.with_document_locked.__wrapped__
+
+    def with_document_locked(self, func, *args, **kwargs):
+        _LOCKED_HERE.depth = getattr(_LOCKED_HERE, "depth", 0) + 1
+        try:
+            return inner(self, func, *args, **kwargs)
+        finally:
+            _LOCKED_HERE.depth -= 1
+
+    wrapped = bokeh_session._needs_document_lock(with_document_locked)
+    wrapped._fbs_marks_thread = True
+    cls.with_document_locked = wrapped
+
+    held = type(state)._document_lock_held
+
+    def lock_held_here(self) -> bool:
+        return getattr(_LOCKED_HERE, "depth", 0) > 0 and held.fget(self)
+
+    type(state)._document_lock_held = property(lock_held_here, doc=held.__doc__)  # type: ignore[method-assign,assignment]
