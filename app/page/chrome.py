@@ -17,6 +17,7 @@ from ..report import Provenance, ReportData
 from ..runtime import reports
 from ..runtime.activity import ACTIVITIES
 from ..runtime.draw import on_document, served_document
+from ..runtime.panel_private import html_model, html_text
 
 __all__ = [
     "HELP_TEXT",
@@ -59,26 +60,52 @@ def busy_html(text: str) -> str:
     return f'<div role="status" aria-live="polite">{_SPINNER}{html.escape(text)} ...</div>'
 
 
-def busy_indicator(results: Any) -> pn.pane.HTML:
+class BusyIndicator:
     """What the session is busy with while long work runs (``results.working``, written
     by :mod:`app.runtime.activity`): a spinner and e.g. "Computing the coupled response of
-    the whole car (12 s)"; hidden otherwise."""
-    doc = served_document()
-    pane = pn.pane.HTML(
-        busy_html(results.working),
-        visible=bool(results.working),
-        css_classes=["busy-indicator"],
-        margin=(8, 10),
-        styles={"color": "#664d03", "font-weight": "600"},
-        sizing_mode="stretch_width",
-    )
+    the whole car (12 s)"; hidden otherwise.
 
-    def show(*_: Any) -> None:
-        text = results.working
-        on_document(doc, lambda: pane.param.update(object=busy_html(text), visible=bool(text)))
+    Its text changes every second while work runs, so it is set in place on Panel's HTML
+    model (one small patch; a ``pn.pane.HTML`` given a new object re-sends its stylesheets
+    as new models each time: :mod:`app.runtime.panel_private`).
+    """
 
-    results.param.watch(show, "working")
-    return pane
+    def __init__(self, results: Any) -> None:
+        self._doc = served_document()
+        self._results = results
+        self.object = busy_html(results.working)
+        self.model = html_model(
+            self.object,
+            visible=bool(self.object),
+            css_classes=["busy-indicator"],
+            margin=(8, 10),
+            styles={"color": "#664d03", "font-weight": "600"},
+            sizing_mode="stretch_width",
+        )
+        self._pane = pn.pane.Bokeh(self.model, sizing_mode="stretch_width")
+        results.param.watch(self._show, "working")
+
+    @property
+    def visible(self) -> bool:
+        """Whether the indicator is shown."""
+        return bool(self.model.visible)
+
+    def _show(self, *_: Any) -> None:
+        text = busy_html(self._results.working)
+
+        def draw() -> None:
+            self.object = text
+            self.model.update(text=html_text(text), visible=bool(text))
+
+        on_document(self._doc, draw)
+
+    def __panel__(self) -> pn.pane.Bokeh:
+        return self._pane
+
+
+def busy_indicator(results: Any) -> BusyIndicator:
+    """The session's busy indicator (:class:`BusyIndicator`)."""
+    return BusyIndicator(results)
 
 
 def report_buttons(report: Callable[[], ReportData], owner: Any = None) -> pn.Row:
