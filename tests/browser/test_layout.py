@@ -298,6 +298,19 @@ def test_every_typed_field_reads_or_refuses_with_a_message(browser, dashboard):
                         )
                     except Exception:
                         problems.append(f"{cls} {text!r}: slider not at {in_force}")
+            # once the page is quiet the field shows the value in force (as a person sees
+            # it before typing the next value)
+            try:
+                page.wait_for_function(
+                    """([cls, want]) => [...Bokeh.documents[0].all_models].filter(
+                         m => m.css_classes && m.css_classes.includes(cls) && 'value' in m)
+                         .every(m => /^-?[0-9]+([.][0-9]*)?$/.test(String(m.value).trim())
+                                     && parseFloat(m.value) === want)""",
+                    arg=[cls, in_force],
+                    timeout=60_000,
+                )
+            except Exception:
+                problems.append(f"{cls} {text!r}: the field does not show {in_force}")
         shot(page, f"typed_{cls[4:]}")
     assert not problems, "\n".join(problems)
     ctx.close()
