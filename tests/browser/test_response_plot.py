@@ -112,7 +112,9 @@ def test_cursors_readout_snap_overlay_and_linear_axis(browser, dashboard):
     )
     lin = source(page, "mobility.truncated")
     np.testing.assert_allclose(lin["level"], 10 ** (lv / 20), rtol=1e-9)
-    assert _query(page, "lvl") == "linear" and "x" in (_query(page, "over") or "")
+    # the link follows (written once the change is handled; the plot may come first)
+    _wait_query(page, "lvl", "v === 'linear'")
+    assert "x" in (_query(page, "over") or "")
     wait_stable(page)
     assert not layout_problems(page, 1366)
     # the readout's table lies above the plot's canvas, not over it
