@@ -1,4 +1,4 @@
-"""Cached calls into :mod:`fbs_core.analysis` for the Analysis card (issue 18).
+"""Cached calls into :mod:`fbs_core.analysis` for the Analysis card.
 
 Like :mod:`app.compute` (whose caches and model tokens it shares): process-wide caches
 keyed by the session's ``Models`` token, so reference results are shared by all sessions

@@ -1,4 +1,4 @@
-"""State of the "Analysis" card (issue 18): which tab is shown, the phase view's options,
+"""State of the "Analysis" card: which tab is shown, the phase view's options,
 the delta cursors, the picked speed and frequency, and the pinned baselines.
 
 Plain state (no numerics), one :class:`AnalysisState` per session, held by the session's

@@ -11,7 +11,7 @@ on the first screen also at 1280x720), then (:func:`below_first_screen`) the sug
 and eigenfrequencies, the "Your data" card, the noise band and one card per entry of
 :data:`EXTRA_CARDS`, the place where further views (in their own modules under
 ``app/views/``) add themselves with one line. A served page sends its first screen first and
-builds the rest once the browser shows it (issue 33: the first plot of a page of ~1,000 Bokeh
+builds the rest once the browser shows it (the first plot of a page of ~1,000 Bokeh
 models waited 2.5 s for all of them).
 """
 
@@ -230,12 +230,12 @@ class PageParts:
 #: Further cards, below the built-in plots, in this order: ``builder(parts) -> panel object``
 #: (None: nothing). A view in its own module under ``app/views/`` adds its builder here.
 EXTRA_CARDS: list[Callable[[PageParts], Any]] = []
-EXTRA_CARDS.append(wheels_card)  # issue 31: per-wheel contributions (vehicle scope)
-EXTRA_CARDS.append(  # issue 18: compare, phase and peaks, across speed, contributions
+EXTRA_CARDS.append(wheels_card)  # per-wheel contributions (vehicle scope)
+EXTRA_CARDS.append(  # compare, phase and peaks, across speed, contributions
     lambda parts: analysis_card(parts.results, parts.freq, page=parts.page)
 )
 EXTRA_CARDS.append(campaign_card)  # campaign result files of FBS_CAMPAIGN_DIR (unset: how to)
-EXTRA_CARDS.append(landmarks_card)  # issue 14: the thesis' landmarks next to this tire's
+EXTRA_CARDS.append(landmarks_card)  # the thesis' landmarks next to this tire's
 
 
 def extra_cards(parts: PageParts) -> list:
@@ -257,7 +257,7 @@ class PlotViews:
         self.parts = parts
         self.mobility = MobilityView(store=r, x_range=parts.freq, mode=mode)
         # the views themselves are kept: a layout holds what a view's __panel__ returned, so
-        # the error map in its column never heard of the Presentation button (issue 29)
+        # the error map in its column never heard of the Presentation button
         self.map_view = self._map(p.n_axis)
         self.uncoupled_view: UncoupledView | None = None
         self.truncation = pn.Column(self.map_view, sizing_mode="stretch_both")
@@ -379,7 +379,7 @@ def data_card(parts: PageParts) -> pn.Card:
 def link_notice_pane(parts: PageParts) -> pn.pane.HTML:
     """The notice of a link made with uploads this session lacks; the link names the
     uploads in use. An HTML pane of escaped text, not Markdown: the notice repeats the
-    link's value, which must stay text (issue 28, finding 2)."""
+    link's value, which must stay text."""
     state, page = parts.state, parts.page
     notice = pn.pane.HTML(
         "",
@@ -566,7 +566,7 @@ def create_app(
         )
     if served():
         closed_pages.quiet_closed_page_writes()  # once per process: the server's loop
-        # the first screen is sent and shown first (issue 33: a page of ~1,000 Bokeh models
+        # the first screen is sent and shown first (a page of ~1,000 Bokeh models
         # took 2.5 s to its first plot); the rest follows once the browser shows it
         pn.state.onload(complete)
         if link is not None:
@@ -595,7 +595,7 @@ def close_page(page: pn.template.BootstrapTemplate, log: logging.Logger = log) -
     session (Panel's ``--liveness`` check, a warm-up, a test) is not among them, and
     Panel's registry of JavaScript callbacks (``panel.links.Callback.registry``, used by
     the editable sliders of the controls) would then keep the whole page, its results and
-    its data alive for the life of the process (finding 2 of issue 20).
+    its data alive for the life of the process.
     """
     page.results.close()
     # (``log`` is bound as a default: Bokeh may clear the module's namespace before the

@@ -1,4 +1,4 @@
-"""Cached calls into the core's mode analyses (issue 30) for the Modes and Selection tabs.
+"""Cached calls into the core's mode analyses for the Modes and Selection tabs.
 
 Like :mod:`app.compute` (whose caches and model tokens it shares): process-wide caches
 keyed by the session's ``Models`` token, so reference results are shared by all sessions

@@ -3,7 +3,7 @@
 ``param.Number`` and ``param.Integer`` accept ``True``/``False`` (a bool is an int in
 Python), and Panel reads a link's ``?noise=true`` as the boolean ``True``: the state then
 held ``True`` and the page's number field refused it while the page was built, a blank page
-(issue 28's URL fuzz). These refuse booleans with param's usual ``ValueError``, so a link's
+(found by the URL fuzz tests). These refuse booleans with param's usual ``ValueError``, so a link's
 boolean is ignored like any other value out of range.
 """
 

@@ -47,7 +47,7 @@ MAX_NOISE_PCT = 99.99
 MAX_SEED = 2**32 - 1
 #: What the truncation error map shows.
 MAP_MODES = ("selected DOF", "max over 6 DOFs")
-#: What is coupled: the thesis' rear corner (one tire) or the whole car (four tires, issue 31).
+#: What is coupled: the thesis' rear corner (one tire) or the whole car (four tires).
 SCOPES = ("corner", "vehicle")
 #: How the right track's road relates to the left one's (docs/vehicle-model.md, "The road as
 #: each wheel sees it"): in phase (coherency 1), anti-phase (-1) or a coherency in [-1, 1].
@@ -234,7 +234,7 @@ LEVEL_SCALES = ("dB", "linear")
 
 class ResponsePlotState(param.Parameterized):
     """The coupled-response plot as in a test lab's FRF display: DOFs overlaid, the level
-    axis, two labelled cursors with a readout (issue 29)."""
+    axis, two labelled cursors with a readout."""
 
     overlay = param.ListSelector(
         default=[],

@@ -88,7 +88,7 @@ SHOWN_FIRST_ORDER = "while the first-order band is shown"
 _SHOWN_BY = {SHOWN_UNCOUPLED: "show_uncoupled", SHOWN_FIRST_ORDER: "first_order"}
 #: ... on a thread of its own (the scatter band), not when the store is made.
 OWN_THREAD = "on a thread of its own"
-#: ... only in vehicle scope (the whole car, issue 31).
+#: ... only in vehicle scope (the whole car).
 IN_VEHICLE = "in vehicle scope"
 _TAB = "while the Analysis tab is shown: "
 
@@ -211,7 +211,7 @@ def scoped(corner: Callable[[Snapshot], Any], car: Callable[[Snapshot], Any]):
 
 #: The case of a coupled response.
 CASE = ("harmonic", "n_modes", "dof", "coupling", "residual", "models")
-#: The whole car's fields (vehicle scope, issue 31).
+#: The whole car's fields (vehicle scope).
 VEHICLE = ("scope", *VEHICLE_FIELDS)
 #: The settings of a scatter band (its cache key).
 BAND = (

@@ -1,4 +1,4 @@
-"""Cached calls into :mod:`fbs_core.vehicle` for the dashboard's vehicle scope (issue 31).
+"""Cached calls into :mod:`fbs_core.vehicle` for the dashboard's vehicle scope.
 
 The whole car: the reference vehicle with the session's tire on all four wheels (the right
 ones mirrored), a harmonic road on both tracks (the rear wheels a wheelbase later), the

@@ -5,7 +5,7 @@ wraps the provider ``panel serve`` builds (:class:`panel.auth.BasicAuthProvider`
 provider of Bokeh's public :class:`~bokeh.server.auth_provider.AuthProvider` interface
 that adds:
 
-Throttled logins (issue 28, finding 6)
+Throttled logins
     Failures are counted per *(client address, user name)*: from the 4th within
     :data:`LOGIN_WINDOW_S` each answer is held (0.5 s, doubling up to 8 s, without blocking
     the server), from the ``max_failures``-th on that user is refused from that address

@@ -20,28 +20,27 @@ A cheap health check
     loaded, kernels compiled, the first page's results cached); a script or an on-load
     callback that fails stops the server with the error (the container exits; a restart
     policy retries).
-    The port opens within seconds of the start (issue 33: 23.6 s when a warm-up and the
+    The port opens within seconds of the start (23.6 s when a warm-up and the
     proof ran before listening); a page requested meanwhile is served, computing what it
     needs beside the proof. No request, authenticated or not, makes the health check build
-    a page (Panel's own ``--liveness`` built one on the event loop for every request;
-    finding 2 of issue 20).
+    a page (Panel's own ``--liveness`` built one on the event loop for every request).
 Throttled logins, revocable cookies
     Wrong basic-auth logins are logged and slowed, then refused, per (client address, user
     name); a login cookie stops working on logout, when its user is removed or the
     password changed (``docker/fbs_auth.py``).
 Only the app's own routes are open to code paths of the request
     Panel's component-resource route (``/components/<module>/...``) imported the module the
-    URL named before any check, without login (``venv.__main__`` ended the process: issue
-    28, finding 1). Here it is behind the login and serves only modules of Panel that are
-    already loaded (:func:`allowed_component_module`), so a URL never imports anything. An
+    URL named before any check, without login (``venv.__main__`` ended the process).
+    Here it is behind the login and serves only modules of Panel that are already loaded
+    (:func:`allowed_component_module`), so a URL never imports anything. An
     exception that escapes any request handler or callback (even ``SystemExit``) is logged
     and the server goes on (:class:`Supervised`).
 Small HTTP bodies, large websocket messages
     Every HTTP request body is limited to :data:`HTTP_MAX_BODY_BYTES` (the login form is the
     only body the app takes; uploads travel over the websocket), so no request can make the
-    event loop read and parse megabytes (finding 8); the read buffer of a connection is
+    event loop read and parse megabytes; the read buffer of a connection is
     as large as the largest websocket message, so a file upload up to that size reaches the
-    app and gets its refusal instead of a closed connection (finding 9). A larger
+    app and gets its refusal instead of a closed connection. A larger
     websocket message is refused by the size its frame declares, before any of it is read,
     and a Bokeh message whose frames (content and buffers) add up to more is refused as
     its frames arrive; either closes that websocket with a log line naming the client
@@ -301,7 +300,7 @@ def preload_imports(files: list[str]) -> float:
 
     Run before the port opens (1.5-2 s for the dashboard: its libraries, the reference
     models' code and what its pages import on first use, ``app/runtime/libraries.py``), so
-    that the first page requested does not wait for them (issue 33). A module that fails
+    that the first page requested does not wait for them. A module that fails
     to import is left to the proof, which reports the script's error. Then a preloaded
     module's ``warm_before_serving()``, if it has one, is called: what the app's first
     page computes, computed before the port opens (the dashboard's default results).

@@ -1,4 +1,4 @@
-"""The server's proof steps aside while users' pages open (issue 33, the first page).
+"""The server's proof steps aside while users' pages open (the first page).
 
 The server proves its app once the port is open (``fbs_server.prove_in_background``): one
 page built and loaded on a thread of its own. Python runs one thread at a time, so a page a

@@ -100,7 +100,7 @@ class ChassisParameters:
 
 @dataclass(frozen=True)
 class ChassisVariantParameters(ChassisParameters):
-    """:class:`ChassisParameters` plus the scales of a parameter variant (issue 32).
+    """:class:`ChassisParameters` plus the scales of a parameter variant.
 
     The reference chassis is a plain :class:`ChassisParameters` (its stored parameters and
     numbers are unchanged); a variant of the corridor study (:mod:`fbs_core.variants`) may

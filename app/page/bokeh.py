@@ -45,7 +45,7 @@ STYLES: dict[str, dict[str, str]] = {
 #: lines wrapped at their separators, :func:`wrap_line`).
 TITLE_LINES = 9
 #: Characters per title-block line before it wraps: 10 px type in a half-width plot of a
-#: 1280 px window, 16 px type in a half-width plot without the sidebar (issue 29: the
+#: 1280 px window, 16 px type in a half-width plot without the sidebar (the
 #: presentation view's lines were cut at the plot's right edge).
 WRAP = {"normal": 72, "present": 62}
 #: Columns of a legend below a plot (the same widths).

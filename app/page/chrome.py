@@ -211,5 +211,5 @@ def link_notice(wanted: str, provenance: Provenance) -> str:
 
 def link_notice_html(text: str) -> str:
     """The notice's text as HTML: escaped, never markup (it repeats a value of the link, so
-    a crafted link must not put an element or a link into the page: issue 28, finding 2)."""
+    a crafted link must not put an element or a link into the page)."""
     return f'<div class="alert alert-warning" role="alert">{html.escape(text)}</div>'

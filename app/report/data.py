@@ -529,7 +529,7 @@ class ReportData:
 
     @property
     def vehicle(self) -> bool:
-        """Whether the report is of the whole car (vehicle scope, issue 31)."""
+        """Whether the report is of the whole car (vehicle scope)."""
         return self.settings.get("scope") == "vehicle"
 
     @property

@@ -1,4 +1,4 @@
-"""The report's first page: what someone who was not in the room reads first (issue 29).
+"""The report's first page: what someone who was not in the room reads first.
 
 The suggested N and the chosen N's largest eq. 5.1 error, the scatter band's width at the
 peaks, the largest contributions and the table of peaks, all read from the results the

@@ -51,7 +51,7 @@ VIEWS: dict[str, str] = {
     "selected-modes": "Selected tire modes beside the lowest N (table 5.1)",
     "chassis-truncation": "Truncation of the chassis side (eq. 5.1, the tire exact)",
 }
-#: What a view shows in vehicle scope, where it differs (the whole car, issue 31).
+#: What a view shows in vehicle scope, where it differs (the whole car).
 _VEHICLE_WHAT = {
     "coupled-response": "Coupled response of the car v_e* (eq. 4.1, four tires): all tire "
     "modes and N modes",

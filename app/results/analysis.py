@@ -1,4 +1,4 @@
-"""The results of the Analysis card (issue 18), each a pure function of one snapshot.
+"""The results of the Analysis card, each a pure function of one snapshot.
 
 Contributions of the interface forces (eq. 4.1 term by term), the phase view and its peaks
 (with the coupled modes nearby, computed in the background), the Campbell diagram, the

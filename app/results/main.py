@@ -59,7 +59,7 @@ def res_part(s: Snapshot) -> str:
 
 
 def tire_meta(s: Snapshot, harmonics=None) -> dict:
-    """The tire's interpolation quality and speed coverage for a CSV header (issue 13)."""
+    """The tire's interpolation quality and speed coverage for a CSV header."""
     q = compute.tire_quality(s.models)
     ks = [s.harmonic] if harmonics is None else list(harmonics)
     idx = [list(q["harmonic"]).index(k) for k in ks]

@@ -1,4 +1,4 @@
-"""The results of the Modes and Selection tabs (issue 30), each a pure function of one
+"""The results of the Modes and Selection tabs, each a pure function of one
 snapshot.
 
 Which tire modes matter (:func:`participation_result`: the ranking of the tire's stored

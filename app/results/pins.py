@@ -1,4 +1,4 @@
-"""Pinned baselines of the Compare tab (issue 18): what a pin holds and the comparison.
+"""Pinned baselines of the Compare tab: what a pin holds and the comparison.
 
 A pin is the session's snapshot at one moment, named (up to four,
 :data:`fbs_core.analysis.MAX_PINS`). In the URL (``pins=``) it travels as the settings that

@@ -1,4 +1,4 @@
-"""The coupled-response plot as a test lab's FRF display (issue 29): further bushing DOFs
+"""The coupled-response plot as a test lab's FRF display: further bushing DOFs
 overlaid, a dB or linear level axis, two labelled cursors with a readout (frequency, level
 of every curve, difference) that may snap to the nearest peak.
 

@@ -1,5 +1,5 @@
 """How a result names the scope it is of: the corner, or the whole car's wheels, tracks and
-response point (vehicle scope, issue 31), in CSV headers, captions and file names."""
+response point (vehicle scope), in CSV headers, captions and file names."""
 
 from __future__ import annotations
 

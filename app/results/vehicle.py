@@ -1,4 +1,4 @@
-"""The main views' results in vehicle scope (issue 31), each a pure function of one snapshot.
+"""The main views' results in vehicle scope, each a pure function of one snapshot.
 
 The whole car: the reference vehicle with the session's tire on all four wheels, a harmonic
 road on both tracks (the rear wheels a wheelbase later; the right track in phase, in

@@ -4,7 +4,7 @@ What nobody waits for (the coupled modes next to the phase view's peak labels, t
 suggested N with residual compensation, the reference studies warmed once per process)
 and what is computed ahead (the speed map of the next step of the N slider) runs on a
 fixed number of threads of the process, whatever the number of sessions and of their
-changes (issue 28: four tabs flipping the phase view's DOF and N started one thread per
+changes (four tabs flipping the phase view's DOF and N started one thread per
 change; 437 MB more memory and another session's p95 319 -> 733 ms):
 
 - :data:`BACKGROUND`: one thread at a lower CPU priority (:data:`~app.runtime.priority.
@@ -140,7 +140,7 @@ def warm_reference_studies(coupling: str = "6dof") -> threading.Thread | None:
     selector), so that the first change to another harmonic finds them computed; then the
     long-lived objects are frozen (:func:`freeze_long_lived`). Each map, and the freeze,
     waits for a quiet moment (:func:`app.runtime.collector.wait_quiet`): started by the
-    first page, the warm-up ran beside that page and the next ones opened (issue 33).
+    first page, the warm-up ran beside that page and the next ones opened.
     Returns the thread, or None if the warm-up was already started."""
     with _warm_lock:
         if _warmed.is_set():

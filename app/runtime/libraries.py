@@ -6,7 +6,7 @@ each on first use (and numba registers its implementations on its first kernel).
 The server imports the modules an app script imports before its port
 opens (``docker/fbs_server.py``, ``preload_imports``), this one included: without it, the
 first page requested after a start imported them itself (0.4 s of imports on an idle
-machine, 0.7 s while the server's own proof of the app ran beside it; issue 33).
+machine, 0.7 s while the server's own proof of the app ran beside it).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def warm_before_serving() -> None:
     page's results - the reference models loaded, their first error map and responses,
     the kernels loaded from numba's cache. A page requested the moment the port opened
     computed them itself (0.5-0.7 s of CPU more than a later page: 2.1-2.5 s to its first
-    plot instead of 1.6-1.8 s; issue 33). They are the shared results every page reads
+    plot instead of 1.6-1.8 s). They are the shared results every page reads
     (``app.compute``), so computing them here changes no number."""
     from app.state import DashboardState
     from app.store import Results

@@ -11,7 +11,7 @@ the futures (the session's :class:`~app.runtime.bands.Job` is asked every 0.1 s)
 in-process one to the last bit (the subsystem arrays are computed here and shipped).
 
 Without the variable nothing changes. Whenever the cluster cannot compute a band it is
-computed here, as without the variable (issue 28): the scheduler cannot be reached (the
+computed here, as without the variable: the scheduler cannot be reached (the
 connection is tried for :data:`CONNECT_TIMEOUT_S` by one band at a time, the others do
 not wait for it; after a failure the scheduler is left alone for :data:`BACKOFF_S`
 seconds, doubling up to :data:`MAX_BACKOFF_S`), it has no workers, or it or its workers

@@ -2,7 +2,7 @@
 
 The server proves the app once its port is open by building a page on a thread of its own
 (``docker/fbs_server.py``); a user's page opened meanwhile shared the one Python
-interpreter with it (issue 33: 2.6-2.8 s to the first plot instead of 1.65 s). Such a
+interpreter with it (2.6-2.8 s to the first plot instead of 1.65 s). Such a
 thread carries a ``step_aside`` attribute, a callable that returns once no user's page is
 opening (``docker/page_gate.py``), and so does its document while its on-load callbacks
 run (on Panel's worker threads). :func:`step_aside` calls it where the build holds

@@ -3,7 +3,7 @@
 Drawing a report (matplotlib, the PDF writer) holds the interpreter for seconds, in C code
 too. A served click waits on the session's event loop for :data:`REPORTS` (one thread:
 the sessions asking wait for their turn without holding one of Panel's worker threads;
-issue 28, finding 7: four tabs asking for PDF reports in a loop took every worker, another
+four tabs asking for PDF reports in a loop took every worker, another
 session's p95 went from 0.1 to 2.2 s), and that thread has the file drawn by the report
 process (:func:`draw_apart`, at a lower priority). What a report shows is
 :mod:`app.report`'s; the buttons are :func:`app.page.chrome.report_buttons`.

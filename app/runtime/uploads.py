@@ -2,8 +2,8 @@
 
 Reading an upload takes up to the sandbox's time limit (30 s) and used to run on the Panel
 worker thread that handled the upload (``FBS_NUM_THREADS``, 4): four tabs uploading slow
-files held every thread, and every other session's control changes waited (issue 28,
-finding 3: p95 from 0.17 s to over 60 s). Here an upload is a job of :data:`UPLOADS`:
+files held every thread, and every other session's control changes waited
+(p95 from 0.17 s to over 60 s). Here an upload is a job of :data:`UPLOADS`:
 
 - a few threads of its own read the files, as many as the sandbox has parser processes
   (``fbs_core.io._sandbox.parsers()``), so Panel's threads answer the controls meanwhile;

@@ -1,4 +1,4 @@
-"""Shared base of the Analysis card's views (issue 18) and the card itself.
+"""Shared base of the Analysis card's views and the card itself.
 
 An :class:`AnalysisView` is a :class:`~app.views.live.LiveView` that draws a result of the
 session's store (:mod:`app.store`: the rows computed while their tab is shown) and shows
@@ -132,7 +132,7 @@ def analysis_card(results, x_range=None, tabs: dict | None = None, page=None) ->
     # each view has the height of its plots (app/views/layout.py: the window's height within
     # limits); the card and its tabs state their sizing, so it is never inferred from their
     # content (a card of no height given a stretch_both sizing got no height at all in the
-    # page column: issue 29)
+    # page column)
     body = pn.Column(_building(), sizing_mode="stretch_width", css_classes=["analysis-body"])
     card = pn.Card(
         body,

@@ -1,4 +1,4 @@
-"""The Modes and Selection tabs of the Analysis card (issue 30).
+"""The Modes and Selection tabs of the Analysis card.
 
 Modes: the participation ranking of the tire modes for the harmonic, the bushing DOF and
 the band (bars of the chosen measure, the picked mode highlighted), the picked mode's shape

@@ -21,7 +21,7 @@ A page costs no file access: the card's browser opens nothing until the card is 
 (:meth:`CampaignBrowser.activate`), the list of campaign files and each opened file are
 kept per process and read again only when a file changes (:func:`open_cached`: size and
 modification time), and a file is read on a thread of its own while the card says so. A
-malformed file (issue 28, finding 4) is a message in the card naming the file and the
+malformed file is a message in the card naming the file and the
 problem (:class:`~fbs_core.campaign.CampaignError`), never an error of the page.
 """
 
@@ -243,7 +243,7 @@ def _parameters_of(s: dict, model: str) -> str:
 
 
 def _variants_row(c) -> dict[str, Any]:
-    """A variants case (issue 32) in the table's columns: its harmonics, the varied tire and
+    """A variants case in the table's columns: its harmonics, the varied tire and
     chassis parameters, its design and size."""
     s = c.settings
     n_variants = c.n_lines - 1 if c.n_lines else 0  # the nominal models are one unit
@@ -350,7 +350,7 @@ def scatter_case_result(result, name: str, dof: str) -> Result:
 
 def variants_case_result(result, name: str, dof: str, harmonic: int | None = None) -> Result:
     """The corridor of a variants case at ``bushing:dof`` over its nominal response, and the
-    per-band leaders of its Sobol' indices (a Saltelli design only; issue 32,
+    per-band leaders of its Sobol' indices (a Saltelli design only; see
     docs/corridor.md).
 
     The numbers are those of :meth:`CampaignResult.variants`: the study as stored, its

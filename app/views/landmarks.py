@@ -1,4 +1,4 @@
-"""The thesis' landmarks next to the reference tire's (issue 14): a small read-only table.
+"""The thesis' landmarks next to the reference tire's: a small read-only table.
 
 The table is measured by ``fbs_core.tire.landmarks`` (each physics addition of the
 reference tire switched off in turn, each mechanism behind table 5.1's trend switched) and

@@ -10,7 +10,7 @@ A box whose height comes from CSS has ``sizing_mode="stretch_width"`` and no hei
 own; its content stretches into it. Panel's layouts would infer a ``stretch_both`` sizing of
 such a box from its content (a column of stretching plots); in a page column of no fixed
 height a ``stretch_both`` box is given no height at all (its flex basis is 0): that was
-the Analysis card of height 0 of issue 29. So the page sets
+how the Analysis card once had height 0. So the page sets
 ``pn.config.respect_explicit_sizing`` (:data:`PANEL_CONFIG`): a sizing mode stated on a
 layout is the one it gets, and Panel has nothing to warn about.
 

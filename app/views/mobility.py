@@ -80,7 +80,7 @@ class MobilityView(LiveView):
             tooltips=level_tooltips("N retained modes"),
         )
         # the lines of the DOFs overlaid are made when first overlaid (six lines made up
-        # front were 66 of the first screen's ~400 models, issue 33); their legend entries
+        # front were 66 of the first screen's ~400 models); their legend entries
         # and hover tools are here from the start, empty and hidden: a tool added later
         # lays the toolbar out again, and BokehJS then left the legend outside the canvas
         self._over: dict[str, ColumnDataSource] = {}

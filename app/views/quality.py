@@ -1,4 +1,4 @@
-"""How far the session's tire can be trusted between its operating points (issue 13).
+"""How far the session's tire can be trusted between its operating points.
 
 A badge and a one-row table next to the data source: the leave-one-out interpolation
 error per harmonic band (every interior operating point predicted from its neighbours,

@@ -26,7 +26,7 @@ FIRST_ORDER_LEGEND = "first-order band (linearised)"
 #: The progress bar is hidden when idle (its box kept: no new layout of the page). The rule
 #: follows the bar's own ``active`` class: the bar's ``styles`` are copied onto the inner
 #: ``<progress>`` element once, when it is drawn, so a bar drawn idle stayed hidden for
-#: good (issue 29: no bar on a page whose first band was ready when it loaded).
+#: good (no bar on a page whose first band was ready when it loaded).
 IDLE_CSS = "progress:not(.active) { visibility: hidden; }"
 
 

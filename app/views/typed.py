@@ -2,7 +2,7 @@
 
 Bokeh's numeric fields drop the characters they do not expect while the user types, so
 ``1e5`` became 15, ``1.5`` became 15 in a whole-number field, ``5,5`` became 55 and ``abc``
-was ignored, all without a word (issue 29). A :class:`NumberField` is a plain text field
+was ignored, all without a word. A :class:`NumberField` is a plain text field
 whose text is read here by :func:`parse_number`; what cannot be read, or lies outside the
 parameter's bounds, is refused with a message under the field that names the field, what
 was typed and what is allowed, and the field shows the value in force again. A field may

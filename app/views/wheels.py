@@ -1,4 +1,4 @@
-"""Vehicle scope (issue 31): the contribution of each wheel's road to the car's response.
+"""Vehicle scope: the contribution of each wheel's road to the car's response.
 
 The four lines are the levels of ``VehicleResponse.by_wheel`` at the response point (the
 road under each wheel, a wheelbase apart front to rear, the right track in phase, in

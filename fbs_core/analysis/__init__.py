@@ -1,4 +1,4 @@
-"""Analysis of coupled results for a design review (issue 18): contributions of the
+"""Analysis of coupled results for a design review: contributions of the
 interface forces, peaks and nearby modes, phase views and cursors, comparison of
 states, the tire across speed (Campbell diagram, speed-frequency map), and CSV
 export with provenance. See ``docs/analysis.md``.

@@ -3,7 +3,7 @@
 A campaign is the cross product of the settings listed in its ``[scatter]`` table (noise
 scatter bands, thesis 5.2, eqs. 5.2-5.4) and its ``[truncation]`` table (truncation error
 maps and suggested mode counts, thesis 5.1, eq. 5.1 and table 5.1), plus an optional
-``[variants]`` table: a corridor study of physical parameters (issue 32, :mod:`.variants`,
+``[variants]`` table: a corridor study of physical parameters (:mod:`.variants`,
 ``campaigns/corridor.toml``). The layout, with every key and its default, is documented in
 ``campaigns/example.toml``::
 

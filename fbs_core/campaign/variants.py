@@ -1,4 +1,4 @@
-"""The "variants" study of a campaign: a corridor of systematic errors on Dask (issue 32).
+"""The "variants" study of a campaign: a corridor of systematic errors on Dask.
 
 A campaign file's ``[variants]`` table describes a corridor study (:mod:`fbs_core.variants`):
 the named physical parameters and their ranges, the design and its size, the harmonics and

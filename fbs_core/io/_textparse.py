@@ -511,7 +511,7 @@ def _contents(sets: list[dict[str, Any]]) -> dict[str, int]:
 # -- CSV ---------------------------------------------------------------------------------
 #: Most columns of a CSV file: 10,000 complex FRF columns (e.g. 1,666 output DOFs x 6
 #: inputs). Each column becomes labels and Python objects in the server process: a file of
-#: 100,000 columns (4 MB) took 17 s and 160 MB there (issue 28).
+#: 100,000 columns (4 MB) took 17 s and 160 MB there.
 MAX_COLUMNS = 20_000
 
 

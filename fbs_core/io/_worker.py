@@ -279,7 +279,7 @@ def _walk(root: Any, h5py: Any) -> Iterator[tuple[str, Any]]:
     at most :data:`MAX_OBJECTS` of them and :data:`MAX_DEPTH` levels deep.
 
     Each object is opened relative to its group: HDF5's own visit resolves every full
-    path from the root, which took minutes for groups nested 3,000 deep (issue 28).
+    path from the root, which took minutes for groups nested 3,000 deep.
     """
     count = 0
     stack: list[tuple[Any, str, Iterator[str]]] = [(root, "", iter(root))]

@@ -1,4 +1,4 @@
-"""What a tire mode looks like: the belt's geometry from the physical DOFs (issue 30).
+"""What a tire mode looks like: the belt's geometry from the physical DOFs.
 
 The tire's physical DOFs (:mod:`.ring`) are the rim's 6 hub DOFs (vehicle axes), the
 belt's Ritz coordinates (family ``f``, circumferential order ``n``, ``cos`` or ``sin``;

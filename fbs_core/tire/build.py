@@ -42,7 +42,7 @@ OPERATING_POINTS: tuple[float, ...] = tuple(20.0 + 2.5 * i for i in range(41))
 #: Relative error of the interpolated hub mobility / free hub velocity against the
 #: direct solution between operating points above which an interval is halved (1 %,
 #: 0.09 dB). At a deep minimum of the coupled response (chassis and tire cancelling)
-#: a few per cent on the tire's side become several dB at the bushing (issue 13).
+#: a few per cent on the tire's side become several dB at the bushing.
 REFINE_TOL = 0.01
 #: Smallest spacing the refinement creates, km/h.
 REFINE_MIN_STEP = 0.625

@@ -1,4 +1,4 @@
-"""Residual terms of a truncated modal model estimated from FRFs (issue 15).
+"""Residual terms of a truncated modal model estimated from FRFs.
 
 A supplier with the full modal set gives the residual of the modes left out per
 operating point directly (``TireModel.truncations(..., residual=True)``: every mode

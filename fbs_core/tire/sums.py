@@ -22,13 +22,13 @@ them from cache; a tile's ``1 / (s - lambda)`` of all modes come first, in one l
 compiler vectorises; the blocks' sums join the sums up to the previous block as each
 block ends (no array of all blocks' sums); the loops index elements and take no array
 views, and the innermost functions are inlined: each array view or argument of a call
-costs two atomic reference counts (issue 33: the kernel's CPU time for the seven maps
+costs two atomic reference counts (the kernel's CPU time for the seven maps
 0.18 -> 0.14 s, the numbers the same to rounding). Nothing is kept between calls: a
 line's sums depend on that line alone
 (the same bits whatever else is computed, in any order, on any thread), so a call's tiles
 are dealt to a few threads of the process (the kernel releases the GIL; one per core,
 :func:`_run_tiles`): the seven truncation maps of the reference tire 0.21 -> 0.12 s on two
-cores (``bench/bench_tire_lines.py``, issue 33).
+cores (``bench/bench_tire_lines.py``).
 
 Roots of a split cluster's polynomial (3 or 4 members; 2 in closed form) come from the
 Aberth-Ehrlich iteration (O. Aberth, Math. Comp. 27, 1973) started from the member

@@ -3,7 +3,7 @@
 :class:`~fbs_core.tire.TireModel` synthesises the hub mobility and the free hub
 velocity as sums over its modes (``H = sum_r R_r / (s - lambda_r)``, thesis eq. 2.5
 with the residues ``R_r = psi_r chi_r^T`` and ``psi_r p_r``), every line at its own
-speed. For "which modes matter" (issue 30) the sum is wanted term by term: the term of
+speed. For "which modes matter" the sum is wanted term by term: the term of
 every stored (tracked) mode pair at every line, such that the terms add up to the
 model's own all-modes synthesis.
 

@@ -1,4 +1,4 @@
-"""Systematic errors: corridors from physical parameters and their sensitivities (issue 32).
+"""Systematic errors: corridors from physical parameters and their sensitivities.
 
 The thesis' section 7 asks for "a noise corridor for systematic errors" from a
 "simultaneous change of physical properties such as mass and stiffness". Here:

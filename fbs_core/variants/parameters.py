@@ -1,4 +1,4 @@
-"""Named physical parameters of the reference models and their documented ranges (issue 32).
+"""Named physical parameters of the reference models and their documented ranges.
 
 The thesis' noise study scales FRF elements at random (eqs. 5.2-5.4); its section 7 asks
 for the corridor of *systematic* errors: "simultaneous change of physical properties such

@@ -1,4 +1,4 @@
-"""The whole car: four rolling tires on one body, the road seen by each wheel (issue 31).
+"""The whole car: four rolling tires on one body, the road seen by each wheel.
 
 See docs/vehicle-model.md.
 """
