@@ -61,6 +61,20 @@ def test_the_url_and_the_title_links_are_one_function_of_the_state():
     )
 
 
+def test_a_number_has_one_spelling_whether_dragged_or_typed():
+    # a slider sends a whole number as an int (JSON 36), a typed field as a float (36.0): one
+    # setting, so the URL and a view id's snapshot must write it the same (the random walk
+    # found a title link "thr=36.0" under a page URL "thr=36")
+    dragged, typed = DashboardState(), DashboardState()
+    dragged.truncation.threshold = 36
+    typed.truncation.threshold = 36.0
+    assert state_query(dragged) == state_query(typed) == state_query(Snapshot.of(dragged))
+    c = Controls(state=DashboardState())
+    bar = c.fields["truncation.threshold"].bar
+    bar.value = 36  # the browser's JSON number
+    assert type(c.state.truncation.threshold) is float
+
+
 def test_a_long_link_is_a_view_id_that_opens_its_state_and_the_table_is_bounded():
     links = ViewLinks(max_entries=3, max_chars=400)
     s = DashboardState()

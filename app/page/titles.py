@@ -12,6 +12,8 @@ import weakref
 from collections.abc import Mapping
 from typing import Any
 
+import param
+
 import fbs_core
 
 from ..public_url import public_link
@@ -171,6 +173,15 @@ def _serialize(obj_cls: Any, name: str, value: Any) -> str:
     p = obj_cls.param[name]
     if isinstance(value, tuple):
         value = list(value)
+    if (
+        isinstance(p, param.Number)
+        and not isinstance(p, param.Integer)
+        and isinstance(value, int)
+        and not isinstance(value, bool)
+    ):
+        # one spelling per value: a slider's whole number (an int from the browser) and the
+        # same number typed (a float) are one setting, written as the float
+        value = float(value)
     try:
         out = p.serialize(value)
     except Exception:

@@ -231,7 +231,7 @@ class NumberField(Viewer):
         return value
 
     def _from_bar(self, value: float) -> float | int:
-        return int(round(value)) if self._integer else value
+        return int(round(value)) if self._integer else float(value)
 
     def __panel__(self):
         if self.compact:  # as wide as the label and the field: beside other controls
