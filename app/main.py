@@ -417,6 +417,7 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
         options={"Normal view": "normal", "Presentation": "present"},
         css_classes=["ctl-page-view"],
         width=220,
+        in_draw=True,  # the whole page restyled in one message: laid out once
     )
     # the page's type (page.py) and the sidebar at once
     view_switch.jscallback(value=VIEW_SWITCH_JS + VIEW_SIDEBAR_JS)

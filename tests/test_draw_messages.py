@@ -98,3 +98,23 @@ def test_a_draw_reaches_the_page_as_one_message_holding_all_its_changes(served_p
     np.testing.assert_array_equal(np.asarray(src.data["y"]), np.ones(4))
     assert replica.get_model_by_id(page.fig.title.id).text == "after"
     assert replica.get_model_by_id(page.fig.x_range.id).start == -1.0
+
+
+def test_draws_asked_for_by_a_draw_join_its_message(served_page):
+    # the view switch: one draw sets the page's view, and each view's restyle asks for a
+    # draw of its own; they must reach the page in the first draw's one message (as separate
+    # messages the page laid itself out again after each one)
+    page, url = served_page
+
+    def draw():
+        page.source.data = {"x": np.arange(4.0), "y": np.ones(4)}
+        on_document(page.doc, lambda: setattr(page.fig.title, "text", "after"))
+        on_document(page.doc, lambda: setattr(page.fig.x_range, "start", -1.0))
+        on_document(page.doc, lambda: setattr(page.div, "text", "after"))
+
+    patches, replica = in_own_loop(
+        asyncio.wait_for(_client(url, page, draw), 2 * TIMEOUT), 3 * TIMEOUT
+    )
+    assert len(patches) == 1, [len(p.content["events"]) for p in patches]
+    assert replica.get_model_by_id(page.fig.title.id).text == "after"
+    assert replica.get_model_by_id(page.fig.x_range.id).start == -1.0

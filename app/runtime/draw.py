@@ -44,12 +44,24 @@ def served_document():
     return doc if doc is not None and doc.session_context is not None else None
 
 
+#: The document whose draw this thread is running (a draw's own requests join it).
+_drawing = threading.local()
+
+
 def on_document(doc, fn) -> None:
     """Run ``fn`` (changes of Bokeh models) where it may change the served document
     ``doc``: on the session's event loop under its lock, whichever thread asks (``doc``
-    None: no server, at once), after the changes asked for before it (:class:`DrawQueue`)."""
+    None: no server, at once), after the changes asked for before it (:class:`DrawQueue`).
+
+    Asked for by a draw of ``doc`` itself, ``fn`` runs at once, inside that draw: its
+    changes leave in the draw's one message. (The view switch restyles a dozen figures,
+    each through its own view: as separate draws they reached the browser as a dozen
+    messages, and the page laid itself out again after each one, ~0.4 s apiece.)
+    """
     if doc is None or doc.session_context is None:
         fn()  # no server: tests, notebooks, exports
+    elif getattr(_drawing, "doc", None) is doc:
+        fn()
     else:
         DrawQueue.of(doc).add(fn)
 
@@ -167,5 +179,10 @@ def _run_on(fn, doc) -> None:
     # building the serializer's map of the page's ~750 models: a quarter of the server's
     # CPU with 20 sessions changing (``bench/load_test.py``, profiled; tested by
     # ``tests/test_draw_messages.py``).
-    with set_curdoc(doc), pn.io.unlocked():
-        fn()
+    outer = getattr(_drawing, "doc", None)
+    _drawing.doc = doc
+    try:
+        with set_curdoc(doc), pn.io.unlocked():
+            fn()
+    finally:
+        _drawing.doc = outer

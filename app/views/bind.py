@@ -41,6 +41,7 @@ import threading
 import time
 import weakref
 from collections.abc import Callable, Iterator
+from functools import partial
 from typing import Any
 
 import panel as pn
@@ -86,6 +87,7 @@ class Binding:
         to_widget: Callable[[Any], Any] | None = None,
         to_state: Callable[[Any], Any] | None = None,
         refused: Callable[[str], None] | None = None,
+        in_draw: bool = False,
     ) -> None:
         self.widget = widget
         self.obj = obj
@@ -93,6 +95,10 @@ class Binding:
         self.to_widget = to_widget or (lambda v: v)
         self.to_state = to_state or (lambda v: v)
         self.refused = refused
+        #: The parameter is set in a draw of the page (:func:`app.runtime.draw.on_document`):
+        #: everything its watchers change on the page leaves in one message (a change of the
+        #: whole page's layout, such as the view switch, is then laid out once).
+        self.in_draw = in_draw
         #: User changes of the widget being handled now (on Panel's worker threads).
         self.busy = 0
 
@@ -182,7 +188,9 @@ class Binder:
     def _take(self, b: Binding, event: param.parameterized.Event) -> None:
         try:
             value = b.to_state(event.new)
-            if not _same(value, getattr(b.obj, b.name)):
+            if b.in_draw and self.doc is not None:
+                on_document(self.doc, partial(b.obj.param.update, **{b.name: value}))
+            elif not _same(value, getattr(b.obj, b.name)):
                 b.obj.param.update(**{b.name: value})
         except (Refused, ValueError, TypeError) as exc:
             message = str(exc)
@@ -306,11 +314,13 @@ def control(
     to_widget: Callable[[Any], Any] | None = None,
     to_state: Callable[[Any], Any] | None = None,
     refused: Callable[[str], None] | None = None,
+    in_draw: bool = False,
     **params: Any,
 ) -> pn.widgets.Widget:
     """A widget of class ``cls`` for ``parameter`` (of a ``Parameterized`` instance), bound
     to it (:func:`bind`): the replacement of ``cls.from_param``. ``name`` is its label;
-    options and a slider's bounds and step come from the parameter unless given."""
+    options and a slider's bounds and step come from the parameter unless given;
+    ``in_draw``: see :class:`Binding`."""
     obj, name = parameter.owner, parameter.name
     if "name" not in params:
         params["name"] = parameter.label
@@ -327,5 +337,7 @@ def control(
     if "description" in cls.param and "description" not in params and parameter.doc:
         params["description"] = " ".join(parameter.doc.split())
     widget = cls(**params)
-    bind(widget, obj, name, to_widget=to_widget, to_state=to_state, refused=refused)
+    bind(
+        widget, obj, name, to_widget=to_widget, to_state=to_state, refused=refused, in_draw=in_draw
+    )
     return widget

@@ -8,6 +8,7 @@ path is printed)."""
 from __future__ import annotations
 
 import io
+import json
 import re
 from html.parser import HTMLParser
 from pathlib import Path
@@ -244,9 +245,12 @@ def test_presentation_switch_changes_the_type_without_a_reload(browser, dashboar
     needed a reload with ?view=present)."""
     ctx = _context(browser, size)
     page = ctx.new_page()
+    frames: list = []
+    page.on("websocket", lambda ws: ws.on("framereceived", lambda f: frames.append(f)))
     open_dashboard(page, dashboard.url + "?rounds=1000")
     body0, card0 = _type_sizes(page)
     page.evaluate("() => { window.__fbs_not_reloaded = true; }")
+    before = len(frames)
     page.locator(".ctl-page-view button", has_text="Presentation").click()
     page.wait_for_function("() => parseFloat(getComputedStyle(document.body).fontSize) >= 17")
     body1, card1 = _type_sizes(page)
@@ -257,12 +261,39 @@ def test_presentation_switch_changes_the_type_without_a_reload(browser, dashboar
         ".every(f => f.left.every(a => parseFloat(a.major_label_text_font_size) >= 16))"
     )
     assert page.evaluate("() => window.__fbs_not_reloaded === true")  # same page
+    # the whole restyle reached the page in one message: laid out once (a message per view
+    # kept the page busy for 10-15 s, laying itself out again after each one)
+    restyles = [
+        events
+        for kind, events in _bokeh_messages(frames[before:])
+        if kind == "PATCH-DOC" and any(e.get("attr", "").endswith("font_size") for e in events)
+    ]
+    assert len(restyles) == 1, [len(e) for e in restyles]
     page.locator(".ctl-page-view button", has_text="Normal view").click()
     page.wait_for_function(
         f"() => parseFloat(getComputedStyle(document.body).fontSize) === {body0}"
     )
     assert _type_sizes(page) == (body0, card0)
     ctx.close()
+
+
+def _bokeh_messages(frames: list) -> list[tuple[str, list]]:
+    """The Bokeh messages in websocket text frames received by the page: (message type,
+    events of its content) for each (a message is a header, metadata and content frame,
+    then its binary buffers)."""
+    out: list[tuple[str, list]] = []
+    texts = [json.loads(f) for f in frames if isinstance(f, str)]
+    i = 0
+    while i < len(texts):
+        head = texts[i]
+        if isinstance(head, dict) and "msgtype" in head and i + 2 < len(texts):
+            content = texts[i + 2]
+            events = content.get("events", []) if isinstance(content, dict) else []
+            out.append((head["msgtype"], [e for e in events if isinstance(e, dict)]))
+            i += 3
+        else:
+            i += 1
+    return out
 
 
 def _status(page, words: str, timeout=120_000):
