@@ -554,6 +554,11 @@ def band_key(
     return corner if vehicle is None else (*corner, tuple(vehicle))
 
 
+def is_car_key(key: tuple) -> bool:
+    """Whether :func:`band_key` ``key`` is a car's (it ends in the vehicle part)."""
+    return len(key) == 10
+
+
 def cached_band(key: tuple):
     """The band of ``key`` if it was computed before, else None."""
     with _bands_lock:
@@ -572,14 +577,10 @@ def band(*args, cancel=None, progress=None, **kwargs):
     band at once share one computation (:class:`app.runtime.bands.SharedRun`).
     """
     key = band_key(*args, **kwargs)
+    if is_car_key(key):
+        raise ValueError("a car's band is computed by app.vehicle_compute.cached_band")
     res = cached_band(key)
     if res is not None:
-        return res
-    if len(key) > 9:  # a car's band (vehicle scope)
-        from . import vehicle_compute
-
-        res = vehicle_compute.band(key, cancel=cancel, progress=progress)
-        remember_band(key, res)
         return res
     harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models = key
     t0 = time.perf_counter()

@@ -20,7 +20,7 @@ The checks are the core's (every view must run on the models):
 - tire: :func:`fbs_core.io.checks.check_tire` (hub DOFs, at least 20 complex modes, the
   operating points of all seven harmonic cases and of the eigenfrequency view);
 - a measured chassis (sensors and impacts around the knuckle, with a geometry upload):
-  :func:`fbs_core.vpt.load_measured_chassis` (the channels' positions and directions, six
+  :func:`fbs_core.io.load_measured_chassis` (the channels' positions and directions, six
   DOFs observable) turns it into the spindle chassis above, with its consistency
   (docs/vpt.md);
 - the pair: :func:`fbs_core.io.checks.check_pair` (the interface matrix
@@ -371,7 +371,7 @@ class DataSource(param.Parameterized):
 
     def _read_measured(self, data, name, spindle, bushing, interpolate, quantity=None):
         """A measured set and the geometry upload -> the spindle chassis (docs/vpt.md)."""
-        from fbs_core.vpt import load_measured_chassis
+        from fbs_core.io import load_measured_chassis
 
         assert self._geometry is not None
         geo, geo_name = self._geometry

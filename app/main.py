@@ -68,7 +68,7 @@ from app.views import (
     UncoupledView,
     UploadView,
 )
-from app.views.analysis_base import analysis_card
+from app.views.analysis_card import analysis_card
 from app.views.bind import control
 from app.views.campaign import campaign_card
 from app.views.landmarks import landmarks_card

@@ -56,7 +56,7 @@ from fbs_core.errors import FBSError
 
 from . import compute
 from . import modes_compute as mc
-from .analysis_state import check_pin_name, encode_pins
+from .pin_settings import check_pin_name, encode_pins
 from .results import (
     FIELDS,
     Band,

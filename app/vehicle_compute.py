@@ -29,7 +29,8 @@ from fbs_core.vehicle import Road, vehicle_scatter_band, vehicle_transfer, vehic
 from fbs_core.vehicle.response import VehicleResponse, WheelTransfer
 from fbs_core.vocabulary import fraction
 
-from .compute import Q_LEVELS, _key, _n, _tire, frequencies, shared_cache
+from .compute import Q_LEVELS, _key, _n, _tire, frequencies, remember_band, shared_cache
+from .compute import cached_band as compute_cached_band
 
 __all__ = ["band", "coherent", "response", "road", "transfer", "truncation_map"]
 
@@ -158,6 +159,15 @@ def truncation_map_ready(
 
 #: Keys of the maps computed (the cache may have dropped some since: then recomputed).
 _MAPS_DONE: set = set()
+
+
+def cached_band(key: tuple, cancel=None, progress=None):
+    """:func:`band` of ``key``, from and into the bands' cache of :mod:`app.compute`."""
+    res = compute_cached_band(key)
+    if res is None:
+        res = band(key, cancel=cancel, progress=progress)
+        remember_band(key, res)
+    return res
 
 
 def band(key: tuple, cancel=None, progress=None):

@@ -20,6 +20,7 @@ from fbs_core.vocabulary import magnitude_db, percent
 
 from . import figures
 from .data import SETTING_KEYS, ExtraSection, ReportData, ReportError, present
+from .figures import FigureBlock
 from .method import EQUATIONS, METHOD_PARAGRAPHS, THESIS, Equation
 from .summary import Summary, report_summary, suggested_n
 from .titles import (
@@ -48,21 +49,6 @@ class Table:
     caption: str
     header: tuple[str, ...]
     rows: tuple[tuple[str, ...], ...]
-
-
-@dataclass(frozen=True)
-class FigureBlock:
-    """A plot: its title block and a function drawing it into a matplotlib figure region.
-
-    ``draw(fig, rect)`` adds axes inside ``rect = (left, bottom, width, height)`` (figure
-    fraction), legends included; ``aspect`` is the height / width ratio it wants.
-    """
-
-    key: str
-    title: TitleBlock
-    draw: figures.Draw
-    aspect: float = 0.55
-    stem: str = ""
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,8 @@ from __future__ import annotations
 import io
 import threading
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import Any
 
 import matplotlib
 import numpy as np
@@ -34,13 +35,26 @@ from .colormap import LINE_STYLES, ErrorColorScale, threshold_contour
 from .data import ReportData, present
 from .titles import TitleBlock
 
-if TYPE_CHECKING:
-    from .content import FigureBlock
-
 #: A plot's region of a figure: ``(left, bottom, width, height)`` in figure fraction.
 type Rect = tuple[float, float, float, float]
 #: What every ``draw_*`` returns: ``draw(fig, rect)`` adds the plot's axes inside ``rect``.
 type Draw = Callable[[Figure, Rect], None]
+
+
+@dataclass(frozen=True)
+class FigureBlock:
+    """A plot: its title block and a function drawing it into a matplotlib figure region.
+
+    ``draw(fig, rect)`` adds axes inside ``rect = (left, bottom, width, height)`` (figure
+    fraction), legends included; ``aspect`` is the height / width ratio it wants.
+    """
+
+    key: str
+    title: TitleBlock
+    draw: Draw
+    aspect: float = 0.55
+    stem: str = ""
+
 
 __all__ = [
     "COLORS",

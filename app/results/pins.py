@@ -2,7 +2,7 @@
 
 A pin is the session's snapshot at one moment, named (up to four,
 :data:`fbs_core.analysis.MAX_PINS`). In the URL (``pins=``) it travels as the settings that
-change its numbers (:class:`~app.analysis_state.PinSettings`: the case, residual
+change its numbers (:class:`~app.pin_settings.PinSettings`: the case, residual
 compensation included, the noise study, the models); in the session it keeps its whole
 :class:`~app.results.base.Snapshot` and its data as a :class:`fbs_core.analysis.PinnedState`
 (the coupled response with N and all modes at its DOF, made by the coupled-response view's
@@ -38,8 +38,8 @@ from fbs_core.errors import FBSError
 from fbs_core.vocabulary import magnitude_db, percent
 
 from .. import compute
-from ..analysis_state import PinSettings, decode_pins
 from ..datasource import REFERENCE
+from ..pin_settings import PinSettings, decode_pins
 from ..report.titles import NOISE_WHERE
 from .base import Band, Result, Snapshot, csv_name
 from .main import res_part, response_result

@@ -43,7 +43,7 @@ import panel as pn
 
 from fbs_core.errors import FBSError, StudyCancelled
 
-from .. import compute
+from .. import compute, vehicle_compute
 from . import offload
 from .draw import served
 from .priority import BACKGROUND_NICE
@@ -259,7 +259,10 @@ def _compute(shared: SharedRun, turns: Turnstile) -> None:
                 KERNELS_WARM.set()  # a chunk ran here: the kernels are compiled
                 shared.report(done, total)
 
-            res = compute.band(*shared.key, cancel=cancel, progress=progress)
+            if compute.is_car_key(shared.key):
+                res = vehicle_compute.cached_band(shared.key, cancel=cancel, progress=progress)
+            else:
+                res = compute.band(*shared.key, cancel=cancel, progress=progress)
         shared.result = res
     except StudyCancelled:
         pass

@@ -22,13 +22,13 @@ Example
 """
 
 from .browse import CampaignResult, CaseEntry, TruncationEntry, open_campaign
+from .fields import case_seed
 from .run import SCHEDULER_ENV, RunReport, Task, group_blocks, make_client, plan, run_campaign
 from .spec import (
     BandCase,
     Campaign,
     CampaignError,
     TruncationCase,
-    case_seed,
     load_campaign,
     parse_campaign,
 )

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._typing import AnyArray, FloatArray, IntArray
-from .spec import CampaignError
+from ..errors import CampaignError
 from .store import CampaignStore, read_file
 
 if TYPE_CHECKING:

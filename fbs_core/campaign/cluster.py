@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ClusterUnavailable, FBSError, StudyCancelled
+from ..workers import has_workers
 from . import work
 from .run import block_lines
 
@@ -37,14 +38,6 @@ if TYPE_CHECKING:
     from ..studies.scatter import ScatterBand
 
 __all__ = ["ClusterUnavailable", "line_blocks", "scatter_band_on"]
-
-
-def has_workers(client: Any) -> bool:
-    """Whether the client's scheduler is connected and has at least one worker."""
-    try:
-        return client.status == "running" and bool(client.scheduler_info().get("workers"))
-    except Exception:  # noqa: BLE001 (a closed or broken connection: no)
-        return False
 
 
 #: Round-lines of a dashboard block: about 1.6 s on one core (0.81 us per round-line,

@@ -46,8 +46,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import CampaignError
 from ..hdf5_guard import open_h5
-from .spec import CampaignError
 
 if TYPE_CHECKING:
     from .spec import Campaign

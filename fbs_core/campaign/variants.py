@@ -136,7 +136,7 @@ class VariantsCase:
         return {"kind": self.kind, **asdict(self)}
 
     def digest(self) -> str:
-        from .spec import _digest
+        from .fields import _digest
 
         return _digest(self.settings())
 
@@ -208,7 +208,7 @@ def parse_variants(d: dict[str, Any], campaign_seed: int, seeds: str, df: float)
         naming the key and what is allowed.
     """
     from ..variants import DESIGNS, ParameterSpace, sample_design
-    from .spec import _choice, _float, _int, _known, _list, _name, case_seed
+    from .fields import _choice, _float, _int, _known, _list, _name, case_seed
 
     w = "[variants]"
     _known(d, _KEYS, w)

@@ -80,6 +80,8 @@ __all__ = [
     "interface_check",
     "load_frf",
     "load_geometry",
+    "load_measured_chassis",
+    "MeasuredChassis",
     "load_result",
     "load_tire_model",
     "prepare_chassis",
@@ -413,3 +415,8 @@ def load_tire_model(
     return import_tire_model(
         source, filename=filename, format=format, max_bytes=max_bytes, timeout=timeout
     )
+
+
+# a measured chassis from its two files: built on this package's readers (above) and the
+# virtual point transformation
+from .measured import MeasuredChassis, load_measured_chassis  # noqa: E402

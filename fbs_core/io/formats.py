@@ -141,7 +141,7 @@ REGISTRY: Mapping[str, FileFormat] = MappingProxyType(
                 read=hdf5.read_hdf5,
                 write=hdf5.write_hdf5,
                 read_options=("name",),
-                export=results.result_to_hdf5,
+                export=hdf5.result_to_hdf5,
                 read_tire=modal.read_tire_native,
                 tire_label="tire-fbs tire model",
             ),

@@ -21,7 +21,7 @@ import io
 import json
 import time
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -30,11 +30,16 @@ from ..frf import FRF
 from ._sandbox import DEFAULT_TIMEOUT, parse_isolated
 from .assembly import FileUnits, assemble, dof_labels, metadata_from_json
 from .checks import Source, check_finite, frequency_from_units, kinds_text, units_line
+from .results import ResultData
 
-if TYPE_CHECKING:
-    from .results import ResultData
-
-__all__ = ["read_hdf5", "read_hdf5_result", "write_hdf5", "write_hdf5_result", "root_attrs"]
+__all__ = [
+    "read_hdf5",
+    "read_hdf5_result",
+    "result_to_hdf5",
+    "write_hdf5",
+    "write_hdf5_result",
+    "root_attrs",
+]
 
 FORMAT_VERSION = 1
 
@@ -226,8 +231,6 @@ def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT) -> Result
     DataFormatError
         For files of another layout or damaged ones.
     """
-    from .results import ResultData
-
     what = f"HDF5 file {src.name!r}"
     meta, arrays = parse_isolated("hdf5", src.raw, what, timeout=timeout)
     ds, groups = meta["datasets"], meta["groups"]
@@ -262,3 +265,8 @@ def read_hdf5_result(src: Source, *, timeout: float = DEFAULT_TIMEOUT) -> Result
     if "/frf/freq" in ds:
         res.frfs["frf"] = read_hdf5(src, name="frf", timeout=timeout)[0]
     return res
+
+
+def result_to_hdf5(res: ResultData) -> bytes:
+    """HDF5 content of a result (the layout of :func:`write_hdf5_result`)."""
+    return write_hdf5_result(res, res.metadata)

@@ -34,7 +34,6 @@ __all__ = [
     "as_result_data",
     "result_to_csv",
     "result_to_uff",
-    "result_to_hdf5",
     "FREQ_DIMS",
 ]
 
@@ -308,13 +307,6 @@ def result_to_csv(res: ResultData) -> bytes:
                 ]
             )
     return out.getvalue().encode()
-
-
-def result_to_hdf5(res: ResultData) -> bytes:
-    """HDF5 content of a result (layout in :mod:`fbs_core.io.hdf5`)."""
-    from .hdf5 import write_hdf5_result
-
-    return write_hdf5_result(res, res.metadata)
 
 
 def result_to_uff(

@@ -25,6 +25,7 @@ from .._typing import ComplexArray, FloatArray
 from ..errors import DataFormatError, StudyCancelled
 from ..vocabulary import DIRECTIONS
 from ..vocabulary import readonly as _ro
+from ..workers import has_workers
 from .corridor import Corridor, corridor
 from .design import Design, sample_design
 from .models import TireCache, VariantSettings, tire_key, variant_responses
@@ -212,7 +213,7 @@ def run_variants(
         with :class:`~fbs_core.StudyCancelled` (the tasks not started are cancelled).
     client : distributed.Client, optional
         A Dask client: the groups run as tasks on its cluster when it has workers
-        (:func:`fbs_core.campaign.cluster.has_workers`), else in this process.
+        (:func:`fbs_core.workers.has_workers`), else in this process.
     processes : int
         Without a cluster: worker processes of this machine (1: this process).
     poll : float
@@ -245,7 +246,7 @@ def run_variants(
     def stop() -> None:
         raise StudyCancelled(f"variant study cancelled after {done} of {design.n} variants")
 
-    use_dask = client is not None and _has_workers(client)
+    use_dask = client is not None and has_workers(client)
     if use_dask or (int(processes) > 1 and len(groups) > 1):
         pool: Any = None
         if use_dask:
@@ -289,12 +290,6 @@ def run_variants(
         nominal={k: _ro(v) for k, v in nominal.items()},
         tire_keys=tuple(keys),
     )
-
-
-def _has_workers(client: Any) -> bool:
-    from ..campaign.cluster import has_workers
-
-    return has_workers(client)
 
 
 def corridor_study(

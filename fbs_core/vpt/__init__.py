@@ -10,18 +10,18 @@ consistent the measurement was (docs/vpt.md):
   displacement modes, the observability check;
 - :mod:`.transform`: the least-squares transformations and :func:`virtual_point`;
 - :mod:`.quality`: sensor and impact consistency, overall and per channel;
-- :mod:`.measured`: a measured chassis from its two files, ready for the coupling
-  (:func:`load_measured_chassis`);
 - :mod:`.validation`: the reference chassis with a flexible knuckle, "measured" at a
   realistic layout (the tests' and ``scripts/print_vpt_validation.py``'s truth).
 
-Geometry files (UFF 15/2411, CSV, HDF5) are read by :func:`fbs_core.io.load_geometry`.
+Geometry files (UFF 15/2411, CSV, HDF5) are read by :func:`fbs_core.io.load_geometry`, and
+a measured chassis from its two files, ready for the coupling, by
+:func:`fbs_core.io.load_measured_chassis` (files are the io package's: this one is the
+arithmetic below it).
 """
 
 from __future__ import annotations
 
 from .geometry import Channels, Layout, check_observable, displacement_modes
-from .measured import MeasuredChassis, load_measured_chassis
 from .quality import Consistency, consistency
 from .transform import VirtualPoint, transformation, virtual_point, vpt_kernel
 
@@ -29,12 +29,10 @@ __all__ = [
     "Channels",
     "Consistency",
     "Layout",
-    "MeasuredChassis",
     "VirtualPoint",
     "check_observable",
     "consistency",
     "displacement_modes",
-    "load_measured_chassis",
     "transformation",
     "virtual_point",
     "vpt_kernel",

@@ -4,7 +4,7 @@ One call does what a test engineer's data needs before the coupling (docs/vpt.md
 measured FRFs (:func:`fbs_core.io.load_frf`: outputs the sensor channels and the bushing's,
 inputs the impacts) and the channels' positions and directions
 (:func:`fbs_core.io.load_geometry`), transform to the virtual point at the wheel centre
-(:func:`.transform.virtual_point`), and make the chassis the coupling takes
+(:func:`fbs_core.vpt.virtual_point`), and make the chassis the coupling takes
 (:func:`fbs_core.io.prepare_chassis`, :class:`fbs_core.FRFChassis`). Every check of those
 steps applies; a refused input changes nothing.
 """
@@ -19,7 +19,7 @@ from typing import Any
 from ..chassis import FRFChassis
 from ..dofs import parse_label
 from ..errors import DataFormatError, DOFError
-from .transform import VirtualPoint, virtual_point
+from ..vpt.transform import VirtualPoint, virtual_point
 
 __all__ = ["MeasuredChassis", "load_measured_chassis"]
 
@@ -87,7 +87,7 @@ def load_measured_chassis(
         From the readers and the transformation, naming the file, channel or node; also a
         set without outputs at ``bushing``.
     """
-    from ..io import load_frf, load_geometry, prepare_chassis
+    from . import load_frf, load_geometry, prepare_chassis
 
     res = load_frf(frf_source, filename=frf_filename, nodes=nodes, quantity=quantity)
     frf = res.frf
