@@ -111,7 +111,10 @@ def test_variants_on_two_worker_processes(tmp_path):
     st = open_campaign(c.output).variants(case.name)
     ref = _in_process(case)
     scale = np.abs(ref.responses[4]).max()
-    np.testing.assert_allclose(st.responses[4], ref.responses[4], rtol=1e-9, atol=1e-12 * scale)
+    # the workers run BLAS on one thread, this process on as many as the machine has: the
+    # tires' eigensolutions then round differently (5e-8 relative seen on a 2-core Xeon); a
+    # variant given another variant's tire or parameters differs by O(1)
+    np.testing.assert_allclose(st.responses[4], ref.responses[4], rtol=1e-6, atol=1e-9 * scale)
 
 
 @pytest.mark.parametrize(

@@ -388,7 +388,10 @@ def test_workers_and_a_dask_cluster_give_the_numbers_of_this_process():
         Client(cluster) as client,
     ):
         on_dask = fv.run_variants(design, SETTINGS, client=client)
+    # other processes may run BLAS on another number of threads: the tires' eigensolutions
+    # round differently (up to 5e-8 relative seen on a 2-core Xeon); a variant given another
+    # variant's tire or parameters differs by O(1)
     for other in (pooled, on_dask):
         assert other.tire_keys == here.tire_keys
-        np.testing.assert_allclose(other.responses[4], here.responses[4], rtol=1e-12, atol=0)
-        np.testing.assert_array_equal(other.nominal[4], here.nominal[4])
+        np.testing.assert_allclose(other.responses[4], here.responses[4], rtol=1e-6, atol=0)
+        np.testing.assert_allclose(other.nominal[4], here.nominal[4], rtol=1e-6, atol=0)
