@@ -10,9 +10,8 @@ and decoded in the test process into a ``DashboardState``; then
 * the coupled response holds ``fbs_core.bushing_response`` of that state, and the error
   map ``app.compute.error_map_data`` of it.
 
-``test_200_random_quick_interactions`` is seeded (``FBS_TRUTH_SEED``, default 41) and logs
-each action to ``tests/browser/artifacts/screen_truth_<seed>.log``, so a failure replays
-with the same seed.
+The random walk of 200 quick interactions that ends in these checks is
+``test_walk_screen_truth``.
 """
 
 from __future__ import annotations
@@ -78,8 +77,24 @@ JS_SHOWN = """
     return title || t;
   }
   const nText = deep(document, []).map(text).join(' ');
-  const titles = ms.filter(m => m.type === 'Title' && m.visible && m.text).map(m => m.text);
-  const legends = ms.filter(m => m.type === 'LegendItem').map(m => {
+  // what is on the page: the title blocks and legends of the plots laid out now (a plot in
+  // an analysis tab not shown is not on the screen; it is drawn again when its tab opens)
+  function displayed(fig) {
+    const v = Bokeh.index.find_one(fig);
+    if (v == null || !fig.visible) return false;
+    const r = v.el.getBoundingClientRect();
+    if (r.width < 1 || r.height < 1) return false;
+    for (let e = v.el; e; e = e.parentElement || (e.getRootNode && e.getRootNode().host)) {
+      const st = getComputedStyle(e);
+      if (st.display === 'none' || st.visibility === 'hidden') return false;
+    }
+    return true;
+  }
+  const figs = ms.filter(m => m.type === 'Figure' && displayed(m));
+  const parts = figs.flatMap(f => [f.title, ...f.above, ...f.below, ...f.left, ...f.right,
+                                   ...f.center]).filter(m => m != null);
+  const titles = parts.filter(m => m.type === 'Title' && m.visible && m.text).map(m => m.text);
+  const legends = parts.filter(m => m.type === 'Legend').flatMap(l => l.items).map(m => {
       const l = m.label; return l && typeof l === 'object' && 'value' in l ? l.value : String(l);
   });
   const progress = ms.filter(m => m.css_classes && m.css_classes.includes('scatter-progress'))
