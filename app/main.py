@@ -40,11 +40,13 @@ from app.page.chrome import (
     report_buttons,
 )
 from app.page.layout import (
+    BAR_WIDTHS,
     CARD_CSS,
     PAGE_CSS,
     PAGE_URL_KEYS,
     VIEW_SWITCH_JS,
     PageState,
+    bar_stylesheet,
     present_css,
 )
 from app.page.titles import PAGES, PageLink, page_url, read_link, resolve_view_id
@@ -432,15 +434,22 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
     )
     sidebar = sidebar_toggle(page)
 
-    def fit(view: str) -> None:  # the buttons as wide as their labels in the view's type
-        w = BAR_WIDTHS[view]
-        sidebar.width, help_button.width, view_switch.width, n_axis.width = w[:4]
-        for b in reports.objects:
-            b.width = w[4]
-        reports.param.update(sizing_mode=None, width=2 * w[4] + 20)
-
-    fit(page.view)
-    page.param.watch(lambda e: fit(e.new), "view")
+    # the buttons as wide as their labels in the view's type (the page's CSS variables)
+    normal = BAR_WIDTHS["normal"]
+    for widget, part in (
+        (sidebar, "sidebar"),
+        (help_button, "help"),
+        (view_switch, "view"),
+        (n_axis, "naxis"),
+    ):
+        widget.param.update(width=normal[part], stylesheets=[bar_stylesheet(part)])
+    for b in reports.objects:
+        b.param.update(width=normal["report"], stylesheets=[bar_stylesheet("report")])
+    reports.param.update(
+        sizing_mode=None,
+        width=2 * normal["report"] + 20,
+        stylesheets=[bar_stylesheet("report", times=2, plus=20)],
+    )
     return pn.Row(
         sidebar,
         reports,
@@ -452,11 +461,6 @@ def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:
         sizing_mode="stretch_width",
         margin=(2, 4),
     )
-
-
-#: Widths (px) of the page bar's buttons: sidebar switch, help, view switch, N axis switch
-#: and each report button, in the normal and the presentation view's type.
-BAR_WIDTHS = {"normal": (100, 70, 220, 150, 140), "present": (115, 80, 285, 190, 165)}
 
 
 def create_app(

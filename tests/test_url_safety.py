@@ -15,8 +15,8 @@ import html
 
 import pytest
 
-from app.analysis_state import PinSettings, decode_pins, encode_pins, shown
 from app.page.chrome import link_notice, link_notice_html
+from app.pin_settings import PinSettings, decode_pins, encode_pins, shown
 from app.report import Provenance
 from fbs_core.errors import FBSError
 

@@ -182,7 +182,7 @@ def test_files_without_geometry_are_refused(tmp_path) -> None:
 
 
 def test_measured_chassis_from_two_files_couples_like_the_exact_one() -> None:
-    from fbs_core.vpt import load_measured_chassis
+    from fbs_core.io import load_measured_chassis
 
     f = fc.harmonic(4).frequencies()
     m = val.knuckle_measurement(f, quantity="accelerance")

@@ -18,6 +18,8 @@ __all__ = [
     "PRESENT_CLASS",
     "NORMAL_CLASS",
     "VIEW_SWITCH_JS",
+    "BAR_WIDTHS",
+    "bar_stylesheet",
     "present_css",
 ]
 
@@ -69,8 +71,32 @@ PRESENT_RULE = "font-size: 17px; --bokeh-font-size: 17px;"
 PRESENT_CLASS, NORMAL_CLASS = "fbs-present", "fbs-normal"
 
 
+#: Widths (px) of the page bar's buttons in the normal and the presentation view's type, as
+#: wide as their labels: sidebar switch, help, view switch, N axis switch, each report button.
+BAR_WIDTHS = {
+    "normal": {"sidebar": 100, "help": 70, "view": 220, "naxis": 150, "report": 140},
+    "present": {"sidebar": 115, "help": 80, "view": 285, "naxis": 190, "report": 165},
+}
+
+
+def _bar_vars(view: str) -> str:
+    return " ".join(f"--fbs-bar-{k}: {w}px;" for k, w in BAR_WIDTHS[view].items())
+
+
+def bar_stylesheet(part: str, times: int = 1, plus: int = 0) -> str:
+    """Stylesheet of a page-bar element ``part`` (a key of :data:`BAR_WIDTHS`): its width
+    follows the view from the page's CSS variables (``times`` such widths plus ``plus`` px).
+
+    The switch changes the variables on ``<body>``: one layout of the page in the browser. Set
+    as each widget's width from the server, every width laid the whole page out again
+    (~0.25 s each in chromium, a dozen per switch).
+    """
+    w = f"calc({times} * var(--fbs-bar-{part}) + {plus}px)"
+    return f":host {{ width: {w} !important; min-width: {w} !important; }}"
+
+
 def present_css(loaded_present: bool) -> str:
-    """CSS of the presentation view's larger type.
+    """CSS of the presentation view's larger type and page-bar widths.
 
     The view switch toggles :data:`PRESENT_CLASS` / :data:`NORMAL_CLASS` on ``<body>``
     (a JavaScript callback of the switch), so the type follows the switch at once. A page
@@ -80,7 +106,9 @@ def present_css(loaded_present: bool) -> str:
     prefixes = [f"body.{PRESENT_CLASS}"]
     if loaded_present:
         prefixes.append(f"body:not(.{NORMAL_CLASS})")
-    return "".join(f"{p} {{ {PRESENT_RULE} }}\n" for p in prefixes)
+    rule = f"{PRESENT_RULE} {_bar_vars('present')}"
+    normal = f":root {{ {_bar_vars('normal')} }}\n"
+    return normal + "".join(f"{p} {{ {rule} }}\n" for p in prefixes)
 
 
 #: JavaScript of the view switch (a RadioButtonGroup: ``active`` 1 is the presentation).

@@ -19,6 +19,7 @@ from playwright.sync_api import expect
 from pypdf import PdfReader
 
 from app.export import read_csv
+from app.page.layout import BAR_WIDTHS
 
 from .conftest import model_value, open_dashboard, set_model_value, table_json, wait_band_idle
 
@@ -269,12 +270,23 @@ def test_presentation_switch_changes_the_type_without_a_reload(browser, dashboar
         if kind == "PATCH-DOC" and any(e.get("attr", "").endswith("font_size") for e in events)
     ]
     assert len(restyles) == 1, [len(e) for e in restyles]
+    # the page bar's buttons follow the view by the page's CSS (a width set from the server
+    # laid the whole page out again, one change at a time)
+    widths = [e for e in restyles[0] if e.get("attr") in ("width", "min_width")]
+    assert not widths, widths
+    assert abs(_bar_width(page, ".ctl-page-view") - BAR_WIDTHS["present"]["view"]) <= 1
     page.locator(".ctl-page-view button", has_text="Normal view").click()
     page.wait_for_function(
         f"() => parseFloat(getComputedStyle(document.body).fontSize) === {body0}"
     )
     assert _type_sizes(page) == (body0, card0)
+    assert abs(_bar_width(page, ".ctl-page-view") - BAR_WIDTHS["normal"]["view"]) <= 1
     ctx.close()
+
+
+def _bar_width(page, selector: str) -> float:
+    """The width (px) of a page-bar element as laid out (its host element)."""
+    return page.locator(selector).first.evaluate("e => e.getBoundingClientRect().width")
 
 
 def _bokeh_messages(frames: list) -> list[tuple[str, list]]:
