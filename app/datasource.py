@@ -36,23 +36,29 @@ import threading
 
 import param
 
+from fbs_core.candidates import Candidate, CandidateSet
 from fbs_core.chassis import FRFChassis
 from fbs_core.dofs import parse_label
 from fbs_core.errors import DOFError, FBSError
 from fbs_core.harmonics import harmonic
 from fbs_core.io.checks import check_pair, check_tire
+from fbs_core.targets import IncumbentTarget, Target, read_targets
 from fbs_core.vocabulary import DIRECTIONS, EIGEN_SPEEDS, HARMONIC_CASES
+
+from .review import EMPTY_REVIEW, Review
 
 __all__ = [
     "CHASSIS_ACCEPT",
     "GEOMETRY_ACCEPT",
     "EIGEN_SPEEDS",
     "HARMONICS",
+    "TARGET_ACCEPT",
     "TIRE_ACCEPT",
     "DataSource",
     "FRFChassis",
     "Models",
     "REFERENCE",
+    "candidate_models",
 ]
 
 BUSHING = tuple(f"bushing:{d}" for d in DIRECTIONS)
@@ -62,6 +68,7 @@ HARMONICS = HARMONIC_CASES
 CHASSIS_ACCEPT = ".uff,.unv,.uf,.58,.mat,.csv,.txt,.h5,.hdf5,.hdf"
 GEOMETRY_ACCEPT = ".uff,.unv,.uf,.csv,.txt,.h5,.hdf5,.hdf"
 TIRE_ACCEPT = ".h5,.hdf5,.hdf,.mat"
+TARGET_ACCEPT = ".csv,.txt,.uff,.unv,.uf,.58"
 
 
 class Models:
@@ -112,6 +119,11 @@ class Models:
     def is_reference(self) -> bool:
         return self.tire is None and self.chassis is None
 
+    @property
+    def chassis_key(self) -> str:
+        """The digest of the chassis upload ("" for the reference chassis)."""
+        return self.key.partition(";chassis=")[2] if self.chassis is not None else ""
+
     def describe(self) -> str:
         t = f"uploaded tire {self.tire_name!r}" if self.tire is not None else "reference tire"
         c = (
@@ -140,6 +152,25 @@ def _models(tire, tire_key, tire_name, chassis, chassis_key, chassis_name) -> Mo
         tire_name if tire is not None else "",
         chassis_name if chassis is not None else "",
     )
+
+
+def candidate_models(models: Models, candidate: Candidate) -> Models:
+    """The models of a review candidate with the chassis of ``models``."""
+    ck = models.chassis_key
+    if candidate.is_reference:
+        return _models(None, "", "", models.chassis, ck, models.chassis_name)
+    return _models(
+        candidate.model, candidate.digest, candidate.name, models.chassis, ck, models.chassis_name
+    )
+
+
+def _unique(name: str, taken) -> str:
+    """``name``, or ``name (2)``, ``name (3)``... if it is taken."""
+    out, i = name, 1
+    while out in taken:
+        i += 1
+        out = f"{name} ({i})"
+    return out
 
 
 def _digest(data: bytes, **settings) -> str:
@@ -200,6 +231,13 @@ class DataSource(param.Parameterized):
         default=None,
         doc="The virtual point transformation of a measured chassis in use "
         "(fbs_core.vpt.VirtualPoint), else None.",
+    )
+    review = param.ClassSelector(
+        class_=Review,
+        default=EMPTY_REVIEW,
+        instantiate=False,
+        doc="The review: tire candidates (the reference and every tire uploaded), targets "
+        "and the incumbent rule (app/review.py).",
     )
     error = param.String(default="", doc="Why the last upload was refused ('' if it was not).")
     spindle = param.String(
@@ -431,15 +469,140 @@ class DataSource(param.Parameterized):
             self.error = f"{name}: {e}"
             return False
         key = _digest(bytes(data))
-        self._tire_key = key
-        m = self.models
+        review = self.review
+        cands = review.candidates or CandidateSet([Candidate.reference()])
+        if key in cands.digests:  # the same file again: it becomes the current tire
+            cands = cands.with_current(key)
+        else:
+            try:
+                cand = Candidate(_unique(name, cands.names), key, res.model, notes=tuple(notes))
+                cands = cands.add(cand, current=True)
+            except FBSError as e:
+                self.error = f"{name}: {e}"
+                return False
         summary = res.summary + ("\nnotes: " + "; ".join(notes) if notes else "")
-        with param.parameterized.batch_call_watchers(self):
-            self.param.update(error="", tire_summary=summary)
-            self.models = _models(
-                res.model, key, name, m.chassis, self._chassis_key, m.chassis_name
-            )
+        self._use_candidates(review.with_candidates(cands), summary)
         return True
+
+    def _use_candidates(self, review: Review, tire_summary: str | None = None) -> None:
+        """Make ``review`` the session's and its current candidate the session's tire."""
+        cands = review.candidates
+        cur = None if cands is None else cands.current
+        m = self.models
+        if cur is None or cur.is_reference:
+            self._tire_key = ""
+            models = _models(None, "", "", m.chassis, self._chassis_key, m.chassis_name)
+        else:
+            self._tire_key = cur.digest
+            models = _models(
+                cur.model, cur.digest, cur.name, m.chassis, self._chassis_key, m.chassis_name
+            )
+        changes: dict = {"error": "", "review": review}
+        if tire_summary is not None:
+            changes["tire_summary"] = tire_summary
+        elif cur is not None:
+            changes["tire_summary"] = f"candidate {cur.name!r}: {cur.model.n_modes} modes" + (
+                "\nnotes: " + "; ".join(cur.notes) if cur.notes else ""
+            )
+        with param.parameterized.batch_call_watchers(self):
+            self.param.update(changes)
+            self.models = models
+
+    # -- the review: candidates, targets -----------------------------------------------------
+    def models_of(self, candidate: str) -> Models:
+        """The models of a candidate (by name or digest) with the session's chassis.
+
+        Raises
+        ------
+        FBSError
+            For a candidate the session does not hold.
+        """
+        cands = self.review.candidates or CandidateSet([Candidate.reference()])
+        return candidate_models(self.models, cands.get(candidate))
+
+    def _change_review(self, what: str, change) -> bool:
+        """Apply ``change(review) -> review``; an FBSError is the message, nothing changes."""
+        with self._lock:
+            try:
+                review = change(self.review)
+            except FBSError as e:
+                self.error = f"{what}: {e}"
+                return False
+            if review.candidates is self.review.candidates:
+                self.param.update(error="", review=review)
+            else:
+                self._use_candidates(review)
+            return True
+
+    def select_candidate(self, candidate: str) -> bool:
+        """Make a candidate (name or digest) the current tire of the detail views."""
+
+        def change(r: Review) -> Review:
+            if r.candidates is None:
+                r.digest_of(candidate)  # only the reference: raises for any other
+                return r
+            return r.with_candidates(r.candidates.with_current(candidate))
+
+        return self._change_review("current candidate", change)
+
+    def remove_candidate(self, candidate: str) -> bool:
+        """Remove a candidate (name or digest); the last one is kept."""
+
+        def change(r: Review) -> Review:
+            if r.candidates is None or len(r.candidates) <= 1:
+                raise FBSError("the session needs one tire: the last candidate stays")
+            return r.with_candidates(r.candidates.remove(candidate))
+
+        return self._change_review(f"removing {candidate!r}", change)
+
+    def describe_candidate(self, candidate: str, **fields: str) -> bool:
+        """Change a candidate's name, supplier, size or version."""
+
+        def change(r: Review) -> Review:
+            cands = r.candidates or CandidateSet([Candidate.reference()])
+            new = cands.renamed(candidate, **fields)
+            out = r.with_candidates(new)
+            old = cands.get(candidate)
+            inc = r.incumbent
+            if inc is not None and inc.candidate in (old.name, old.digest):  # follows a rename
+                out = out.with_incumbent(
+                    IncumbentTarget(new.get(old.digest).name, inc.margin_db, inc.dofs)
+                )
+            return out
+
+        return self._change_review(f"candidate {candidate!r}", change)
+
+    def load_targets(self, data: bytes, filename: str | None = None) -> bool:
+        """Read target curves (target CSV or UFF 58, :func:`fbs_core.targets.read_targets`)
+        for the bushing DOFs; each replaces a target of the same DOF and harmonic."""
+        name = filename or "upload"
+
+        def change(r: Review) -> Review:
+            targets = read_targets(bytes(data), filename=name, dofs=BUSHING)
+            if not targets:
+                raise FBSError("the file holds no target")
+            return r.with_targets(targets)
+
+        return self._change_review(name, change)
+
+    def add_target(self, target: Target) -> bool:
+        """Add one target (e.g. straight segments typed on the page)."""
+        return self._change_review(f"target of {target.dof}", lambda r: r.with_targets((target,)))
+
+    def clear_targets(self) -> bool:
+        """Remove every target curve (the incumbent rule stays)."""
+        return self._change_review("targets", lambda r: r.without_targets())
+
+    def set_incumbent(self, candidate: str | None, margin_db: float = 0.0) -> bool:
+        """Judge against "the incumbent + margin dB" (None: no incumbent rule)."""
+
+        def change(r: Review) -> Review:
+            if candidate is None:
+                return r.with_incumbent(None)
+            name = r.candidates.get(candidate).name if r.candidates is not None else candidate
+            return r.with_incumbent(IncumbentTarget(name, margin_db))
+
+        return self._change_review("incumbent", change)
 
     def reset(self) -> None:
         """Back to the shipped reference tire and chassis."""
@@ -447,9 +610,16 @@ class DataSource(param.Parameterized):
             self._last_chassis = self._last_settings = None
             self._geometry = None
             self._tire_key = self._chassis_key = ""
+            review = self.review
+            keep = Review(None, review.targets)  # the targets stay, the uploads go
             with param.parameterized.batch_call_watchers(self):
                 self.param.update(
-                    error="", tire_summary="", chassis_summary="", geometry_summary="", vpt=None
+                    error="",
+                    tire_summary="",
+                    chassis_summary="",
+                    geometry_summary="",
+                    vpt=None,
+                    review=keep,
                 )
                 self.models = REFERENCE
 

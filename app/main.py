@@ -85,6 +85,7 @@ from app.views.layout import (
 )
 from app.views.plots import frequency_range, modes_range
 from app.views.quality import TireQualityView
+from app.views.review import review_card
 from app.views.wheels import wheels_card
 
 # bokeh-tables: the Selected modes tab's DataTable is built when the tab is first shown,
@@ -232,6 +233,7 @@ class PageParts:
 #: Further cards, below the built-in plots, in this order: ``builder(parts) -> panel object``
 #: (None: nothing). A view in its own module under ``app/views/`` adds its builder here.
 EXTRA_CARDS: list[Callable[[PageParts], Any]] = []
+EXTRA_CARDS.append(review_card)  # candidates against targets: the verdict (built on opening)
 EXTRA_CARDS.append(wheels_card)  # per-wheel contributions (vehicle scope)
 EXTRA_CARDS.append(  # compare, phase and peaks, across speed, contributions
     lambda parts: analysis_card(parts.results, parts.freq, page=parts.page)

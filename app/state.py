@@ -15,6 +15,7 @@ from fbs_core.vocabulary import COUPLINGS, DIRECTIONS
 from .analysis_state import AnalysisState
 from .datasource import REFERENCE, DataSource, Models
 from .params import Integer, Number
+from .review import EMPTY_REVIEW, Review
 
 __all__ = [
     "DIRECTIONS",
@@ -147,6 +148,14 @@ class CaseState(param.Parameterized):
         instantiate=False,
         precedence=-1,
         doc="The session's tire and chassis (uploads or the reference), mirrored from "
+        "DashboardState.data; not a control and not in the URL.",
+    )
+    review = param.ClassSelector(
+        class_=Review,
+        default=EMPTY_REVIEW,
+        instantiate=False,
+        precedence=-1,
+        doc="The session's review (tire candidates, targets, incumbent rule), mirrored from "
         "DashboardState.data; not a control and not in the URL.",
     )
 
@@ -287,8 +296,8 @@ class DashboardState(param.Parameterized):
         params.setdefault("analysis", AnalysisState())
         params.setdefault("plot", ResponsePlotState())
         super().__init__(**params)
-        self.case.models = self.data.models
-        self.data.param.watch(self._use_models, "models")
+        self.case.param.update(models=self.data.models, review=self.data.review)
+        self.data.param.watch(self._use_models, ["models", "review"])
         self.case.param.watch(self._scope_rounds, "scope")
 
     def _scope_rounds(self, event):
@@ -297,8 +306,9 @@ class DashboardState(param.Parameterized):
         if self.noise.rounds == defaults.get(event.old):
             self.noise.rounds = defaults[event.new]
 
-    def _use_models(self, event):
-        self.case.models = event.new
+    def _use_models(self, *events):
+        # the models and the review change together (one pass of the store)
+        self.case.param.update(models=self.data.models, review=self.data.review)
 
 
 #: URL query keys of each state parameter (short, stable: links are shared in reviews).

@@ -68,6 +68,7 @@ from .results import (
     modes,
     pins,
     response_plot,
+    review,
     vehicle,
 )
 from .results.base import VEHICLE_FIELDS, progress_status
@@ -238,7 +239,7 @@ CRITERION = ("harmonic", "coupling", "residual", "models", "map_mode", "dof", "t
 TABLE: tuple[Row, ...] = (
     Row(
         "pins",
-        ("pin_text", "models"),
+        ("pin_text", "models", "review"),
         pins.build_pins,
         kind=tuple,
         problem=True,
@@ -406,6 +407,13 @@ TABLE: tuple[Row, ...] = (
         modes.chassis_truncation_result,
         when=while_tab("selection"),
         doc="Eq. 5.1 truncation of the chassis side (the tire exact).",
+    ),
+    Row(
+        "verdict",
+        review.VERDICT_DEPENDS,
+        review.verdict_result,
+        slow=review.verdict_work,
+        doc="The review's verdict: every candidate tire against the targets, ranked.",
     ),
     # last: its thread starts once the pass's other results are out (it publishes later)
     Row("band", BAND, None, when=OWN_THREAD, kind=Band, doc="The latest scatter band."),

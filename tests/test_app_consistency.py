@@ -39,7 +39,9 @@ from app.report import report_content
 from app.report.session import depends as report_depends
 from app.report.session import report_data
 from app.results import FIELDS, Result
+from app.review import EMPTY_REVIEW, Review
 from app.store import TABLE, Results, depends
+from fbs_core.targets import Target
 from fbs_core.tire import TireModel
 
 CREATED = dt.datetime(2026, 1, 2, tzinfo=dt.UTC)
@@ -133,6 +135,8 @@ def small_tire() -> TireModel:
 
 
 UPLOAD = Models(tire=small_tire(), key="tire=consistency120", tire_name="tire120.h5")
+#: A review with one typed target (the verdict of the reference against it).
+REVIEW = Review(None, (Target.segments("bushing:z", [(20.0, -20.0), (90.0, -30.0)]),))
 
 
 # -- one session and what it shows ------------------------------------------------------------
@@ -265,6 +269,10 @@ def _report_output(session: Session) -> Output:
         for x in (snap.reference, snap.truncated):
             if x is not None:
                 nums.append(np.asarray(x.data))
+        if rep.verdict is not None:  # the review's verdict: its tables name the targets
+            for t in (*rep.verdict.tables, *rep.verdict.long_tables):
+                nums.append(np.array([c for row in t.rows for c in row], dtype=object))
+                desc += [" | ".join(row) for row in t.rows]
         for sec in rep.sections:
             for t in sec.tables:
                 nums.append(np.array([c for row in t.rows for c in row], dtype=object))
@@ -362,6 +370,7 @@ CHANGES = [
     # last: the reference models restored after it are a new object (the title blocks name
     # the time the data were set)
     _to("models", UPLOAD, r"tire120\.h5", r"upload"),
+    _to("review", REVIEW, r"bushing:z h\w+ segments", r"\| bushing:z \|.*\| segments$"),
     # the car's fields (issue 31): in corner scope they change nothing
     _to("scope", "vehicle", r"\bvehicle\b", r"\bcar\b"),
     _to("wheels", ["fl", "rl"], r"\bFL RL\b", r"wflrl"),
@@ -415,7 +424,7 @@ def base(session):
 
 def _restore(session: Session) -> None:
     session.set(**{k: v for k, v in session.base.items() if session.get(k) != v})
-    session.set(models=Models())
+    session.set(models=Models(), review=EMPTY_REVIEW)
     if len(session.store.pins) > 2:
         session.store.unpin("p3")
 

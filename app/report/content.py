@@ -7,9 +7,10 @@ the PDF hold the same text.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
-from typing import SupportsFloat
+from typing import Any, SupportsFloat
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -79,6 +80,9 @@ class Report:
     method: tuple[str, ...]
     equations: tuple[Equation, ...]
     thesis: str
+    #: The review's verdict (candidates against targets), first after the title; None
+    #: without targets.
+    verdict: Section | None = None
 
 
 def _fixed(x: SupportsFloat, digits: int) -> str:
@@ -383,6 +387,54 @@ def _extra_section(snap: ReportData, ex: ExtraSection) -> Section:
     )
 
 
+def _cell(x: float, fmt: str = "+.2f") -> str:
+    return "-" if not math.isfinite(x) else format(x, fmt)
+
+
+def verdict_section(v: Any) -> Section:
+    """The review's verdict (:class:`fbs_core.verdict.Verdict`): the ranking, each
+    candidate's delivery, then every candidate x harmonic x DOF row."""
+    ranking = Table(
+        "Ranking: worst level - target in dB (> 0 fails), where it is worst",
+        ("rank", "candidate", "status", "worst dB", "harmonic", "DOF", "Hz", "km/h",
+         "fail / noise / pass"),
+        tuple(
+            (str(s.rank), s.candidate, s.status, _cell(s.worst_db),
+             str(s.harmonic) if s.harmonic else "-", s.dof or "-", _cell(s.freq, ".1f"),
+             _cell(s.speed, ".0f"), f"{s.fails} / {s.noise_fails} / {s.passes}")
+            for s in v.ranking
+        ),
+    )  # fmt: skip
+    delivery = Table(
+        "Delivery: the candidate's modes against table 5.1's suggested N (harmonics 1-7)",
+        ("candidate", "adequate", "modes", "suggested N", "km/h", "warnings"),
+        tuple(
+            (d.candidate, "yes" if d.adequate else "no", str(d.n_modes),
+             " ".join(str(int(x)) for x in d.suggested), f"{d.speeds[0]:g}-{d.speeds[1]:g}",
+             "; ".join(d.warnings) or "-")
+            for d in v.deliveries
+        ),
+    )  # fmt: skip
+    rows = Table(
+        "Every candidate x harmonic x DOF against its target",
+        ("candidate", "harmonic", "DOF", "status", "worst dB", "margin dB", "Hz", "km/h",
+         "target"),
+        tuple(
+            (r.candidate, str(r.harmonic), r.dof, r.status, _cell(r.worst_db),
+             _cell(r.margin_db), _cell(r.freq, ".1f"), _cell(r.speed, ".0f"), r.target)
+            for r in v.rows
+        ),
+    )  # fmt: skip
+    best = v.ranking[0] if v.ranking else None
+    text = (
+        "Which candidate tire meets the bushing targets: each candidate's coupled bushing "
+        "response (eq. 4.1, every mode it delivered) against the targets on every harmonic "
+        "(docs/verdict.md)."
+        + (f" Best: {best.candidate} ({best.status})." if best is not None else "")
+    )
+    return Section("verdict", "Verdict", (text,), None, (ranking, delivery), long_tables=(rows,))
+
+
 def report_content(snap: ReportData) -> Report:
     """The formatted content of the report of a snapshot (all results it holds)."""
     sections = []
@@ -424,6 +476,7 @@ def report_content(snap: ReportData) -> Report:
         method=METHOD_PARAGRAPHS,
         equations=EQUATIONS,
         thesis=THESIS,
+        verdict=None if snap.verdict is None else verdict_section(snap.verdict),
     )
 
 

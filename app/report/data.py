@@ -397,6 +397,8 @@ class ReportData:
         settings (the summary's largest contributions).
     extra : tuple of ExtraSection
         Sections contributed by other views (after the built-in ones).
+    verdict : fbs_core.verdict.Verdict, optional
+        The review's verdict (candidates against targets): the report's first section.
     """
 
     settings: Mapping[str, Any]
@@ -414,6 +416,7 @@ class ReportData:
     peaks: tuple[Any, ...] = ()
     contributions: Any = None
     extra: tuple[ExtraSection, ...] = ()
+    verdict: Any = None
 
     def __post_init__(self) -> None:
         s = normalise_settings(self.settings)

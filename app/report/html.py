@@ -108,6 +108,12 @@ def render_html(rep: Report) -> str:
             f'<p>Reproduce this page: <a href="{_e(rep.url)}" id="reproduce">{_e(rep.url)}</a></p>'
         )
     out.append(f'<p class="note">{_e(rep.reproduce_note)}</p>')
+    if rep.verdict is not None:  # the review's question first
+        v = rep.verdict
+        out.append(f'<section id="{_e(v.key)}"><h2>{_e(v.heading)}</h2>')
+        out += [f"<p>{_e(p)}</p>" for p in v.paragraphs]
+        out += [_table(t) for t in (*v.tables, *v.long_tables)]
+        out.append("</section>")
     sm = rep.summary
     out.append('<section id="summary"><h2>Summary</h2>')
     out.append(_table(Table("The case in numbers", ("quantity", "value"), sm.rows)))

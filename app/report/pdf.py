@@ -143,6 +143,14 @@ def render_pdf(rep: Report) -> bytes:
         if rep.url:
             pages.para(f"Reproduce this page: {rep.url}", 8.5)
         pages.para(rep.reproduce_note, 8.5, color="#862e9c")
+        if rep.verdict is not None:  # the review's question on the first page
+            v = rep.verdict
+            pages.heading(v.heading)
+            for p in v.paragraphs:
+                pages.para(p, 9.0)
+            for t in (*v.tables, *v.long_tables):
+                pages.table(t)
+            pages.page_break()
         sm = rep.summary
         pages.heading("Summary")
         pages.table(Table("The case in numbers", ("quantity", "value"), sm.rows), wrap=True)

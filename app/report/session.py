@@ -23,7 +23,7 @@ __all__ = ["BUILTIN_RESULTS", "depends", "provenance_of", "report_data", "settin
 #: (or tuple of them) of the store becomes a section of its own.
 BUILTIN_RESULTS = ("response", "error_map", "suggested", "eigen", "band_curves", "band")
 #: Results that are no section: the pins themselves (their comparison is, ``pinned``).
-NOT_SECTIONS = ("pins",)
+NOT_SECTIONS = ("pins", "verdict")
 
 
 def _digests(key: str) -> dict[str, str]:
@@ -164,4 +164,5 @@ def report_data(
             else None
         ),
         extra=_sections(current) + _sections(outside),
+        verdict=current["verdict"].core.get("verdict") if "verdict" in current else None,
     )

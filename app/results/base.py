@@ -39,6 +39,7 @@ FIELDS: dict[str, tuple[str, str]] = {
     "show_uncoupled": ("case", "show_uncoupled"),
     "spindle_input": ("case", "spindle_input"),
     "models": ("case", "models"),
+    "review": ("case", "review"),
     "scope": ("case", "scope"),
     "wheels": ("case", "wheels"),
     "tracks": ("case", "tracks"),
@@ -96,6 +97,7 @@ class Snapshot:
     show_uncoupled: bool
     spindle_input: str
     models: Any  # app.datasource.Models (hashed by the digest of the uploads)
+    review: Any  # app.review.Review (candidates, targets; hashed by their digest)
     scope: str
     wheels: tuple
     tracks: str

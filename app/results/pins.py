@@ -38,7 +38,7 @@ from fbs_core.errors import FBSError
 from fbs_core.vocabulary import magnitude_db, percent
 
 from .. import compute
-from ..datasource import REFERENCE
+from ..datasource import REFERENCE, candidate_models
 from ..pin_settings import PinSettings, decode_pins
 from ..report.titles import NOISE_WHERE
 from .base import Band, Result, Snapshot, csv_name
@@ -100,8 +100,16 @@ def _snapshot_of(ps: PinSettings, current: Snapshot) -> Snapshot | None:
         models = current.models
     elif ps.models == REFERENCE.key:
         models = REFERENCE
-    else:
-        return None
+    else:  # a pin of another candidate of the review: kept while that candidate is loaded
+        cands = current.review.candidates
+        found = [
+            m
+            for m in (candidate_models(current.models, c) for c in (cands or ()))
+            if m.key == ps.models
+        ]
+        if not found:
+            return None
+        models = found[0]
     return current.settings().replace(
         harmonic=ps.harmonic,
         n_modes=ps.n_modes,
@@ -162,7 +170,12 @@ def build_pins(s: Snapshot) -> tuple[Pin, ...]:
         For a malformed link (the pins stay as they were).
     """
     wanted = decode_pins(s.pin_text)
-    have = {p.settings: p for p in s.pins}
+    # a pin is kept while its models are loaded (a candidate removed: built again, said)
+    have = {
+        p.settings: p
+        for p in s.pins
+        if (p.snapshot is None) == (_snapshot_of(p.settings, s) is None)
+    }
     return tuple(have.get(ps) or build_pin(ps, s) for ps in wanted)
 
 

@@ -1,0 +1,226 @@
+"""The review in a session: candidates, targets and the published verdict.
+
+Truth: the verdict the session publishes is compared with one built here from the core
+directly (``fbs_core.bushing_response`` of each candidate tire, all modes, on the
+harmonic's own grid, judged by :func:`fbs_core.verdict.verdict`): a second path past the
+app's caches and truncation maps. The targets are made from those direct responses with a
+known margin or exceedance, so the expected statuses and dB figures are known by
+construction, not read back from the app.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import fbs_core
+from app.datasource import REFERENCE, DataSource
+from app.state import DashboardState
+from app.store import Results
+from fbs_core.candidates import MAX_CANDIDATES, Candidate, CandidateSet
+from fbs_core.targets import Target, response_level
+from fbs_core.tire import TireModel
+from fbs_core.tire.storage import save_tire_model
+from fbs_core.verdict import verdict
+
+H = 3  # the harmonic the targets are written for
+
+
+def _tire(scale: float = 1.0, n_modes: int | None = None, tag: str = "t") -> TireModel:
+    """The reference tire with its poles scaled (another tire's resonances) or cut."""
+    t = fbs_core.reference_tire()
+    m = slice(None) if n_modes is None else slice(0, n_modes)
+    return TireModel(
+        t.speeds, t.poles[:, m] * scale, t.psi[:, m], t.chi[:, m], t.wavelengths,
+        t.participation[:, :, m], meta={"source": tag},
+    )  # fmt: skip
+
+
+def _bytes(tmp_path, model: TireModel, name: str) -> bytes:
+    return save_tire_model(model, tmp_path / name).read_bytes()
+
+
+@pytest.fixture(scope="module")
+def tires():
+    return {"soft.h5": _tire(0.97, tag="soft"), "stiff.h5": _tire(1.04, tag="stiff")}
+
+
+def _direct(model: TireModel | None, k: int) -> fbs_core.FRF:
+    """The all-modes bushing response of the core, on the harmonic's own grid."""
+    kw = {} if model is None else {"tire": model}
+    return fbs_core.bushing_response(k, **kw)
+
+
+def _target_csv(level_db: float, f: np.ndarray, dof: str = "bushing:z", k: int = H) -> bytes:
+    text = (
+        "# tire-fbs target\n# quantity: mobility\n# scale: dB\n"
+        f"# harmonic: {k}\nfreq [Hz],{dof}\n{float(f[0])!r},{float(level_db)!r}\n"
+        f"{float(f[-1])!r},{float(level_db)!r}\n"
+    )
+    return text.encode()
+
+
+def _session(tmp_path, tires) -> tuple[DashboardState, Results]:
+    st = DashboardState()
+    store = Results(st)
+    for name, model in tires.items():
+        assert st.data.load_tire(_bytes(tmp_path, model, name), name), st.data.error
+    return st, store
+
+
+def test_uploads_become_candidates_and_the_current_one_is_the_sessions_tire(tmp_path, tires):
+    st, _store = _session(tmp_path, tires)
+    ds = st.data
+    cands = ds.review.candidates
+    assert cands.names == ("reference", "soft.h5", "stiff.h5")
+    assert cands.current.name == "stiff.h5" and ds.models.tire is cands.current.model
+    np.testing.assert_array_equal(ds.models.tire.poles, tires["stiff.h5"].poles)
+    # the same file again is not a new candidate: it becomes current
+    assert ds.load_tire(_bytes(tmp_path, tires["soft.h5"], "soft.h5"), "again.h5"), ds.error
+    assert ds.review.candidates.names == cands.names
+    assert ds.models.tire is ds.review.candidates.get("soft.h5").model
+    # choosing the reference: the session's models are the reference's
+    assert ds.select_candidate("reference")
+    assert ds.models is REFERENCE and st.case.models is REFERENCE
+    assert st.case.review == ds.review
+    # colours stay with their candidate when another leaves
+    slot = ds.review.candidates.slot("stiff.h5")
+    assert ds.remove_candidate("soft.h5")
+    assert ds.review.candidates.names == ("reference", "stiff.h5")
+    assert ds.review.candidates.slot("stiff.h5") == slot
+    assert ds.describe_candidate("stiff.h5", name="Supplier Y", supplier="Y", version="2")
+    c = ds.review.candidates.get("Supplier Y")
+    assert (c.supplier, c.version) == ("Y", "2")
+
+
+def test_the_verdict_is_the_cores_of_the_direct_responses(tmp_path, tires):
+    st, store = _session(tmp_path, tires)
+    f = fbs_core.harmonic(H).frequencies()
+    soft = response_level(_direct(tires["soft.h5"], H).sel(outputs="bushing:z"))[:, 0]
+    stiff = response_level(_direct(tires["stiff.h5"], H).sel(outputs="bushing:z"))[:, 0]
+    # a flat target 1.5 dB above the soft tire's highest level on this harmonic: the soft
+    # tire passes with a 1.5 dB margin; the stiff one's level is known too
+    level = 20 * np.log10(soft.max()) + 1.5
+    assert st.data.load_targets(_target_csv(level, f), "target.csv"), st.data.error
+    r = store.verdict
+    v = r.core["verdict"]
+    row = v.row("soft.h5", H, "bushing:z")
+    assert row.status == "pass"
+    assert row.margin_db == pytest.approx(1.5, abs=1e-6)
+    row_y = v.row("stiff.h5", H, "bushing:z")
+    expect = 20 * np.log10(stiff.max()) - level
+    assert row_y.worst_db == pytest.approx(expect, abs=1e-6)
+    assert row_y.status == ("fail" if expect > 0 else "pass")
+    # the whole table: the core's verdict of the direct responses
+    cands = CandidateSet([Candidate.reference(), *(Candidate(n, n, m) for n, m in tires.items())])
+    direct = verdict(
+        {(c.name, k): _direct(None if c.is_reference else c.model, k) for c in cands for k in (H,)},
+        st.data.review.targets,
+        candidates=cands,
+    )
+    got = {(x.candidate, x.harmonic, x.dof): x for x in v.rows}
+    assert len(got) == len(direct.rows) == 3
+    for x in direct.rows:
+        y = got[(x.candidate, x.harmonic, x.dof)]
+        assert y.status == x.status
+        assert y.worst_db == pytest.approx(x.worst_db, abs=1e-6)
+        assert y.freq == x.freq
+    assert [s.candidate for s in v.ranking] == [s.candidate for s in direct.ranking]
+    # the delivery of each candidate is beside it, and the CSV has all three tables
+    assert [d.candidate for d in v.deliveries] == ["reference", "soft.h5", "stiff.h5"]
+    csv = v.to_csv().decode()
+    assert "# table: verdict" in csv and "# table: ranking" in csv and "# table: delivery" in csv
+
+
+def test_the_incumbent_rule_judges_the_others_against_it(tmp_path, tires):
+    st, store = _session(tmp_path, tires)
+    assert st.data.set_incumbent("reference", 0.0), st.data.error
+    v = store.verdict.core["verdict"]
+    # the incumbent against itself: level equal to target everywhere passes with margin 0
+    for x in v.rows:
+        if x.candidate == "reference":
+            assert x.status == "pass" and x.margin_db == pytest.approx(0.0, abs=1e-9)
+    # a candidate against the incumbent: the largest level difference of the direct paths
+    k = 5
+    ref = response_level(_direct(None, k).sel(outputs="bushing:x"))[:, 0]
+    soft = response_level(_direct(tires["soft.h5"], k).sel(outputs="bushing:x"))[:, 0]
+    expect = float(np.max(20 * np.log10(soft) - 20 * np.log10(ref)))
+    assert v.row("soft.h5", k, "bushing:x").worst_db == pytest.approx(expect, abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("text", "name", "words"),
+    [
+        (b"# quantity: mobility\nfreq [Hz],bushing:q\n10,1e-3\n100,1e-3\n", "t.csv", "bushing:q"),
+        (b"# quantity: mobility\nfreq [Hz],hub:z\n10,1e-3\n100,1e-3\n", "t.csv", "hub:z"),
+        (b"# quantity: mobility\nfreq [Hz],bushing:z\n10,nan\n100,1e-3\n", "t.csv", "line"),
+        (b"# units: N/m\nfreq [Hz],bushing:z\n10,1e-3\n100,1e-3\n", "t.csv", "N/m"),
+        (b"# quantity: mobility\nfreq [Hz],bushing:z\n100,1e-3\n10,1e-3\n", "t.csv", "line"),
+        (b"freq,bushing:z\n10,1\n", "t.xlsx", ".xlsx"),
+    ],
+)
+def test_a_bad_target_file_is_named_and_changes_nothing(text, name, words):
+    ds = DataSource()
+    assert ds.add_target(Target.segments("bushing:y", [(10.0, -20.0), (100.0, -30.0)]))
+    before = ds.review
+    assert not ds.load_targets(text, name)
+    assert name in ds.error and words in ds.error, ds.error
+    assert ds.review is before
+
+
+def test_the_candidate_limit_is_a_message(tmp_path):
+    ds = DataSource()
+    small = _tire(n_modes=60)
+    for i in range(MAX_CANDIDATES - 1):  # the reference is the first
+        small = TireModel(
+            small.speeds, small.poles, small.psi, small.chi, small.wavelengths,
+            small.participation, meta={"source": f"c{i}"},
+        )  # fmt: skip
+        assert ds.load_tire(_bytes(tmp_path, small, f"c{i}.h5"), f"c{i}.h5"), ds.error
+    before = (ds.review, ds.models)
+    extra = TireModel(
+        small.speeds, small.poles, small.psi, small.chi, small.wavelengths,
+        small.participation, meta={"source": "one too many"},
+    )  # fmt: skip
+    assert not ds.load_tire(_bytes(tmp_path, extra, "extra.h5"), "extra.h5")
+    assert f"at most {MAX_CANDIDATES}" in ds.error or f"holds {MAX_CANDIDATES}" in ds.error
+    assert (ds.review, ds.models) == before
+
+
+def test_a_pin_of_a_loaded_candidate_is_never_lost(tmp_path, tires):
+    st, store = _session(tmp_path, tires)
+    st.case.n_modes = 60
+    store.pin("p1")  # of the stiff tire (current)
+    assert st.data.select_candidate("soft.h5")
+    store.pin("p2")
+    assert st.data.select_candidate("reference")
+    notes = {p.settings.name: p.note for p in store.pins}
+    assert "not loaded" not in notes["p1"] and "not loaded" not in notes["p2"], notes
+    # removing a candidate loses its pins' data (said), never the others'
+    assert st.data.remove_candidate("stiff.h5")
+    notes = {p.settings.name: p.note for p in store.pins}
+    assert "not loaded" in notes["p1"] and "not loaded" not in notes["p2"], notes
+
+
+def test_typed_points_are_parsed_and_bad_ones_named():
+    from app.views.review import parse_points
+
+    assert parse_points("20:-20, 200:-30") == [(20.0, -20.0), (200.0, -30.0)]
+    assert parse_points("20=-20; 1e2 : -25") == [(20.0, -20.0), (100.0, -25.0)]
+    for bad, word in (("20", "20"), ("20:-20", "two points"), ("a:1, 2:3", "a:1")):
+        with pytest.raises(fbs_core.FBSError, match=word):
+            parse_points(bad)
+
+
+def test_the_reports_first_section_is_the_verdict(tmp_path, tires):
+    from app.report.html import build_html
+    from app.report.session import report_data
+
+    st, store = _session(tmp_path, tires)
+    assert st.data.set_incumbent("reference", 1.0), st.data.error
+    _name, text = build_html(report_data(store, url="http://localhost:5006/main"))
+    assert 0 < text.index('id="verdict"') < text.index('id="summary"')
+    v = store.verdict.core["verdict"]
+    for s in v.ranking:  # every candidate ranked in the report, in the verdict's order
+        assert f"<td>{s.candidate}</td>" in text
+    assert text.count("<td>fail</td>") + text.count("<td>pass</td>") >= len(v.rows)
