@@ -11,7 +11,8 @@ The rule, as a reader meets it:
   of its file above it.
 * The working directory is the repository root, as for a reader who runs the examples
   there: ``data/...`` paths name the shipped reference data. An example that writes a
-  file says where (a temporary folder); a block that leaves a new file or folder in the
+  file says where: a folder of ``tempfile.mkdtemp()`` (here made under the test's
+  ``tmp_path``, which pytest removes); a block that leaves a new file or folder in the
   repository root, ``data/`` or ``docs/`` fails.
 * No block is skipped or expected to fail; a slow example is made small in the document
   itself (its prose says how to scale it up).
@@ -26,6 +27,7 @@ from __future__ import annotations
 
 import ast
 import re
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -120,8 +122,9 @@ def _run(block: Block, namespace: dict[str, object]) -> None:
 
 
 @pytest.mark.parametrize("block", BLOCKS, ids=lambda b: b.id)
-def test_example_runs(block: Block, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_example_runs(block: Block, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     monkeypatch.chdir(ROOT)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # pytest cleans up after
     same_file = [b for b in BLOCKS if b.path == block.path]
     k = same_file.index(block)
     done, namespace = _sessions.pop(block.path, (-1, {}))
