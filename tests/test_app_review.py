@@ -224,3 +224,37 @@ def test_the_reports_first_section_is_the_verdict(tmp_path, tires):
     for s in v.ranking:  # every candidate ranked in the report, in the verdict's order
         assert f"<td>{s.candidate}</td>" in text
     assert text.count("<td>fail</td>") + text.count("<td>pass</td>") >= len(v.rows)
+
+
+def test_the_cards_controls_change_the_review(tmp_path, tires):
+    """The card without a server: its widgets' callbacks reach the data source."""
+    from app.views.review import ReviewView
+
+    st, store = _session(tmp_path, tires)
+    view = ReviewView(store=store)
+    view.__panel__()
+    assert view.current.options == ["reference", "soft.h5", "stiff.h5"]
+    assert view.current.value == "stiff.h5"
+    view.current.value = "soft.h5"
+    assert st.data.review.candidates.current.name == "soft.h5"
+    view.cand_supplier.value = "X"
+    view.describe.clicks += 1
+    assert st.data.review.candidates.get("soft.h5").supplier == "X"
+    view.seg_points.value = "20:-20, 90:-25"
+    view.seg_harmonic.value = "4"
+    view.seg_add.clicks += 1
+    (t,) = st.data.review.targets
+    assert (t.dof, t.harmonic, list(t.freq)) == ("bushing:z", 4, [20.0, 90.0])
+    assert "Ranking" in view.verdict_text.text and "soft.h5" in view.verdict_text.text
+    view.seg_points.value = "20"
+    view.seg_add.clicks += 1
+    assert "typed target" in st.data.error and len(st.data.review.targets) == 1
+    view.incumbent.value = "reference"
+    view.margin.value = 2.0
+    view.use_incumbent.clicks += 1
+    assert st.data.review.incumbent.margin_db == 2.0
+    view.clear.clicks += 1
+    assert st.data.review.targets == () and st.data.review.incumbent is not None
+    view.current.value = "stiff.h5"
+    view.remove.clicks += 1
+    assert st.data.review.candidates.names == ("reference", "soft.h5")

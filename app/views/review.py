@@ -138,10 +138,14 @@ class ReviewView(Viewer):
         self.remove = W.Button(
             name="Remove", button_type="light", css_classes=["review-remove"], width=90
         )
-        self.name = W.TextInput(name="Name", css_classes=["review-name"], width=150)
-        self.supplier = W.TextInput(name="Supplier", css_classes=["review-supplier"], width=130)
-        self.size = W.TextInput(name="Size / description", css_classes=["review-size"], width=150)
-        self.version = W.TextInput(name="Version", css_classes=["review-version"], width=90)
+        self.cand_name = W.TextInput(name="Name", css_classes=["review-name"], width=150)
+        self.cand_supplier = W.TextInput(
+            name="Supplier", css_classes=["review-supplier"], width=130
+        )
+        self.cand_size = W.TextInput(
+            name="Size / description", css_classes=["review-size"], width=150
+        )
+        self.cand_version = W.TextInput(name="Version", css_classes=["review-version"], width=90)
         self.describe = W.Button(
             name="Save description", button_type="light", css_classes=["review-describe"], width=140
         )
@@ -247,10 +251,10 @@ class ReviewView(Viewer):
         cur = "reference" if cands is None or cands.current is None else cands.current.name
         self._data.describe_candidate(
             cur,
-            name=self.name.value.strip(),
-            supplier=self.supplier.value.strip(),
-            size=self.size.value.strip(),
-            version=self.version.value.strip(),
+            name=self.cand_name.value.strip(),
+            supplier=self.cand_supplier.value.strip(),
+            size=self.cand_size.value.strip(),
+            version=self.cand_version.value.strip(),
         )
 
     def _add_segments(self) -> None:
@@ -290,10 +294,10 @@ class ReviewView(Viewer):
         cur = "reference" if cands is None or cands.current is None else cands.current.name
         self.current.param.update(options=names, value=cur)  # (select() skips its own)
         c = None if cands is None else cands.current
-        self.name.value = cur
-        self.supplier.value = "" if c is None else c.supplier
-        self.size.value = "" if c is None else c.size
-        self.version.value = "" if c is None else c.version
+        self.cand_name.value = cur
+        self.cand_supplier.value = "" if c is None else c.supplier
+        self.cand_size.value = "" if c is None else c.size
+        self.cand_version.value = "" if c is None else c.version
         self.remove.disabled = len(names) <= 1
         inc = review.incumbent
         self.incumbent.param.update(
@@ -473,10 +477,10 @@ class ReviewView(Viewer):
                 sizing_mode="stretch_width",
             ),
             pn.FlexBox(
-                self.name,
-                self.supplier,
-                self.size,
-                self.version,
+                self.cand_name,
+                self.cand_supplier,
+                self.cand_size,
+                self.cand_version,
                 self.describe,
                 flex_wrap="wrap",
                 align_items="flex-end",
