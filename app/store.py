@@ -415,6 +415,13 @@ TABLE: tuple[Row, ...] = (
         slow=review.verdict_work,
         doc="The review's verdict: every candidate tire against the targets, ranked.",
     ),
+    Row(
+        "review_curves",
+        review.CURVES_DEPENDS,
+        review.review_curves_result,
+        slow=review.curves_work,
+        doc="The other candidates' responses and the target on the coupled-response plot.",
+    ),
     # last: its thread starts once the pass's other results are out (it publishes later)
     Row("band", BAND, None, when=OWN_THREAD, kind=Band, doc="The latest scatter band."),
 )

@@ -258,3 +258,35 @@ def test_the_cards_controls_change_the_review(tmp_path, tires):
     view.current.value = "stiff.h5"
     view.remove.clicks += 1
     assert st.data.review.candidates.names == ("reference", "soft.h5")
+
+
+def test_the_response_plot_draws_the_other_candidates_and_the_target(tmp_path, tires):
+    from app.views.mobility import MobilityView
+
+    st, store = _session(tmp_path, tires)  # the stiff tire is current
+    st.case.param.update(harmonic=H, dof="z")
+    f = fbs_core.harmonic(H).frequencies()
+    assert st.data.add_target(
+        Target.segments("bushing:z", [(f[0], -10.0), (f[-1], 10.0)], axis="linear")
+    )
+    view = MobilityView(store=store)
+    view.__panel__()
+    d = store.review_curves.draw
+    assert [c["name"] for c in d["curves"]] == ["reference", "soft.h5"]
+    cands = st.data.review.candidates
+    for c in d["curves"]:
+        model = None if c["name"] == "reference" else tires[c["name"]]
+        h = _direct(model, H).sel(outputs="bushing:z").data[:, 0, 0]
+        np.testing.assert_allclose(c["y"], 20 * np.log10(np.abs(h)), atol=1e-6)
+        # drawn in the candidate's colour slot, on the plot's own source
+        src = next(m for m in view._fig.select({"name": f"mobility.candidate{c['slot']}"}))
+        np.testing.assert_allclose(src.data["level"], c["y"])
+        assert c["slot"] == cands.slot(c["name"])
+    # the target: straight in dB over frequency between its two points
+    np.testing.assert_allclose(d["target"], -10.0 + 20.0 * (f - f[0]) / (f[-1] - f[0]), atol=1e-9)
+    tsrc = next(m for m in view._fig.select({"name": "mobility.target"}))
+    np.testing.assert_allclose(tsrc.data["level"], d["target"])
+    # another DOF without a target: no target line drawn
+    st.case.dof = "x"
+    assert store.review_curves.draw["target"] is None
+    assert not view._target_item.visible

@@ -81,6 +81,8 @@ def _sections(current: dict[str, Any]) -> tuple[ExtraSection, ...]:
             continue
         if name == "response_plot" and not _plot_extras(value):
             continue  # the coupled response as the report shows it already
+        if name == "review_curves" and not value.draw["curves"] and value.draw["target"] is None:
+            continue  # no other candidate and no target: nothing beside the coupled response
         if isinstance(value, Result):
             out.append(ExtraSection.of_result(name, value))
         elif isinstance(value, tuple) and all(isinstance(v, Result) for v in value):

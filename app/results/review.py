@@ -31,7 +31,15 @@ from .. import compute
 from ..datasource import candidate_models
 from .base import Result, Snapshot
 
-__all__ = ["VERDICT_DEPENDS", "candidates_of", "verdict_result", "verdict_work"]
+__all__ = [
+    "CURVES_DEPENDS",
+    "VERDICT_DEPENDS",
+    "candidates_of",
+    "curves_work",
+    "review_curves_result",
+    "verdict_result",
+    "verdict_work",
+]
 
 #: The snapshot fields the verdict is made of.
 VERDICT_DEPENDS = ("review", "coupling", "models", "threshold", "f_max")
@@ -183,4 +191,111 @@ def verdict_result(s: Snapshot) -> Result:
         ),
         draw={"state": "done", "verdict": v, "candidates": cands},
         core={"verdict": v},
+    )
+
+
+# -- the candidates and the target on the coupled-response plot ---------------------------------
+#: The snapshot fields the overlay of the candidates and the target is made of.
+CURVES_DEPENDS = ("review", "harmonic", "dof", "coupling", "models", "level_scale", "scope")
+
+
+def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
+    """The target level (dB re 1 SI, NaN outside its range) of the shown DOF and harmonic:
+    its own target, else one of every harmonic, else the incumbent rule (None: none)."""
+    dof = f"bushing:{s.dof}"
+    mine = [t for t in s.review.targets if t.dof == dof]
+    t = next((t for t in mine if t.harmonic == s.harmonic), None) or next(
+        (t for t in mine if t.harmonic is None), None
+    )
+    if t is not None:
+        k = "all" if t.harmonic is None else t.harmonic
+        return np.asarray(t.level_db_at(freq, "mobility", 1.0), float), f"{t.dof} h{k} {t.source}"
+    inc = s.review.incumbent
+    if inc is None or (inc.dofs is not None and dof not in inc.dofs):
+        return None, ""
+    c = candidates_of(s).get(inc.candidate)
+    m = candidate_models(s.models, c)
+    if (s.harmonic, s.coupling, m) not in _DONE:
+        return None, ""  # the incumbent's response is being computed (curves_work)
+    j = DIRECTIONS.index(s.dof)
+    h = _response(s.harmonic, s.coupling, m).data[:, j, 0]
+    return 20 * np.log10(
+        np.abs(h)
+    ) + inc.margin_db, f"incumbent {inc.candidate} {inc.margin_db:+g} dB"
+
+
+def _others(s: Snapshot) -> list[tuple[Candidate, Any, int]]:
+    """The candidates other than the current one, with their models and colour slots."""
+    cands = s.review.candidates
+    if cands is None or s.vehicle:
+        return []
+    return [
+        (c, candidate_models(s.models, c), cands.slot(c.digest))
+        for c in cands
+        if c.digest != cands.current_digest
+    ]
+
+
+def curves_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
+    """The other candidates' responses to the shown harmonic not computed yet (None: none)."""
+    todo = [(s.harmonic, s.coupling, m) for _c, m, _slot in _others(s)]
+    inc = s.review.incumbent
+    if inc is not None and not s.vehicle and inc.candidate in candidates_of(s):
+        todo.append(
+            (
+                s.harmonic,
+                s.coupling,
+                candidate_models(s.models, candidates_of(s).get(inc.candidate)),
+            )
+        )
+    todo = [t for t in dict.fromkeys(todo) if t not in _DONE]
+    if not todo:
+        return None
+
+    def work() -> Iterator[None]:
+        for k, coupling, m in todo:
+            _response(k, coupling, m)
+            yield
+
+    return work
+
+
+def review_curves_result(s: Snapshot) -> Result:
+    """The other candidates' coupled responses (all modes) to the shown harmonic at the
+    shown DOF, and the target there, for the coupled-response plot (corner scope)."""
+    freq = np.asarray(compute.frequencies(s.harmonic), float)
+    j = DIRECTIONS.index(s.dof)
+    lin = s.level_scale != "dB"
+    curves, cols, pending = [], {"freq_Hz": freq}, []
+    for c, m, slot in _others(s):
+        if (s.harmonic, s.coupling, m) not in _DONE:
+            pending.append(c.name)
+            continue
+        r = _response(s.harmonic, s.coupling, m)
+        h = r.data[:, j, 0]
+        db = 20 * np.log10(np.abs(h))
+        cols[f"{c.name}_dB"] = db
+        curves.append({"name": c.name, "slot": slot, "y": np.abs(h) if lin else db, "freq": r.freq})
+    target, label = (None, "") if s.vehicle else _target_of(s, freq)
+    if target is not None:
+        cols["target_dB"] = target
+    return Result(
+        columns=cols,
+        meta={
+            "view": "review: the other candidates (all modes) and the target at the response",
+            "harmonic": s.harmonic,
+            "response DOF": f"bushing:{s.dof}",
+            "coupling": s.coupling,
+            "candidates": ", ".join(str(c["name"]) for c in curves) or "none",
+            "target": label or "none",
+            "models": s.models.describe(),
+        },
+        filename=f"review_curves_h{s.harmonic}_{s.dof}_{s.review.key[:8]}.csv",
+        draw={
+            "freq": freq,
+            "curves": curves,
+            "target": None if target is None else (10 ** (target / 20) if lin else target),
+            "target_label": f"target: {label}" if label else "",
+            "pending": bool(pending),
+        },
     )

@@ -17,6 +17,21 @@ COLORS = {
     "first_order": "#ae3ec9",
 }
 
+#: One colour per review candidate's colour slot (fbs_core.candidates: kept while the
+#: candidate stays), distinct from the main curves' colours above (Okabe-Ito and three more).
+CANDIDATE_COLORS = (
+    "#0072b2",
+    "#e69f00",
+    "#009e73",
+    "#cc79a7",
+    "#56b4e9",
+    "#8c6d31",
+    "#7048e8",
+    "#5c940d",
+)
+#: The target line on the response plots.
+TARGET_COLOR = "#c92a2a"
+
 FREQ_LABEL = "Frequency (Hz)"
 MODES_LABEL = "Retained modes N"
 

@@ -1,5 +1,8 @@
 """Coupled mobility at the bushing: all-modes reference and truncated curve (figs. 4.8-4.9).
 
+With a review (app/review.py), the other tire candidates' responses (all modes, one colour
+per candidate) and the target of the shown DOF and harmonic are drawn over them.
+
 On request also the uncoupled subsystems: the tire's free hub velocity (figs. 4.6-4.7) and the
 chassis' spindle-to-bushing mobility (figs. 4.2-4.3).
 """
@@ -15,12 +18,21 @@ from bokeh.core.property.vectorization import value
 from bokeh.events import Tap
 from bokeh.models import ColumnDataSource, HoverTool, Label, LegendItem, Span
 
+from fbs_core.candidates import MAX_CANDIDATES
 from fbs_core.vocabulary import DIRECTIONS
 
 from ..results.base import made_of_same
 from ..store import CASE
 from .analysis_base import TERM_COLORS
-from .common import COLORS, FREQ_LABEL, level_label, level_tooltips, tap_cursor
+from .common import (
+    CANDIDATE_COLORS,
+    COLORS,
+    FREQ_LABEL,
+    TARGET_COLOR,
+    level_label,
+    level_tooltips,
+    tap_cursor,
+)
 from .layout import font
 from .live import LiveText, LiveView
 from .plots import add_line, frequency_range, new_figure
@@ -41,7 +53,7 @@ class MobilityView(LiveView):
 
     key = "mobility"
     result_name = "response"
-    also = ("response_plot",)
+    also = ("response_plot", "review_curves")
     x_range = param.Parameter(
         default=None,
         doc="Frequency range shared with other views (linked zoom and pan); a new one if None.",
@@ -94,6 +106,19 @@ class MobilityView(LiveView):
             for d in DIRECTIONS
         }
         fig.add_tools(*self._over_tools.values())
+        # the review's candidates (a line per colour slot) and the target: lines made on
+        # first use, their legend entries and one hover tool here from the start (as above)
+        self._cand: dict[int, ColumnDataSource] = {}
+        self._cand_items = [
+            LegendItem(label=value(f"candidate {k + 1}"), renderers=[], visible=False)
+            for k in range(MAX_CANDIDATES)
+        ]
+        self._target_item = LegendItem(label=value("target"), renderers=[], visible=False)
+        fig.legend[0].items = [*fig.legend[0].items, *self._cand_items, self._target_item]
+        self._cand_tool = HoverTool(
+            renderers=[], tooltips=level_tooltips("@name", "level"), mode="vline"
+        )
+        fig.add_tools(self._cand_tool)
         self._cursor_spans = [
             Span(
                 location=0,
@@ -165,6 +190,70 @@ class MobilityView(LiveView):
         self._over_tools[dof].renderers = [line]
         return src
 
+    def _review_line(self, slot: int | None) -> ColumnDataSource:
+        """The source of a candidate's line (``slot``) or of the target's (None), the line
+        made on first use."""
+        key = -1 if slot is None else slot
+        src = self._cand.get(key)
+        if src is not None:
+            return src
+        name = "mobility.target" if slot is None else f"mobility.candidate{slot}"
+        src = self._cand[key] = ColumnDataSource(
+            {"freq": np.zeros(0), "level": np.zeros(0), "name": []}, name=name
+        )
+        line = self._fig.line(
+            "freq",
+            "level",
+            source=src,
+            line_color=TARGET_COLOR if slot is None else CANDIDATE_COLORS[slot],
+            line_width=2.6 if slot is None else 1.8,
+            line_dash="dotdash" if slot is None else "solid",
+            visible=False,
+        )
+        item = self._target_item if slot is None else self._cand_items[slot]
+        item.renderers = [line]
+        self._cand_tool.renderers = [*self._cand_tool.renderers, line]
+        return src
+
+    def _draw_review(self, r, scale: str) -> None:
+        """The other candidates and the target, when they are of the case ``r`` shows and
+        in the level scale drawn (``scale``)."""
+        rc = self.store.review_curves
+        fields = ("harmonic", "dof", "coupling", "models")
+        ok = (
+            rc is not None
+            and made_of_same(rc, r, fields)
+            and rc.snapshot is not None
+            and (rc.snapshot.level_scale == "dB") == (scale == "dB")
+        )
+        d = rc.draw if ok and rc is not None else {"curves": [], "target": None}
+        shown = set()
+        for cv in d["curves"]:
+            n = len(cv["y"])
+            self._review_line(cv["slot"]).data = {
+                "freq": cv["freq"],
+                "level": cv["y"],
+                "name": [cv["name"]] * n,
+            }
+            self._cand_items[cv["slot"]].label = value(f"{cv['name']} (all modes)")
+            shown.add(cv["slot"])
+        if d["target"] is not None:
+            y = d["target"]
+            self._review_line(None).data = {
+                "freq": d["freq"],
+                "level": y,
+                "name": [d["target_label"]] * len(y),
+            }
+            self._target_item.label = value(d["target_label"])
+            shown.add(-1)
+        for key in self._cand:
+            item = self._target_item if key == -1 else self._cand_items[key]
+            on = key in shown
+            if item.visible != on:
+                item.visible = on
+                for line in item.renderers:
+                    line.visible = on
+
     def _set_overlays(self, shown) -> None:
         for dof, item in self._over_items.items():
             item.visible = dof in shown
@@ -202,6 +291,7 @@ class MobilityView(LiveView):
         for item in self._legend_items() if label else ():
             if item.renderers and item.renderers[0].data_source is self._tr:
                 item.label = value(label)  # "N retained modes" or "... + residual"
+        self._draw_review(r, "dB" if extras is None else extras.draw["scale"])
         self._fit(self.x_range, f)
 
     def _draw_extras(self, d) -> None:

@@ -33,23 +33,12 @@ from ..export import dated
 from ..runtime.bands import served
 from ..runtime.draw import on_document, served_document
 from ..runtime.uploads import UPLOADS
+from .common import CANDIDATE_COLORS
 from .live import LiveText, export_meta
 from .upload import _alert, _uploaded
 
-__all__ = ["CANDIDATE_COLORS", "ReviewView", "parse_points", "review_card"]
+__all__ = ["ReviewView", "parse_points", "review_card"]
 
-#: One colour per candidate colour slot (fbs_core.candidates: a slot is kept while the
-#: candidate stays), distinct for the eight a review holds (Okabe-Ito and two more).
-CANDIDATE_COLORS = (
-    "#1f2937",
-    "#e69f00",
-    "#0072b2",
-    "#009e73",
-    "#d55e00",
-    "#cc79a7",
-    "#56b4e9",
-    "#8c6d31",
-)
 assert len(CANDIDATE_COLORS) >= MAX_CANDIDATES
 
 STATUS_COLORS = {
