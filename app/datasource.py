@@ -45,7 +45,7 @@ from fbs_core.io.checks import check_pair, check_tire
 from fbs_core.targets import IncumbentTarget, Target, read_targets
 from fbs_core.vocabulary import DIRECTIONS, EIGEN_SPEEDS, HARMONIC_CASES
 
-from .review import EMPTY_REVIEW, Review
+from .review import EMPTY_REVIEW, LinkReview, Review, read_review_link
 
 __all__ = [
     "CHASSIS_ACCEPT",
@@ -164,6 +164,29 @@ def candidate_models(models: Models, candidate: Candidate) -> Models:
     )
 
 
+def _settle(review: Review, want: LinkReview | None) -> tuple[Review, LinkReview | None]:
+    """``review`` with what ``want`` asks that is loaded now (the current candidate, the
+    incumbent), and what it still asks (None: nothing)."""
+    if want is None:
+        return review, None
+    cands = review.candidates
+    loaded = {d: c for c in (cands or ()) for d in (c.digest, c.digest[:12])}
+    if cands is not None and want.current in loaded:
+        review = review.with_candidates(cands.with_current(loaded[want.current].digest))
+    inc = want.incumbent
+    if inc is not None and (inc[0] in loaded or inc[0] == "reference"):
+        name = loaded[inc[0]].name if inc[0] in loaded else "reference"
+        review = review.with_incumbent(IncumbentTarget(name, inc[1]))
+        inc = None
+    rest = tuple(d for d in want.candidates if d not in loaded and d != "reference")
+    # the link's current candidate stays asked for until every candidate is loaded (a later
+    # upload would otherwise become current)
+    current = "" if not rest or want.current in ("", "reference") else want.current
+    if not rest and inc is None:
+        return review, None
+    return review, LinkReview(rest, current, inc)
+
+
 def _unique(name: str, taken) -> str:
     """``name``, or ``name (2)``, ``name (3)``... if it is taken."""
     out, i = name, 1
@@ -238,6 +261,14 @@ class DataSource(param.Parameterized):
         instantiate=False,
         doc="The review: tire candidates (the reference and every tire uploaded), targets "
         "and the incumbent rule (app/review.py).",
+    )
+    pending = param.ClassSelector(
+        class_=LinkReview,
+        default=None,
+        allow_None=True,
+        doc="What the page's link asked of the review that this session has not loaded yet "
+        "(candidates whose files are not uploaded; the current one and the incumbent among "
+        "them): restored as their files are uploaded.",
     )
     error = param.String(default="", doc="Why the last upload was refused ('' if it was not).")
     spindle = param.String(
@@ -481,8 +512,33 @@ class DataSource(param.Parameterized):
                 self.error = f"{name}: {e}"
                 return False
         summary = res.summary + ("\nnotes: " + "; ".join(notes) if notes else "")
-        self._use_candidates(review.with_candidates(cands), summary)
+        review, pending = _settle(review.with_candidates(cands), self.pending)
+        self._use_candidates(review, summary)
+        self.pending = pending
         return True
+
+    def apply_link(self, text: str) -> bool:
+        """Restore the review a link names (:func:`app.review.review_link`): its targets and
+        incumbent rule at once, its candidates as their files are uploaded (``pending``).
+        A malformed value is the ``error`` and changes nothing."""
+        if not text:
+            return True
+        with self._lock:
+            try:
+                want = read_review_link(text)
+                review = self.review
+                if want.targets:
+                    review = review.without_targets().with_targets(want.targets)
+                review, pending = _settle(review, want)
+            except FBSError as e:
+                self.error = f"link: {e}"
+                return False
+            if review.candidates is not self.review.candidates:
+                self._use_candidates(review)
+            else:
+                self.param.update(error="", review=review)
+            self.pending = pending
+            return True
 
     def _use_candidates(self, review: Review, tire_summary: str | None = None) -> None:
         """Make ``review`` the session's and its current candidate the session's tire."""
@@ -543,7 +599,10 @@ class DataSource(param.Parameterized):
                 return r
             return r.with_candidates(r.candidates.with_current(candidate))
 
-        return self._change_review("current candidate", change)
+        done = self._change_review("current candidate", change)
+        if done and self.pending is not None and self.pending.current:  # the user's choice
+            self.pending = LinkReview(self.pending.candidates, "", self.pending.incumbent)
+        return done
 
     def remove_candidate(self, candidate: str) -> bool:
         """Remove a candidate (name or digest); the last one is kept."""

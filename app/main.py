@@ -52,6 +52,7 @@ from app.page.layout import (
 from app.page.titles import PAGES, PageLink, page_url, read_link, resolve_view_id
 from app.public_url import public_base
 from app.report.session import provenance_of, report_data
+from app.review import review_link
 from app.runtime import background, closed_pages, libraries  # noqa: F401 (libraries: preloaded)
 from app.runtime.collector import count_alive, session_ended, session_started
 from app.runtime.collector import start as start_quiet_collections
@@ -404,7 +405,22 @@ def link_notice_pane(parts: PageParts) -> pn.pane.HTML:
     page.param.watch(check, "data")
     state.data.param.watch(data_in_use, "models")
     check()
+    review_in_link(parts)
     return notice
+
+
+def review_in_link(parts: PageParts) -> None:
+    """The review the link names, restored once (its targets and incumbent at once, its
+    candidates as their files are uploaded); from then on the link names the session's."""
+    state, page = parts.state, parts.page
+    data = state.data
+    if page.review:
+        data.apply_link(page.review)
+
+    def write(*_):
+        page.review = review_link(data.review, data.pending)
+
+    data.param.watch(write, ["review", "pending"])
 
 
 def page_bar(parts: PageParts, report: Callable, open_help: Callable) -> pn.Row:

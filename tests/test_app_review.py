@@ -290,3 +290,56 @@ def test_the_response_plot_draws_the_other_candidates_and_the_target(tmp_path, t
     st.case.dof = "x"
     assert store.review_curves.draw["target"] is None
     assert not view._target_item.visible
+
+
+def test_the_link_restores_the_review_where_its_files_are_loaded(tmp_path, tires):
+    from app.review import read_review_link, review_link
+
+    st, store = _session(tmp_path, tires)
+    ds = st.data
+    f = fbs_core.harmonic(H).frequencies()
+    assert ds.load_targets(_target_csv(-3.25, f), "target.csv"), ds.error
+    assert ds.add_target(Target.segments("bushing:x", [(20.0, -20.1), (90.0, -30.7)]))
+    assert ds.set_incumbent("soft.h5", 1.5) and ds.select_candidate("soft.h5")
+    text = review_link(ds.review)
+    before = store.verdict.core["verdict"]
+
+    # a new session opens the link: targets and the rule's wish at once, the files pending
+    st2 = DashboardState()
+    store2 = Results(st2)
+    assert st2.data.apply_link(text), st2.data.error
+    got = {(t.dof, t.harmonic): t for t in st2.data.review.targets}
+    for t in ds.review.targets:  # exact levels, not rounded
+        g = got[(t.dof, t.harmonic)]
+        assert (g.axis, g.quantity) == (t.axis, t.quantity)
+        np.testing.assert_array_equal(g.freq, t.freq)
+        np.testing.assert_array_equal(g.level_db, t.level_db)
+    want = st2.data.pending
+    assert len(want.candidates) == 2 and want.current and want.incumbent[1] == 1.5
+    # the link keeps asking for them
+    assert read_review_link(review_link(st2.data.review, want)).candidates == want.candidates
+    # the files uploaded, the link's current one first: it stays current after the other
+    for name in ("soft.h5", "stiff.h5"):
+        assert st2.data.load_tire(_bytes(tmp_path, tires[name], name), name), st2.data.error
+    assert st2.data.pending is None
+    r2 = st2.data.review
+    assert r2.candidates.current.name == "soft.h5" and r2.incumbent.candidate == "soft.h5"
+    after = store2.verdict.core["verdict"]
+    rows = {(x.candidate, x.harmonic, x.dof): x for x in after.rows}
+    assert len(rows) == len(before.rows)
+    for y in before.rows:  # (the candidates in the order their files came)
+        x = rows[(y.candidate, y.harmonic, y.dof)]
+        assert x.status == y.status
+        assert x.worst_db == pytest.approx(y.worst_db, abs=1e-9, nan_ok=True)
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["c:abc$", "inc:abc:nan", "t:bushing:z:*:log:mobility:1:20_-20_30", "zz:1", "t:bushing:z"],
+)
+def test_a_crafted_review_link_is_named_and_changes_nothing(text):
+    ds = DataSource()
+    assert ds.add_target(Target.segments("bushing:y", [(10.0, -20.0), (100.0, -30.0)]))
+    before = ds.review
+    assert not ds.apply_link(text)
+    assert "link" in ds.error and ds.review is before and ds.pending is None

@@ -41,6 +41,11 @@ class PageState(param.Parameterized):
     data = param.String(
         default="", doc="The uploads the page's results need (empty: the reference models)."
     )
+    review = param.String(
+        default="",
+        doc="The review: candidates' digests, the current one, the incumbent rule and the "
+        "targets (app.review.review_link; empty: no review).",
+    )
     sidebar: param.Selector[str] = param.Selector(
         default="auto",
         objects=["auto", "open", "closed"],
@@ -61,6 +66,7 @@ PAGE_URL_KEYS = {
     "n_axis": "naxis",
     "data": "data",
     "sidebar": "sidebar",
+    "review": "review",
 }
 
 #: Larger type of the controls and cards in the presentation view: the page's font size

@@ -190,6 +190,7 @@ class ReviewView(Viewer):
         self.candidates_text = LiveText(css_classes=["review-candidates"])
         self.targets_text = LiveText(css_classes=["review-targets"])
         self.verdict_text = LiveText(css_classes=["review-verdict"])
+        self.pending_text = LiveText(css_classes=["review-pending-text"])
         self._error = _alert("", "danger", "review-error", visible=False)
         self._doc = served_document()
         # widgets: each a call into the data source
@@ -201,7 +202,7 @@ class ReviewView(Viewer):
         self.seg_add.on_click(lambda _: self._add_segments())
         self.use_incumbent.on_click(lambda _: self._set_incumbent())
         self.clear.on_click(lambda _: ds.clear_targets())
-        ds.param.watch(lambda _e: self._sync_widgets(), ["review"])
+        ds.param.watch(lambda _e: self._sync_widgets(), ["review", "pending"])
         ds.param.watch(lambda _e: self._show_error(), ["error"])
         self.store.param.watch(lambda _e: self.redraw(), ["verdict"])
         self._sync_widgets()
@@ -356,6 +357,14 @@ class ReviewView(Viewer):
             else "<p><i>No targets yet.</i></p>"
         )
         self.verdict_text.text = self._verdict_html()
+        want = self._data.pending
+        self.pending_text.text = (
+            ""
+            if want is None or not want.candidates
+            else "<p class='review-pending'>This page's link names candidates not loaded in "
+            f"this session (digests {_t(', '.join(want.candidates))}): add their tire files "
+            "to restore them.</p>"
+        )
 
     def _verdict_html(self) -> str:
         r = self.store.verdict
@@ -475,6 +484,7 @@ class ReviewView(Viewer):
                 align_items="flex-end",
                 sizing_mode="stretch_width",
             ),  # fmt: skip
+            self.pending_text,
             self.candidates_text,
             label(
                 "**Targets** (bushing velocity per metre of road; docs/verdict.md)", margin=(0, 5)

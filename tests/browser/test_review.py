@@ -114,6 +114,26 @@ def test_two_suppliers_and_the_reference_judged_by_clicking(browser, dashboard, 
     for c in cands:
         assert f"<td>{c.name}</td>" in report
 
+    if size == (1920, 1080):  # the link, opened in a new page, restores the review
+        page.wait_for_function("() => window.location.search.includes('review=')")
+        url = page.evaluate("() => window.location.href")
+        other = ctx.new_page()
+        other.on("pageerror", lambda e: errors.append(str(e)))
+        open_dashboard(other, url)
+        other.locator(".review-card .card-header").first.click()
+        _wait_text(other, "review-pending-text", "add their tire files")
+        _wait_text(other, "review-targets", "from the link")
+        for n, p in paths.items():
+            other.locator(".review-tire input[type=file]").set_input_files(str(p))
+            _wait_text(other, "review-candidates", re.escape(n))
+        _wait_text(other, "review-verdict", "Ranking", timeout=300_000)
+        again = other.locator(".verdict-ranking tr").all_inner_texts()[1:]
+        assert [x.split("\t")[1:4] for x in again] == [x.split("\t")[1:4] for x in shown]
+        other.locator(".review-candidates-table tr").filter(has_text="supplier_x.h5").filter(
+            has_text="yes"
+        ).first.wait_for(timeout=60_000)  # the link's current candidate
+        other.close()
+
     wait_stable(page)
     problems = layout_problems(page, size[0])
     page.screenshot(path=str(ARTIFACTS / f"review_{size[0]}x{size[1]}.png"), full_page=False)
