@@ -15,6 +15,8 @@ nothing (never a verdict of part of the candidates).
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -43,9 +45,40 @@ __all__ = [
 
 #: The snapshot fields the verdict is made of.
 VERDICT_DEPENDS = ("review", "coupling", "models", "threshold", "f_max")
-#: (harmonic, coupling, models) whose all-modes responses are computed.
-_DONE: set[tuple] = set()
 BUSHING = tuple(f"bushing:{d}" for d in DIRECTIONS)
+#: Responses kept (harmonic, coupling, models' digest -> FRF, ~15 kB each): every harmonic
+#: of the candidates of a few sessions. Keyed by the digest, not the models: a tire leaves
+#: memory with its sessions.
+KEPT = 256
+
+
+class _Kept:
+    """The all-modes responses computed so far, most recent last, at most :data:`KEPT`."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._items: OrderedDict[tuple, FRF] = OrderedDict()
+
+    def get(self, key: tuple) -> FRF | None:
+        with self._lock:
+            frf = self._items.get(key)
+            if frf is not None:
+                self._items.move_to_end(key)
+            return frf
+
+    def put(self, key: tuple, frf: FRF) -> None:
+        with self._lock:
+            self._items[key] = frf
+            self._items.move_to_end(key)
+            while len(self._items) > KEPT:
+                self._items.popitem(last=False)
+
+    def __contains__(self, key: tuple) -> bool:
+        with self._lock:
+            return key in self._items
+
+
+_DONE = _Kept()
 
 
 def candidates_of(s: Snapshot) -> CandidateSet:
@@ -54,11 +87,20 @@ def candidates_of(s: Snapshot) -> CandidateSet:
     return CandidateSet([Candidate.reference()]) if c is None else c
 
 
+def _key(k: int, coupling: str, models) -> tuple:
+    return (k, coupling, models.key)
+
+
 def _response(k: int, coupling: str, models) -> FRF:
-    data = compute.coupled_response(k, None, coupling, models)
-    freq = np.asarray(compute.error_map(k, coupling, models).freq, float)
-    _DONE.add((k, coupling, models))
-    return FRF(freq, np.asarray(data)[:, :, None], BUSHING, ["patch"])
+    """The all-modes bushing response of ``models`` to harmonic ``k`` (eq. 4.1)."""
+    key = _key(k, coupling, models)
+    frf = _DONE.get(key)
+    if frf is None:
+        data = compute.coupled_response(k, None, coupling, models)
+        freq = np.asarray(compute.error_map(k, coupling, models).freq, float)
+        frf = FRF(freq, np.asarray(data)[:, :, None], BUSHING, ["patch"])
+        _DONE.put(key, frf)
+    return frf
 
 
 def _jobs(s: Snapshot) -> tuple[list[tuple], list[tuple]]:
@@ -75,7 +117,7 @@ def _jobs(s: Snapshot) -> tuple[list[tuple], list[tuple]]:
 def _missing(s: Snapshot) -> tuple[list[tuple], list[tuple]]:
     responses, tables = _jobs(s)
     return (
-        [r for r in responses if r not in _DONE],
+        [r for r in responses if _key(*r) not in _DONE],
         [t for t in tables if not compute.suggested_table_ready(*t)],
     )
 
@@ -215,7 +257,7 @@ def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
         return None, ""
     c = candidates_of(s).get(inc.candidate)
     m = candidate_models(s.models, c)
-    if (s.harmonic, s.coupling, m) not in _DONE:
+    if _key(s.harmonic, s.coupling, m) not in _DONE:
         return None, ""  # the incumbent's response is being computed (curves_work)
     j = DIRECTIONS.index(s.dof)
     h = _response(s.harmonic, s.coupling, m).data[:, j, 0]
@@ -248,7 +290,7 @@ def curves_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
                 candidate_models(s.models, candidates_of(s).get(inc.candidate)),
             )
         )
-    todo = [t for t in dict.fromkeys(todo) if t not in _DONE]
+    todo = [t for t in dict.fromkeys(todo) if _key(*t) not in _DONE]
     if not todo:
         return None
 
@@ -268,7 +310,7 @@ def review_curves_result(s: Snapshot) -> Result:
     lin = s.level_scale != "dB"
     curves, cols, pending = [], {"freq_Hz": freq}, []
     for c, m, slot in _others(s):
-        if (s.harmonic, s.coupling, m) not in _DONE:
+        if _key(s.harmonic, s.coupling, m) not in _DONE:
             pending.append(c.name)
             continue
         r = _response(s.harmonic, s.coupling, m)
