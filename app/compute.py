@@ -24,6 +24,7 @@ import time
 from collections import OrderedDict
 from dataclasses import dataclass
 from functools import lru_cache, wraps
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -45,6 +46,7 @@ __all__ = [
     "EIGEN_SPEEDS",
     "PERCENTILE_BANDS",
     "Q_LEVELS",
+    "BandKey",
     "BandTime",
     "CONVERGENCE_WITHIN_DB",
     "band",
@@ -522,6 +524,30 @@ _bands: OrderedDict = OrderedDict()
 _bands_lock = threading.Lock()
 
 
+class BandKey(NamedTuple):
+    """The settings that define a scatter band (its cache key), by name.
+
+    ``vehicle``: ``(wheels, track relation, response point)`` of a car's band (vehicle
+    scope, :mod:`app.vehicle_compute`); None for a corner's band.
+    """
+
+    harmonic: int
+    n_modes: int | None
+    coupling: str
+    noise_pct: float
+    target: str
+    frequency_dependent: bool
+    rounds: int
+    seed: int
+    models: Any
+    vehicle: tuple | None = None
+
+    @property
+    def is_car(self) -> bool:
+        """Whether it is a car's band (vehicle scope)."""
+        return self.vehicle is not None
+
+
 def band_key(
     harmonic: int,
     n_modes: int | None,
@@ -533,30 +559,26 @@ def band_key(
     seed: int,
     models=None,
     vehicle: tuple | None = None,
-) -> tuple:
-    """The settings that define a scatter band (its cache key), normalised.
-
-    ``vehicle``: ``(wheels, track relation, response point)`` of a car's band (vehicle
-    scope, :mod:`app.vehicle_compute`); a corner's key is the nine settings alone.
-    """
-    models = _key(models)
-    corner = (
+) -> BandKey:
+    """The settings that define a scatter band (its cache key), normalised
+    (:class:`BandKey`)."""
+    return BandKey(
         int(harmonic),
-        _n(models, n_modes),
+        _n(_key(models), n_modes),
         str(coupling),
         float(noise_pct),
         str(target),
         bool(frequency_dependent),
         int(rounds),
         int(seed),
-        models,
+        _key(models),
+        None if vehicle is None else tuple(vehicle),
     )
-    return corner if vehicle is None else (*corner, tuple(vehicle))
 
 
-def is_car_key(key: tuple) -> bool:
-    """Whether :func:`band_key` ``key`` is a car's (it ends in the vehicle part)."""
-    return len(key) == 10
+def is_car_key(key: BandKey) -> bool:
+    """Whether :func:`band_key` ``key`` is a car's (vehicle scope)."""
+    return key.is_car
 
 
 def cached_band(key: tuple):
@@ -582,7 +604,7 @@ def band(*args, cancel=None, progress=None, **kwargs):
     res = cached_band(key)
     if res is not None:
         return res
-    harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models = key
+    harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models, _ = key
     t0 = time.perf_counter()
     res = studies.scatter_band(
         harmonic,

@@ -809,7 +809,7 @@ class Results(param.Parameterized):
         with self._lock:
             if job is not self._band_job or job.cancelled or self.closed:
                 return
-            rounds = job.key[6]
+            rounds = job.key.rounds
             self.band_status = progress_status(rounds, job.done, job.total, job.seconds_left())
 
     def cancel_band(self) -> None:

@@ -90,7 +90,7 @@ def wanted(key: tuple) -> bool:
     A car's band (vehicle scope: a key with its road and point) is computed in-process:
     the cluster's workers run the corner's band function; vehicle scope starts at fewer
     rounds instead (``app.state.VEHICLE_ROUNDS``)."""
-    return bool(scheduler()) and len(key) == 9 and int(key[6]) >= min_rounds()
+    return bool(scheduler()) and not key.is_car and key.rounds >= min_rounds()
 
 
 def client():
@@ -176,7 +176,7 @@ def band(key: tuple, cancel, progress=None):
 
 
 def _on(c, key: tuple, cancel, progress):
-    harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models = key
+    harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models, _ = key
     return scatter_band_on(
         c,
         harmonic,
