@@ -27,7 +27,7 @@ from fbs_core.candidates import Candidate, CandidateSet
 from fbs_core.delivery import assess_delivery
 from fbs_core.errors import FBSError
 from fbs_core.verdict import Verdict, verdict
-from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES
+from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES, magnitude_db
 
 from .. import compute
 from ..datasource import candidate_models
@@ -261,9 +261,8 @@ def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
         return None, ""  # the incumbent's response is being computed (curves_work)
     j = DIRECTIONS.index(s.dof)
     h = _response(s.harmonic, s.coupling, m).data[:, j, 0]
-    return 20 * np.log10(
-        np.abs(h)
-    ) + inc.margin_db, f"incumbent {inc.candidate} {inc.margin_db:+g} dB"
+    label = f"incumbent {inc.candidate} {inc.margin_db:+g} dB"
+    return magnitude_db(h) + inc.margin_db, label
 
 
 def _others(s: Snapshot) -> list[tuple[Candidate, Any, int]]:
@@ -315,7 +314,7 @@ def review_curves_result(s: Snapshot) -> Result:
             continue
         r = _response(s.harmonic, s.coupling, m)
         h = r.data[:, j, 0]
-        db = 20 * np.log10(np.abs(h))
+        db = magnitude_db(h)
         cols[f"{c.name}_dB"] = db
         curves.append({"name": c.name, "slot": slot, "y": np.abs(h) if lin else db, "freq": r.freq})
     target, label = (None, "") if s.vehicle else _target_of(s, freq)
