@@ -109,10 +109,10 @@ def test_a_newer_request_cancels_the_running_band_and_nothing_queues(turns):
     _wait(lambda: res.band is not None and not res.band_status.busy, "the last band")
     assert res.band.settings.seed == 17 and res.band.result.rounds == 300
     _wait(lambda: _live_band_threads() == 0, "every band thread to end")
-    long_key = (7, 50, "6dof", 10.0, "both", False, 150_000, 11, None)
+    long_key = compute.band_key(7, 50, "6dof", 10.0, "both", False, 150_000, 11)
     # the long band stopped after a few chunks instead of running its ~100
     assert 2 <= turns.turns.count(long_key) < 20
-    ran = {k[7] for k in turns.turns}
+    ran = {k.seed for k in turns.turns}
     assert ran <= {11, 12, 13, 14, 15, 16, 17}
 
 
@@ -129,7 +129,7 @@ def test_bands_of_two_sessions_take_turns_chunk_by_chunk(turns):
     # the small band finished while the long one still runs: it waited for at most one
     # chunk of the long band per chunk of its own
     assert hog.band_status.busy and hog.band is None
-    order = [k[7] for k in turns.turns[: done_at[0]]]
+    order = [k.seed for k in turns.turns[: done_at[0]]]
     first_small = order.index(22)
     assert order[first_small + 1 :].count(21) <= order.count(22)
     hog.close()
@@ -320,7 +320,7 @@ def test_a_shared_band_stops_once_every_session_cancelled_it(turns):
     for res in sessions:
         res.state.case.harmonic = 7
         res.request_band()
-    key = (7, 50, "6dof", 10.0, "both", False, 150_000, 81, None)
+    key = compute.band_key(7, 50, "6dof", 10.0, "both", False, 150_000, 81)
     _wait(lambda: turns.turns.count(key) >= 2, "the long band to run")
     sessions[0].cancel_band()
     n = turns.turns.count(key)
