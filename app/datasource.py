@@ -544,15 +544,8 @@ class DataSource(param.Parameterized):
         """Make ``review`` the session's and its current candidate the session's tire."""
         cands = review.candidates
         cur = None if cands is None else cands.current
-        m = self.models
-        if cur is None or cur.is_reference:
-            self._tire_key = ""
-            models = _models(None, "", "", m.chassis, self._chassis_key, m.chassis_name)
-        else:
-            self._tire_key = cur.digest
-            models = _models(
-                cur.model, cur.digest, cur.name, m.chassis, self._chassis_key, m.chassis_name
-            )
+        models = candidate_models(self.models, cur or Candidate.reference())
+        self._tire_key = "" if cur is None or cur.is_reference else cur.digest
         changes: dict = {"error": "", "review": review}
         if tire_summary is not None:
             changes["tire_summary"] = tire_summary
@@ -565,17 +558,6 @@ class DataSource(param.Parameterized):
             self.models = models
 
     # -- the review: candidates, targets -----------------------------------------------------
-    def models_of(self, candidate: str) -> Models:
-        """The models of a candidate (by name or digest) with the session's chassis.
-
-        Raises
-        ------
-        FBSError
-            For a candidate the session does not hold.
-        """
-        cands = self.review.candidates or CandidateSet([Candidate.reference()])
-        return candidate_models(self.models, cands.get(candidate))
-
     def _change_review(self, what: str, change) -> bool:
         """Apply ``change(review) -> review``; an FBSError is the message, nothing changes."""
         with self._lock:

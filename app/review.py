@@ -27,17 +27,7 @@ __all__ = [
     "Review",
     "read_review_link",
     "review_link",
-    "target_label",
 ]
-
-
-def target_label(t: Target) -> str:
-    """A target in one line: DOF, harmonic, range and source."""
-    k = "every harmonic" if t.harmonic is None else f"harmonic {t.harmonic}"
-    return (
-        f"{t.dof} ({k}, {t.quantity}, {float(t.freq[0]):g}-{float(t.freq[-1]):g} Hz, "
-        f"{t.level_db.min():.1f} to {t.level_db.max():.1f} dB): {t.source or 'typed'}"
-    )
 
 
 def _digest(candidates: CandidateSet | None, targets, incumbent) -> str:

@@ -26,6 +26,7 @@ from fbs_core import FRF
 from fbs_core.candidates import Candidate, CandidateSet
 from fbs_core.delivery import assess_delivery
 from fbs_core.errors import FBSError
+from fbs_core.targets import Target
 from fbs_core.verdict import Verdict, verdict
 from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES, magnitude_db
 
@@ -259,10 +260,11 @@ def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
     m = candidate_models(s.models, c)
     if _key(s.harmonic, s.coupling, m) not in _DONE:
         return None, ""  # the incumbent's response is being computed (curves_work)
-    j = DIRECTIONS.index(s.dof)
-    h = _response(s.harmonic, s.coupling, m).data[:, j, 0]
     label = f"incumbent {inc.candidate} {inc.margin_db:+g} dB"
-    return magnitude_db(h) + inc.margin_db, label
+    t = Target.from_response(
+        _response(s.harmonic, s.coupling, m), dof, inc.margin_db, s.harmonic, label
+    )
+    return np.asarray(t.level_db_at(freq, "mobility", 1.0), float), label
 
 
 def _others(s: Snapshot) -> list[tuple[Candidate, Any, int]]:

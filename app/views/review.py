@@ -30,12 +30,10 @@ from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES
 
 from ..datasource import TARGET_ACCEPT, TIRE_ACCEPT
 from ..export import dated
-from ..runtime.bands import served
 from ..runtime.draw import on_document, served_document
-from ..runtime.uploads import UPLOADS
 from .common import CANDIDATE_COLORS
 from .live import LiveText, export_meta
-from .upload import _alert, _uploaded
+from .upload import _alert, _uploaded, queue_read
 
 __all__ = ["ReviewView", "parse_points", "review_card"]
 
@@ -212,10 +210,7 @@ class ReviewView(Viewer):
     # -- actions -------------------------------------------------------------------------
     def _read(self, slot: str, fn, got) -> None:
         """Read a file on the upload queue (a slow file holds no thread of the sessions)."""
-        if not served():
-            fn(*got)
-        elif UPLOADS.submit(self._data, slot, lambda: fn(*got), self._refused) is None:
-            return
+        queue_read(self._data, slot, lambda: fn(*got), self._refused)
 
     def _refused(self, message: str) -> None:
         self._data.error = message

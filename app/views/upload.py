@@ -86,6 +86,16 @@ def _uploaded(widget: pn.widgets.FileInput, events) -> tuple[bytes, str] | None:
     return (b"" if value is None else bytes(value)), str(name or "upload")
 
 
+def queue_read(owner, slot: str, job, refused) -> bool:
+    """Run ``job`` (a file's reading) on the upload queue (:mod:`app.runtime.uploads`), or
+    at once without a server (a notebook or a test: no other sessions); False when the
+    queue refused it (``refused(message)`` was called)."""
+    if not served():
+        job()
+        return True
+    return UPLOADS.submit(owner, slot, job, refused) is not None
+
+
 class UploadView(Viewer):
     """File inputs for a chassis FRF and a tire model, the import summary or the error."""
 
@@ -160,9 +170,7 @@ class UploadView(Viewer):
 
         self._busy(True)
         self.data.error = ""  # the earlier file's error is stale: this one is being read
-        if not served():  # a notebook or a test: no other sessions, read here
-            job()
-        elif UPLOADS.submit(self.data, slot, job, self._refused) is None:
+        if not queue_read(self.data, slot, job, self._refused):
             self._busy(False)
 
     def _refused(self, message: str) -> None:
