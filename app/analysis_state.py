@@ -13,6 +13,7 @@ from __future__ import annotations
 import param
 
 from .params import Integer, Number
+from .schema import setting
 
 __all__ = ["ANALYSIS_TABS", "AnalysisState"]
 
@@ -34,58 +35,91 @@ class AnalysisState(param.Parameterized):
     """Settings of the Analysis card (one per session)."""
 
     tab = param.Selector(
+        metadata=setting("atab"),
         default="",
         objects=list(ANALYSIS_TABS),
         doc="Tab shown ('' while the card is collapsed): only its results are computed.",
     )
     frf = param.Selector(
+        metadata=setting("afrf"),
         default="coupled",
         objects=list(PHASE_FRFS),
         doc="FRF of the phase view: coupled bushing response (eq. 4.1), the tire's free "
         "hub velocity, or the chassis spindle-to-bushing mobility.",
     )
     phase_mode = param.Selector(
-        default="bode", objects=list(PHASE_MODES), doc="Magnitude/phase or real/imaginary."
+        metadata=setting("aphase"),
+        default="bode",
+        objects=list(PHASE_MODES),
+        doc="Magnitude/phase or real/imaginary.",
     )
-    log_freq = param.Boolean(default=False, doc="Logarithmic frequency axis (phase view).")
-    cursor1 = Number(default=0.0, bounds=(0.0, 1000.0), doc="Delta cursor 1 in Hz (0: off).")
-    cursor2 = Number(default=0.0, bounds=(0.0, 1000.0), doc="Delta cursor 2 in Hz (0: off).")
+    log_freq = param.Boolean(
+        metadata=setting("alog"), default=False, doc="Logarithmic frequency axis (phase view)."
+    )
+    cursor1 = Number(
+        metadata=setting("c1"),
+        default=0.0,
+        bounds=(0.0, 1000.0),
+        doc="Delta cursor 1 in Hz (0: off).",
+    )
+    cursor2 = Number(
+        metadata=setting("c2"),
+        default=0.0,
+        bounds=(0.0, 1000.0),
+        doc="Delta cursor 2 in Hz (0: off).",
+    )
     picked_speed = Number(
-        default=0.0, bounds=(0.0, 300.0), doc="Speed picked in the speed views, km/h (0: none)."
+        metadata=setting("pv"),
+        default=0.0,
+        bounds=(0.0, 300.0),
+        doc="Speed picked in the speed views, km/h (0: none).",
     )
     picked_freq = Number(
-        default=0.0, bounds=(0.0, 1000.0), doc="Frequency picked in a view, Hz (0: none)."
+        metadata=setting("pf"),
+        default=0.0,
+        bounds=(0.0, 1000.0),
+        doc="Frequency picked in a view, Hz (0: none).",
     )
     contrib_mode = param.Selector(
-        default="lines", objects=list(CONTRIBUTION_MODES), doc="Contributions as lines or stacked."
+        metadata=setting("acontrib"),
+        default="lines",
+        objects=list(CONTRIBUTION_MODES),
+        doc="Contributions as lines or stacked.",
     )
     pins = param.String(
+        metadata=setting("pins", field="pin_text"),
         default="",
         doc="Pinned baselines as settings (app.pin_settings.encode_pins); their data live in "
         "the results.",
     )
     compare_to = param.String(
-        default="", doc="Pin the difference map is taken against ('': the first pin)."
+        metadata=setting("cmp"),
+        default="",
+        doc="Pin the difference map is taken against ('': the first pin).",
     )
     mode_pick = Integer(
+        metadata=setting("mode"),
         default=-1,
         bounds=(-1, MAX_MODE_PAIR),
         doc="Tire mode drawn in the Modes tab: its stored pair index (-1: the mode at the top "
         "of the participation ranking).",
     )
     mode_speed = Number(
+        metadata=setting("mv"),
         default=0.0,
         bounds=(0.0, 300.0),
         doc="Speed (km/h) the mode shape is drawn at (0: where the harmonic line meets the "
         "mode in the band).",
     )
     mode_rank = param.Selector(
+        metadata=setting("mrank"),
         default="loo",
         objects=list(MODE_RANKINGS),
         doc="Measure of the participation ranking: leave-one-out error (both paths), the same "
         "over the floating band, band share, level, or the direct path alone.",
     )
     waves_all = param.Boolean(
+        metadata=setting("wall"),
         default=False,
         doc="Campbell diagram of the waves: every branch (else the readable default: the "
         "branches in the harmonic's band of the orders that carry its response).",

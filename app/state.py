@@ -14,8 +14,10 @@ from fbs_core.vocabulary import COUPLINGS, DIRECTIONS
 
 from .analysis_state import AnalysisState
 from .datasource import REFERENCE, DataSource, Models
+from .page.layout import PageState
 from .params import Integer, Number
 from .review import EMPTY_REVIEW, Review
+from .schema import Schema, setting
 
 __all__ = [
     "DIRECTIONS",
@@ -34,6 +36,7 @@ __all__ = [
     "ResponsePlotState",
     "DashboardState",
     "URL_KEYS",
+    "SCHEMA",
 ]
 
 #: Where the Monte-Carlo noise is applied (thesis eqs. 5.2-5.4).
@@ -85,51 +88,77 @@ class _TargetSelector(param.Selector):
 class CaseState(param.Parameterized):
     """The prediction case: harmonic, retained tire modes, response DOF, hub coupling."""
 
-    harmonic = Integer(default=1, bounds=(1, 7), doc="Harmonic excitation case (thesis fig. 4.4).")
+    harmonic = Integer(
+        metadata=setting("h", "harmonic case 1-7"),
+        default=1,
+        bounds=(1, 7),
+        doc="Harmonic excitation case (thesis fig. 4.4).",
+    )
     n_modes = param.Selector(
+        metadata=setting("N", "retained tire modes N"),
         default=50,
         objects=list(MODE_COUNTS),
         doc="Retained complex tire modes N, 10-400 in steps of 10 (in +/- pairs: N/2 "
         "physical modes, lowest first; thesis 5.1).",
     )
-    dof = param.Selector(default="z", objects=list(DIRECTIONS), doc="Response DOF at the bushing.")
+    dof = param.Selector(
+        metadata=setting("dof", "response DOF direction at the bushing"),
+        default="z",
+        objects=list(DIRECTIONS),
+        doc="Response DOF at the bushing.",
+    )
     coupling = param.Selector(
+        metadata=setting("coupling", "hub coupling"),
         default="6dof",
         objects=list(COUPLINGS),
         doc="Couple all 6 hub DOFs (braked wheel) or 5 with the spin (ry) released.",
     )
     show_uncoupled = param.Boolean(
-        default=False, doc="Also show the uncoupled tire (hub) and chassis FRFs."
+        metadata=setting("uncoupled", "uncoupled subsystems shown"),
+        default=False,
+        doc="Also show the uncoupled tire (hub) and chassis FRFs.",
     )
     spindle_input = param.Selector(
+        metadata=setting("input", "spindle input of the uncoupled chassis mobility"),
         default="z",
         objects=list(DIRECTIONS),
         doc="Spindle input DOF of the uncoupled chassis spindle-to-bushing mobility.",
     )
     residual = param.Boolean(
+        metadata=setting("res", "residual compensation of the tire modes left out of N"),
         default=False,
         doc="Residual compensation: the tire modes left out of N still enter with their "
         "quasi-static part (upper residual flexibility, docs/tire-model.md); acts on the "
         "coupled response, the error map and the suggested N it marks.",
     )
     scope = param.Selector(
+        metadata=setting(
+            "scope", "corner (the thesis' tire on the rear corner) or vehicle (the whole car)"
+        ),
         default="corner",
         objects=list(SCOPES),
         doc="Corner: the thesis' tire on the rear corner. Vehicle: the reference car with the "
         "tire on all four wheels (docs/vehicle-model.md).",
     )
     wheels = _WheelsSelector(
+        metadata=setting(
+            "wheels", "vehicle scope: the wheels whose road input is on", vehicle=True
+        ),
         default=list(WHEELS),
         objects=list(WHEELS),
         doc="Vehicle scope: the wheels whose road input is on (the others still carry their tire).",
     )
     tracks = param.Selector(
+        metadata=setting(
+            "tracks", "vehicle scope: the right track's road against the left's", vehicle=True
+        ),
         default="in phase",
         objects=list(TRACK_RELATIONS),
         doc="Vehicle scope: the right track's road against the left's: in phase, in "
         "anti-phase, or partially coherent (the coherence value).",
     )
     coherence = Number(
+        metadata=setting("coh", "vehicle scope: coherency of the two tracks", vehicle=True),
         default=0.5,
         bounds=(-1.0, 1.0),
         step=0.05,
@@ -137,12 +166,14 @@ class CaseState(param.Parameterized):
         "(1 in phase, -1 anti-phase, 0 independent).",
     )
     point = param.Selector(
+        metadata=setting("point", "vehicle scope: the car's response point", vehicle=True),
         default="bushing_rl",
         objects=list(RESPONSE_NODES),
         doc="Vehicle scope: the response point (six DOFs; the response DOF picks one). "
         "bushing_rl is the thesis' bushing on the car.",
     )
     models = param.ClassSelector(
+        metadata=setting(None),
         class_=Models,
         default=REFERENCE,
         instantiate=False,
@@ -151,6 +182,7 @@ class CaseState(param.Parameterized):
         "DashboardState.data; not a control and not in the URL.",
     )
     review = param.ClassSelector(
+        metadata=setting(None),
         class_=Review,
         default=EMPTY_REVIEW,
         instantiate=False,
@@ -164,6 +196,7 @@ class NoiseState(param.Parameterized):
     """Monte-Carlo noise study settings (thesis section 5.2)."""
 
     noise = Number(
+        metadata=setting("noise", "noise level p in %"),
         default=10.0,
         bounds=(0.0, MAX_NOISE_PCT),
         softbounds=(0.0, 10.0),
@@ -172,33 +205,42 @@ class NoiseState(param.Parameterized):
         "(below 100 %: a factor must stay positive, as fbs_core.scatter_band requires).",
     )
     target = _TargetSelector(
-        default="both", objects=list(NOISE_TARGETS), doc="Subsystem(s) that get noise."
+        metadata=setting("target", "subsystem(s) with noise"),
+        default="both",
+        objects=list(NOISE_TARGETS),
+        doc="Subsystem(s) that get noise.",
     )
     frequency_dependent = param.Boolean(
+        metadata=setting("fdep", "new scaling matrix at every line"),
         default=False,
         doc="New scaling matrix at every frequency line (else one per round).",
     )
     rounds = Integer(
+        metadata=setting("rounds", "Monte-Carlo rounds R"),
         default=CORNER_ROUNDS,
         bounds=(1, 200_000),
         doc="Number of Monte-Carlo rounds R.",
     )
     seed = Integer(
+        metadata=setting("seed", "random seed"),
         default=0,
         bounds=(0, MAX_SEED),
         doc="Random seed of the study (up to 2**32 - 1: exact in a browser's numbers).",
     )
     single_round = Integer(
+        metadata=setting("round", "index of the single round drawn"),
         default=0,
         bounds=(0, 200_000 - 1),
         doc="Index of the single polluted round drawn inside the band (0-based).",
     )
     percentile = param.Selector(
+        metadata=setting("pct", "width of the central percentile band in %"),
         default=90,
         objects=[50, 80, 90, 95, 99],
         doc="Width of the central percentile band in percent (90 -> 5-95 %).",
     )
     first_order = param.Boolean(
+        metadata=setting("fo", "first-order band overlaid on the scatter band"),
         default=False,
         doc="Overlay the first-order (linearised) band of the same noise on the scatter "
         "band: |v| +- k std with k the Gaussian quantile of the central percentile band "
@@ -217,6 +259,7 @@ class TruncationState(param.Parameterized):
     """Truncation study settings (thesis section 5.1)."""
 
     threshold = Number(
+        metadata=setting("thr", "error threshold in %"),
         default=20.0,
         bounds=(0.1, 1000.0),
         softbounds=(1.0, 50.0),
@@ -224,6 +267,7 @@ class TruncationState(param.Parameterized):
         doc="Error threshold in percent: colour cap of the map and criterion of the table.",
     )
     f_max = Number(
+        metadata=setting("fmax", "upper frequency of the suggested N in Hz"),
         default=160.0,
         bounds=(1.0, 1000.0),
         softbounds=(50.0, 450.0),
@@ -231,6 +275,7 @@ class TruncationState(param.Parameterized):
         doc="Upper frequency in Hz for the suggested number of modes (table 5.1).",
     )
     map_mode = param.Selector(
+        metadata=setting("map", "error map of the selected DOF or the maximum over 6 DOFs"),
         default=MAP_MODES[0],
         objects=list(MAP_MODES),
         doc="Error map of the selected DOF (fig. 5.3/5.7) or the maximum over 6 DOFs (fig. 5.6).",
@@ -246,23 +291,32 @@ class ResponsePlotState(param.Parameterized):
     axis, two labelled cursors with a readout."""
 
     overlay = param.ListSelector(
+        metadata=setting("over"),
         default=[],
         objects=list(DIRECTIONS),
         doc="Further bushing DOFs overlaid on the coupled response (their curves with N "
         "modes); the selected DOF is always shown.",
     )
     level_scale = param.Selector(
+        metadata=setting("lvl"),
         default="dB",
         objects=list(LEVEL_SCALES),
         doc="Level axis: dB (20 log10 |v|) or the magnitude |v| on a linear axis.",
     )
     cursor1 = Number(
-        default=0.0, bounds=(0.0, 1000.0), doc="Cursor 1 on the coupled response in Hz (0: off)."
+        metadata=setting("mc1", field="mcursor1"),
+        default=0.0,
+        bounds=(0.0, 1000.0),
+        doc="Cursor 1 on the coupled response in Hz (0: off).",
     )
     cursor2 = Number(
-        default=0.0, bounds=(0.0, 1000.0), doc="Cursor 2 on the coupled response in Hz (0: off)."
+        metadata=setting("mc2", field="mcursor2"),
+        default=0.0,
+        bounds=(0.0, 1000.0),
+        doc="Cursor 2 on the coupled response in Hz (0: off).",
     )
     snap = param.Boolean(
+        metadata=setting("snap"),
         default=False,
         doc="The cursors snap to the nearest peak of the selected DOF's curve with N modes.",
     )
@@ -311,55 +365,17 @@ class DashboardState(param.Parameterized):
         self.case.param.update(models=self.data.models, review=self.data.review)
 
 
+#: The dashboard's settings, each declared once on its parameter (``metadata=setting(...)``):
+#: the link's keys, the snapshot's fields and the report's settings table are derived here.
+SCHEMA = Schema(
+    {
+        "case": CaseState,
+        "noise": NoiseState,
+        "truncation": TruncationState,
+        "analysis": AnalysisState,
+        "plot": ResponsePlotState,
+    },
+    page={"page": PageState},
+)
 #: URL query keys of each state parameter (short, stable: links are shared in reviews).
-URL_KEYS: dict[str, dict[str, str]] = {
-    "case": {
-        "harmonic": "h",
-        "n_modes": "N",
-        "dof": "dof",
-        "coupling": "coupling",
-        "show_uncoupled": "uncoupled",
-        "spindle_input": "input",
-        "residual": "res",
-        "scope": "scope",
-        "wheels": "wheels",
-        "tracks": "tracks",
-        "coherence": "coh",
-        "point": "point",
-    },
-    "noise": {
-        "noise": "noise",
-        "target": "target",
-        "frequency_dependent": "fdep",
-        "rounds": "rounds",
-        "seed": "seed",
-        "single_round": "round",
-        "percentile": "pct",
-        "first_order": "fo",
-    },
-    "truncation": {"threshold": "thr", "f_max": "fmax", "map_mode": "map"},
-    "analysis": {
-        "tab": "atab",
-        "frf": "afrf",
-        "phase_mode": "aphase",
-        "log_freq": "alog",
-        "cursor1": "c1",
-        "cursor2": "c2",
-        "picked_speed": "pv",
-        "picked_freq": "pf",
-        "contrib_mode": "acontrib",
-        "pins": "pins",
-        "compare_to": "cmp",
-        "mode_pick": "mode",
-        "mode_speed": "mv",
-        "mode_rank": "mrank",
-        "waves_all": "wall",
-    },
-    "plot": {
-        "overlay": "over",
-        "level_scale": "lvl",
-        "cursor1": "mc1",
-        "cursor2": "mc2",
-        "snap": "snap",
-    },
-}
+URL_KEYS: dict[str, dict[str, str]] = SCHEMA.url_keys

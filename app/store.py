@@ -214,19 +214,10 @@ def scoped(corner: Callable[[Snapshot], Any], car: Callable[[Snapshot], Any]):
 CASE = ("harmonic", "n_modes", "dof", "coupling", "residual", "models")
 #: The whole car's fields (vehicle scope).
 VEHICLE = ("scope", *VEHICLE_FIELDS)
+#: The noise study's own settings of a scatter band.
+NOISE_STUDY = ("noise", "target", "frequency_dependent", "rounds", "seed")
 #: The settings of a scatter band (its cache key).
-BAND = (
-    "harmonic",
-    "n_modes",
-    "coupling",
-    "models",
-    "noise",
-    "target",
-    "frequency_dependent",
-    "rounds",
-    "seed",
-    *VEHICLE,
-)
+BAND = ("harmonic", "n_modes", "coupling", "models", *NOISE_STUDY, *VEHICLE)
 #: The FRFs of the phase view.
 PHASE = (*CASE, "spindle_input", "frf")
 #: The participation of the tire modes: the harmonic's band up to f_max, every mode.
@@ -366,7 +357,7 @@ TABLE: tuple[Row, ...] = (
     ),
     Row(
         "compare",
-        (*CASE, "pins", "compare_to", "band", "percentile", "map_mode", *BAND[4:]),
+        (*CASE, "pins", "compare_to", "band", "percentile", "map_mode", *NOISE_STUDY, *VEHICLE),
         pins.compare_result,
         when=while_tab("compare"),
         doc="The current state against the pins.",

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import param
 
+from ..schema import setting, url_keys_of
+
 __all__ = [
     "PageState",
     "PAGE_URL_KEYS",
@@ -28,25 +30,36 @@ class PageState(param.Parameterized):
     """How the page is laid out (not what it computes)."""
 
     view: param.Selector[str] = param.Selector(
+        metadata=setting("view"),
         default="normal",
         objects=["normal", "present"],
         doc="normal, or present: the presentation view for a projector.",
     )
     data_card: param.Selector[str] = param.Selector(
-        default="open", objects=["open", "closed"], doc="The 'Your data' card open or collapsed."
+        metadata=setting("card"),
+        default="open",
+        objects=["open", "closed"],
+        doc="The 'Your data' card open or collapsed.",
     )
     n_axis: param.Selector[str] = param.Selector(
-        default="linear", objects=["linear", "log"], doc="Scale of the error map's N axis."
+        metadata=setting("naxis", "scale of the N axis of the error map"),
+        default="linear",
+        objects=["linear", "log"],
+        doc="Scale of the error map's N axis.",
     )
     data = param.String(
-        default="", doc="The uploads the page's results need (empty: the reference models)."
+        metadata=setting("data"),
+        default="",
+        doc="The uploads the page's results need (empty: the reference models).",
     )
     review = param.String(
+        metadata=setting("review"),
         default="",
         doc="The review: candidates' digests, the current one, the incumbent rule and the "
         "targets (app.review.review_link; empty: no review).",
     )
     sidebar: param.Selector[str] = param.Selector(
+        metadata=setting("sidebar"),
         default="auto",
         objects=["auto", "open", "closed"],
         doc="The controls' sidebar: auto (open in the normal view, collapsed in the "
@@ -60,14 +73,7 @@ class PageState(param.Parameterized):
 
 
 #: URL query keys of the page state.
-PAGE_URL_KEYS = {
-    "view": "view",
-    "data_card": "card",
-    "n_axis": "naxis",
-    "data": "data",
-    "sidebar": "sidebar",
-    "review": "review",
-}
+PAGE_URL_KEYS = url_keys_of(PageState)
 
 #: Larger type of the controls and cards in the presentation view: the page's font size
 #: and Bokeh's font-size variable, which the widgets and cards inside their shadow roots

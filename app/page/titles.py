@@ -100,17 +100,9 @@ def view_title(
 
 def _url_defaults() -> dict[str, object]:
     """Default value of every URL query key of the page (state and layout)."""
-    from ..state import URL_KEYS, DashboardState
-    from .layout import PAGE_URL_KEYS, PageState
+    from ..state import SCHEMA
 
-    out: dict[str, object] = {}
-    for group, keys in URL_KEYS.items():
-        cls = DashboardState.param[group].class_
-        for name, key in keys.items():
-            out[key] = cls.param[name].default
-    for name, key in PAGE_URL_KEYS.items():
-        out[key] = PageState.param[name].default
-    return out
+    return {st.url: st.default for st in SCHEMA.settings if st.url}
 
 
 def _is_default(value: Any, default: object) -> bool:
@@ -189,52 +181,36 @@ def _serialize(obj_cls: Any, name: str, value: Any) -> str:
     return out if isinstance(out, str) else json.dumps(out)
 
 
-def state_query(s: Any, layout: Mapping[str, Any] | None = None) -> dict[str, str]:
+def state_query(
+    s: Any, layout: Mapping[str, Any] | None = None, schema: Any = None
+) -> dict[str, str]:
     """The URL query of the settings of ``s`` (a :class:`app.results.Snapshot`, or a
     ``DashboardState``) that differ from the defaults, written as the page writes its URL;
     ``layout``: page-layout keys (``naxis``, ``data``...) added when not at their default.
+    ``schema``: the declared settings (default :data:`app.state.SCHEMA`).
 
     The same function writes the page's URL and every title block's link, so that a plot's
     link and the URL of the state it was drawn for are the same text."""
-    from ..results.base import FIELDS
-    from ..state import URL_KEYS, DashboardState
+    from ..state import SCHEMA, DashboardState
 
-    by_param = {(group, p): field for field, (group, p) in FIELDS.items()}
-    query: dict[str, Any] = {}
-    for group, keys in URL_KEYS.items():
-        cls = DashboardState.param[group].class_
-        obj = getattr(s, group) if isinstance(s, DashboardState) else None
-        for name, key in keys.items():
-            if obj is not None:
-                value = getattr(obj, name)
-            else:
-                value = getattr(s, by_param[(group, name)])
-            query[key] = _serialize(cls, name, value)
-    if layout:
-        from .layout import PAGE_URL_KEYS, PageState
-
-        keys = {v: k for k, v in PAGE_URL_KEYS.items()}
-        for key, value in layout.items():
-            if key in keys:
-                query[key] = _serialize(PageState, keys[key], value)
-    defaults = {k: _serialize_default(k) for k in query}
-    return {k: str(v) for k, v in query.items() if v != defaults[k]}
-
-
-def _serialize_default(key: str) -> str | None:
-    """The serialized default value of URL key ``key`` (None: no such key)."""
-    from ..state import URL_KEYS, DashboardState
-    from .layout import PAGE_URL_KEYS, PageState
-
-    for group, keys in URL_KEYS.items():
-        cls = DashboardState.param[group].class_
-        for name, k in keys.items():
-            if k == key:
-                return _serialize(cls, name, cls.param[name].default)
-    for name, k in PAGE_URL_KEYS.items():
-        if k == key:
-            return _serialize(PageState, name, PageState.param[name].default)
-    return None
+    schema = SCHEMA if schema is None else schema
+    layout = layout or {}
+    query: dict[str, str] = {}
+    for st in schema.settings:
+        if not st.url:
+            continue
+        if st.field is None:  # the page's layout
+            if st.url not in layout:
+                continue
+            value = layout[st.url]
+        elif isinstance(s, DashboardState):
+            value = getattr(getattr(s, st.group), st.name)
+        else:
+            value = getattr(s, st.field)
+        text = _serialize(st.owner, st.name, value)
+        if text != _serialize(st.owner, st.name, st.default):
+            query[st.url] = str(text)
+    return query
 
 
 class ViewLinks:

@@ -24,6 +24,8 @@ from fbs_core.analysis import Contributions, Peak
 from fbs_core.errors import FBSError
 from fbs_core.vocabulary import COUPLINGS, DIRECTIONS, percent
 
+from ..state import SCHEMA
+
 __all__ = [
     "present",
     "ExtraSection",
@@ -41,48 +43,15 @@ __all__ = [
 
 #: Noise targets, map modes and N-axis scales accepted in the settings (the dashboard's
 #: choices; the DOF directions and couplings are the core's vocabulary).
-NOISE_TARGETS = ("both", "tire", "chassis")
-MAP_MODES = ("selected DOF", "max over 6 DOFs")
-N_AXES = ("linear", "log")
+NOISE_TARGETS = SCHEMA.choices["target"]
+MAP_MODES = SCHEMA.choices["map_mode"]
+N_AXES = SCHEMA.choices["n_axis"]
 
-#: Settings a report may hold: name -> (type, meaning). The first four are required.
-SETTING_KEYS: dict[str, tuple[type, str]] = {
-    "harmonic": (int, "harmonic case 1-7"),
-    "n_modes": (int, "retained tire modes N"),
-    "dof": (str, "response DOF direction at the bushing"),
-    "coupling": (str, "hub coupling"),
-    "residual": (bool, "residual compensation of the tire modes left out of N"),
-    "spindle_input": (str, "spindle input of the uncoupled chassis mobility"),
-    "show_uncoupled": (bool, "uncoupled subsystems shown"),
-    "threshold": (float, "error threshold in %"),
-    "f_max": (float, "upper frequency of the suggested N in Hz"),
-    "map_mode": (str, "error map of the selected DOF or the maximum over 6 DOFs"),
-    "n_axis": (str, "scale of the N axis of the error map"),
-    "noise": (float, "noise level p in %"),
-    "target": (str, "subsystem(s) with noise"),
-    "frequency_dependent": (bool, "new scaling matrix at every line"),
-    "rounds": (int, "Monte-Carlo rounds R"),
-    "seed": (int, "random seed"),
-    "single_round": (int, "index of the single round drawn"),
-    "percentile": (int, "width of the central percentile band in %"),
-    "scope": (str, "corner (the thesis' tire on the rear corner) or vehicle (the whole car)"),
-    "wheels": (str, "vehicle scope: the wheels whose road input is on"),
-    "tracks": (str, "vehicle scope: the right track's road against the left's"),
-    "coherence": (float, "vehicle scope: coherency of the two tracks"),
-    "point": (str, "vehicle scope: the car's response point"),
-    "first_order": (bool, "first-order band overlaid on the scatter band"),
-}
+#: Settings a report may hold: name -> (type, meaning), from the settings schema (each
+#: setting's declaration gives its label). The first four are required.
+SETTING_KEYS: dict[str, tuple[type, str]] = SCHEMA.report_keys
 _REQUIRED = ("harmonic", "n_modes", "dof", "coupling")
-_CHOICES = {
-    "dof": DIRECTIONS,
-    "spindle_input": DIRECTIONS,
-    "coupling": COUPLINGS,
-    "target": NOISE_TARGETS,
-    "map_mode": MAP_MODES,
-    "n_axis": N_AXES,
-    "scope": ("corner", "vehicle"),
-    "tracks": ("in phase", "anti-phase", "coherence"),
-}
+_CHOICES = SCHEMA.choices
 #: Settings each result needs to be described.
 _NEEDS = {
     "truncation": ("threshold", "f_max", "map_mode"),

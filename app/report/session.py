@@ -15,6 +15,7 @@ import datetime as dt
 from collections.abc import Iterable
 from typing import Any
 
+from ..state import SCHEMA
 from .data import SETTING_KEYS, DataFile, ExtraSection, Provenance, ReportData, ReportError
 
 __all__ = ["BUILTIN_RESULTS", "depends", "provenance_of", "report_data", "settings_of"]
@@ -59,7 +60,7 @@ def settings_of(s: Any, n_axis: str = "linear") -> dict[str, Any]:
     out = {k: getattr(s, k) for k in SETTING_KEYS if hasattr(s, k)}
     out["n_axis"] = n_axis
     if out.get("scope") != "vehicle":  # the car's settings only where they act
-        for k in ("wheels", "tracks", "coherence", "point"):
+        for k in SCHEMA.vehicle_fields:
             out.pop(k, None)
     else:
         out["wheels"] = " ".join(w.upper() for w in out.get("wheels", ())) or "none"

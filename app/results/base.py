@@ -11,11 +11,12 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import numpy as np
 
 from .. import compute
+from ..state import SCHEMA
 
 __all__ = [
     "FIELDS",
@@ -30,127 +31,48 @@ __all__ = [
 ]
 
 #: Field of a snapshot -> (group of the session's state, parameter of that group).
-FIELDS: dict[str, tuple[str, str]] = {
-    "harmonic": ("case", "harmonic"),
-    "n_modes": ("case", "n_modes"),
-    "dof": ("case", "dof"),
-    "coupling": ("case", "coupling"),
-    "residual": ("case", "residual"),
-    "show_uncoupled": ("case", "show_uncoupled"),
-    "spindle_input": ("case", "spindle_input"),
-    "models": ("case", "models"),
-    "review": ("case", "review"),
-    "scope": ("case", "scope"),
-    "wheels": ("case", "wheels"),
-    "tracks": ("case", "tracks"),
-    "coherence": ("case", "coherence"),
-    "point": ("case", "point"),
-    "noise": ("noise", "noise"),
-    "target": ("noise", "target"),
-    "frequency_dependent": ("noise", "frequency_dependent"),
-    "rounds": ("noise", "rounds"),
-    "seed": ("noise", "seed"),
-    "single_round": ("noise", "single_round"),
-    "percentile": ("noise", "percentile"),
-    "first_order": ("noise", "first_order"),
-    "threshold": ("truncation", "threshold"),
-    "f_max": ("truncation", "f_max"),
-    "map_mode": ("truncation", "map_mode"),
-    "tab": ("analysis", "tab"),
-    "frf": ("analysis", "frf"),
-    "phase_mode": ("analysis", "phase_mode"),
-    "log_freq": ("analysis", "log_freq"),
-    "cursor1": ("analysis", "cursor1"),
-    "cursor2": ("analysis", "cursor2"),
-    "picked_speed": ("analysis", "picked_speed"),
-    "picked_freq": ("analysis", "picked_freq"),
-    "contrib_mode": ("analysis", "contrib_mode"),
-    "pin_text": ("analysis", "pins"),
-    "compare_to": ("analysis", "compare_to"),
-    "overlay": ("plot", "overlay"),
-    "level_scale": ("plot", "level_scale"),
-    "mcursor1": ("plot", "cursor1"),
-    "mcursor2": ("plot", "cursor2"),
-    "snap": ("plot", "snap"),
-    "mode_pick": ("analysis", "mode_pick"),
-    "mode_speed": ("analysis", "mode_speed"),
-    "mode_rank": ("analysis", "mode_rank"),
-    "waves_all": ("analysis", "waves_all"),
-}
+FIELDS: dict[str, tuple[str, str]] = SCHEMA.fields
 #: Fields of a snapshot that are published results, not settings.
 PUBLISHED = ("band", "pins")
-_TYPES = {"int": int, "float": float, "bool": bool, "str": str, "tuple": tuple}
 #: Fields that act only in vehicle scope (a corner's results are not made of them).
-VEHICLE_FIELDS = ("wheels", "tracks", "coherence", "point")
+VEHICLE_FIELDS = SCHEMA.vehicle_fields
 
 
 @dataclass(frozen=True)
-class Snapshot:
+class _SnapshotBase:
     """A session's state at one moment: its settings (plain values) and the published
-    inputs other results are made of. Equal snapshots make equal results."""
+    inputs other results are made of. Equal snapshots make equal results.
 
-    harmonic: int
-    n_modes: int
-    dof: str
-    coupling: str
-    residual: bool
-    show_uncoupled: bool
-    spindle_input: str
-    models: Any  # app.datasource.Models (hashed by the digest of the uploads)
-    review: Any  # app.review.Review (candidates, targets; hashed by their digest)
-    scope: str
-    wheels: tuple
-    tracks: str
-    coherence: float
-    point: str
-    noise: float
-    target: str
-    frequency_dependent: bool
-    rounds: int
-    seed: int
-    single_round: int
-    percentile: int
-    first_order: bool
-    threshold: float
-    f_max: float
-    map_mode: str
-    tab: str
-    frf: str
-    phase_mode: str
-    log_freq: bool
-    cursor1: float
-    cursor2: float
-    picked_speed: float
-    picked_freq: float
-    contrib_mode: str
-    pin_text: str
-    compare_to: str
-    overlay: tuple
-    level_scale: str
-    mcursor1: float
-    mcursor2: float
-    snap: bool
-    mode_pick: int
-    mode_speed: float
-    mode_rank: str
-    waves_all: bool
+    Its settings are one keyword field per setting of the session's state
+    (:data:`app.state.SCHEMA`, e.g. ``harmonic``, ``n_modes``, ``dof``), each held as a
+    plain value of its declared type; ``models`` and ``review`` are the session's uploads
+    and review (hashed by their digests)."""
+
     band: Any = None  # the published Band (compared by identity)
     pins: tuple = ()  # the published pins (app.results.pins.Pin, by identity)
+    #: The settings schema the fields were made from (set on the made class).
+    schema: ClassVar[Any] = None
+
+    if TYPE_CHECKING:  # the settings' fields are made from the schema
+
+        def __init__(self, **fields: Any) -> None: ...
+
+        def __getattr__(self, name: str) -> Any: ...
 
     @classmethod
-    def of(cls, state: Any, band: Any = None, pins: tuple = ()) -> Snapshot:
+    def of(cls, state: Any, band: Any = None, pins: tuple = ()) -> Self:
         """The snapshot of a ``DashboardState`` (and the published band and pins)."""
-        kw: dict[str, Any] = {}
-        for name, (group, p) in FIELDS.items():
-            value = getattr(getattr(state, group), p)
-            kind = cls.__dataclass_fields__[name].type
-            kw[name] = _TYPES[kind](value) if kind in _TYPES else value
+        kw = {
+            s.field: s.convert(getattr(getattr(state, s.group), s.name))
+            for s in cls.schema.settings
+            if s.field
+        }
         return cls(**kw, band=band, pins=tuple(pins))
 
-    def replace(self, **changes: Any) -> Snapshot:
+    def replace(self, **changes: Any) -> Self:
         return dataclasses.replace(self, **changes)
 
-    def settings(self) -> Snapshot:
+    def settings(self) -> Self:
         """This snapshot without the published inputs (what a band or a pin keeps)."""
         return dataclasses.replace(self, band=None, pins=())
 
@@ -206,6 +128,12 @@ class Snapshot:
         """The published band if it was computed for this snapshot's settings."""
         b = self.band
         return b if b is not None and b.settings.band_key() == self.band_key() else None
+
+
+if TYPE_CHECKING:
+    Snapshot = _SnapshotBase
+else:
+    Snapshot = SCHEMA.snapshot_class(_SnapshotBase)
 
 
 @dataclass(frozen=True, eq=False)
