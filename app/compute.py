@@ -3,8 +3,10 @@
 The studies the dashboard shows are computed here (:mod:`app.analysis_compute` for the
 Analysis card's): results are cached per argument tuple (the core result objects are
 immutable), so that a control change that only selects (another response DOF, another N
-of the truncation map) costs a lookup. The only arithmetic done here is the conversion
-to dB for display (:func:`fbs_core.vocabulary.magnitude_db`).
+of the truncation map) costs a lookup. No statistics are computed here: the band's own
+(its percentiles' confidence, :meth:`fbs_core.ScatterBand.percentile_confidence_db`) are
+methods of the core's result; what is added is the conversion to dB for display
+(:func:`fbs_core.vocabulary.magnitude_db`) and the selection of one DOF's columns.
 
 The coupled response for N retained modes is read from the harmonic's truncation map
 (:func:`fbs_core.studies.truncation_map` computes the eq. 4.1 response for every
@@ -48,7 +50,6 @@ __all__ = [
     "Q_LEVELS",
     "BandKey",
     "BandTime",
-    "CONVERGENCE_WITHIN_DB",
     "band",
     "band_computed",
     "band_data",
@@ -59,8 +60,6 @@ __all__ = [
     "frequencies",
     "level_unit",
     "mobility_data",
-    "percentile_confidence_db",
-    "percentile_interval_db",
     "single_round_data",
     "suggested_table",
     "suggested_table_ready",
@@ -720,85 +719,3 @@ def single_round_data(result, index: int, dof: str) -> dict:
 def peak_round(result, freq: float, dof: str, which: str = "max") -> int:
     """The round with the highest (lowest) level at the line nearest ``freq``."""
     return int(result.peak_round(float(freq), _label(dof), which))
-
-
-def convergence_db(result) -> float:
-    """Largest change of either band edge (dB) between the last two checkpoints.
-
-    Of the minimum and maximum over the rounds: extreme values, driven by the rare rounds
-    that move an antiresonance or a resonance; they do not settle as rounds are added (29.5
-    dB at 10,000 rounds, 36.5 dB at 100,000, harmonic 1), so the page judges the band by
-    :func:`percentile_confidence_db` instead.
-    """
-    step = np.asarray(result.convergence.step_change_db, float)
-    return float(step[-1]) if step.size else float("nan")
-
-
-#: The lines a band's convergence is judged on: within this many dB of the peak of the
-#: unpolluted response at each DOF (the deep antiresonances, where a level in dB swings
-#: from round to round, are left out).
-CONVERGENCE_WITHIN_DB = 30.0
-#: Normal quantile of the two-sided 95 % confidence of :func:`percentile_confidence_db`.
-Z95 = 1.959964
-
-
-def percentile_interval_db(result, edge: float, z: float = Z95) -> tuple:
-    """The confidence interval (dB) of the band's ``edge`` % percentile at every line and
-    DOF: ``(low, high)``, arrays of shape ``(n_f, n_dof)``.
-
-    The rank of the empirical q-quantile of R independent rounds is binomial, so the true
-    quantile lies between the empirical quantiles of ``q -+ z sqrt(q (1 - q) / R)`` with
-    the normal confidence of ``z`` (1.96: 95 %; distribution-free, from order statistics);
-    those are read off the band's stored percentiles, interpolated linearly in ``q`` (and
-    clipped to the stored ones).
-    """
-    q = np.asarray(result.q, float)
-    lv = magnitude_db(np.asarray(result.percentiles, float))  # (n_q, n_f, n_dof)
-    r = max(int(result.rounds), 1)
-    dq = 100 * z * np.sqrt(edge / 100 * (1 - edge / 100) / r)
-    at = (np.clip(edge - dq, q[0], q[-1]), np.clip(edge + dq, q[0], q[-1]))
-    return _interp_levels(q, lv, float(at[0])), _interp_levels(q, lv, float(at[1]))
-
-
-def percentile_confidence_db(
-    result, width: float = 90, within_db: float = CONVERGENCE_WITHIN_DB
-) -> float:
-    """How well R rounds fix the central percentile band: the largest 95 % confidence
-    half-width (dB, :func:`percentile_interval_db`) of its two edges over the lines within
-    ``within_db`` of each DOF's peak. It falls as ``1 / sqrt(R)``: four times the rounds
-    halve it.
-
-    Parameters
-    ----------
-    result : fbs_core.ScatterBand
-        A band with the percentiles ``(100 -+ width) / 2`` and neighbours on both sides.
-    width : float
-        The central band in percent (90: the 5 % and 95 % percentiles).
-    within_db : float
-        Lines more than this below a DOF's peak reference level are left out.
-
-    Returns
-    -------
-    float
-        dB; NaN when no line qualifies.
-    """
-    q = np.asarray(result.q, float)
-    lv = magnitude_db(np.asarray(result.percentiles, float))
-    ref = magnitude_db(np.abs(np.asarray(result.reference)))  # (n_f, n_dof)
-    keep = ref >= np.nanmax(ref, axis=0, keepdims=True) - within_db
-    worst = np.nan
-    for edge in ((100 - width) / 2, (100 + width) / 2):
-        at = lv[int(np.argmin(np.abs(q - edge)))]
-        low, high = percentile_interval_db(result, edge)
-        half = np.where(keep, np.maximum(at - low, high - at), np.nan)
-        if np.isfinite(half).any():
-            worst = float(np.nanmax(half)) if worst != worst else max(worst, np.nanmax(half))
-    return float(worst)
-
-
-def _interp_levels(q: np.ndarray, lv: np.ndarray, x: float) -> np.ndarray:
-    """The levels ``lv`` (n_q, ...) at the percentile ``x``, linear between stored ones."""
-    i = int(np.clip(np.searchsorted(q, x) - 1, 0, q.size - 2))
-    t = (x - q[i]) / (q[i + 1] - q[i])
-    out: np.ndarray = (1 - t) * lv[i] + t * lv[i + 1]
-    return out

@@ -1,7 +1,7 @@
 """The band's status line (issue 29): a convergence measure that raising R can meet, and a
 band that was computed before said so.
 
-The measure (``compute.percentile_confidence_db``) is the 95 % confidence half-width of the
+The measure (``ScatterBand.percentile_confidence_db``) is the 95 % confidence half-width of the
 central band's edges from order statistics. Truth: independent replications (other seeds)
 against a band of many more rounds, whose percentiles stand for the true ones; and the
 ``1 / sqrt(R)`` law of the binomial rank. The extreme edges (minimum and maximum over the
@@ -15,6 +15,7 @@ import pytest
 
 from app import compute
 from app.runtime import bands
+from fbs_core.studies.scatter import EDGES_JUDGED_WITHIN_DB
 from fbs_core.vocabulary import magnitude_db
 
 H, N = 1, 50  # harmonic 1: 78 lines, the quickest band
@@ -35,13 +36,13 @@ def test_the_confidence_intervals_cover_the_true_edges(truth):
     rounds, seeds = 1000, range(20)
     q = list(np.asarray(truth.q, float))
     ref = magnitude_db(np.abs(truth.reference))
-    keep = ref >= ref.max(axis=0) - compute.CONVERGENCE_WITHIN_DB
+    keep = ref >= ref.max(axis=0) - EDGES_JUDGED_WITHIN_DB
     hits, total = 0, 0
     for seed in seeds:
         b = _band(rounds, seed)
         for edge in (5.0, 95.0):
             true = magnitude_db(truth.percentiles[q.index(edge)])
-            low, high = compute.percentile_interval_db(b, edge)
+            low, high = b.percentile_interval_db(edge)
             inside = (low <= true) & (true <= high)
             hits += int(inside[keep].sum())
             total += int(keep.sum())
@@ -52,7 +53,7 @@ def test_the_confidence_intervals_cover_the_true_edges(truth):
 
 
 def _half_widths(b, edge=5.0):
-    low, high = compute.percentile_interval_db(b, edge)
+    low, high = b.percentile_interval_db(edge)
     return (high - low) / 2
 
 
@@ -60,16 +61,14 @@ def test_four_times_the_rounds_halve_the_intervals():
     a, b = _half_widths(_band(2000, 3)), _half_widths(_band(8000, 3))
     ratio = float(np.median(a / b))  # the law per line; the largest line is noisier
     assert 1.6 <= ratio <= 2.5, ratio
-    assert compute.percentile_confidence_db(_band(8000, 3)) < compute.percentile_confidence_db(
-        _band(2000, 3)
-    )
+    assert _band(8000, 3).percentile_confidence_db() < _band(2000, 3).percentile_confidence_db()
 
 
 def test_the_extreme_edges_do_not_settle():
     """Why the line no longer judges the band by its minimum and maximum: their change over
     the last half of the rounds does not fall as rounds are added."""
-    a = compute.convergence_db(_band(1000, 3))
-    b = compute.convergence_db(_band(4000, 3))
+    a = _band(1000, 3).convergence.step_change_db[-1]
+    b = _band(4000, 3).convergence.step_change_db[-1]
     assert b > 0.5 * a, (a, b)
 
 
@@ -81,7 +80,7 @@ def test_the_line_says_what_it_measures_and_how_long_it_took():
     # asked just before it was ready: computed for this request
     fresh = bands.done_text(res, 2.0, key, now=when.ready + 0.01)
     assert fresh.startswith("1,000 rounds in 2.00 s") and "computed before" not in fresh
-    conf = compute.percentile_confidence_db(res)
+    conf = res.percentile_confidence_db()
     assert f"5-95 % band edges within ±{conf:.2f} dB (95 % confidence" in fresh
     assert "within 30 dB of the peak" in fresh
     # asked long after: a band computed before says so, with the time it took then

@@ -42,6 +42,7 @@ from collections.abc import Callable
 import panel as pn
 
 from fbs_core.errors import FBSError, StudyCancelled
+from fbs_core.studies.scatter import EDGES_JUDGED_WITHIN_DB
 
 from .. import compute, vehicle_compute
 from . import offload
@@ -338,7 +339,8 @@ def done_text(result, seconds: float, key: tuple, now: float | None = None) -> s
     """The status line of a finished band ``result`` of settings ``key``, ``seconds``
     after it was asked for: its rounds, how long it took (or that it was computed before,
     and how long it took then), and how well the rounds fix its central 5-95 % band
-    (:func:`app.compute.percentile_confidence_db`: to halve it, four times the rounds)."""
+    (:meth:`fbs_core.ScatterBand.percentile_confidence_db`: to halve it, four times the
+    rounds)."""
     rec = compute.band_computed(key)
     now = time.monotonic() if now is None else now
     if rec is not None and rec.ready < now - seconds - 0.05:  # ready before it was asked
@@ -346,10 +348,10 @@ def done_text(result, seconds: float, key: tuple, now: float | None = None) -> s
         when = f"computed before{took}"
     else:
         when = f"in {seconds:.2f} s"
-    conf = compute.percentile_confidence_db(result)
+    conf = result.percentile_confidence_db()
     edges = (
         f"5-95 % band edges within ±{conf:.2f} dB (95 % confidence, lines within "
-        f"{compute.CONVERGENCE_WITHIN_DB:g} dB of the peak; four times the rounds halve it)"
+        f"{EDGES_JUDGED_WITHIN_DB:g} dB of the peak; four times the rounds halve it)"
         if conf == conf
         else "no line within the peak's range to judge the band by"
     )

@@ -67,6 +67,7 @@ from .band_kernel import (
 MAX_ROUNDS = 1_000_000
 
 __all__ = [
+    "EDGES_JUDGED_WITHIN_DB",
     "TARGETS",
     "ScatterBand",
     "Convergence",
@@ -161,6 +162,21 @@ class Convergence:
         for r, u, lo in zip(self.rounds, self.upper_change_db, self.lower_change_db, strict=True):
             lines.append(f"{int(r):>6d}   {u:24.3f}   {lo:24.3f}")
         return "\n".join(lines)
+
+
+#: The lines a band's edges are judged on by default: within this many dB of the peak of
+#: the unpolluted response at each DOF (:meth:`ScatterBand.percentile_confidence_db`).
+EDGES_JUDGED_WITHIN_DB = 30.0
+#: Normal quantile of a two-sided 95 % confidence.
+Z95_TWO_SIDED = 1.959963984540054
+
+
+def _interp_levels(q: FloatArray, lv: FloatArray, x: float) -> FloatArray:
+    """The levels ``lv`` (n_q, ...) at the percentile ``x``, linear between stored ones."""
+    i = int(np.clip(np.searchsorted(q, x) - 1, 0, q.size - 2))
+    t = (x - q[i]) / (q[i + 1] - q[i])
+    out: FloatArray = (1 - t) * lv[i] + t * lv[i + 1]
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -295,6 +311,63 @@ class ScatterBand:
         line = int(np.argmin(np.abs(self.freq - freq)))
         arr = self.argmax_round if which == "max" else self.argmin_round
         return int(arr[line, self._dof(dof)])
+
+    def percentile_interval_db(
+        self, edge: float, z: float = Z95_TWO_SIDED
+    ) -> tuple[FloatArray, FloatArray]:
+        """The confidence interval (dB) of the band's ``edge`` % percentile at every line
+        and DOF: ``(low, high)``, arrays of shape ``(n_f, n_dof)``.
+
+        The rank of the empirical q-quantile of R independent rounds is binomial, so the
+        true quantile lies between the empirical quantiles of ``q -+ z sqrt(q (1 - q) / R)``
+        with the normal confidence of ``z`` (1.96: 95 %; distribution-free, from order
+        statistics); those are read off the stored percentiles, interpolated linearly in
+        ``q`` (and clipped to the stored ones).
+        """
+        q = np.asarray(self.q, float)
+        lv = magnitude_db(np.asarray(self.percentiles, float))  # (n_q, n_f, n_dof)
+        r = max(int(self.rounds), 1)
+        dq = 100 * z * np.sqrt(edge / 100 * (1 - edge / 100) / r)
+        lo = float(np.clip(edge - dq, q[0], q[-1]))
+        hi = float(np.clip(edge + dq, q[0], q[-1]))
+        return _interp_levels(q, lv, lo), _interp_levels(q, lv, hi)
+
+    def percentile_confidence_db(
+        self, width: float = 90, within_db: float = EDGES_JUDGED_WITHIN_DB
+    ) -> float:
+        """How well R rounds fix the central percentile band: the largest 95 % confidence
+        half-width (dB, :meth:`percentile_interval_db`) of its two edges over the lines
+        within ``within_db`` of each DOF's peak. It falls as ``1 / sqrt(R)``: four times
+        the rounds halve it. (The minimum and maximum over the rounds are extreme values
+        that do not settle as rounds are added; the percentiles do.)
+
+        Parameters
+        ----------
+        width : float
+            The central band in percent (90: the 5 % and 95 % percentiles; the band must
+            hold them and neighbours on both sides).
+        within_db : float
+            Lines more than this below a DOF's peak reference level are left out (the deep
+            antiresonances, where a level in dB swings from round to round).
+
+        Returns
+        -------
+        float
+            dB; NaN when no line qualifies.
+        """
+        q = np.asarray(self.q, float)
+        lv = magnitude_db(np.asarray(self.percentiles, float))
+        ref = magnitude_db(np.abs(np.asarray(self.reference)))  # (n_f, n_dof)
+        keep = ref >= np.nanmax(ref, axis=0, keepdims=True) - within_db
+        worst = np.nan
+        for edge in ((100 - width) / 2, (100 + width) / 2):
+            at = lv[int(np.argmin(np.abs(q - edge)))]
+            low, high = self.percentile_interval_db(edge)
+            half = np.where(keep, np.maximum(at - low, high - at), np.nan)
+            if np.isfinite(half).any():
+                top = float(np.nanmax(half))
+                worst = top if worst != worst else max(worst, top)
+        return float(worst)
 
     def factors(self, r: int, line: int = 0) -> dict[str, FloatArray]:
         """The scaling factors of round ``r`` at line index ``line``:
