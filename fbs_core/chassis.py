@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import functools
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -37,12 +37,20 @@ import numpy as np
 import scipy.linalg as sla
 from numpy.typing import ArrayLike
 
-from ._typing import ComplexArray, FloatArray, IntArray
+from ._typing import ComplexArray, FloatArray
 from .direct import SecondOrderSystem
 from .dofs import DIRECTIONS, index_of, node_labels
-from .errors import DataFormatError, FrequencyGridError, QuantityError
+from .errors import DataFormatError
 from .fe import FEModel, Material, Section, rigid_body_mass
-from .frf import FRF, QUANTITIES, check_grid
+from .frf import FRF, check_grid
+from .frf_model import (
+    FRFGiven,
+    match_grid,
+    modal_factors,
+    modal_sum,
+    read_model_frf,
+    receptance_frf,
+)
 
 __all__ = [
     "ChassisParameters",
@@ -298,13 +306,11 @@ class ChassisModel:
             ``Y_jj^E`` is ``.sel(outputs=SPINDLE)``, ``Y_ej^E`` ``.sel(outputs=BUSHING)``.
         """
         f = check_grid(freq)
-        outputs = SPINDLE + BUSHING if outputs is None else tuple(outputs)
-        inputs = SPINDLE if inputs is None else tuple(inputs)
-        if quantity not in QUANTITIES:
-            raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
-        data = _synth(self._p, f.tobytes(), tuple(outputs), tuple(inputs))
-        jw = 1j * 2 * np.pi * f
-        return FRF(f, data * (jw ** QUANTITIES[quantity])[:, None, None], outputs, inputs, quantity)
+        outs = SPINDLE + BUSHING if outputs is None else tuple(outputs)
+        ins = SPINDLE if inputs is None else tuple(inputs)
+        return receptance_frf(
+            f, outs, ins, quantity, lambda: _synth(self._p, f.tobytes(), outs, ins)
+        )
 
     def driving_point(self, freq: ArrayLike) -> FRF:
         """``Y_jj^E``: spindle mobility, 6 x 6 (``spindle:*`` to ``spindle:*``).
@@ -335,13 +341,11 @@ class ChassisModel:
 def _synth(
     p: ChassisParameters, fbytes: bytes, outputs: tuple[str, ...], inputs: tuple[str, ...]
 ) -> ComplexArray:
+    """Receptance ``(n_freq, n_out, n_in)`` by the exact modal sum (cached per grid)."""
     s, lam, V, W = _modal(p)
     oi = index_of(s.dofs, outputs, "chassis output DOF")
     ii = index_of(s.dofs, inputs, "chassis input DOF")
-    w2 = (2 * np.pi * np.frombuffer(fbytes, float)) ** 2
-    g = 1.0 / (lam[None, :] - w2[:, None])  # (n_freq, n_modes)
-    # (n_freq, n_out, n_modes) @ (n_modes, n_in) -> (n_freq, n_out, n_in)
-    H = (g[:, None, :] * V[oi][None]) @ W[:, ii]
+    H = modal_sum(modal_factors(lam, np.frombuffer(fbytes, float)), V[oi], W[:, ii])
     H.setflags(write=False)
     return H
 
@@ -362,26 +366,7 @@ def read_chassis_frf(path: str | os.PathLike[str]) -> FRF:
     DataFormatError
         If the file is not a chassis file of a known version.
     """
-    from .hdf5_guard import open_h5
-
-    with open_h5(path) as h:  # refuses links and data leaving the file
-        if h.attrs.get("format") != "tire-fbs" or h.attrs.get("model") != "reference chassis":
-            raise DataFormatError(
-                f"{path}: not a 'tire-fbs' reference chassis file "
-                f"(format={h.attrs.get('format')!r}, model={h.attrs.get('model')!r})"
-            )
-        g = h["frf"]
-
-        def labels(key: str) -> list[str]:
-            return [v.decode() if isinstance(v, bytes) else str(v) for v in g.attrs[key]]
-
-        return FRF(
-            g["freq"][()],
-            g["data"][()],
-            labels("outputs"),
-            labels("inputs"),
-            str(g.attrs["quantity"]),
-        )
+    return read_model_frf(path, "reference chassis")
 
 
 @functools.lru_cache(maxsize=1)
@@ -423,41 +408,7 @@ def carrier_mode_table(chassis: ChassisModel, fmax: float = 100.0) -> dict[str, 
     return {d: float(f[keep][np.argmax(e[keep, k])]) for k, d in enumerate(DIRECTIONS)}
 
 
-def match_grid(available: ArrayLike, wanted: ArrayLike, rtol: float = 1e-9) -> IntArray | None:
-    """Positions of the ``wanted`` frequencies in the sorted grid ``available``.
-
-    A line matches when it lies within ``rtol * max(1, |f|)`` Hz of a wanted frequency
-    (grids read from files carry rounding in their last digits).
-
-    Parameters
-    ----------
-    available : array_like, shape (n,)
-        Increasing frequencies in Hz.
-    wanted : array_like, shape (m,)
-        Frequencies in Hz.
-
-    Returns
-    -------
-    ndarray of int, shape (m,), or None
-        ``None`` when some wanted frequency has no line.
-
-    Examples
-    --------
-    >>> match_grid([1.0, 2.0, 3.0], [3.0, 1.0 + 1e-12]).tolist()
-    [2, 0]
-    >>> match_grid([1.0, 2.0], [1.5]) is None
-    True
-    """
-    F = np.asarray(available, float)
-    f = np.asarray(wanted, float)
-    if F.size == 0:
-        return None if f.size else np.zeros(0, int)
-    tol = rtol * np.maximum(1.0, np.abs(f))
-    idx = np.clip(np.searchsorted(F, f - tol), 0, F.size - 1)
-    return idx if bool(np.all(np.abs(F[idx] - f) <= tol)) else None
-
-
-class FRFChassis:
+class FRFChassis(FRFGiven):
     """A chassis given by a measured or computed mobility FRF, used like :class:`ChassisModel`.
 
     The FRF is used on its own lines; frequencies it does not hold are refused unless the
@@ -481,54 +432,19 @@ class FRFChassis:
     [2.0]
     """
 
-    def __init__(self, frf: FRF, interpolate: bool = False) -> None:
-        self.frf = frf
-        self.interpolate = bool(interpolate)
-
     def __repr__(self) -> str:
         return f"FRFChassis({self.frf!r}, interpolate={self.interpolate})"
 
-    def needs_interpolation(self, freq: ArrayLike) -> bool:
-        """True when some of ``freq`` (Hz) is not a line of the FRF."""
-        return match_grid(self.frf.freq, freq) is None
-
-    def on_grid(self, freq: ArrayLike) -> FRF:
-        """The whole FRF on ``freq`` (Hz): its own lines, else interpolated if allowed.
-
-        Raises
-        ------
-        FrequencyGridError
-            When some frequency is not a line of the FRF and ``interpolate`` is False,
-            naming the first missing one and how to allow interpolation.
-        """
-        f = np.asarray(freq, float)
-        idx = match_grid(self.frf.freq, f)
-        if idx is not None:
-            return self.frf.isel(freq=idx)
-        if self.interpolate:
-            return self.frf.interpolate(f)
+    def _refusal(self, f: FloatArray, missing: FloatArray) -> str:
+        """Names the first missing line and the dashboard's choice that interpolates."""
         F = self.frf.freq
-        tol = 1e-9 * np.maximum(1.0, np.abs(f))
-        near = np.clip(np.searchsorted(F, f - tol), 0, F.size - 1)
-        miss = f[np.abs(F[near] - f) > tol]
-        raise FrequencyGridError(
+        return (
             f"the chassis FRF ({F.size} lines, {F[0]:g}-{F[-1]:g} Hz) has no line at "
-            f"{miss.size} of the {f.size} analysis frequencies {f[0]:g}-{f[-1]:g} Hz "
-            f"(first: {miss[0]:g} Hz); tick 'interpolate onto the analysis grid' to "
+            f"{missing.size} of the {f.size} analysis frequencies {f[0]:g}-{f[-1]:g} Hz "
+            f"(first: {missing[0]:g} Hz); tick 'interpolate onto the analysis grid' to "
             "interpolate it explicitly (linear in real and imaginary part)"
         )
 
-    def mobility(
-        self,
-        freq: ArrayLike,
-        outputs: Iterable[str] | None = None,
-        inputs: Iterable[str] | None = None,
-        quantity: str = "mobility",
-    ) -> FRF:
-        """The FRF on ``freq`` (Hz), same signature as :meth:`ChassisModel.mobility`."""
-        Y = self.on_grid(freq)
-        Y = Y.sel(
-            outputs=SPINDLE + BUSHING if outputs is None else list(outputs),
-            inputs=SPINDLE if inputs is None else list(inputs),
-        )
-        return Y if quantity == Y.quantity else Y.to(quantity)
+    def _default_dofs(self) -> tuple[Sequence[str], Sequence[str]]:
+        """Outputs ``spindle:*`` then ``bushing:*``; inputs ``spindle:*``."""
+        return SPINDLE + BUSHING, SPINDLE

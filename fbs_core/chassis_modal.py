@@ -28,8 +28,9 @@ from numpy.typing import ArrayLike
 from ._typing import ComplexArray, FloatArray
 from .chassis import BUSHING, SPINDLE, ChassisModel, _modal, reference_chassis
 from .dofs import index_of
-from .errors import FBSError, ModeCountError, QuantityError
-from .frf import FRF, QUANTITIES, check_grid
+from .errors import FBSError, ModeCountError
+from .frf import FRF, check_grid
+from .frf_model import modal_factors, modal_sum, receptance_frf
 
 __all__ = ["ModalChassis", "modal_receptances"]
 
@@ -84,13 +85,10 @@ def modal_receptances(
             f"chassis mode counts must be increasing integers in 1..{n_m}, got "
             f"{np.asarray(n_modes).tolist()}"
         )
-    w2 = (2 * np.pi * f) ** 2
     edges = np.r_[0, n]
     out = np.zeros((n.size, f.size, V_out.shape[0], W_in.shape[1]), complex)
     for b, (a, e) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-        g = 1.0 / (lam[None, a:e] - w2[:, None])  # (n_f, k)
-        # (n_f, n_out, k) @ (k, n_in)
-        out[b] = (g[:, None, :] * V_out[None, :, a:e]) @ W_in[a:e]
+        out[b] = modal_sum(modal_factors(lam[a:e], f), V_out[:, a:e], W_in[a:e])
     out = np.cumsum(out, axis=0)
     if residual:
         static = (V_out / lam[None, :])[None] * W_in.T[:, None, :]  # (n_in, n_out, n_m)
@@ -181,13 +179,17 @@ class ModalChassis:
         quantity : {"receptance", "mobility", "accelerance"}
         """
         f = check_grid(freq)
-        outputs = SPINDLE + BUSHING if outputs is None else tuple(outputs)
-        inputs = SPINDLE if inputs is None else tuple(inputs)
-        if quantity not in QUANTITIES:
-            raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
+        outs = SPINDLE + BUSHING if outputs is None else tuple(outputs)
+        ins = SPINDLE if inputs is None else tuple(inputs)
+        return receptance_frf(f, outs, ins, quantity, lambda: self._receptance(f, outs, ins))
+
+    def _receptance(
+        self, f: FloatArray, outputs: tuple[str, ...], inputs: tuple[str, ...]
+    ) -> ComplexArray:
+        """Receptance ``(n_freq, n_out, n_in)`` of the kept modes (plus residual)."""
         s, lam, V, W = _modal(self._chassis.params)
         oi = index_of(s.dofs, outputs, "chassis output DOF")
         ii = index_of(s.dofs, inputs, "chassis input DOF")
-        H = modal_receptances(lam, V[oi], W[:, ii], f, [self.n_modes], self.residual)[0]
-        jw = 1j * 2 * np.pi * f
-        return FRF(f, H * (jw ** QUANTITIES[quantity])[:, None, None], outputs, inputs, quantity)
+        by_count = modal_receptances(lam, V[oi], W[:, ii], f, [self.n_modes], self.residual)
+        H: ComplexArray = by_count[0]
+        return H

@@ -33,7 +33,7 @@ from fbs_core.chassis import (  # noqa: E402
     ChassisModel,
     ChassisParameters,
 )
-from fbs_core.io.hdf5 import write_hdf5  # noqa: E402
+from fbs_core.io.hdf5 import write_model_hdf5  # noqa: E402
 
 COORDINATES = "ISO 8855 vehicle axes: x forward, y left, z up; origin at the subframe centre"
 TARGETS = {"x": 14.0, "y": 37.0, "ry": 47.0}
@@ -55,26 +55,17 @@ def write_h5(ch: ChassisModel, path: Path, freq: np.ndarray) -> None:
     """The project's HDF5 FRF layout (``fbs_core.io.hdf5``: root attributes and
     ``/frf``) plus the model itself: ``/parameters``, ``/system`` (sparse M, K)
     and ``/modes``."""
-    s = ch.system()
-    Y = ch.mobility(freq)
     meta = {
         "model": "reference rear-corner chassis",
         "coordinates": COORDINATES,
         "script": "scripts/build_reference_chassis.py",
     }
-    path.write_bytes(write_hdf5(Y, metadata=meta))
+    Y = ch.mobility(freq)
+    write_model_hdf5(path, Y, meta, "reference chassis", ch.system(), ("M", "K"))
     with h5py.File(path, "a") as h:
-        h.attrs["model"] = "reference chassis"
         g = h.create_group("parameters")
         for key, val in dataclasses.asdict(ch.params).items():
             g.attrs[key] = np.asarray(val, float)
-        g = h.create_group("system")
-        g.attrs.create("dofs", np.array(s.dofs, dtype=object), dtype=h5py.string_dtype())
-        for name in ("M", "K"):
-            a = getattr(s, name).tocsr()
-            sub = g.create_group(name)
-            sub["data"], sub["indices"], sub["indptr"] = a.data, a.indices, a.indptr
-            sub.attrs["shape"] = a.shape
         g = h.create_group("modes")
         g["eigenvalues"] = ch.eigenvalues()
         g["frequency_hz"] = ch.eigenfrequencies()

@@ -19,9 +19,11 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import time
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,12 +34,16 @@ from .assembly import FileUnits, assemble, dof_labels, metadata_from_json
 from .checks import Source, check_finite, frequency_from_units, kinds_text, units_line
 from .results import ResultData
 
+if TYPE_CHECKING:
+    from ..direct import SecondOrderSystem
+
 __all__ = [
     "read_hdf5",
     "read_hdf5_result",
     "result_to_hdf5",
     "write_hdf5",
     "write_hdf5_result",
+    "write_model_hdf5",
     "root_attrs",
 ]
 
@@ -89,6 +95,52 @@ def write_hdf5(frf: FRF, *, metadata: Mapping[str, Any] | None = None) -> bytes:
         _set_attrs(h, root_attrs(metadata, "FRF"))
         _put_frf(h.create_group("frf"), frf)
     return b.getvalue()
+
+
+def write_model_hdf5(
+    path: str | os.PathLike[str],
+    frf: FRF,
+    metadata: Mapping[str, Any],
+    model: str,
+    system: SecondOrderSystem,
+    matrices: Sequence[str],
+) -> None:
+    """Write a shipped model's file: its FRF, what model it is, and its FE system.
+
+    The FRF in the documented layout (:func:`write_hdf5`), so that :func:`read_hdf5` reads
+    it like any user's FRF; the root attribute ``model``, which
+    :func:`fbs_core.frf_model.read_model_frf` checks; and ``/system``: the attribute
+    ``dofs`` (the DOF labels) and one group per name of ``matrices`` (``"M"``, ``"K"``,
+    ``"C"``) holding that matrix in CSR form (``data``, ``indices``, ``indptr``; attribute
+    ``shape``). The caller adds the model's own groups (parameters, modes) afterwards.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write (replaced).
+    frf : FRF
+        The model's FRF, shape (n_freq, n_out, n_in).
+    metadata : mapping
+        The root attribute ``metadata`` (JSON): what the model is, its axes, its script.
+    model : str
+        The root attribute ``model``, e.g. ``"reference chassis"``.
+    system : SecondOrderSystem
+        The model's FE system (sparse matrices).
+    matrices : sequence of str
+        The names of the matrices of ``system`` to store.
+    """
+    import h5py
+
+    Path(path).write_bytes(write_hdf5(frf, metadata=metadata))
+    with h5py.File(path, "a") as h:
+        h.attrs["model"] = model
+        g = h.create_group("system")
+        g.attrs.create("dofs", np.array(system.dofs, dtype=object), dtype=h5py.string_dtype())
+        for name in matrices:
+            a = getattr(system, name).tocsr()
+            sub = g.create_group(name)
+            sub["data"], sub["indices"], sub["indptr"] = a.data, a.indices, a.indptr
+            sub.attrs["shape"] = a.shape
 
 
 def write_hdf5_result(result: ResultData, metadata: Mapping[str, Any]) -> bytes:

@@ -33,12 +33,13 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .._typing import ComplexArray, FloatArray
-from ..chassis import ChassisParameters, match_grid
+from ..chassis import ChassisParameters
 from ..direct import SecondOrderSystem
 from ..dofs import DIRECTIONS, index_of, node_labels, parse_label
-from ..errors import DataFormatError, DOFError, FrequencyGridError, QuantityError
+from ..errors import DataFormatError, DOFError, FrequencyGridError
 from ..fe import offset_transform
-from ..frf import FRF, QUANTITIES, check_grid
+from ..frf import FRF, check_grid
+from ..frf_model import FRFGiven, modal_sum, receptance_frf
 from .layout import WHEELS, spindle_labels
 from .structure import (
     RESPONSE_NODES,
@@ -193,8 +194,7 @@ def _synth(
     for a in range(0, w.size, _CHUNK):
         wc = w[a : a + _CHUNK]
         g = 1.0 / (1.0 - (wc[:, None] ** 2 + SHIFT) * md.mu[None, :])  # (n_c, n_m)
-        # (n_o + n_d, n_m) @ (n_c, n_m, n_i + n_d) -> (n_c, n_o + n_d, n_i + n_d)
-        G = Vx[None] @ (g[:, :, None] * Wx[None])
+        G = modal_sum(g, Vx, Wx)  # (n_c, n_o + n_d, n_i + n_d)
         Hoi, HoB = G[:, :no, :ni], G[:, :no, ni:]
         HBi, HBB = G[:, no:, :ni], G[:, no:, ni:]
         S = HBB + np.eye(nd)[None] / (1j * wc[:, None, None] * st.c[None, None, :])
@@ -298,11 +298,9 @@ class VehicleModel:
             )
         outs = SPINDLES + RESPONSES if outputs is None else tuple(outputs)
         ins = SPINDLES if inputs is None else tuple(inputs)
-        if quantity not in QUANTITIES:
-            raise QuantityError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
-        H = _synth(self._p, f.tobytes(), outs, ins)
-        jw = 1j * 2 * np.pi * f
-        return FRF(f, H * (jw ** QUANTITIES[quantity])[:, None, None], outs, ins, quantity)
+        return receptance_frf(
+            f, outs, ins, quantity, lambda: _synth(self._p, f.tobytes(), outs, ins)
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """The parameters as a plain nested dict (for storage)."""
@@ -315,7 +313,12 @@ def reference_vehicle() -> VehicleModel:
     return VehicleModel()
 
 
-class FRFVehicle:
+def _hub_labels(labels: Iterable[str]) -> list[str]:
+    """The labels of hub DOFs, ``spindle_<w>:<d>``, in their order."""
+    return [lab for lab in labels if parse_label(lab)[0].startswith("spindle_")]
+
+
+class FRFVehicle(FRFGiven):
     """A car without tires given by an FRF, used like :class:`VehicleModel`.
 
     The FRF must hold the hub inputs ``spindle_<w>:<d>`` of the four wheels (at least
@@ -354,7 +357,7 @@ class FRFVehicle:
             raise DataFormatError(
                 f"wheelbase and track must be positive lengths in m, got {wheelbase!r}, {track!r}"
             )
-        hubs = [lab for lab in frf.inputs if parse_label(lab)[0].startswith("spindle_")]
+        hubs = _hub_labels(frf.inputs)
         wheels = {parse_label(lab)[0][len("spindle_") :] for lab in hubs}
         missing = [w for w in WHEELS if w not in wheels]
         if missing:
@@ -363,10 +366,9 @@ class FRFVehicle:
                 f"inputs spindle_<w>:x ... for w in {', '.join(WHEELS)}; inputs: "
                 f"{', '.join(frf.inputs[:12])}{' ...' if len(frf.inputs) > 12 else ''}"
             )
-        self.frf = frf
+        super().__init__(frf, interpolate)
         self.wheelbase = float(wheelbase)
         self.track: tuple[float, float] = (tr[0], tr[1])
-        self.interpolate = bool(interpolate)
 
     def __repr__(self) -> str:
         return f"FRFVehicle({self.frf!r}, wheelbase={self.wheelbase:g}, track={self.track})"
@@ -385,28 +387,27 @@ class FRFVehicle:
     ) -> FRF:
         """The FRF on ``freq`` (Hz): its own lines, else interpolated if allowed.
 
+        ``freq`` must be a valid grid (:func:`fbs_core.frf.check_grid`); by default every
+        output and the hub inputs.
+
         Raises
         ------
         FrequencyGridError
-            When a frequency is not a line of the FRF and ``interpolate`` is False.
+            For an invalid grid, or when a frequency is not a line of the FRF and
+            ``interpolate`` is False.
         """
-        f = check_grid(freq)
-        idx = match_grid(self.frf.freq, f)
-        if idx is not None:
-            Y = self.frf.isel(freq=idx)
-        elif self.interpolate:
-            Y = self.frf.interpolate(f)
-        else:
-            F = self.frf.freq
-            raise FrequencyGridError(
-                f"the vehicle FRF ({F.size} lines, {F[0]:g}-{F[-1]:g} Hz) has no line at some "
-                f"of the {f.size} analysis frequencies {f[0]:g}-{f[-1]:g} Hz; pass "
-                "interpolate=True to interpolate it explicitly (linear in real and imaginary "
-                "part) or analyse on its own lines"
-            )
-        hub = [lab for lab in self.frf.inputs if parse_label(lab)[0].startswith("spindle_")]
-        Y = Y.sel(
-            outputs=list(self.frf.outputs) if outputs is None else list(outputs),
-            inputs=hub if inputs is None else list(inputs),
+        return super().mobility(check_grid(freq), outputs, inputs, quantity)
+
+    def _refusal(self, f: FloatArray, missing: FloatArray) -> str:
+        """Names the FRF's and the analysis' band and how to interpolate."""
+        F = self.frf.freq
+        return (
+            f"the vehicle FRF ({F.size} lines, {F[0]:g}-{F[-1]:g} Hz) has no line at some "
+            f"of the {f.size} analysis frequencies {f[0]:g}-{f[-1]:g} Hz; pass "
+            "interpolate=True to interpolate it explicitly (linear in real and imaginary "
+            "part) or analyse on its own lines"
         )
-        return Y if quantity == Y.quantity else Y.to(quantity)
+
+    def _default_dofs(self) -> tuple[Sequence[str], Sequence[str]]:
+        """Every output of the FRF; its hub inputs ``spindle_<w>:*``."""
+        return list(self.frf.outputs), _hub_labels(self.frf.inputs)

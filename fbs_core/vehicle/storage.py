@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataFormatError
 from ..frf import FRF
+from ..frf_model import read_model_frf
 from .model import VehicleModel
 
 __all__ = ["DATA_FILE", "write_vehicle_h5", "read_vehicle_frf", "FILE_GRID"]
@@ -48,10 +48,8 @@ def write_vehicle_h5(
     """Write the car's FRF and model (layout in the module doc)."""
     import h5py
 
-    from ..io.hdf5 import write_hdf5
+    from ..io.hdf5 import write_model_hdf5
 
-    s = car.system()
-    Y = car.mobility(freq)
     meta = {
         "model": "reference vehicle (body, strut fronts, the thesis' rear axle; no tires)",
         "coordinates": COORDINATES,
@@ -59,19 +57,12 @@ def write_vehicle_h5(
         "wheelbase_m": car.wheelbase,
         "track_m": list(car.track),
     }
-    Path(path).write_bytes(write_hdf5(Y, metadata=meta))
+    Y = car.mobility(freq)
+    write_model_hdf5(path, Y, meta, "reference vehicle", car.system(), ("M", "K", "C"))
     with h5py.File(path, "a") as h:
-        h.attrs["model"] = "reference vehicle"
         h.create_group("parameters").attrs["json"] = json.dumps(
             dataclasses.asdict(car.params), sort_keys=True
         )
-        g = h.create_group("system")
-        g.attrs.create("dofs", np.array(s.dofs, dtype=object), dtype=h5py.string_dtype())
-        for name in ("M", "K", "C"):
-            a = getattr(s, name).tocsr()
-            sub = g.create_group(name)
-            sub["data"], sub["indices"], sub["indptr"] = a.data, a.indices, a.indptr
-            sub.attrs["shape"] = a.shape
         h.create_group("dampers").attrs["json"] = json.dumps(
             [dataclasses.asdict(d) for d in car.dampers]
         )
@@ -86,23 +77,4 @@ def read_vehicle_frf(path: str | os.PathLike[str] = DATA_FILE) -> FRF:
     DataFormatError
         If the file is not a reference vehicle file.
     """
-    from ..hdf5_guard import open_h5
-
-    with open_h5(path) as h:  # refuses links and data leaving the file
-        if h.attrs.get("format") != "tire-fbs" or h.attrs.get("model") != "reference vehicle":
-            raise DataFormatError(
-                f"{path}: not a 'tire-fbs' reference vehicle file "
-                f"(format={h.attrs.get('format')!r}, model={h.attrs.get('model')!r})"
-            )
-        g = h["frf"]
-
-        def labels(key: str) -> list[str]:
-            return [v.decode() if isinstance(v, bytes) else str(v) for v in g.attrs[key]]
-
-        return FRF(
-            g["freq"][()],
-            g["data"][()],
-            labels("outputs"),
-            labels("inputs"),
-            str(g.attrs["quantity"]),
-        )
+    return read_model_frf(path, "reference vehicle")
