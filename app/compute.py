@@ -1,6 +1,6 @@
 """Cached calls into the core's studies, shaped for the results of :mod:`app.results`.
 
-The studies the dashboard shows are computed here (:mod:`app.analysis_compute` for the
+The studies the dashboard shows are computed here (:mod:`app.results.analysis_compute` for the
 Analysis card's): results are cached per argument tuple (the core result objects are
 immutable), so that a control change that only selects (another response DOF, another N
 of the truncation map) costs a lookup. No statistics are computed here: the band's own
@@ -53,6 +53,8 @@ __all__ = [
     "band",
     "band_computed",
     "band_data",
+    "cache_key",
+    "chassis_of",
     "coupled_response",
     "eigen_curves",
     "error_map",
@@ -60,9 +62,12 @@ __all__ = [
     "frequencies",
     "level_unit",
     "mobility_data",
+    "models_kw",
+    "retained",
     "single_round_data",
     "suggested_table",
     "suggested_table_ready",
+    "tire_of",
     "tire_quality",
     "uncoupled_data",
     "version",
@@ -206,29 +211,32 @@ def frequencies(harmonic: int) -> np.ndarray:
     return readonly(fbs_core.harmonic(harmonic).frequencies(), float)
 
 
-def _key(models):
-    """``None`` for the reference models, else the (hashable) session models token."""
+def cache_key(models):
+    """The models' part of a cache key: ``None`` for the reference models, else the
+    (hashable) session models token."""
     return None if models is None or models.is_reference else models
 
 
-def _tire(models=None):
+def tire_of(models=None):
+    """The session's tire model (the reference tire when none is uploaded)."""
     t = None if models is None else models.tire
     return fbs_core.reference_tire() if t is None else t
 
 
-def _chassis(models=None):
+def chassis_of(models=None):
+    """The session's chassis (the reference chassis when none is uploaded)."""
     c = None if models is None else models.chassis
     return fbs_core.reference_chassis() if c is None else c
 
 
-def _models_kw(models) -> dict:
+def models_kw(models) -> dict:
     """``tire=`` / ``chassis=`` for the core (None keeps the core's reference caches)."""
     return {} if models is None else {"tire": models.tire, "chassis": models.chassis}
 
 
-def _n(models, n_modes):
+def retained(models, n_modes):
     """A retained-mode count the session's tire has (``None``: all of its modes)."""
-    if n_modes is None or int(n_modes) >= _tire(models).n_modes:
+    if n_modes is None or int(n_modes) >= tire_of(models).n_modes:
         return None
     return int(n_modes)
 
@@ -242,18 +250,18 @@ def error_map(harmonic: int, coupling: str, models=None, residual: bool = False)
     ``residual``: the N-mode responses compensated by the quasi-static part of the modes
     left out (the reference stays the all-modes response).
     """
-    return _error_map(int(harmonic), coupling, _key(models), bool(residual))
+    return _error_map(int(harmonic), coupling, cache_key(models), bool(residual))
 
 
 @shared_cache(maxsize=48)
 def _error_map(harmonic: int, coupling: str, models, residual: bool = False):
-    n_total = int(_tire(models).n_modes)
+    n_total = int(tire_of(models).n_modes)
     return studies.truncation_map(
         harmonic,
         n_modes=np.arange(10, n_total, 10),
         coupling=coupling,
         residual=residual,
-        **_models_kw(models),
+        **models_kw(models),
     )
 
 
@@ -267,7 +275,7 @@ def _bushing_response(
         freq=frequencies(harmonic),
         coupling=coupling,
         residual=residual,
-        **_models_kw(models),
+        **models_kw(models),
     )
     return np.stack(
         [frf.sel(outputs=f"bushing:{d}").data[:, 0, 0] for d in DIRECTIONS],
@@ -284,8 +292,8 @@ def coupled_response(
     holds that N (:meth:`fbs_core.studies.TruncationMap.response_for`), else computed with
     :func:`fbs_core.bushing_response`; ``residual`` compensates the modes left out.
     """
-    models = _key(models)
-    n = _n(models, n_modes)
+    models = cache_key(models)
+    n = retained(models, n_modes)
     residual = bool(residual) and n is not None  # all modes: nothing left out
     m = error_map(harmonic, coupling, models, residual)
     order = [m.dofs.index(f"bushing:{d}") for d in DIRECTIONS]
@@ -355,7 +363,7 @@ def suggested_table(
     ``residual``: judged on the residual-compensated responses. ``result`` is the core's
     :class:`~fbs_core.studies.SuggestedModes` the columns come from.
     """
-    key = (float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual))
+    key = (float(threshold_pct), float(f_max), coupling, dof, cache_key(models), bool(residual))
     out = _suggested_table(*key)
     _TABLES_DONE.add(key)
     return out
@@ -375,7 +383,7 @@ def suggested_table_ready(
 ) -> bool:
     """True when :func:`suggested_table` of these arguments has been computed before
     (then it is a cache look-up, unless the cache has dropped it since)."""
-    key = (float(threshold_pct), float(f_max), coupling, dof, _key(models), bool(residual))
+    key = (float(threshold_pct), float(f_max), coupling, dof, cache_key(models), bool(residual))
     return key in _TABLES_DONE
 
 
@@ -417,7 +425,7 @@ def tire_quality(models=None) -> dict:
         str (one per band needing speeds outside the stored ones), ``speeds`` (min, max)
         km/h, ``n_points``, ``method`` (str).
     """
-    return _tire_quality(_key(models))
+    return _tire_quality(cache_key(models))
 
 
 @shared_cache(maxsize=8)
@@ -427,7 +435,7 @@ def _tire_quality(models) -> dict:
     from fbs_core.tire.quality import SpeedRangeWarning, interpolation_quality, speed_coverage
     from fbs_core.vocabulary import HARMONIC_CASES
 
-    tire = _tire(models)
+    tire = tire_of(models)
     ks = tuple(HARMONIC_CASES)
     stored = tire.meta.get("interpolation_quality", {}).get("worst_db", {})
     if models is None and all(str(k) in stored for k in ks):
@@ -462,7 +470,7 @@ def eigen_curves(models=None) -> dict:
     """Highest retained eigenfrequency versus N at 20, 80, 120 km/h (thesis fig. 5.8):
     ``n_modes``, ``f_20``, ``f_80``, ``f_120`` and the core's ``result``
     (:class:`~fbs_core.studies.ModeFrequencies`)."""
-    return _eigen_curves(_key(models))
+    return _eigen_curves(cache_key(models))
 
 
 @shared_cache(maxsize=8)
@@ -477,14 +485,14 @@ def _eigen_curves(models) -> dict:
 # -- uncoupled subsystems --------------------------------------------------------------------
 @shared_cache(maxsize=64)
 def _tire_hub(harmonic: int, n_modes: int | None, models=None):
-    return _tire(models).patch_response(
-        frequencies(harmonic), fbs_core.harmonic(harmonic), _n(models, n_modes)
+    return tire_of(models).patch_response(
+        frequencies(harmonic), fbs_core.harmonic(harmonic), retained(models, n_modes)
     )
 
 
 @shared_cache(maxsize=8)
 def _chassis_frf(harmonic: int, models=None):
-    return _chassis(models).mobility(frequencies(harmonic))
+    return chassis_of(models).mobility(frequencies(harmonic))
 
 
 def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str, models=None) -> dict:
@@ -497,7 +505,7 @@ def uncoupled_data(harmonic: int, n_modes: int, dof: str, spindle_input: str, mo
         ``hub:<dof>`` with all / N modes; ``chassis``: chassis mobility ``Y_ej^E`` from
         ``spindle:<spindle_input>`` to ``bushing:<dof>``; and their ``*_db`` columns.
     """
-    models = _key(models)
+    models = cache_key(models)
     t_ref = _tire_hub(harmonic, None, models).sel(outputs=f"hub:{dof}").data[:, 0, 0]
     t_tr = _tire_hub(harmonic, int(n_modes), models).sel(outputs=f"hub:{dof}").data[:, 0, 0]
     ch = (
@@ -527,7 +535,7 @@ class BandKey(NamedTuple):
     """The settings that define a scatter band (its cache key), by name.
 
     ``vehicle``: ``(wheels, track relation, response point)`` of a car's band (vehicle
-    scope, :mod:`app.vehicle_compute`); None for a corner's band.
+    scope, :mod:`app.results.vehicle_compute`); None for a corner's band.
     """
 
     harmonic: int
@@ -563,14 +571,14 @@ def band_key(
     (:class:`BandKey`)."""
     return BandKey(
         int(harmonic),
-        _n(_key(models), n_modes),
+        retained(cache_key(models), n_modes),
         str(coupling),
         float(noise_pct),
         str(target),
         bool(frequency_dependent),
         int(rounds),
         int(seed),
-        _key(models),
+        cache_key(models),
         None if vehicle is None else tuple(vehicle),
     )
 
@@ -599,7 +607,7 @@ def band(*args, cancel=None, progress=None, **kwargs):
     """
     key = band_key(*args, **kwargs)
     if is_car_key(key):
-        raise ValueError("a car's band is computed by app.vehicle_compute.cached_band")
+        raise ValueError("a car's band is computed by app.results.vehicle_compute.cached_band")
     res = cached_band(key)
     if res is not None:
         return res
@@ -617,7 +625,7 @@ def band(*args, cancel=None, progress=None, **kwargs):
         percentiles=Q_LEVELS,
         cancel=cancel,
         progress=progress,
-        **_models_kw(models),
+        **models_kw(models),
     )
     remember_band(key, res, time.perf_counter() - t0)
     return res
@@ -668,9 +676,14 @@ def first_order(
 ):
     """The first-order band (:func:`fbs_core.first_order_band`) of a scatter band's settings
     (its rounds, seed and frequency dependence do not enter), cached."""
-    models = _key(models)
+    models = cache_key(models)
     return _first_order(
-        int(harmonic), _n(models, n_modes), str(coupling), float(noise_pct), str(target), models
+        int(harmonic),
+        retained(models, n_modes),
+        str(coupling),
+        float(noise_pct),
+        str(target),
+        models,
     )
 
 
@@ -682,7 +695,7 @@ def _first_order(harmonic, n_modes, coupling, noise_pct, target, models):
         target=target,
         n_modes=n_modes,
         coupling=coupling,
-        **_models_kw(models),
+        **models_kw(models),
     )
 
 

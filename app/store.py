@@ -55,8 +55,6 @@ from fbs_core.analysis import add_pin, pin_state, remove_pin
 from fbs_core.errors import FBSError
 
 from . import compute
-from . import modes_compute as mc
-from .pin_settings import check_pin_name, encode_pins
 from .results import (
     FIELDS,
     Band,
@@ -71,11 +69,13 @@ from .results import (
     review,
     vehicle,
 )
+from .results import modes_compute as mc
 from .results.base import VEHICLE_FIELDS, progress_status
 from .runtime import background, bands, uploads
 from .runtime.activity import ACTIVITIES
 from .runtime.draw import served
 from .state import MODE_COUNTS, DashboardState
+from .state.pins import check_pin_name, encode_pins
 
 __all__ = ["ALWAYS", "LIVE", "TABLE", "Results", "Row", "depends"]
 

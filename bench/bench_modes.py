@@ -69,8 +69,8 @@ def show(label, t, target=None):
 
 def app_paths(r: int) -> None:
     """The Modes tab's results as the dashboard makes them (module notes)."""
-    from app import modes_compute as mc
     from app.results import Snapshot
+    from app.results import modes_compute as mc
     from app.results.modes import mode_shape_result, participation_result
     from app.state import DashboardState
 

@@ -311,7 +311,7 @@ def test_peak_modes_are_the_nearest_coupled_modes_and_nearby_peaks_share_a_solve
     """A peak's labels: the coupled system's modes nearest the peak (truth: a wider
     eigenvalue solve of the assembled tire + chassis at the snapped speed, sorted here by
     distance to the peak); a peak moved a little by a change of N reuses the solve."""
-    from app import analysis_compute as ac
+    from app.results import analysis_compute as ac
     from fbs_core.analysis.peaks import coupled_system, system_modes_near
 
     speed, f = 61.3, 117.37
@@ -398,7 +398,7 @@ def test_a_step_of_the_n_slider_on_the_speed_tab_computes_the_next_step_ahead(st
     """Served, a step of N on the speed tab computes the speed map of the next count in the
     same direction on the process' worker for work ahead: the next step is a cache hit. A
     change of harmonic computes nothing ahead."""
-    from app import analysis_compute as ac
+    from app.results import analysis_compute as ac
     from app.runtime.background import AHEAD
 
     r = store

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pytest
 
-from app.analysis_state import AnalysisState
 from app.state import DashboardState
+from app.state.analysis import AnalysisState
 from app.views.controls import Controls
 from app.views.typed import NumberField, TypedInputError, parse_number
 

@@ -19,9 +19,9 @@ import pytest
 from server_util import wait_for
 
 import fbs_core
-from app import modes_compute as mc
 from app.datasource import Models
 from app.page.chrome import busy_indicator
+from app.results import modes_compute as mc
 from app.runtime import background
 from app.runtime.uploads import UploadQueue
 from app.store import Results

@@ -175,7 +175,7 @@ def test_help_page_names_the_thesis_equations_and_the_harmonics():
 def test_help_covers_the_analysis_card_residual_compensation_presentation_and_uploads():
     """Issue 29: the help said nothing of these. Each has a section, and each tab of the
     Analysis card (the state's own list) and each upload format is named in it."""
-    from app.analysis_state import ANALYSIS_TABS
+    from app.state.analysis import ANALYSIS_TABS
 
     text = (Path(__file__).parents[1] / "app" / "page" / "help.md").read_text()
     heads = re.findall(r"^## (.+)$", text, flags=re.M)

@@ -17,13 +17,13 @@ import pytest
 
 from app.page import titles
 from app.page.layout import PAGE_URL_KEYS, PageState
-from app.params import Number
 from app.report import data as report_data
 from app.report.session import settings_of
 from app.results import FIELDS, Snapshot
 from app.results.base import VEHICLE_FIELDS, _SnapshotBase
 from app.schema import Schema, setting
 from app.state import SCHEMA, URL_KEYS, DashboardState, NoiseState
+from app.state.params import Number
 
 
 class _WobblyNoise(NoiseState):

@@ -28,7 +28,7 @@ from url_fuzz import (
     served_location,
 )
 
-from app.analysis_state import ANALYSIS_TABS
+from app.state.analysis import ANALYSIS_TABS
 
 #: The published result of the store (app.store.TABLE) each Analysis tab shows first.
 SHOWN_FIRST = {
@@ -47,9 +47,9 @@ def test_every_key_the_page_reads_is_one_setting(monkeypatch):
     """The fuzz below sends what a page build itself syncs with the URL (recorded, not
     listed): every state group of the page is among it, no key names two settings, and
     they are the keys ``app.state.URL_KEYS`` and ``app.page.layout.PAGE_URL_KEYS`` list."""
-    from app.analysis_state import AnalysisState
     from app.page.layout import PageState
     from app.state import DashboardState
+    from app.state.analysis import AnalysisState
 
     rec = page_keys(monkeypatch)
     groups = {type(obj) for obj, _ in rec.synced}
@@ -116,8 +116,8 @@ def test_hostile_values_in_every_url_key_leave_the_page_whole(monkeypatch):
     turn ('': collapsed): the page builds with the reference models plotted and the tab's
     result computed, every setting is its default or what the value means for it, the
     settings kept as text are answered for, and no value reaches the page as markup."""
-    from app.analysis_state import AnalysisState
     from app.main import close_page, create_app
+    from app.state.analysis import AnalysisState
 
     keys = page_keys(monkeypatch)
     tab_key = keys.key_of(AnalysisState, "tab")

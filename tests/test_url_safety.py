@@ -16,8 +16,8 @@ import html
 import pytest
 
 from app.page.chrome import link_notice, link_notice_html
-from app.pin_settings import PinSettings, decode_pins, encode_pins, shown
 from app.report import Provenance
+from app.state.pins import PinSettings, decode_pins, encode_pins, shown
 from fbs_core.errors import FBSError
 
 GOOD = PinSettings("base", 2, 60, "z", "6dof", False, 10.0, "both", False, 1000, 7, 90, "reference")

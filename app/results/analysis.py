@@ -19,8 +19,8 @@ from fbs_core.analysis import delta_cursor, phase_deg
 from fbs_core.errors import FBSError
 from fbs_core.vocabulary import magnitude_db, percent
 
-from .. import analysis_compute as ac
 from .. import compute
+from . import analysis_compute as ac
 from .base import Result, Snapshot, csv_name
 from .main import NOT_COMPENSATED, chassis_label, res_part, residual_meta, response_result
 

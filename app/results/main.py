@@ -18,8 +18,8 @@ from fbs_core import FRF
 from fbs_core.units import frf_unit, input_kind, output_kind
 from fbs_core.vocabulary import EIGEN_SPEEDS, HARMONIC_CASES, magnitude_db
 
-from .. import analysis_compute as ac
 from .. import compute
+from . import analysis_compute as ac
 from .base import Result, Snapshot, csv_name
 from .scope import file_parts, vehicle_meta
 

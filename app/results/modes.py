@@ -8,7 +8,7 @@ follows the belt waves (:func:`waves_result`, solved once per tire for every ses
 a thread of its own, each waiting session told how it moves: :func:`waves_wait`), the
 modes a case needs chosen by importance beside table 5.1's lowest ``N``
 (:func:`selected_modes_result`) and the truncation of the chassis side
-(:func:`chassis_truncation_result`). The numbers are the core's (:mod:`app.modes_compute`);
+(:func:`chassis_truncation_result`). The numbers are the core's (:mod:`app.results.modes_compute`);
 docs/modes.md derives them.
 """
 
@@ -25,7 +25,7 @@ from fbs_core.errors import FBSError
 from fbs_core.vocabulary import percent
 
 from .. import compute
-from .. import modes_compute as mc
+from . import modes_compute as mc
 from .base import Result, Snapshot, csv_name
 from .main import res_part, residual_meta
 
@@ -238,7 +238,7 @@ def mode_shape_result(s: Snapshot) -> Result:
     view = "tire mode shape: the deformed belt over one period"
     try:
         mode, speed, how = _chosen(s)
-        n_p = compute._tire(s.models).n_modes // 2
+        n_p = compute.tire_of(s.models).n_modes // 2
         if not 0 <= mode < n_p:
             raise FBSError(f"mode {mode} does not exist: the tire's pairs are 0..{n_p - 1}")
         t = mc.shape(mode, speed, s.models)
@@ -471,7 +471,7 @@ def waves_result(s: Snapshot) -> Result:
 
 def waves_wait(s: Snapshot, listener_key=None, told=None) -> None:
     """Ask for the waves of the session's tire, computed once for every session
-    (:data:`app.modes_compute.WAVES`); ``told(status)`` as it moves on. Without a page to
+    (:data:`app.results.modes_compute.WAVES`); ``told(status)`` as it moves on. Without a page to
     be told on (``told`` None: tests, exports) it is computed here."""
     if told is None:
         try:
@@ -537,7 +537,7 @@ def selected_modes_result(s: Snapshot) -> Result:
         n_low = _lowest(s)
     except (FBSError, AttributeError, TypeError) as e:
         return _unavailable(s, view, "selected_modes", f"the tire's per-mode terms: {e}")
-    tire = compute._tire(s.models)
+    tire = compute.tire_of(s.models)
     n_p = tire.n_modes // 2
     counts = [n_low] + [sel[b].n_modes for b in mc.SELECTION_ORDERS]
     first = [n_low] + [sel[b].n_first for b in mc.SELECTION_ORDERS]
@@ -611,7 +611,7 @@ def chassis_truncation_result(s: Snapshot) -> Result:
     view = "truncation of the chassis side: eq. 5.1 with N chassis modes, the tire exact"
     try:
         m = mc.chassis_map(s.harmonic, s.residual, s.coupling, s.models)
-        eig = compute._chassis(s.models).eigenfrequencies()
+        eig = compute.chassis_of(s.models).eigenfrequencies()
         n_tire = _lowest(s)
     except (FBSError, AttributeError, TypeError) as e:
         return _unavailable(s, view, "chassis_truncation", f"the chassis' FE model: {e}")

@@ -2,7 +2,7 @@
 
 A pin is the session's snapshot at one moment, named (up to four,
 :data:`fbs_core.analysis.MAX_PINS`). In the URL (``pins=``) it travels as the settings that
-change its numbers (:class:`~app.pin_settings.PinSettings`: the case, residual
+change its numbers (:class:`~app.state.pins.PinSettings`: the case, residual
 compensation included, the noise study, the models); in the session it keeps its whole
 :class:`~app.results.base.Snapshot` and its data as a :class:`fbs_core.analysis.PinnedState`
 (the coupled response with N and all modes at its DOF, made by the coupled-response view's
@@ -39,8 +39,8 @@ from fbs_core.vocabulary import magnitude_db, percent
 
 from .. import compute
 from ..datasource import REFERENCE, candidate_models
-from ..pin_settings import PinSettings, decode_pins
 from ..report.titles import NOISE_WHERE
+from ..state.pins import PinSettings, decode_pins
 from .base import Band, Result, Snapshot, csv_name
 from .main import res_part, response_result
 

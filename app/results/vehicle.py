@@ -3,7 +3,7 @@
 The whole car: the reference vehicle with the session's tire on all four wheels, a harmonic
 road on both tracks (the rear wheels a wheelbase later; the right track in phase, in
 anti-phase or partially coherent with the left), the response at one of the car's points
-(:mod:`app.vehicle_compute`, cached calls into :mod:`fbs_core.vehicle`). The same columns
+(:mod:`app.results.vehicle_compute`, cached calls into :mod:`fbs_core.vehicle`). The same columns
 and views as the corner's (:mod:`app.results.main`), with the scope, the wheels driven,
 the track relation and the response point in every description; and the contribution of
 each wheel's road to the response (:func:`wheels_result`).
@@ -24,7 +24,7 @@ from fbs_core.vehicle import WHEELS
 from fbs_core.vocabulary import HARMONIC_CASES, fraction, magnitude_db, percent
 
 from .. import compute
-from .. import vehicle_compute as vc
+from . import vehicle_compute as vc
 from .base import Result, Snapshot, csv_name
 from .main import map_result, res_part, residual_meta, tire_meta
 from .scope import file_parts, tracks_text, vehicle_caption, vehicle_meta, wheels_text

@@ -44,7 +44,8 @@ import panel as pn
 from fbs_core.errors import FBSError, StudyCancelled
 from fbs_core.studies.scatter import EDGES_JUDGED_WITHIN_DB
 
-from .. import compute, vehicle_compute
+from .. import compute
+from ..results import vehicle_compute
 from . import offload
 from .draw import served
 from .priority import BACKGROUND_NICE

@@ -190,5 +190,5 @@ def _on(c, key: tuple, cancel, progress):
         percentiles=compute.Q_LEVELS,
         progress=progress,
         cancel=cancel,
-        **compute._models_kw(models),
+        **compute.models_kw(models),
     )

@@ -19,7 +19,7 @@ tire..." for as long as the session lived. A :class:`SharedJobs` instead:
 - keeps a failure for ``failed_ttl`` seconds (every waiter sees the message); a request
   after that tries again.
 
-Nothing here computes a result: the work comes from the caller (:mod:`app.modes_compute`).
+Nothing here computes a result: the work comes from the caller (:mod:`app.results.modes_compute`).
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import panel as pn
 
-from ..analysis_state import ANALYSIS_TABS
+from ..state.analysis import ANALYSIS_TABS
 from .analysis_compare import CompareView
 from .analysis_contrib import ContributionsView
 from .analysis_modes import modes_tab, selection_tab
@@ -53,7 +53,7 @@ TABS_CSS = 'div[style*="visibility: hidden"] { display: none !important; }'
 def analysis_card(results, x_range=None, tabs: dict | None = None, page=None) -> pn.Card:
     """The "Analysis" card: one tab per analysis view, computed only while shown.
 
-    ``tabs`` maps tab keys (:data:`~app.analysis_state.ANALYSIS_TABS`) to a function
+    ``tabs`` maps tab keys (:data:`~app.state.analysis.ANALYSIS_TABS`) to a function
     ``(results, x_range) -> viewable``; default all views of the card. ``page``
     (the page's layout state): the default views follow its view (type sizes of the normal
     or the presentation view).

@@ -15,7 +15,7 @@ from typing import Any
 
 from fbs_core.errors import FBSError
 
-from .state import CaseState, NoiseState
+from . import CaseState, NoiseState
 
 __all__ = ["PIN_NAME", "PinSettings", "check_pin_name", "decode_pins", "encode_pins", "shown"]
 

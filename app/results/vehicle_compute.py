@@ -29,8 +29,16 @@ from fbs_core.vehicle import Road, vehicle_scatter_band, vehicle_transfer, vehic
 from fbs_core.vehicle.response import VehicleResponse, WheelTransfer
 from fbs_core.vocabulary import fraction
 
-from .compute import Q_LEVELS, _key, _n, _tire, frequencies, remember_band, shared_cache
-from .compute import cached_band as compute_cached_band
+from ..compute import (
+    Q_LEVELS,
+    cache_key,
+    frequencies,
+    remember_band,
+    retained,
+    shared_cache,
+    tire_of,
+)
+from ..compute import cached_band as compute_cached_band
 
 __all__ = ["band", "coherent", "response", "road", "transfer", "truncation_map"]
 
@@ -66,8 +74,8 @@ def transfer(
 ) -> WheelTransfer:
     """The car's response at ``point`` (six DOFs) per metre of road under each wheel, with
     ``n_modes`` tire modes (None: all), on the harmonic's analysis grid."""
-    models = _key(models)
-    n = _n(models, n_modes)
+    models = cache_key(models)
+    n = retained(models, n_modes)
     return _transfer(int(harmonic), n, coupling, point, models, bool(residual) and n is not None)
 
 
@@ -121,13 +129,13 @@ def truncation_map(
             f"in phase or in anti-phase (now a coherence of {float(tracks):g})"
         )
     return _truncation_map(
-        int(harmonic), coupling, point, tracks, tuple(wheels), _key(models), bool(residual)
+        int(harmonic), coupling, point, tracks, tuple(wheels), cache_key(models), bool(residual)
     )
 
 
 @shared_cache(maxsize=48)
 def _truncation_map(harmonic, coupling, point, tracks, wheels, models, residual):
-    n_total = int(_tire(models).n_modes)
+    n_total = int(tire_of(models).n_modes)
     m = vehicle_truncation_map(
         harmonic,
         np.arange(10, n_total, 10),
@@ -153,7 +161,7 @@ def truncation_map_ready(
 ) -> bool:
     """Whether :func:`truncation_map` of these arguments was computed (a suggested table
     of the car reads only the maps computed so far; the rest come in the background)."""
-    key = (int(harmonic), coupling, point, tracks, tuple(wheels), _key(models), bool(residual))
+    key = (int(harmonic), coupling, point, tracks, tuple(wheels), cache_key(models), bool(residual))
     return key in _MAPS_DONE
 
 

@@ -16,8 +16,8 @@ from collections import OrderedDict
 from fbs_core import FRF, analysis
 from fbs_core.errors import FBSError
 
-from . import compute
-from .compute import _key, _models_kw, _n, shared_cache
+from .. import compute
+from ..compute import cache_key, models_kw, retained, shared_cache
 
 __all__ = [
     "campbell",
@@ -45,8 +45,8 @@ def contributions(harmonic: int, n_modes: int, coupling: str, models=None, resid
     FBSError
         For residual compensation of a count the residual map does not hold.
     """
-    models = _key(models)
-    n = _n(models, n_modes)
+    models = cache_key(models)
+    n = retained(models, n_modes)
     return _contributions(int(harmonic), n, coupling, models, bool(residual) and n is not None)
 
 
@@ -65,7 +65,7 @@ def _contributions(harmonic, n_modes, coupling, models, residual=False):
         n_modes=n_modes,
         freq=compute.frequencies(harmonic),
         coupling=coupling,
-        **_models_kw(models),
+        **models_kw(models),
     )
 
 
@@ -123,7 +123,7 @@ def peak_modes(
     f = float(freq)
     f_snap = max(PEAK_SNAP_HZ, round(f / PEAK_SNAP_HZ) * PEAK_SNAP_HZ)
     v_snap = round(float(speed_kmh) / PEAK_SNAP_KMH) * PEAK_SNAP_KMH
-    args = (f_snap, v_snap, coupling, _key(models), max(PEAK_CANDIDATES, n))
+    args = (f_snap, v_snap, coupling, cache_key(models), max(PEAK_CANDIDATES, n))
     with _KNOWN_LOCK:
         cand = _KNOWN.get(args)
     if cand is None:
@@ -155,7 +155,7 @@ def _peak_modes(freq, speed, coupling, models, n):
 # -- across speed -----------------------------------------------------------------------------
 def campbell(models=None):
     """Campbell diagram of the session's tire (slope criterion: works for any modal model)."""
-    return _campbell(_key(models))
+    return _campbell(cache_key(models))
 
 
 @shared_cache(maxsize=8)
@@ -165,11 +165,11 @@ def _campbell(models):
 
 def speed_map(harmonic: int, n_modes: int, coupling: str, models=None):
     """:func:`fbs_core.analysis.speed_map` of a harmonic (every 5 km/h), cached."""
-    models = _key(models)
-    n = _n(models, n_modes)
+    models = cache_key(models)
+    n = retained(models, n_modes)
     return _speed_map(int(harmonic), n, coupling, models)
 
 
 @shared_cache(maxsize=16)
 def _speed_map(harmonic, n_modes, coupling, models):
-    return analysis.speed_map(harmonic, n_modes, coupling=coupling, **_models_kw(models))
+    return analysis.speed_map(harmonic, n_modes, coupling=coupling, **models_kw(models))

@@ -5,15 +5,15 @@ Plain state (no numerics), one :class:`AnalysisState` per session, held by the s
 :class:`~app.state.DashboardState` as ``state.analysis`` and kept in the URL
 (``URL_KEYS["analysis"]``). The pins are in the URL as their *settings* (a pin's data are
 recomputed from them in a new session; pins of uploaded data only where the same upload is
-loaded), see :mod:`app.pin_settings`.
+loaded), see :mod:`app.state.pins`.
 """
 
 from __future__ import annotations
 
 import param
 
+from ..schema import setting
 from .params import Integer, Number
-from .schema import setting
 
 __all__ = ["ANALYSIS_TABS", "AnalysisState"]
 
@@ -89,7 +89,7 @@ class AnalysisState(param.Parameterized):
     pins = param.String(
         metadata=setting("pins", field="pin_text"),
         default="",
-        doc="Pinned baselines as settings (app.pin_settings.encode_pins); their data live in "
+        doc="Pinned baselines as settings (app.state.pins.encode_pins); their data live in "
         "the results.",
     )
     compare_to = param.String(

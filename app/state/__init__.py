@@ -12,12 +12,12 @@ import param
 from fbs_core.vehicle import RESPONSE_NODES, WHEELS
 from fbs_core.vocabulary import COUPLINGS, DIRECTIONS
 
-from .analysis_state import AnalysisState
-from .datasource import REFERENCE, DataSource, Models
-from .page.layout import PageState
+from ..datasource import REFERENCE, DataSource, Models
+from ..page.layout import PageState
+from ..review import EMPTY_REVIEW, Review
+from ..schema import Schema, setting
+from .analysis import AnalysisState
 from .params import Integer, Number
-from .review import EMPTY_REVIEW, Review
-from .schema import Schema, setting
 
 __all__ = [
     "DIRECTIONS",

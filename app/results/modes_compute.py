@@ -19,8 +19,8 @@ from fbs_core.analysis import mode_participation, select_modes, tire_mode_shape,
 from fbs_core.errors import FBSError
 from fbs_core.studies import chassis_truncation_map
 
-from .compute import _key, _models_kw, _tire, shared_cache
-from .runtime.shared_jobs import JobStatus, SharedJobs
+from ..compute import cache_key, models_kw, shared_cache, tire_of
+from ..runtime.shared_jobs import JobStatus, SharedJobs
 
 __all__ = [
     "chassis_map",
@@ -52,20 +52,20 @@ def participation(harmonic: int, f_max: float, coupling: str, models=None):
     """:func:`fbs_core.analysis.mode_participation` of the harmonic over
     :func:`participation_band`, all six bushing DOFs, cached."""
     band = participation_band(harmonic, f_max)
-    return _participation(int(harmonic), band, coupling, _key(models))
+    return _participation(int(harmonic), band, coupling, cache_key(models))
 
 
 @shared_cache(maxsize=32)
 def _participation(harmonic, band, coupling, models):
-    return mode_participation(harmonic, band, coupling=coupling, **_models_kw(models))
+    return mode_participation(harmonic, band, coupling=coupling, **models_kw(models))
 
 
 def shape(mode: int, speed_kmh: float, models=None):
     """:func:`fbs_core.analysis.tire_mode_shape` of a stored pair at a speed, cached; the
     speed is clipped to the tire's operating points and rounded to 0.1 km/h."""
-    tire = _tire(models)
+    tire = tire_of(models)
     v = float(np.clip(round(float(speed_kmh), 1), tire.speeds[0], tire.speeds[-1]))
-    return _shape(int(mode), v, _key(models))
+    return _shape(int(mode), v, cache_key(models))
 
 
 @shared_cache(maxsize=64)
@@ -95,7 +95,7 @@ def _waves_job(models):
 def _no_matrices(models) -> JobStatus | None:
     """A failed status at once for a tire without its matrices (an uploaded modal model),
     else None."""
-    tire = _tire(models)
+    tire = tire_of(models)
     if getattr(tire, "params", None) is not None:
         return None
     try:
@@ -109,14 +109,14 @@ def waves_status(models=None) -> JobStatus | None:
     """Where the waves' diagram of the session's tire stands (a look-up: nothing is
     computed): None when nobody asked for it yet, else a :class:`JobStatus` (its ``value``
     the :class:`~fbs_core.analysis.WaveCampbell` once done)."""
-    return _no_matrices(models) or WAVES.status(("waves", _key(models)))
+    return _no_matrices(models) or WAVES.status(("waves", cache_key(models)))
 
 
 def request_waves(models=None, listener_key=None, listener=None) -> JobStatus:
     """Ask for the waves' diagram of the session's tire (see :data:`WAVES`); ``listener``
     is told of its progress, its end or its failure."""
     return _no_matrices(models) or WAVES.request(
-        ("waves", _key(models)), _waves_job(_key(models)), listener_key, listener
+        ("waves", cache_key(models)), _waves_job(cache_key(models)), listener_key, listener
     )
 
 
@@ -131,7 +131,7 @@ def waves(models=None, timeout: float = 600.0):
         failed or did not end within ``timeout`` seconds (the message says which).
     """
     st = _no_matrices(models) or WAVES.run_here(
-        ("waves", _key(models)), _waves_job(_key(models)), timeout
+        ("waves", cache_key(models)), _waves_job(cache_key(models)), timeout
     )
     if st.state == "done":
         return st.value
@@ -162,7 +162,7 @@ def selection(
         bool(residual),
         dof,
         coupling,
-        _key(models),
+        cache_key(models),
     )
 
 
@@ -176,17 +176,17 @@ def _selection(harmonic, threshold_pct, f_max, by, residual, dof, coupling, mode
         residual=residual,
         dof=dof,
         coupling=coupling,
-        **_models_kw(models),
+        **models_kw(models),
     )
 
 
 def chassis_map(harmonic: int, residual: bool, coupling: str, models=None):
     """:func:`fbs_core.studies.chassis_truncation_map` of the harmonic, cached."""
-    return _chassis_map(int(harmonic), bool(residual), coupling, _key(models))
+    return _chassis_map(int(harmonic), bool(residual), coupling, cache_key(models))
 
 
 @shared_cache(maxsize=32)
 def _chassis_map(harmonic, residual, coupling, models):
     return chassis_truncation_map(
-        harmonic, residual=residual, coupling=coupling, **_models_kw(models)
+        harmonic, residual=residual, coupling=coupling, **models_kw(models)
     )
