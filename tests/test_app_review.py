@@ -258,6 +258,11 @@ def test_the_cards_controls_change_the_review(tmp_path, tires):
     view.current.value = "stiff.h5"
     view.remove.clicks += 1
     assert st.data.review.candidates.names == ("reference", "soft.h5")
+    st.noise.rounds = 50  # the band switch: a band per candidate and harmonic
+    view.band_switch.value = True
+    assert st.noise.verdict_band and "with the noise band" in store.verdict.caption
+    st.noise.verdict_band = False
+    assert view.band_switch.value is False
 
 
 def test_the_response_plot_draws_the_other_candidates_and_the_target(tmp_path, tires):
@@ -343,3 +348,47 @@ def test_a_crafted_review_link_is_named_and_changes_nothing(text):
     before = ds.review
     assert not ds.apply_link(text)
     assert "link" in ds.error and ds.review is before and ds.pending is None
+
+
+def test_the_noise_band_judges_a_target_only_its_upper_edge_crosses():
+    """A flat target between the nominal response's peak and the noise band's upper 95 %
+    edge there: the nominal passes, the band does not. Truth: the core's own band of the
+    same noise settings (same seed, so the same rounds) and the core's verdict of it."""
+    from fbs_core.verdict import NoiseEdge
+
+    st = DashboardState()
+    store = Results(st)
+    st.noise.param.update(noise=10.0, target="both", rounds=300, seed=7, percentile=90)
+    nominal = _direct(None, H)
+    band = fbs_core.scatter_band(
+        H, noise=0.1, target="both", rounds=300, seed=7, n_modes=None, percentiles=(5.0, 95.0)
+    )
+    z = list(band.dofs).index("bushing:z")
+    peak = 20 * np.log10(response_level(nominal.sel(outputs="bushing:z"))[:, 0].max())
+    edge_peak = 20 * np.log10(band.percentiles[1][:, z].max())
+    assert edge_peak > peak + 0.2  # 10 % noise lifts the 95 % edge above the nominal peak
+    level = peak + (edge_peak - peak) / 2
+    f = fbs_core.harmonic(H).frequencies()
+    assert st.data.load_targets(_target_csv(level, f), "target.csv"), st.data.error
+    row = store.verdict.core["verdict"].row("reference", H, "bushing:z")
+    assert row.status == "pass"
+    assert row.margin_db == pytest.approx((edge_peak - peak) / 2, abs=1e-6)
+    st.noise.verdict_band = True
+    r = store.verdict
+    assert "noise band" in r.caption and "upper 95 % edge of 300 rounds" in r.meta["noise band"]
+    v = r.core["verdict"]
+    assert v.row("reference", H, "bushing:z").status == "fails within the noise band"
+    direct = verdict(
+        {("reference", H): nominal},
+        st.data.review.targets,
+        {("reference", H): NoiseEdge.of_band(band, 95.0)},
+    )
+    assert [(x.status, x.worst_db, x.freq) for x in v.rows] == [
+        (x.status, pytest.approx(x.worst_db, abs=1e-6), x.freq) for x in direct.rows
+    ]
+    # another noise level is another band: more noise, a higher edge, still within the band
+    st.noise.noise = 20.0
+    assert store.verdict.meta["noise band"].startswith("upper 95 % edge of 300 rounds, noise 20")
+    # off again: the nominal verdict
+    st.noise.verdict_band = False
+    assert store.verdict.core["verdict"].row("reference", H, "bushing:z").status == "pass"

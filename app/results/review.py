@@ -27,7 +27,7 @@ from fbs_core.candidates import Candidate, CandidateSet
 from fbs_core.delivery import assess_delivery
 from fbs_core.errors import FBSError
 from fbs_core.targets import Target
-from fbs_core.verdict import Verdict, verdict
+from fbs_core.verdict import NoiseEdge, Verdict, verdict
 from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES, magnitude_db
 
 from .. import compute
@@ -44,8 +44,18 @@ __all__ = [
     "verdict_work",
 ]
 
+#: The noise settings of the verdict's bands (while ``verdict_band`` is on).
+BAND_FIELDS = ("noise", "target", "frequency_dependent", "rounds", "seed", "percentile")
 #: The snapshot fields the verdict is made of.
-VERDICT_DEPENDS = ("review", "coupling", "models", "threshold", "f_max")
+VERDICT_DEPENDS = (
+    "review",
+    "coupling",
+    "models",
+    "threshold",
+    "f_max",
+    "verdict_band",
+    *BAND_FIELDS,
+)
 BUSHING = tuple(f"bushing:{d}" for d in DIRECTIONS)
 #: Responses kept (harmonic, coupling, models' digest -> FRF, ~15 kB each): every harmonic
 #: of the candidates of a few sessions. Keyed by the digest, not the models: a tire leaves
@@ -54,20 +64,21 @@ KEPT = 256
 
 
 class _Kept:
-    """The all-modes responses computed so far, most recent last, at most :data:`KEPT`."""
+    """What the verdict computed so far (responses, band edges), most recent last, at most
+    :data:`KEPT`."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._items: OrderedDict[tuple, FRF] = OrderedDict()
+        self._items: OrderedDict[tuple, Any] = OrderedDict()
 
-    def get(self, key: tuple) -> FRF | None:
+    def get(self, key: tuple) -> Any:
         with self._lock:
             frf = self._items.get(key)
             if frf is not None:
                 self._items.move_to_end(key)
             return frf
 
-    def put(self, key: tuple, frf: FRF) -> None:
+    def put(self, key: tuple, frf: Any) -> None:
         with self._lock:
             self._items[key] = frf
             self._items.move_to_end(key)
@@ -80,6 +91,8 @@ class _Kept:
 
 
 _DONE = _Kept()
+#: The noise bands' upper edges computed so far (NoiseEdge, ~4 kB each; not the bands).
+_EDGES = _Kept()
 
 
 def candidates_of(s: Snapshot) -> CandidateSet:
@@ -104,22 +117,56 @@ def _response(k: int, coupling: str, models) -> FRF:
     return frf
 
 
-def _jobs(s: Snapshot) -> tuple[list[tuple], list[tuple]]:
-    """What the verdict needs: responses ``(k, coupling, models)`` and tables
-    ``(threshold, f_max, coupling, None, models)``, each list in the candidates' order."""
-    responses, tables = [], []
+def _band_settings(s: Snapshot) -> tuple:
+    """The noise settings of the verdict's bands and the upper edge's percentile."""
+    return (
+        float(s.noise),
+        s.target,
+        bool(s.frequency_dependent),
+        int(s.rounds),
+        int(s.seed),
+        (100 + float(s.percentile)) / 2,
+    )
+
+
+def _edge_key(k: int, coupling: str, models, band: tuple) -> tuple:
+    return (k, coupling, models.key, *band)
+
+
+def _edge(k: int, coupling: str, models, band: tuple) -> NoiseEdge:
+    """The upper edge (percentile ``band[-1]``) of the all-modes scatter band of ``models``
+    to harmonic ``k`` at the noise settings ``band`` (thesis eqs. 5.2-5.4)."""
+    key = _edge_key(k, coupling, models, band)
+    edge = _EDGES.get(key)
+    if edge is None:
+        noise, target, fdep, rounds, seed, q = band
+        res = compute.band(k, None, coupling, noise, target, fdep, rounds, seed, models)
+        edge = NoiseEdge.of_band(res, q)
+        _EDGES.put(key, edge)
+    return edge
+
+
+def _jobs(s: Snapshot) -> tuple[list[tuple], list[tuple], list[tuple]]:
+    """What the verdict needs: responses ``(k, coupling, models)``, tables
+    ``(threshold, f_max, coupling, None, models)`` and, with the noise band on, band edges
+    ``(k, coupling, models, band settings)``, each list in the candidates' order."""
+    responses, tables, edges = [], [], []
+    band = _band_settings(s)
     for c in candidates_of(s):
         m = candidate_models(s.models, c)
         responses += [(k, s.coupling, m) for k in HARMONIC_CASES]
         tables.append((s.threshold, s.f_max, s.coupling, None, m))
-    return responses, tables
+        if s.verdict_band:
+            edges += [(k, s.coupling, m, band) for k in HARMONIC_CASES]
+    return responses, tables, edges
 
 
-def _missing(s: Snapshot) -> tuple[list[tuple], list[tuple]]:
-    responses, tables = _jobs(s)
+def _missing(s: Snapshot) -> tuple[list[tuple], list[tuple], list[tuple]]:
+    responses, tables, edges = _jobs(s)
     return (
         [r for r in responses if _key(*r) not in _DONE],
         [t for t in tables if not compute.suggested_table_ready(*t)],
+        [e for e in edges if _edge_key(*e) not in _EDGES],
     )
 
 
@@ -127,8 +174,8 @@ def verdict_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The responses and tables the verdict still lacks, one by one (None: none)."""
     if not s.review.judged:
         return None
-    responses, tables = _missing(s)
-    if not responses and not tables:
+    responses, tables, edges = _missing(s)
+    if not responses and not tables and not edges:
         return None
 
     def work() -> Iterator[None]:
@@ -138,6 +185,9 @@ def verdict_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
         for t in tables:
             compute.suggested_table(*t)
             yield
+        for e in edges:  # the slowest last: the verdict without them is not shown meanwhile
+            _edge(*e)
+            yield
 
     return work
 
@@ -145,17 +195,21 @@ def verdict_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
 def _verdict(s: Snapshot) -> Verdict:
     cands = candidates_of(s)
     responses: dict[tuple[str, int], FRF] = {}
+    bands: dict[tuple[str, int], NoiseEdge] = {}
     deliveries = []
+    band = _band_settings(s)
     for c in cands:
         m = candidate_models(s.models, c)
         for k in HARMONIC_CASES:
             responses[(c.name, k)] = _response(k, s.coupling, m)
+            if s.verdict_band:
+                bands[(c.name, k)] = _edge(k, s.coupling, m, band)
         table = compute.suggested_table(s.threshold, s.f_max, s.coupling, None, m)
         deliveries.append(assess_delivery(c, table["result"]))
     targets: list[Any] = list(s.review.targets)
     if s.review.incumbent is not None:
         targets.append(s.review.incumbent)
-    return verdict(responses, targets, candidates=cands, deliveries=deliveries)
+    return verdict(responses, targets, bands or None, candidates=cands, deliveries=deliveries)
 
 
 def _meta(s: Snapshot, cands: CandidateSet) -> dict[str, Any]:
@@ -173,6 +227,14 @@ def _meta(s: Snapshot, cands: CandidateSet) -> dict[str, Any]:
         "incumbent rule": "none"
         if r.incumbent is None
         else f"{r.incumbent.candidate} {r.incumbent.margin_db:+g} dB",
+        "noise band": (
+            f"upper {(100 + s.percentile) / 2:g} % edge of {s.rounds:,} rounds, noise "
+            f"{s.noise:g} % on {s.target}"
+            + (", a new factor per line" if s.frequency_dependent else "")
+            + f", seed {s.seed}"
+            if s.verdict_band
+            else "off (pass or fail of the nominal responses only)"
+        ),
         "delivery threshold_pct": s.threshold,
         "delivery f_max_Hz": s.f_max,
         "models": s.models.describe(),
@@ -184,7 +246,8 @@ def verdict_result(s: Snapshot) -> Result:
     ranking and the deliveries; pending while :func:`verdict_work` computes."""
     cands = candidates_of(s)
     meta = _meta(s, cands)
-    name = f"verdict_{len(cands)}cand_{s.review.key[:8]}_{s.coupling}.csv"
+    band = f"_band{s.noise:g}pct_R{s.rounds}_s{s.seed}" if s.verdict_band else ""
+    name = f"verdict_{len(cands)}cand_{s.review.key[:8]}_{s.coupling}{band}.csv"
     if not s.review.judged:
         return Result(
             meta=meta,
@@ -192,14 +255,15 @@ def verdict_result(s: Snapshot) -> Result:
             caption="No targets: load a target file, type a target or choose the incumbent.",
             draw={"state": "no targets", "candidates": cands},
         )
-    responses, tables = _missing(s)
-    if responses or tables:
-        total = len(cands) * (len(HARMONIC_CASES) + 1)
-        done = total - len(responses) - len(tables)
+    responses, tables, edges = _missing(s)
+    if responses or tables or edges:
+        total = len(cands) * (len(HARMONIC_CASES) * (2 if s.verdict_band else 1) + 1)
+        done = total - len(responses) - len(tables) - len(edges)
+        what = "responses and noise bands" if s.verdict_band else "responses"
         return Result(
             meta=meta,
             filename=name,
-            caption=f"Computing the candidates' responses: {done} of {total} ...",
+            caption=f"Computing the candidates' {what}: {done} of {total} ...",
             draw={"state": "pending", "pending": True, "candidates": cands},
         )
     try:
@@ -230,6 +294,7 @@ def verdict_result(s: Snapshot) -> Result:
         caption=(
             f"**{len(cands)} candidates** against {len(s.review.targets)} target(s)"
             + ("" if s.review.incumbent is None else " and the incumbent rule")
+            + (" with the noise band" if s.verdict_band else "")
             + (f"; best: **{best.candidate}** ({best.status})" if best is not None else "")
         ),
         draw={"state": "done", "verdict": v, "candidates": cands},

@@ -246,6 +246,14 @@ class NoiseState(param.Parameterized):
         "band: |v| +- k std with k the Gaussian quantile of the central percentile band "
         "(docs/corridor.md section 6; computed only while shown).",
     )
+    verdict_band = param.Boolean(
+        metadata=setting("vband", "verdict judged with the noise band's upper edge"),
+        default=False,
+        doc="Judge the review's verdict with the noise band too: a scatter band of these "
+        "noise settings for every candidate and harmonic (all modes), whose upper edge of "
+        "the central percentile band crossing a target makes 'fails within the noise band' "
+        "(docs/verdict.md).",
+    )
 
     @param.depends("rounds", watch=True, on_init=True)
     def _clip_single_round(self):

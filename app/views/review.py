@@ -31,6 +31,7 @@ from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES
 from ..datasource import TARGET_ACCEPT, TIRE_ACCEPT
 from ..export import dated
 from ..runtime.draw import on_document, served_document
+from .bind import control
 from .common import CANDIDATE_COLORS
 from .live import LiveText, export_meta
 from .upload import _alert, _uploaded, queue_read
@@ -184,6 +185,14 @@ class ReviewView(Viewer):
             button_type="light",
             css_classes=["review-csv"],
             width=130,
+        )
+        self.band_switch = control(
+            W.Checkbox,
+            self.store.state.noise.param.verdict_band,
+            name="Judge with the noise band (a band of the noise settings per candidate and "
+            "harmonic, all modes: a target crossed only by its upper edge is 'fails within "
+            "the noise band')",
+            css_classes=["review-band"],
         )
         self.candidates_text = LiveText(css_classes=["review-candidates"])
         self.targets_text = LiveText(css_classes=["review-targets"])
@@ -506,6 +515,7 @@ class ReviewView(Viewer):
             ),  # fmt: skip
             self.targets_text,
             pn.Row(label("**Verdict**", margin=(0, 5)), self.download),
+            self.band_switch,
             self.verdict_text,
             sizing_mode="stretch_width",
         )
