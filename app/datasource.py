@@ -45,7 +45,7 @@ from fbs_core.io.checks import check_pair, check_tire
 from fbs_core.targets import IncumbentTarget, Target, read_targets
 from fbs_core.vocabulary import DIRECTIONS, EIGEN_SPEEDS, HARMONIC_CASES
 
-from .review import EMPTY_REVIEW, LinkReview, Review, read_review_link
+from .review import EMPTY_REVIEW, LINK_DIGEST, LinkReview, Review, read_review_link
 
 __all__ = [
     "CHASSIS_ACCEPT",
@@ -179,12 +179,27 @@ def _settle(review: Review, want: LinkReview | None) -> tuple[Review, LinkReview
         review = review.with_incumbent(IncumbentTarget(name, inc[1]))
         inc = None
     rest = tuple(d for d in want.candidates if d not in loaded and d != "reference")
+    order = want.order or want.candidates
+    if not rest and cands is not None:
+        review = review.with_candidates(_in_order(review.candidates or cands, order))
     # the link's current candidate stays asked for until every candidate is loaded (a later
     # upload would otherwise become current)
     current = "" if not rest or want.current in ("", "reference") else want.current
     if not rest and inc is None:
         return review, None
-    return review, LinkReview(rest, current, inc)
+    return review, LinkReview(rest, current, inc, order=order)
+
+
+def _in_order(cands: CandidateSet, order: tuple[str, ...]) -> CandidateSet:
+    """The candidates in the link's order (by digest or its link prefix; others after, as
+    they were), their colours in that order: the page of the link as it was shared."""
+    by = {d: c for c in cands for d in (c.digest, c.digest[:LINK_DIGEST])}
+    first = list({by[d].digest: by[d] for d in order if d in by}.values())
+    seen = {c.digest for c in first}
+    ordered = first + [c for c in cands if c.digest not in seen]
+    if [c.digest for c in ordered] == list(cands.digests):
+        return cands
+    return CandidateSet(ordered, current=cands.current_digest)
 
 
 def _unique(name: str, taken) -> str:

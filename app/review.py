@@ -152,6 +152,8 @@ class LinkReview:
     incumbent: tuple[str, float] | None = None
     targets: tuple[Target, ...] = ()
     targets_left_out: bool = False
+    #: Every candidate of the link in its order (``candidates``: those still to load).
+    order: tuple[str, ...] = ()
 
 
 def _short(digest: str) -> str:
@@ -248,4 +250,4 @@ def read_review_link(text: str) -> LinkReview:
         except (ValueError, FBSError) as e:
             shown = part if len(part) <= 60 else part[:60] + "..."
             raise FBSError(f"the link's review part {shown!r} cannot be read: {e}") from None
-    return LinkReview(cands, current, incumbent, tuple(targets), left_out)
+    return LinkReview(cands, current, incumbent, tuple(targets), left_out, cands)

@@ -323,11 +323,17 @@ def test_the_link_restores_the_review_where_its_files_are_loaded(tmp_path, tires
     assert len(want.candidates) == 2 and want.current and want.incumbent[1] == 1.5
     # the link keeps asking for them
     assert read_review_link(review_link(st2.data.review, want)).candidates == want.candidates
-    # the files uploaded, the link's current one first: it stays current after the other
-    for name in ("soft.h5", "stiff.h5"):
+    # the files uploaded in the other order: once all are there, the link's order and
+    # colours are restored, and its current candidate stays current
+    for name in ("stiff.h5", "soft.h5"):
         assert st2.data.load_tire(_bytes(tmp_path, tires[name], name), name), st2.data.error
     assert st2.data.pending is None
     r2 = st2.data.review
+    assert r2.candidates.names == ds.review.candidates.names
+    assert [r2.candidates.slot(n) for n in r2.candidates.names] == [
+        ds.review.candidates.slot(n) for n in ds.review.candidates.names
+    ]
+    assert review_link(r2) == text
     assert r2.candidates.current.name == "soft.h5" and r2.incumbent.candidate == "soft.h5"
     after = store2.verdict.core["verdict"]
     rows = {(x.candidate, x.harmonic, x.dof): x for x in after.rows}
