@@ -413,6 +413,13 @@ TABLE: tuple[Row, ...] = (
         slow=review.curves_work,
         doc="The other candidates' responses and the target on the coupled-response plot.",
     ),
+    Row(
+        "review_bands",
+        review.BANDS_DEPENDS,
+        review.review_bands_result,
+        slow=review.bands_work,
+        doc="The other candidates' scatter bands (the page's band settings) on the band plot.",
+    ),
     # last: its thread starts once the pass's other results are out (it publishes later)
     Row("band", BAND, None, when=OWN_THREAD, kind=Band, doc="The latest scatter band."),
 )

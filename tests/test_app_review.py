@@ -398,3 +398,39 @@ def test_the_noise_band_judges_a_target_only_its_upper_edge_crosses():
     # off again: the nominal verdict
     st.noise.verdict_band = False
     assert store.verdict.core["verdict"].row("reference", H, "bushing:z").status == "pass"
+
+
+def test_the_other_candidates_bands_are_the_cores_bands_of_their_tires(tmp_path, tires):
+    """The scatter plot's other candidates: each one's central band at the page's band
+    settings. Truth: the core's scatter band of that tire (same seed: the same rounds)."""
+    st, store = _session(tmp_path, tires)  # current: stiff.h5
+    st.noise.param.update(noise=5.0, rounds=200, seed=3, percentile=80)
+    st.case.param.update(harmonic=2, n_modes=60, dof="x")
+    r = store.review_bands
+    got = {c["name"]: c for c in r.draw["curves"]}
+    assert set(got) == {"reference", "soft.h5"} and not r.draw["pending"]
+    for name, model in (("reference", None), ("soft.h5", tires["soft.h5"])):
+        kw = {} if model is None else {"tire": model}
+        band = fbs_core.scatter_band(
+            2, noise=0.05, rounds=200, seed=3, n_modes=60, percentiles=(10.0, 90.0), **kw
+        )
+        j = list(band.dofs).index("bushing:x")
+        np.testing.assert_allclose(got[name]["low"], 20 * np.log10(band.percentiles[0][:, j]))
+        np.testing.assert_allclose(got[name]["high"], 20 * np.log10(band.percentiles[1][:, j]))
+        assert got[name]["slot"] == st.data.review.candidates.slot(name)
+    assert r.meta["percentiles"] == "10-90" and "soft.h5" in r.meta["candidates"]
+    # drawn on the band plot in each candidate's colour, beside the page's own band
+    from app.views.scatter import ScatterBandView
+
+    store.request_band(wait=True)
+    view = ScatterBandView(store=store)
+    view.__panel__()
+    for name, c in got.items():
+        src = next(m for m in view._fig.select({"name": f"scatter.candidate{c['slot']}"}))
+        np.testing.assert_allclose(src.data["high"], c["high"])
+        assert view._cand_items[c["slot"]].visible
+    # the current candidate's band is the page's own, not drawn again; in vehicle scope none
+    st.data.select_candidate("soft.h5")
+    assert {c["name"] for c in store.review_bands.draw["curves"]} == {"reference", "stiff.h5"}
+    st.case.scope = "vehicle"
+    assert store.review_bands.draw["curves"] == []

@@ -84,6 +84,8 @@ def _sections(current: dict[str, Any]) -> tuple[ExtraSection, ...]:
             continue  # the coupled response as the report shows it already
         if name == "review_curves" and not value.draw["curves"] and value.draw["target"] is None:
             continue  # no other candidate and no target: nothing beside the coupled response
+        if name == "review_bands" and not value.draw["curves"]:
+            continue  # no other candidate's band
         if isinstance(value, Result):
             out.append(ExtraSection.of_result(name, value))
         elif isinstance(value, tuple) and all(isinstance(v, Result) for v in value):

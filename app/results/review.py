@@ -35,10 +35,13 @@ from ..datasource import candidate_models
 from .base import Result, Snapshot
 
 __all__ = [
+    "BANDS_DEPENDS",
     "CURVES_DEPENDS",
     "VERDICT_DEPENDS",
     "candidates_of",
     "curves_work",
+    "bands_work",
+    "review_bands_result",
     "review_curves_result",
     "verdict_result",
     "verdict_work",
@@ -70,6 +73,7 @@ class _Kept:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._items: OrderedDict[tuple, Any] = OrderedDict()
+        self.limit = KEPT
 
     def get(self, key: tuple) -> Any:
         with self._lock:
@@ -82,7 +86,7 @@ class _Kept:
         with self._lock:
             self._items[key] = frf
             self._items.move_to_end(key)
-            while len(self._items) > KEPT:
+            while len(self._items) > self.limit:
                 self._items.popitem(last=False)
 
     def __contains__(self, key: tuple) -> bool:
@@ -406,4 +410,110 @@ def review_curves_result(s: Snapshot) -> Result:
             "target_label": f"target: {label}" if label else "",
             "pending": bool(pending),
         },
+    )
+
+
+# -- the candidates' scatter bands on the scatter-band plot -------------------------------------
+#: The snapshot fields the other candidates' bands are made of (those of the page's band).
+BANDS_DEPENDS = (
+    "review",
+    "harmonic",
+    "n_modes",
+    "dof",
+    "coupling",
+    "models",
+    "percentile",
+    "scope",
+    *BAND_FIELDS[:5],
+)
+#: Band edges kept (per candidate, harmonic, N, noise settings and percentile band: the
+#: central band's two edges at the six DOFs, at most ~0.2 MB each).
+KEPT_BANDS = 64
+_BANDS = _Kept()
+_BANDS.limit = KEPT_BANDS
+
+
+def _band_key(s: Snapshot, m) -> tuple:
+    return (
+        compute.band_key(
+            s.harmonic, s.n_modes, s.coupling, s.noise, s.target, s.frequency_dependent,
+            s.rounds, s.seed, m,
+        ),
+        int(s.percentile),
+    )  # fmt: skip
+
+
+def _band_edges(s: Snapshot, m) -> dict[str, Any]:
+    """The central percentile band of ``models`` at the page's band settings (thesis
+    eqs. 5.2-5.4, N modes as the page's band): its two edges at the six DOFs."""
+    key = _band_key(s, m)
+    got = _BANDS.get(key)
+    if got is None:
+        res = compute.band(
+            s.harmonic, s.n_modes, s.coupling, s.noise, s.target, s.frequency_dependent,
+            s.rounds, s.seed, m,
+        )  # fmt: skip
+        lo, hi = (100 - s.percentile) / 2, (100 + s.percentile) / 2
+        q = [float(x) for x in np.asarray(res.q, float)]
+        pct = np.asarray(res.percentiles, float)
+        got = {
+            "freq": np.asarray(res.freq, float),
+            "dofs": tuple(res.dofs),
+            "low": pct[q.index(lo)].copy(),
+            "high": pct[q.index(hi)].copy(),
+        }
+        _BANDS.put(key, got)
+    return got
+
+
+def bands_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
+    """The other candidates' bands not computed yet (None: none)."""
+    todo = [m for _c, m, _slot in _others(s) if _band_key(s, m) not in _BANDS]
+    if not todo:
+        return None
+
+    def work() -> Iterator[None]:
+        for m in todo:
+            _band_edges(s, m)
+            yield
+
+    return work
+
+
+def review_bands_result(s: Snapshot) -> Result:
+    """The other candidates' central percentile bands at the shown DOF, at the page's band
+    settings (N modes, noise, rounds, seed), for the scatter-band plot (corner scope)."""
+    label = f"bushing:{s.dof}"
+    curves, pending = [], []
+    freq = np.asarray(compute.frequencies(s.harmonic), float)
+    cols: dict[str, np.ndarray] = {"freq_Hz": freq}
+    for c, m, slot in _others(s):
+        if _band_key(s, m) not in _BANDS:
+            pending.append(c.name)
+            continue
+        e = _band_edges(s, m)
+        j = e["dofs"].index(label)
+        low, high = magnitude_db(e["low"][:, j]), magnitude_db(e["high"][:, j])
+        cols[f"{c.name}_low_dB"], cols[f"{c.name}_high_dB"] = low, high
+        curves.append({"name": c.name, "slot": slot, "freq": e["freq"], "low": low, "high": high})
+    lo, hi = (100 - s.percentile) / 2, (100 + s.percentile) / 2
+    return Result(
+        columns=cols,
+        meta={
+            "view": "review: the other candidates' scatter bands (central percentile band)",
+            "harmonic": s.harmonic,
+            "N": s.n_modes,
+            "response DOF": label,
+            "coupling": s.coupling,
+            "noise_pct": s.noise,
+            "target": s.target,
+            "frequency_dependent": s.frequency_dependent,
+            "rounds": s.rounds,
+            "seed": s.seed,
+            "percentiles": f"{lo:g}-{hi:g}",
+            "candidates": ", ".join(str(c["name"]) for c in curves) or "none",
+            "models": s.models.describe(),
+        },
+        filename=f"review_bands_h{s.harmonic}_N{s.n_modes}_{s.dof}_{s.review.key[:8]}.csv",
+        draw={"curves": curves, "pending": pending},
     )

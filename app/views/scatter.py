@@ -14,15 +14,23 @@ import panel as pn
 import param
 from bokeh.core.properties import value
 from bokeh.events import Tap
-from bokeh.models import ColumnDataSource
+from bokeh.models import ColumnDataSource, HoverTool, LegendItem
 
-from .common import COLORS, FREQ_LABEL, level_label, level_tooltips
+from fbs_core.candidates import MAX_CANDIDATES
+
+from ..results.base import made_of_same
+from .common import CANDIDATE_COLORS, COLORS, FREQ_LABEL, level_label, level_tooltips
 from .layout import font
 from .live import LiveText, LiveView, downloads, inline_html
 from .plots import add_band, add_line, frequency_range, new_figure, set_data
 
 #: The overlay's legend (its band's quantile said once drawn).
 FIRST_ORDER_LEGEND = "first-order band (linearised)"
+#: What the other candidates' bands and the shown band must share to be drawn together.
+BANDS_SAME = (
+    "harmonic", "n_modes", "dof", "coupling", "percentile", "noise", "target",
+    "frequency_dependent", "rounds", "seed",
+)  # fmt: skip
 #: The progress bar is hidden when idle (its box kept: no new layout of the page). The rule
 #: follows the bar's own ``active`` class: the bar's ``styles`` are copied onto the inner
 #: ``<progress>`` element once, when it is drawn, so a bar drawn idle stayed hidden for
@@ -35,7 +43,7 @@ class ScatterBandView(LiveView):
 
     key = "scatter"
     result_name = "band_curves"
-    also = ("band_status", "first_order")
+    also = ("band_status", "first_order", "review_bands")
     x_range = param.Parameter(
         default=None,
         doc="Frequency range shared with other views (linked zoom and pan); a new one if None.",
@@ -141,8 +149,66 @@ class ScatterBandView(LiveView):
             for item in leg.items:
                 if getattr(item.label, "value", None) == FIRST_ORDER_LEGEND:
                     item.visible = False
+        # the review's other candidates: their central band's two edges in their colour (a
+        # pair of lines per colour slot, made on first use; legend entries here from the start)
+        self._cand: dict[int, ColumnDataSource] = {}
+        self._cand_items = [
+            LegendItem(label=value(f"candidate {k + 1}"), renderers=[], visible=False)
+            for k in range(MAX_CANDIDATES)
+        ]
+        fig.legend[0].items = [*fig.legend[0].items, *self._cand_items]
+        self._cand_tool = HoverTool(
+            renderers=[], tooltips=level_tooltips("@name", "level"), mode="vline"
+        )
+        fig.add_tools(self._cand_tool)
         fig.on_event(Tap, self._tapped)
         return [fig]
+
+    def _cand_lines(self, slot: int) -> ColumnDataSource:
+        """The source of a candidate's band edges (colour ``slot``), its lines made on first
+        use: the upper edge solid, the lower dashed."""
+        src = self._cand.get(slot)
+        if src is not None:
+            return src
+        src = self._cand[slot] = ColumnDataSource(
+            {"freq": np.zeros(0), "low": np.zeros(0), "high": np.zeros(0), "name": []},
+            name=f"scatter.candidate{slot}",
+        )
+        lines = [
+            self._fig.line(
+                "freq", edge, source=src, line_color=CANDIDATE_COLORS[slot], line_width=1.6,
+                line_dash=dash, visible=False,
+            )
+            for edge, dash in (("high", "solid"), ("low", "dashed"))
+        ]  # fmt: skip
+        self._cand_items[slot].renderers = lines
+        self._cand_tool.renderers = [*self._cand_tool.renderers, *lines]
+        return src
+
+    def _draw_candidates(self, r) -> None:
+        """The other candidates' bands when they are of the band ``r`` shows (its case,
+        DOF, percentile band and noise settings)."""
+        rb = self.store.review_bands
+        ok = rb is not None and made_of_same(rb, r, BANDS_SAME)
+        shown = set()
+        for cv in rb.draw["curves"] if ok and rb is not None else []:
+            n = len(cv["freq"])
+            self._cand_lines(cv["slot"]).data = {
+                "freq": cv["freq"],
+                "low": cv["low"],
+                "high": cv["high"],
+                "name": [cv["name"]] * n,
+            }
+            label = f"{cv['name']}: central band"
+            if getattr(self._cand_items[cv["slot"]].label, "value", None) != label:
+                self._cand_items[cv["slot"]].label = value(label)
+            shown.add(cv["slot"])
+        for slot in self._cand:
+            item, on = self._cand_items[slot], slot in shown
+            if item.visible != on:
+                item.visible = on
+                for line in item.renderers:
+                    line.visible = on
 
     def _overlay(self, r):
         """The published first-order result when it is shown and of the drawn band, DOF and
@@ -226,4 +292,5 @@ class ScatterBandView(LiveView):
                 item = leg.items[len(labels) - 1]
                 if item.visible != (fo is not None):
                     item.visible = fo is not None
+        self._draw_candidates(r)
         self._fit(self.x_range, f)
