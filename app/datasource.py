@@ -184,7 +184,7 @@ def _settle(review: Review, want: LinkReview | None) -> tuple[Review, LinkReview
         review = review.with_candidates(_in_order(review.candidates or cands, order))
     # the link's current candidate stays asked for until every candidate is loaded (a later
     # upload would otherwise become current)
-    current = "" if not rest or want.current in ("", "reference") else want.current
+    current = "" if not rest else want.current
     if not rest and inc is None:
         return review, None
     return review, LinkReview(rest, current, inc, order=order)

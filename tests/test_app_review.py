@@ -434,3 +434,19 @@ def test_the_other_candidates_bands_are_the_cores_bands_of_their_tires(tmp_path,
     assert {c["name"] for c in store.review_bands.draw["curves"]} == {"reference", "stiff.h5"}
     st.case.scope = "vehicle"
     assert store.review_bands.draw["curves"] == []
+
+
+def test_a_link_whose_current_tire_is_the_reference_keeps_it_current(tmp_path, tires):
+    from app.review import review_link
+
+    st, _store = _session(tmp_path, tires)
+    assert st.data.select_candidate("reference")
+    text = review_link(st.data.review)
+    st2 = DashboardState()
+    Results(st2)
+    assert st2.data.apply_link(text), st2.data.error
+    for name in ("stiff.h5", "soft.h5"):  # each upload would become current by itself
+        assert st2.data.load_tire(_bytes(tmp_path, tires[name], name), name), st2.data.error
+        assert st2.data.review.candidates.current.name == "reference"
+    assert st2.data.pending is None and review_link(st2.data.review) == text
+    assert st2.data.models.is_reference  # the session's tire is the current candidate's

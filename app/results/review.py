@@ -466,6 +466,15 @@ def _band_edges(s: Snapshot, m) -> dict[str, Any]:
     return got
 
 
+def _digest_of(curves: list[dict[str, Any]]) -> str:
+    """A short digest of the candidates drawn (their files' digests): a file name of its own
+    per set of candidates, not per target."""
+    import hashlib
+
+    digests = "\n".join(str(c["digest"]) for c in curves)
+    return hashlib.sha256(digests.encode()).hexdigest()[:8]
+
+
 def bands_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The other candidates' bands not computed yet (None: none)."""
     todo = [m for _c, m, _slot in _others(s) if _band_key(s, m) not in _BANDS]
@@ -495,7 +504,10 @@ def review_bands_result(s: Snapshot) -> Result:
         j = e["dofs"].index(label)
         low, high = magnitude_db(e["low"][:, j]), magnitude_db(e["high"][:, j])
         cols[f"{c.name}_low_dB"], cols[f"{c.name}_high_dB"] = low, high
-        curves.append({"name": c.name, "slot": slot, "freq": e["freq"], "low": low, "high": high})
+        curves.append(
+            {"name": c.name, "digest": c.digest, "slot": slot, "freq": e["freq"], "low": low,
+             "high": high}
+        )  # fmt: skip
     lo, hi = (100 - s.percentile) / 2, (100 + s.percentile) / 2
     return Result(
         columns=cols,
@@ -507,13 +519,13 @@ def review_bands_result(s: Snapshot) -> Result:
             "coupling": s.coupling,
             "noise_pct": s.noise,
             "target": s.target,
-            "frequency_dependent": s.frequency_dependent,
+            "frequency dependent": s.frequency_dependent,
             "rounds": s.rounds,
             "seed": s.seed,
             "percentiles": f"{lo:g}-{hi:g}",
             "candidates": ", ".join(str(c["name"]) for c in curves) or "none",
             "models": s.models.describe(),
         },
-        filename=f"review_bands_h{s.harmonic}_N{s.n_modes}_{s.dof}_{s.review.key[:8]}.csv",
+        filename=f"review_bands_h{s.harmonic}_N{s.n_modes}_{s.dof}_{_digest_of(curves)}.csv",
         draw={"curves": curves, "pending": pending},
     )

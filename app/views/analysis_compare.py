@@ -18,11 +18,15 @@ from bokeh.palettes import RdBu11
 from fbs_core.analysis import MAX_PINS
 from fbs_core.vocabulary import magnitude_db
 
+from ..page.bokeh import wrap_line
 from .analysis_base import PICK_COLOR, TERM_COLORS, AnalysisView
 from .analysis_speed import _pick_spans
 from .common import COLORS, level_label
 from .layout import plot_rows, weight
 from .plots import add_image, set_data
+
+#: Characters per line of the error map's title (its type in a half-width plot at 1280 px).
+TITLE_CHARS = 56
 
 __all__ = ["CompareView"]
 
@@ -292,7 +296,8 @@ class CompareView(AnalysisView):
             self._bar.major_label_overrides = (
                 {ticks[0]: f"\u2264 {-lim:.3g}", ticks[-1]: f"\u2265 {lim:.3g}"} if beyond else {}
             )
-            self._mp.title.text = title
+            # on lines that fit a half-width plot (one long line widened the page)
+            self._mp.title.text = "\n".join(wrap_line(title, TITLE_CHARS))
             self._map_glyph.visible = self._bar.visible = True
         else:
             self._img.data = {

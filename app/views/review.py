@@ -189,9 +189,7 @@ class ReviewView(Viewer):
         self.band_switch = control(
             W.Checkbox,
             self.store.state.noise.param.verdict_band,
-            name="Judge with the noise band (a band of the noise settings per candidate and "
-            "harmonic, all modes: a target crossed only by its upper edge is 'fails within "
-            "the noise band')",
+            name="Judge with the noise band",
             css_classes=["review-band"],
         )
         self.candidates_text = LiveText(css_classes=["review-candidates"])
@@ -515,7 +513,19 @@ class ReviewView(Viewer):
             ),  # fmt: skip
             self.targets_text,
             pn.Row(label("**Verdict**", margin=(0, 5)), self.download),
-            self.band_switch,
+            pn.FlexBox(
+                self.band_switch,
+                label(
+                    "a band of the noise settings per candidate and harmonic (all modes): a "
+                    "target crossed only by its upper percentile edge *fails within the noise "
+                    "band*",
+                    margin=(0, 5),
+                    styles={"font-size": "0.85em"},
+                ),
+                flex_wrap="wrap",
+                align_items="center",
+                sizing_mode="stretch_width",
+            ),
             self.verdict_text,
             sizing_mode="stretch_width",
         )

@@ -21,7 +21,7 @@ from fbs_core.tire import TireModel
 from fbs_core.tire.storage import save_tire_model
 from fbs_core.verdict import verdict
 
-from .conftest import ARTIFACTS, open_dashboard
+from .conftest import ARTIFACTS, open_dashboard, source, wait_loaded
 from .layout_util import layout_problems, wait_stable
 
 pytestmark = pytest.mark.browser
@@ -39,6 +39,59 @@ def _tire(scale: float, tag: str) -> TireModel:
 
 def _wait_text(page, cls: str, pattern: str, timeout: float = 180_000) -> None:
     page.locator(f".{cls}").filter(has_text=re.compile(pattern)).first.wait_for(timeout=timeout)
+
+
+def _open_compare(page) -> None:
+    """Open the Analysis card (unless it is open) and its Compare tab."""
+    collapsed = page.evaluate(
+        """() => [...Bokeh.documents[0].all_models].filter(m => m.css_classes
+             && m.css_classes.includes('analysis-card'))[0].collapsed"""
+    )
+    if collapsed:
+        page.locator(".analysis-card .card-header").first.click()
+    page.locator(".analysis-tabs .bk-tab", has_text="Compare").first.click(timeout=180_000)
+
+
+def _pin(page, name: str) -> None:
+    """Pin the current state under ``name`` (the Compare tab's name field and button)."""
+    box = page.locator(".ctl-analysis-pin_name input").first
+    box.click(timeout=20_000)
+    box.fill(name)
+    box.press("Enter")
+    page.wait_for_function(
+        """(n) => [...Bokeh.documents[0].all_models].some(m => m.css_classes
+             && m.css_classes.includes('ctl-analysis-pin_name') && m.value === n)""",
+        arg=name,
+    )
+    page.locator(".ctl-analysis-pin button").first.click()
+    page.wait_for_function("(n) => window.location.search.includes(n + '~')", arg=name)
+
+
+def _check_pins(page, pins: dict) -> None:
+    """The Compare tab draws each pin as the core's response of its own tire (the page's
+    case: harmonic 1, N = 50, bushing:z)."""
+    names = list(pins)
+    page.wait_for_function(
+        """(names) => { const shown = [...Bokeh.documents[0].all_models].filter(
+             m => m.type === 'Legend').flatMap(l => l.items).filter(i => i.visible)
+             .map(i => i.label && i.label.value);
+           return names.every(n => shown.includes(n)); }""",
+        arg=names,
+        timeout=180_000,
+    )
+    labels = page.evaluate(
+        """() => [...Bokeh.documents[0].all_models].filter(m => m.type === 'Figure'
+             && m.name === 'compare.levels').flatMap(f => [...f.center, ...f.below]
+             .filter(r => r.type === 'Legend')).flatMap(l => l.items)
+             .map(i => i.label.value)"""
+    )
+    for name in names:  # legend item i is curve i
+        kw = {} if pins[name] is None else {"tire": pins[name]}
+        want = fbs_core.bushing_response(1, n_modes=50, **kw).sel(outputs="bushing:z")
+        got = source(page, f"compare.curve{labels.index(name)}")
+        np.testing.assert_allclose(
+            got["level"], 20 * np.log10(np.abs(want.data[:, 0, 0])), atol=1e-6, err_msg=name
+        )
 
 
 @pytest.mark.parametrize("size", [(1280, 720), (1920, 1080)], ids=["1280x720", "1920x1080"])
@@ -106,8 +159,20 @@ def test_two_suppliers_and_the_reference_judged_by_clicking(browser, dashboard, 
         has_text="yes"  # the "current" column (text content: no separators between cells)
     ).first.wait_for(timeout=120_000)
 
+    # a pin of each candidate, by clicking: supplier X (current now), then the reference;
+    # both keep their curves (each pin names its candidate's models)
+    _open_compare(page)
+    wait_loaded(page, ["compare.curve0"], timeout=180_000)
+    _pin(page, "supx")
+    page.locator(".review-current select").select_option("reference")
+    page.locator(".review-candidates-table tr").filter(has_text="reference").filter(
+        has_text="yes"
+    ).first.wait_for(timeout=120_000)
+    _pin(page, "ref")
+    _check_pins(page, {"supx": tires["supplier_x.h5"], "ref": None})
+
     # the report opens with the verdict
-    with page.expect_download() as info:
+    with page.expect_download(timeout=300_000) as info:  # drawn in a process of its own
         page.locator(".report-html button, .report-html a").first.click()
     report = open(info.value.path()).read()
     assert 0 < report.index('id="verdict"') < report.index('id="summary"')
@@ -129,9 +194,12 @@ def test_two_suppliers_and_the_reference_judged_by_clicking(browser, dashboard, 
         _wait_text(other, "review-verdict", "Ranking", timeout=300_000)
         again = other.locator(".verdict-ranking tr").all_inner_texts()[1:]
         assert [x.split("\t")[1:4] for x in again] == [x.split("\t")[1:4] for x in shown]
-        other.locator(".review-candidates-table tr").filter(has_text="supplier_x.h5").filter(
+        other.locator(".review-candidates-table tr").filter(has_text="reference").filter(
             has_text="yes"
         ).first.wait_for(timeout=60_000)  # the link's current candidate
+        # the pins of both candidates are back with their curves
+        _open_compare(other)  # (the link opened the card on its Compare tab already)
+        _check_pins(other, {"supx": tires["supplier_x.h5"], "ref": None})
         other.close()
 
     wait_stable(page)
