@@ -17,6 +17,7 @@ import h5py
 import numpy as np
 import pytest
 
+from app.runtime import campaign_files
 from app.views import campaign as view
 from app.views.campaign import CampaignBrowser
 from fbs_core.campaign import CampaignError, open_campaign, parse_campaign, run_campaign
@@ -190,8 +191,8 @@ def test_a_page_build_reads_no_campaign_file_and_a_file_is_read_once_per_change(
     shutil.copy(good, d / "good.h5")
     monkeypatch.setenv(view.CAMPAIGN_DIR_ENV, str(d))
     opened = []
-    real = view.open_campaign
-    monkeypatch.setattr(view, "open_campaign", lambda p: opened.append(p) or real(p))
+    real = campaign_files.open_campaign
+    monkeypatch.setattr(campaign_files, "open_campaign", lambda p: opened.append(p) or real(p))
     pages = []
     for _ in range(2):
         state = DashboardState()

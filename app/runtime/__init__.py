@@ -15,6 +15,9 @@
   thread of its own;
 - :mod:`~app.runtime.reports`: reports drawn one at a time in a process of their own while
   the click waits on the event loop;
+- :mod:`~app.runtime.campaign_files`: the campaign result files of ``FBS_CAMPAIGN_DIR``,
+  listed and opened (their case tables made by :mod:`app.results.campaign`), kept per
+  process and read again only when a file changes;
 - :mod:`~app.runtime.priority`: lower CPU priority of the threads that are not interactive;
 - :mod:`~app.runtime.libraries`: what a page imports on first use, imported with the app
   (the server preloads it before its port opens);

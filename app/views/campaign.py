@@ -1,39 +1,34 @@
-"""Browse a campaign's result file: its cases, and one case's band or error map.
+"""The campaign card: browse a campaign's result file, its cases and one case's view.
 
-The files come from a server-side directory the operator trusts, ``FBS_CAMPAIGN_DIR``
-(the campaigns' ``output`` files, e.g. a volume the campaign runs write to): its ``*.h5``
-files are listed in a selector and opened with :func:`fbs_core.campaign.open_campaign`
-(together with the parts of a run still going on). Nothing is uploaded: an HDF5 file from a
-browser is never opened in the server process (see ``fbs_core.io``'s sandbox), and a
-campaign file holds many cases, so it belongs on the server's disk anyway.
+The view lists the cases of a campaign file of ``FBS_CAMPAIGN_DIR`` (harmonic, noise,
+target, frequency dependence, truncation range, tire and chassis variants, coupling,
+rounds, seed, status) with filters, and shows the chosen case: a scatter case's band at
+one bushing DOF, a truncation case's error map with its suggested mode counts, or a
+variants case's corridor with its sensitivity leaders, each with its provenance and a CSV
+export whose header carries the same provenance.
 
-The view lists the cases (harmonic, noise, target, frequency dependence, truncation range,
-tire and chassis variants, coupling, rounds, seed, status) with filters, and shows the
-chosen case: a scatter case's band at one bushing DOF (reference, min/max, percentiles; thesis
-5.2) or a truncation case's error map (eq. 5.1) with its suggested mode counts (table 5.1),
-both with their provenance (campaign, seeds, case digest, where and with what it ran) and a
-CSV export whose header carries the same provenance.
+This module holds the page's side only: :class:`CampaignBrowser` (widgets, filters, the
+figures it draws, the thread that opens a file) and :func:`campaign_card` (the card, or
+:data:`HOW_TO` when the server has no campaign directory). What it shows is made
+elsewhere, so each part can be read and tested without the others:
 
-The numbers are the file's: the band is :meth:`CampaignResult.band` (the stored blocks
-joined), the map :meth:`CampaignResult.truncation`; nothing is recomputed.
+- :mod:`app.runtime.campaign_files`: the campaign files on the server's disk, listed and
+  opened, kept per process and read again only when a file changes;
+- :mod:`app.results.campaign`: the case table and each case's :class:`~app.results.Result`
+  (pure functions of the opened file; nothing is recomputed).
 
 A page costs no file access: the card's browser opens nothing until the card is expanded
-(:meth:`CampaignBrowser.activate`), the list of campaign files and each opened file are
-kept per process and read again only when a file changes (:func:`open_cached`: size and
-modification time), and a file is read on a thread of its own while the card says so. A
-malformed file is a message in the card naming the file and the
-problem (:class:`~fbs_core.campaign.CampaignError`), never an error of the page.
+(:meth:`CampaignBrowser.activate`), and a file is read on a thread of its own while the
+card says so. A malformed file is a message in the card naming the file and the problem
+(:class:`~fbs_core.campaign.CampaignError`), never an error of the page.
 """
 
 from __future__ import annotations
 
 import html
 import logging
-import os
 import threading
-from collections import OrderedDict
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import panel as pn
@@ -41,10 +36,24 @@ import param
 from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure
 
-from fbs_core.campaign import CampaignError, CampaignResult, open_campaign
-from fbs_core.vocabulary import DIRECTIONS, magnitude_db, percent
+from fbs_core.campaign import CampaignError, CampaignResult
+from fbs_core.vocabulary import DIRECTIONS
 
 from ..results import Result
+from ..results.campaign import (
+    case_rows,
+    scatter_case_result,
+    truncation_case_result,
+    variants_case_result,
+)
+from ..runtime.campaign_files import (
+    CAMPAIGN_DIR_ENV,
+    Opened,
+    campaign_dir,
+    list_campaigns,
+    read_campaign,
+    relative_names,
+)
 from ..runtime.draw import served_document
 from .common import COLORS, FREQ_LABEL, MODES_LABEL, level_label
 from .live import download_button, inline_html
@@ -62,406 +71,9 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-CAMPAIGN_DIR_ENV = "FBS_CAMPAIGN_DIR"
-#: Opened campaign files kept per process (their case tables with them).
-CACHED_FILES = 4
 ALL = "all"
 STATUSES = (ALL, "complete", "partial")
 KINDS = (ALL, "scatter", "truncation", "variants")
-
-
-def campaign_dir() -> Path | None:
-    """The configured campaign directory (``$FBS_CAMPAIGN_DIR``), None when unset."""
-    raw = os.environ.get(CAMPAIGN_DIR_ENV, "").strip()
-    return Path(raw).resolve() if raw else None
-
-
-#: path -> ((mtime_ns, size), is a campaign result)
-_IS_CAMPAIGN: dict[Path, tuple[tuple[int, int], bool]] = {}
-
-
-def _stamp(p: Path) -> tuple[int, int]:
-    st = p.stat()
-    return st.st_mtime_ns, st.st_size
-
-
-def _is_campaign(p: Path) -> bool:
-    """Whether ``p``'s root says it is a campaign result (read again only when it changed)."""
-    from fbs_core.hdf5_guard import ForeignDataError, open_h5
-
-    stamp = _stamp(p)
-    known = _IS_CAMPAIGN.get(p)
-    if known is not None and known[0] == stamp:
-        return known[1]
-    try:
-        with open_h5(p) as h:
-            ok = h.attrs.get("content") == "campaign"
-    except ForeignDataError:  # listed: opening it says why it is refused
-        ok = True
-    except (OSError, ValueError, TypeError, KeyError, RuntimeError):  # not (readable) HDF5
-        ok = False
-    _IS_CAMPAIGN[p] = (stamp, ok)
-    return ok
-
-
-def list_campaigns(directory: Path | None) -> list[str]:
-    """Names of the campaign result files directly in ``directory`` (sorted).
-
-    Only regular ``*.h5`` files inside the directory (a link pointing elsewhere is left
-    out) whose root says it is a campaign result; a file is opened for that only when it is
-    new or changed since it was last looked at.
-    """
-    if directory is None or not directory.is_dir():
-        return []
-    out = []
-    for p in sorted(directory.glob("*.h5")):
-        try:
-            if p.is_file() and p.resolve().parent == directory and _is_campaign(p):
-                out.append(p.name)
-        except OSError:  # removed meanwhile
-            continue
-    return out
-
-
-class Opened:
-    """A campaign file as the browser shows it: the result, its case table, its first line."""
-
-    def __init__(self, result: CampaignResult) -> None:
-        self.result = result
-        self.rows = case_rows(result)
-        self.headline = result.headline(planned=False)
-
-
-_OPENED: OrderedDict[tuple, Opened | CampaignError] = OrderedDict()
-_OPENING: dict[tuple, threading.Lock] = {}
-_OPEN_LOCK = threading.Lock()
-
-
-def _file_key(path: Path) -> tuple:
-    """The file and the parts of a run not merged yet, with their sizes and times."""
-    from fbs_core.campaign.store import CampaignStore
-
-    try:
-        files = CampaignStore(path).files()
-        return (str(path), *((str(p), *_stamp(p)) for p in files))
-    except OSError as exc:
-        return (str(path), "unreadable", str(exc))
-
-
-def open_cached(path: Path) -> Opened:
-    """:class:`Opened` of the campaign file ``path``, read once per change of the file.
-
-    Sessions opening the same file at once wait for one reading; a malformed file's
-    :class:`CampaignError` is kept too (not read again until the file changes).
-
-    Raises
-    ------
-    CampaignError
-        For a file that cannot be used, naming the file and the problem.
-    """
-    key = _file_key(path)
-    with _OPEN_LOCK:
-        lock = _OPENING.setdefault(key, threading.Lock())
-    with lock:
-        with _OPEN_LOCK:
-            got = _OPENED.get(key)
-        if got is None:
-            try:
-                got = Opened(open_campaign(path))
-            except CampaignError as exc:
-                got = exc
-            except Exception as exc:  # noqa: BLE001 (the card must say it, not the page fail)
-                log.exception("campaign file %s", path)
-                got = CampaignError(f"{path}: cannot be read ({type(exc).__name__}: {exc})")
-            with _OPEN_LOCK:
-                _OPENED[key] = got
-                while len(_OPENED) > CACHED_FILES:
-                    _OPENED.popitem(last=False)
-        with _OPEN_LOCK:
-            _OPENING.pop(key, None)
-            if key in _OPENED:
-                _OPENED.move_to_end(key)
-    if isinstance(got, CampaignError):
-        raise got
-    return got
-
-
-def _truncation_label(s: dict) -> str:
-    n = s.get("n_modes")
-    return f"N = {n[0]}..{n[-1]} ({len(n)})" if isinstance(n, list) and n else ""
-
-
-def case_rows(result) -> dict[str, list]:
-    """The case table of a :class:`~fbs_core.campaign.CampaignResult`, one row per case.
-
-    Raises
-    ------
-    CampaignError
-        For a case whose settings cannot be shown (naming the file and the case).
-    """
-    cols: dict[str, list] = {
-        k: []
-        for k in (
-            "case",
-            "kind",
-            "harmonic",
-            "noise_pct",
-            "target",
-            "freq_dependent",
-            "truncation",
-            "tire",
-            "chassis",
-            "coupling",
-            "rounds",
-            "seed",
-            "design",
-            "status",
-        )
-    }
-    for c in result.cases:
-        try:
-            row = _case_row(c)
-        except (KeyError, ValueError, TypeError, IndexError) as exc:
-            raise CampaignError(
-                f"{result.path}: case {c.name!r} cannot be shown ({type(exc).__name__}: {exc})"
-            ) from None
-        for k, v in row.items():
-            cols[k].append(v)
-    return cols
-
-
-def _parameters_of(s: dict, model: str) -> str:
-    """The varied parameters of a variants case that belong to ``model`` (comma list), and
-    "base changed" when the case replaces the reference's base parameters."""
-    from fbs_core.variants import PARAMETERS
-
-    names = [n for n in s.get("parameters", ()) if n in PARAMETERS and PARAMETERS[n].model == model]
-    text = ", ".join(names)
-    if s.get(model):
-        text = f"{text}; base changed" if text else "base changed"
-    return text
-
-
-def _variants_row(c) -> dict[str, Any]:
-    """A variants case in the table's columns: its harmonics, the varied tire and
-    chassis parameters, its design and size."""
-    s = c.settings
-    n_variants = c.n_lines - 1 if c.n_lines else 0  # the nominal models are one unit
-    return {
-        "case": c.name,
-        "kind": c.kind,
-        "harmonic": ", ".join(str(int(h)) for h in s["harmonics"]),
-        "noise_pct": None,
-        "target": "",
-        "freq_dependent": None,
-        "truncation": "",
-        "tire": _parameters_of(s, "tire"),
-        "chassis": _parameters_of(s, "chassis"),
-        "coupling": str(s.get("coupling", "")),
-        "rounds": None,
-        "seed": str(s.get("seed", "")),
-        "design": f"{s['design']} n={s['n']} ({n_variants} variants)",
-        "status": "complete"
-        if c.complete
-        else f"partial ({c.lines_done}/{c.n_lines} variants and nominal)",
-    }
-
-
-def _case_row(c) -> dict[str, Any]:
-    s = c.settings
-    if c.kind == "variants":
-        return _variants_row(c)
-    band = c.kind == "scatter"
-    return {
-        "case": c.name,
-        "kind": c.kind,
-        "harmonic": int(s.get("harmonic", 0)),
-        "noise_pct": round(percent(float(s["noise"])), 6) if band else None,
-        "target": str(s["target"]) if band else "",
-        "freq_dependent": bool(s["frequency_dependent"]) if band else None,
-        "truncation": "" if band else _truncation_label(s),
-        "tire": str(s.get("tire", "")),
-        "chassis": str(s.get("chassis", "")),
-        "coupling": str(s.get("coupling", "")),
-        "rounds": int(s["rounds"]) if band else None,
-        "seed": str(s.get("seed", "")) if band else "",
-        "design": "",
-        "status": "complete" if c.complete else f"partial ({c.lines_done}/{c.n_lines} lines)",
-    }
-
-
-def _provenance(result, name: str) -> dict[str, Any]:
-    """Where a case comes from: file, campaign, seeds, digest, the runs that made it."""
-    c = result.case(name)
-    a = result.attrs
-    meta: dict[str, Any] = {
-        "campaign file": result.path.name,
-        "campaign": a.get("campaign_name", ""),
-        "campaign seed": a.get("campaign_seed", ""),
-        "seeds": a.get("seeds", ""),
-        "case": name,
-        "case digest": result.case_attrs(name).get("digest", ""),
-    }
-    meta.update({f"case {k}": v for k, v in c.settings.items() if k != "kind"})
-    if result.runs:
-        r = result.runs[-1]
-        versions = r.get("versions") or {}
-        meta["last run"] = (
-            f"{r.get('started')} {r.get('status')}, {r.get('workers')} worker(s) at "
-            f"{r.get('scheduler')}"
-        )
-        if isinstance(versions, dict):
-            meta["versions"] = ", ".join(f"{k} {v}" for k, v in sorted(versions.items()))
-    return meta
-
-
-def scatter_case_result(result, name: str, dof: str) -> Result:
-    """The band of a scatter case at ``bushing:dof``, as stored (magnitudes and dB)."""
-    band = result.band(name)
-    j = band.dofs.index(f"bushing:{dof}")
-    ref = np.abs(band.reference[:, j])
-    cols = {
-        "freq_Hz": np.asarray(band.freq),
-        "reference": ref,
-        "minimum": np.asarray(band.minimum[:, j]),
-        "maximum": np.asarray(band.maximum[:, j]),
-    }
-    for k, q in enumerate(band.q):
-        cols[f"p{q:g}"] = np.asarray(band.percentiles[k, :, j])
-    db = {f"{k}_dB": magnitude_db(v) for k, v in cols.items() if k != "freq_Hz"}
-    meta = {
-        "view": "campaign scatter band (thesis 5.2)",
-        "response DOF": f"bushing:{dof}",
-        "columns": "magnitudes |v_e| and their levels in dB",
-        **_provenance(result, name),
-    }
-    s = result.case(name).settings
-    return Result(
-        columns={**cols, **db},
-        meta=meta,
-        filename=f"{Path(result.path).stem}_{name}_{dof}.csv",
-        caption=(
-            f"**{name}** &middot; bushing:{dof} &middot; noise {percent(s['noise']):g} % in "
-            f"{s['target']} &middot; {s['rounds']:,} rounds &middot; seed {s['seed']}"
-        ),
-        draw={"kind": "scatter", "dof": dof, "q": tuple(float(q) for q in band.q)},
-    )
-
-
-def variants_case_result(result, name: str, dof: str, harmonic: int | None = None) -> Result:
-    """The corridor of a variants case at ``bushing:dof`` over its nominal response, and the
-    per-band leaders of its Sobol' indices (a Saltelli design only; see
-    docs/corridor.md).
-
-    The numbers are those of :meth:`CampaignResult.variants`: the study as stored, its
-    corridor at the case's percentiles and its sensitivity (:meth:`VariantStudy.corridor`,
-    :meth:`VariantStudy.sensitivity`); ``harmonic`` None: the case's first harmonic.
-    """
-    study = result.variants(name)
-    s = result.case(name).settings
-    harmonics = [int(h) for h in s["harmonics"]]
-    h = harmonics[0] if harmonic is None else int(harmonic)
-    if h not in harmonics:
-        raise CampaignError(
-            f"case {name} has no harmonic {h}; computed: {', '.join(map(str, harmonics))}"
-        )
-    pct = tuple(float(q) for q in s["percentiles"])
-    c = study.corridor(h, percentiles=pct)
-    label = f"bushing:{dof}"
-    j = c.dof_index(label)
-    cols: dict[str, np.ndarray] = {
-        "freq_Hz": np.asarray(c.freq),
-        "nominal": np.abs(c.nominal[:, j]),
-        "minimum": np.asarray(c.minimum[:, j]),
-        "maximum": np.asarray(c.maximum[:, j]),
-    }
-    for k, q in enumerate(c.q):
-        cols[f"p{q:g}"] = np.asarray(c.percentiles[k, :, j])
-    db = {f"{k}_dB": magnitude_db(v) for k, v in cols.items() if k != "freq_Hz"}
-    leaders: list[dict[str, Any]] = []
-    if s["design"] == "saltelli":
-        leaders = study.sensitivity(h).leaders(label)
-        ranking = "; ".join(
-            f"{r['band_low']:.0f}-{r['band_high']:.0f} Hz: {r['parameter']} "
-            f"(S_T {r['total']:.2f}, then {r['second'] or '-'}, {r['std_db']:.1f} dB)"
-            for r in leaders
-        )
-    else:
-        ranking = f"none ({s['design']} design: Sobol' indices need a Saltelli design)"
-    params = ", ".join(s["parameters"])
-    pct_text = ", ".join(f"{q:g}" for q in c.q)
-    meta = {
-        "view": "campaign corridor of systematic errors (docs/corridor.md)",
-        "response DOF": label,
-        "harmonic": h,
-        "parameters": params,
-        "design": f"{s['design']} n={s['n']} ({c.n_variants} variants), seed {s['seed']}",
-        "percentiles": pct_text,
-        "columns": "magnitudes |v_e| over the variants (and the nominal models) and dB",
-        "sensitivity leaders (total Sobol' index per band)": ranking,
-        **_provenance(result, name),
-    }
-    return Result(
-        columns={**cols, **db},
-        meta=meta,
-        filename=f"{Path(result.path).stem}_{name}_h{h}_{dof}.csv",
-        caption=(
-            f"**{name}** &middot; {result.path.name} &middot; harmonic {h} &middot; "
-            f"{label} &middot; {c.n_variants} variants of {params} &middot; "
-            f"percentiles {pct_text} %"
-        ),
-        draw={
-            "kind": "variants",
-            "dof": dof,
-            "q": tuple(float(q) for q in c.q),
-            "leaders": leaders,
-        },
-        core={"corridor": c},
-    )
-
-
-def truncation_case_result(result, name: str, dof: str | None) -> Result:
-    """The error map of a truncation case (``dof`` None: max over the DOFs) and its
-    suggested mode counts, as stored."""
-    t = result.truncation(name)
-    if t.error is None:
-        raise CampaignError(f"case {name} was stored without its error map ([outputs])")
-    if dof is None:
-        err = np.max(t.error, axis=2)
-        what = "max over DOFs"
-    else:
-        err = t.error[:, :, t.dofs.index(f"bushing:{dof}")]
-        what = f"bushing:{dof}"
-    nn, ff = np.meshgrid(t.n_modes, t.centres, indexing="ij")
-    sugg = {}
-    if t.suggested is not None:
-        for i, th in enumerate(t.thresholds):
-            for k, fm in enumerate(t.f_max):
-                sugg[f"{percent(th):g} % up to {fm:g} Hz"] = int(t.suggested[i, k])
-    meta = {
-        "view": "campaign truncation error map (thesis eq. 5.1)",
-        "response DOF": what,
-        "layout": "long: one row per (N, centre freq)",
-        "suggested N (max over DOFs)": "; ".join(f"{k}: {v}" for k, v in sugg.items()),
-        **_provenance(result, name),
-    }
-    return Result(
-        columns={
-            "n_modes": nn.ravel(),
-            "centre_freq_Hz": ff.ravel(),
-            "error_pct": percent(err.ravel()),
-        },
-        meta=meta,
-        filename=f"{Path(result.path).stem}_{name}_{dof or 'maxdof'}.csv",
-        caption=f"**{name}** &middot; {what}",
-        draw={
-            "kind": "truncation",
-            "error_pct": percent(err),
-            "n_modes": np.asarray(t.n_modes),
-            "centres": np.asarray(t.centres),
-            "suggested": sugg,
-        },
-    )
 
 
 class CampaignBrowser(pn.viewable.Viewer):
@@ -517,14 +129,16 @@ class CampaignBrowser(pn.viewable.Viewer):
         file, path = self.file, self.directory / self.file
         doc = self._doc or served_document()
         if not self._lazy or doc is None:
-            self._loaded(file, *_read(path))
+            self._loaded(file, *read_campaign(path))
             return
         # a large file takes seconds to read: on a thread of its own, not a worker of the
-        # server's that other sessions need; the result is applied on the session's loop
+        # server's that other sessions need (app.runtime.background's workers take optional
+        # work, one task after the other, and drop what waits beyond their bound: a read the
+        # card waits for would never be answered); the result is applied on the session's loop
         self.message = f"Reading {file} ..."
 
         def work():
-            outcome = _read(path)
+            outcome = read_campaign(path)
             doc.add_next_tick_callback(lambda: self._loaded(file, *outcome))
 
         threading.Thread(target=work, name="campaign-open", daemon=True).start()
@@ -919,24 +533,6 @@ def _harmonics(cell: int | str) -> tuple[int, ...]:
 def _text_html(text: str) -> str:
     """A message as HTML text (it may quote a file's strings)."""
     return f"<p>{html.escape(text)}</p>"
-
-
-def relative_names(text: str, directory: Path | None) -> str:
-    """``text`` with the campaign folder's path left out of the file names it quotes: a
-    user sees ``run.h5`` or ``run.h5.parts/0001.h5``, never the server's absolute paths."""
-    if directory is None:
-        return text
-    folder = str(directory).rstrip(os.sep)
-    return text.replace(folder + os.sep, "").replace(folder, ".")
-
-
-def _read(path: Path) -> tuple[Opened | None, str]:
-    """(the opened file, "") or (None, the message of its CampaignError, its file names
-    relative to the campaign folder)."""
-    try:
-        return open_cached(path), ""
-    except CampaignError as exc:
-        return None, relative_names(str(exc), path.parent)
 
 
 def _frame(cols: dict[str, list]):
