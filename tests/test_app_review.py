@@ -450,3 +450,29 @@ def test_a_link_whose_current_tire_is_the_reference_keeps_it_current(tmp_path, t
         assert st2.data.review.candidates.current.name == "reference"
     assert st2.data.pending is None and review_link(st2.data.review) == text
     assert st2.data.models.is_reference  # the session's tire is the current candidate's
+
+
+def test_in_vehicle_scope_the_other_candidates_are_the_cars_with_their_tires(tmp_path, tires):
+    """The coupled-response plot of the car draws the other candidates at the page's point,
+    DOF and road. Truth: the core's car response with each tire on its four wheels."""
+    from fbs_core.vehicle import vehicle_response
+
+    st, store = _session(tmp_path, tires)  # current: stiff.h5
+    st.case.param.update(
+        scope="vehicle", harmonic=1, point="bushing_rr", dof="y", tracks="anti-phase",
+        wheels=["fl", "rr"],
+    )  # fmt: skip
+    d = store.review_curves.draw
+    assert [c["name"] for c in d["curves"]] == ["reference", "soft.h5"] and not d["pending"]
+    for c in d["curves"]:
+        kw = {} if c["name"] == "reference" else {"tire": tires[c["name"]]}
+        want = vehicle_response(
+            1, None, fbs_core.harmonic(1).frequencies(), tracks="anti-phase",
+            wheels=("fl", "rr"), outputs="bushing_rr", **kw,
+        )  # fmt: skip
+        e = list(want.response.outputs).index("bushing_rr:y")
+        np.testing.assert_allclose(c["y"], 20 * np.log10(want.level[:, e]), atol=1e-9)
+    assert store.review_curves.meta["response DOF"] == "bushing_rr:y"
+    # another point: the candidates follow it
+    st.case.point = "seat_fl"
+    assert store.review_curves.meta["response point"] == "seat_fl"

@@ -32,7 +32,9 @@ from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES, magnitude_db
 
 from .. import compute
 from ..datasource import candidate_models
-from .base import Result, Snapshot
+from . import vehicle_compute as vc
+from .base import VEHICLE_FIELDS, Result, Snapshot
+from .scope import vehicle_meta
 
 __all__ = [
     "BANDS_DEPENDS",
@@ -308,7 +310,10 @@ def verdict_result(s: Snapshot) -> Result:
 
 # -- the candidates and the target on the coupled-response plot ---------------------------------
 #: The snapshot fields the overlay of the candidates and the target is made of.
-CURVES_DEPENDS = ("review", "harmonic", "dof", "coupling", "models", "level_scale", "scope")
+CURVES_DEPENDS = (
+    "review", "harmonic", "dof", "coupling", "models", "level_scale", "scope",
+    *VEHICLE_FIELDS,
+)  # fmt: skip
 
 
 def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
@@ -336,10 +341,11 @@ def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
     return np.asarray(t.level_db_at(freq, "mobility", 1.0), float), label
 
 
-def _others(s: Snapshot) -> list[tuple[Candidate, Any, int]]:
-    """The candidates other than the current one, with their models and colour slots."""
+def _others(s: Snapshot, vehicle: bool = False) -> list[tuple[Candidate, Any, int]]:
+    """The candidates other than the current one, with their models and colour slots (in
+    vehicle scope only where ``vehicle``: the views that draw the car's candidates)."""
     cands = s.review.candidates
-    if cands is None or s.vehicle:
+    if cands is None or (s.vehicle and not vehicle):
         return []
     return [
         (c, candidate_models(s.models, c), cands.slot(c.digest))
@@ -348,8 +354,42 @@ def _others(s: Snapshot) -> list[tuple[Candidate, Any, int]]:
     ]
 
 
+#: The car's all-modes levels at a point per candidate (one DOF's level per line, the
+#: road's tracks and wheels as the page's), ~15 kB each.
+_CAR = _Kept()
+
+
+def _car_key(s: Snapshot, models) -> tuple:
+    return (s.harmonic, s.coupling, s.point, s.road, tuple(s.wheels), models.key)
+
+
+def _car_levels(s: Snapshot, models) -> np.ndarray:
+    """The car's all-modes response level at the page's point (six DOFs, shape (n_f, 6))
+    with ``models``' tire on the four wheels, to the page's road (thesis eq. 4.1, the four
+    hubs as one interface)."""
+    key = _car_key(s, models)
+    got = _CAR.get(key)
+    if got is None:
+        resp = vc.response(s.harmonic, None, s.coupling, s.point, s.road, tuple(s.wheels), models)
+        outs = list(resp.response.outputs)
+        got = np.stack([resp.level[:, outs.index(f"{s.point}:{d}")] for d in DIRECTIONS], 1)
+        _CAR.put(key, got)
+    return got
+
+
 def curves_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The other candidates' responses to the shown harmonic not computed yet (None: none)."""
+    if s.vehicle:
+        cars = [m for _c, m, _slot in _others(s, True) if _car_key(s, m) not in _CAR]
+        if not cars:
+            return None
+
+        def car_work() -> Iterator[None]:
+            for m in cars:
+                _car_levels(s, m)
+                yield
+
+        return car_work
     todo = [(s.harmonic, s.coupling, m) for _c, m, _slot in _others(s)]
     inc = s.review.incumbent
     if inc is not None and not s.vehicle and inc.candidate in candidates_of(s):
@@ -379,6 +419,14 @@ def review_curves_result(s: Snapshot) -> Result:
     j = DIRECTIONS.index(s.dof)
     lin = s.level_scale != "dB"
     curves, cols, pending = [], {"freq_Hz": freq}, []
+    for c, m, slot in _others(s, True) if s.vehicle else ():
+        if _car_key(s, m) not in _CAR:
+            pending.append(c.name)
+            continue
+        lv = _car_levels(s, m)[:, j]
+        db = magnitude_db(lv)
+        cols[f"{c.name}_dB"] = db
+        curves.append({"name": c.name, "slot": slot, "y": lv if lin else db, "freq": freq})
     for c, m, slot in _others(s):
         if _key(s.harmonic, s.coupling, m) not in _DONE:
             pending.append(c.name)
@@ -396,13 +444,14 @@ def review_curves_result(s: Snapshot) -> Result:
         meta={
             "view": "review: the other candidates (all modes) and the target at the response",
             "harmonic": s.harmonic,
-            "response DOF": f"bushing:{s.dof}",
+            "response DOF": s.output,
             "coupling": s.coupling,
+            **(vehicle_meta(s) if s.vehicle else {}),
             "candidates": ", ".join(str(c["name"]) for c in curves) or "none",
             "target": label or "none",
             "models": s.models.describe(),
         },
-        filename=f"review_curves_h{s.harmonic}_{s.dof}_{s.review.key[:8]}.csv",
+        filename=f"review_curves_h{s.harmonic}_{s.output.replace(':', '_')}_{s.review.key[:8]}.csv",
         draw={
             "freq": freq,
             "curves": curves,
