@@ -71,6 +71,8 @@ from .results import (
 )
 from .results import modes_compute as mc
 from .results.base import VEHICLE_FIELDS, progress_status
+from .results.vpt import ROLES as VPT_ROLES
+from .results.vpt import consistency_results
 from .runtime import background, bands, uploads
 from .runtime.activity import ACTIVITIES
 from .runtime.draw import served
@@ -550,7 +552,16 @@ class Results(param.Parameterized):
                 lambda *events, names=names: self._changed({names[e.name] for e in events}),
                 list(names),
             )
+        # a measured chassis' consistency: in the report beside the rows (no row: it is the
+        # upload's, not the state's)
+        self.state.data.param.watch(lambda _e: self._show_vpt(), "vpt")
+        self._show_vpt()
         self._update(frozenset(row.name for row in TABLE if row.when != OWN_THREAD))
+
+    def _show_vpt(self) -> None:
+        made = consistency_results(self.state.data.vpt)
+        for role in VPT_ROLES:
+            self.show_outside(f"vpt_{role}", made.get(f"vpt_{role}"))
 
     @property
     def threaded(self) -> bool:

@@ -60,3 +60,34 @@ def test_a_refused_geometry_file_changes_nothing() -> None:
     assert not ds.load_geometry(b"channel,role,x\n", "g.csv")
     assert "needs the columns" in ds.error
     assert ds.models is REFERENCE and ds.geometry_summary == ""
+
+
+def test_the_report_draws_the_consistency_of_the_measured_chassis(files) -> None:
+    """A session whose chassis was measured: its report has a section per role (sensors,
+    impacts) drawing each channel's specific consistency over frequency, the core's values;
+    back to the reference, the sections go."""
+    from app.report.session import report_data
+    from app.state import DashboardState
+    from app.store import Results
+
+    _m, frf, geo = files
+    store = Results(DashboardState())
+    ds = store.state.data
+    assert ds.load_geometry(geo, "knuckle.csv") and ds.load_chassis(frf, "knuckle.h5"), ds.error
+    c = ds.vpt.consistency
+    extra = {x.key: x for x in report_data(store).extra}
+    for role, labels, values in (
+        ("sensors", c.sensors, c.sensor_specific),
+        ("impacts", c.impacts, c.impact_specific),
+    ):
+        sec = extra[f"vpt_{role}"]
+        assert sec.plot["kind"] == "lines" and list(sec.plot["groups"]) == list(labels)
+        for k, lab in enumerate(labels):
+            np.testing.assert_array_equal(sec.plot["groups"][lab][0], values[:, k])
+        assert 0.0 <= float(dict(sec.rows)[f"overall {role[:-1]} consistency"]) <= 1.0
+    from app.report.html import build_html
+
+    _name, page = build_html(report_data(store))
+    assert "Virtual point consistency of the sensors" in page and page.count("<svg") >= 2
+    ds.reset()
+    assert not {"vpt_sensors", "vpt_impacts"} & {x.key for x in report_data(store).extra}

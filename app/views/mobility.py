@@ -219,7 +219,7 @@ class MobilityView(LiveView):
         """The other candidates and the target, when they are of the case ``r`` shows and
         in the level scale drawn (``scale``)."""
         rc = self.store.review_curves
-        fields = ("harmonic", "dof", "coupling", "models", "scope")
+        fields: tuple[str, ...] = ("harmonic", "dof", "coupling", "models", "scope")
         if r.snapshot is not None and r.snapshot.vehicle:  # the car's road and point too
             fields += ("point", "wheels", "tracks", "coherence")
         ok = (
