@@ -425,7 +425,7 @@ def test_the_other_candidates_bands_are_the_cores_bands_of_their_tires(tmp_path,
     store.request_band(wait=True)
     view = ScatterBandView(store=store)
     view.__panel__()
-    for name, c in got.items():
+    for c in got.values():
         src = next(m for m in view._fig.select({"name": f"scatter.candidate{c['slot']}"}))
         np.testing.assert_allclose(src.data["high"], c["high"])
         assert view._cand_items[c["slot"]].visible
