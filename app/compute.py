@@ -51,6 +51,7 @@ __all__ = [
     "BandKey",
     "BandTime",
     "band",
+    "band_once",
     "band_computed",
     "band_data",
     "cache_key",
@@ -606,14 +607,33 @@ def band(*args, cancel=None, progress=None, **kwargs):
     band at once share one computation (:class:`app.runtime.bands.SharedRun`).
     """
     key = band_key(*args, **kwargs)
-    if is_car_key(key):
-        raise ValueError("a car's band is computed by app.results.vehicle_compute.cached_band")
     res = cached_band(key)
     if res is not None:
         return res
-    harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models, _ = key
     t0 = time.perf_counter()
-    res = studies.scatter_band(
+    res = _scatter_band(key, cancel, progress)
+    remember_band(key, res, time.perf_counter() - t0)
+    return res
+
+
+def band_once(*args, **kwargs):
+    """The scatter band of :func:`band_key`'s settings: the cached one if it was computed,
+    else computed here **without keeping it**.
+
+    For callers that keep only a small digest of a band (the verdict's upper edges, the
+    other candidates' percentile edges): a candidate x harmonic sweep must not push the
+    bands the pages are showing out of the process-wide cache of :data:`BAND_CACHE_SIZE`.
+    """
+    key = band_key(*args, **kwargs)
+    res = cached_band(key)
+    return _scatter_band(key) if res is None else res
+
+
+def _scatter_band(key: BandKey, cancel=None, progress=None):
+    if is_car_key(key):
+        raise ValueError("a car's band is computed by app.results.vehicle_compute.cached_band")
+    harmonic, n_modes, coupling, noise_pct, target, fdep, rounds, seed, models, _ = key
+    return studies.scatter_band(
         harmonic,
         noise=fraction(noise_pct),
         target=target,
@@ -627,8 +647,6 @@ def band(*args, cancel=None, progress=None, **kwargs):
         progress=progress,
         **models_kw(models),
     )
-    remember_band(key, res, time.perf_counter() - t0)
-    return res
 
 
 def remember_band(key: tuple, res, seconds: float | None = None) -> None:

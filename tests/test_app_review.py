@@ -400,6 +400,30 @@ def test_the_noise_band_judges_a_target_only_its_upper_edge_crosses():
     assert store.verdict.core["verdict"].row("reference", H, "bushing:z").status == "pass"
 
 
+def test_the_verdicts_bands_leave_the_pages_bands_in_the_cache(tmp_path, tires):
+    """The verdict's noise band is a band per candidate and harmonic (here 3 x 7): it keeps
+    their upper edges only, so the scatter bands the session's pages show stay cached (the
+    process keeps :data:`app.compute.BAND_CACHE_SIZE`)."""
+    from app import compute
+
+    st, store = _session(tmp_path, tires)
+    st.noise.param.update(noise=5.0, rounds=40, seed=11)
+    st.case.param.update(harmonic=2, n_modes=40, dof="z")
+    store.request_band(wait=True)
+    before = list(compute._bands)
+    assert before, "the page's band is cached"
+    f = fbs_core.harmonic(H).frequencies()
+    assert st.data.load_targets(_target_csv(0.0, f), "target.csv"), st.data.error
+    st.noise.verdict_band = True
+    r = store.verdict
+    assert "noise band" in r.caption
+    rows = r.core["verdict"].rows
+    assert {x.candidate for x in rows} == {"reference", "soft.h5", "stiff.h5"}
+    assert all(np.isfinite(x.band_worst_db) for x in rows)
+    # every band the pages had is still cached, and none of the verdict's 21 was kept
+    assert set(compute._bands) == set(before)
+
+
 def test_the_other_candidates_bands_are_the_cores_bands_of_their_tires(tmp_path, tires):
     """The scatter plot's other candidates: each one's central band at the page's band
     settings. Truth: the core's scatter band of that tire (same seed: the same rounds)."""

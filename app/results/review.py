@@ -72,10 +72,10 @@ class _Kept:
     """What the verdict computed so far (responses, band edges), most recent last, at most
     :data:`KEPT`."""
 
-    def __init__(self) -> None:
+    def __init__(self, limit: int = KEPT) -> None:
         self._lock = threading.Lock()
         self._items: OrderedDict[tuple, Any] = OrderedDict()
-        self.limit = KEPT
+        self.limit = int(limit)
 
     def get(self, key: tuple) -> Any:
         with self._lock:
@@ -146,7 +146,7 @@ def _edge(k: int, coupling: str, models, band: tuple) -> NoiseEdge:
     edge = _EDGES.get(key)
     if edge is None:
         noise, target, fdep, rounds, seed, q = band
-        res = compute.band(k, None, coupling, noise, target, fdep, rounds, seed, models)
+        res = compute.band_once(k, None, coupling, noise, target, fdep, rounds, seed, models)
         edge = NoiseEdge.of_band(res, q)
         _EDGES.put(key, edge)
     return edge
@@ -478,8 +478,7 @@ BANDS_DEPENDS = (
 #: Band edges kept (per candidate, harmonic, N, noise settings and percentile band: the
 #: central band's two edges at the six DOFs, at most ~0.2 MB each).
 KEPT_BANDS = 64
-_BANDS = _Kept()
-_BANDS.limit = KEPT_BANDS
+_BANDS = _Kept(KEPT_BANDS)
 
 
 def _band_key(s: Snapshot, m) -> tuple:
@@ -498,7 +497,7 @@ def _band_edges(s: Snapshot, m) -> dict[str, Any]:
     key = _band_key(s, m)
     got = _BANDS.get(key)
     if got is None:
-        res = compute.band(
+        res = compute.band_once(
             s.harmonic, s.n_modes, s.coupling, s.noise, s.target, s.frequency_dependent,
             s.rounds, s.seed, m,
         )  # fmt: skip
