@@ -43,6 +43,7 @@ from fbs_core.errors import DOFError, FBSError
 from fbs_core.harmonics import harmonic
 from fbs_core.io.checks import check_pair, check_tire
 from fbs_core.targets import IncumbentTarget, Target, read_targets
+from fbs_core.vehicle import RESPONSE_NODES
 from fbs_core.vocabulary import DIRECTIONS, EIGEN_SPEEDS, HARMONIC_CASES
 
 from .review import EMPTY_REVIEW, LINK_DIGEST, LinkReview, Review, read_review_link
@@ -62,6 +63,10 @@ __all__ = [
 ]
 
 BUSHING = tuple(f"bushing:{d}" for d in DIRECTIONS)
+#: The car's response DOFs (vehicle scope): each response point's six.
+CAR_DOFS = tuple(f"{p}:{d}" for p in RESPONSE_NODES for d in DIRECTIONS)
+#: The DOFs a target may be for: the corner's bushing, and the car's response points.
+TARGET_DOFS = BUSHING + CAR_DOFS
 #: Harmonic cases every view may ask for.
 HARMONICS = HARMONIC_CASES
 #: File endings offered by the upload widgets.
@@ -630,11 +635,12 @@ class DataSource(param.Parameterized):
 
     def load_targets(self, data: bytes, filename: str | None = None) -> bool:
         """Read target curves (target CSV or UFF 58, :func:`fbs_core.targets.read_targets`)
-        for the bushing DOFs; each replaces a target of the same DOF and harmonic."""
+        for the bushing DOFs (corner scope) or the car's response points (vehicle scope,
+        e.g. ``seat_fl:z``); each replaces a target of the same DOF and harmonic."""
         name = filename or "upload"
 
         def change(r: Review) -> Review:
-            targets = read_targets(bytes(data), filename=name, dofs=BUSHING)
+            targets = read_targets(bytes(data), filename=name, dofs=TARGET_DOFS)
             if not targets:
                 raise FBSError("the file holds no target")
             return r.with_targets(targets)

@@ -15,6 +15,7 @@ nothing (never a verdict of part of the candidates).
 
 from __future__ import annotations
 
+import hashlib
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Iterator
@@ -25,19 +26,22 @@ import numpy as np
 from fbs_core import FRF
 from fbs_core.candidates import Candidate, CandidateSet
 from fbs_core.delivery import assess_delivery
+from fbs_core.dofs import parse_label
 from fbs_core.errors import FBSError
-from fbs_core.targets import Target
+from fbs_core.targets import Target, response_level
+from fbs_core.vehicle import RESPONSE_NODES
 from fbs_core.verdict import NoiseEdge, Verdict, verdict
 from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES, magnitude_db
 
 from .. import compute
-from ..datasource import candidate_models
+from ..datasource import CAR_DOFS, candidate_models
 from . import vehicle_compute as vc
 from .base import VEHICLE_FIELDS, Result, Snapshot
 from .scope import vehicle_meta
 
 __all__ = [
     "BANDS_DEPENDS",
+    "CAR_DOFS",
     "CURVES_DEPENDS",
     "VERDICT_DEPENDS",
     "candidates_of",
@@ -60,6 +64,8 @@ VERDICT_DEPENDS = (
     "f_max",
     "verdict_band",
     *BAND_FIELDS,
+    "scope",
+    *VEHICLE_FIELDS,
 )
 BUSHING = tuple(f"bushing:{d}" for d in DIRECTIONS)
 #: Responses kept (harmonic, coupling, models' digest -> FRF, ~15 kB each): every harmonic
@@ -107,20 +113,46 @@ def candidates_of(s: Snapshot) -> CandidateSet:
     return CandidateSet([Candidate.reference()]) if c is None else c
 
 
-def _key(k: int, coupling: str, models) -> tuple:
-    return (k, coupling, models.key)
+#: Where a car's response is taken: ``(point, track relation, wheels driven)``.
+Car = tuple[str, str | float, tuple[str, ...]]
 
 
-def _response(k: int, coupling: str, models) -> FRF:
-    """The all-modes bushing response of ``models`` to harmonic ``k`` (eq. 4.1)."""
-    key = _key(k, coupling, models)
+def _key(k: int, coupling: str, models, car: Car | None = None) -> tuple:
+    return (k, coupling, models.key) if car is None else (k, coupling, models.key, *car)
+
+
+def _response(k: int, coupling: str, models, car: Car | None = None) -> FRF:
+    """The all-modes response of ``models`` to harmonic ``k`` (eq. 4.1): at the corner's
+    bushing to the patch, or (``car``) at a point of the car with the tire on the four
+    wheels, per uncorrelated component of the road (the four hubs as one interface)."""
+    key = _key(k, coupling, models, car)
     frf = _DONE.get(key)
     if frf is None:
-        data = compute.coupled_response(k, None, coupling, models)
-        freq = np.asarray(compute.error_map(k, coupling, models).freq, float)
-        frf = FRF(freq, np.asarray(data)[:, :, None], BUSHING, ["patch"])
+        if car is None:
+            data = compute.coupled_response(k, None, coupling, models)
+            freq = np.asarray(compute.error_map(k, coupling, models).freq, float)
+            frf = FRF(freq, np.asarray(data)[:, :, None], BUSHING, ["patch"])
+        else:
+            point, road, wheels = car
+            frf = vc.response(k, None, coupling, point, road, wheels, models).response
         _DONE.put(key, frf)
     return frf
+
+
+def _joined(frfs: list[FRF]) -> FRF:
+    """The car's responses at several points as one response (their outputs side by side;
+    the points share the road, so its components)."""
+    if len(frfs) == 1:
+        return frfs[0]
+    first = frfs[0]
+    return FRF(
+        first.freq,
+        np.concatenate([f.data for f in frfs], axis=1),
+        [o for f in frfs for o in f.outputs],
+        first.inputs,
+        first.quantity,
+        kinds={i: k for i, k in first.kinds.items() if i in first.inputs},
+    )
 
 
 def _band_settings(s: Snapshot) -> tuple:
@@ -135,35 +167,76 @@ def _band_settings(s: Snapshot) -> tuple:
     )
 
 
-def _edge_key(k: int, coupling: str, models, band: tuple) -> tuple:
-    return (k, coupling, models.key, *band)
+def _edge_key(k: int, coupling: str, models, band: tuple, car: Car | None = None) -> tuple:
+    return (*_key(k, coupling, models, car), *band)
 
 
-def _edge(k: int, coupling: str, models, band: tuple) -> NoiseEdge:
+def _edge(k: int, coupling: str, models, band: tuple, car: Car | None = None) -> NoiseEdge:
     """The upper edge (percentile ``band[-1]``) of the all-modes scatter band of ``models``
-    to harmonic ``k`` at the noise settings ``band`` (thesis eqs. 5.2-5.4)."""
-    key = _edge_key(k, coupling, models, band)
+    to harmonic ``k`` at the noise settings ``band`` (thesis eqs. 5.2-5.4), at the corner
+    or at a point of the car (a coherent road). The band itself is not kept."""
+    key = _edge_key(k, coupling, models, band, car)
     edge = _EDGES.get(key)
     if edge is None:
         noise, target, fdep, rounds, seed, q = band
-        res = compute.band_once(k, None, coupling, noise, target, fdep, rounds, seed, models)
+        if car is None:
+            res = compute.band_once(k, None, coupling, noise, target, fdep, rounds, seed, models)
+        else:
+            point, road, wheels = car
+            bkey = compute.band_key(
+                k, None, coupling, noise, target, fdep, rounds, seed, models, (wheels, road, point)
+            )
+            res = compute.cached_band(bkey) or vc.band(bkey)
         edge = NoiseEdge.of_band(res, q)
         _EDGES.put(key, edge)
     return edge
 
 
+def _joined_edges(edges: list[NoiseEdge]) -> NoiseEdge:
+    e = edges[0]
+    if len(edges) == 1:
+        return e
+    dofs = tuple(d for x in edges for d in x.dofs)
+    return NoiseEdge(
+        e.freq, dofs, np.concatenate([x.upper for x in edges], axis=1), e.q, e.quantity
+    )
+
+
+def car_points(s: Snapshot) -> tuple[str, ...]:
+    """The car's points the verdict judges in vehicle scope: those with a target, and the
+    page's point while the incumbent rule is on (the rule judges the point shown)."""
+    pts = {parse_label(t.dof)[0] for t in s.review.targets if t.dof in CAR_DOFS}
+    if s.review.incumbent is not None:
+        pts.add(s.point)
+    return tuple(p for p in RESPONSE_NODES if p in pts)
+
+
+def _cars(s: Snapshot) -> list[Car | None]:
+    """Where the verdict takes its responses: the corner (``[None]``) or the car's judged
+    points on the page's road."""
+    if not s.vehicle:
+        return [None]
+    return [(p, s.road, tuple(s.wheels)) for p in car_points(s)]
+
+
+def _band_judged(s: Snapshot) -> bool:
+    """Whether the verdict's noise bands can be computed (the car's need a coherent road)."""
+    return bool(s.verdict_band) and (not s.vehicle or vc.coherent(s.road))
+
+
 def _jobs(s: Snapshot) -> tuple[list[tuple], list[tuple], list[tuple]]:
-    """What the verdict needs: responses ``(k, coupling, models)``, tables
+    """What the verdict needs: responses ``(k, coupling, models, car)``, tables
     ``(threshold, f_max, coupling, None, models)`` and, with the noise band on, band edges
-    ``(k, coupling, models, band settings)``, each list in the candidates' order."""
+    ``(k, coupling, models, band settings, car)``, each list in the candidates' order."""
     responses, tables, edges = [], [], []
     band = _band_settings(s)
+    cars = _cars(s)
     for c in candidates_of(s):
         m = candidate_models(s.models, c)
-        responses += [(k, s.coupling, m) for k in HARMONIC_CASES]
+        responses += [(k, s.coupling, m, car) for k in HARMONIC_CASES for car in cars]
         tables.append((s.threshold, s.f_max, s.coupling, None, m))
-        if s.verdict_band:
-            edges += [(k, s.coupling, m, band) for k in HARMONIC_CASES]
+        if _band_judged(s):
+            edges += [(k, s.coupling, m, band, car) for k in HARMONIC_CASES for car in cars]
     return responses, tables, edges
 
 
@@ -176,6 +249,12 @@ def _missing(s: Snapshot) -> tuple[list[tuple], list[tuple], list[tuple]]:
     )
 
 
+def _judged_targets(s: Snapshot) -> list[Target]:
+    """The targets of the scope: the corner's bushing, or the car's response points."""
+    car = set(CAR_DOFS)
+    return [t for t in s.review.targets if (t.dof in car) == s.vehicle]
+
+
 def verdict_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The responses and tables the verdict still lacks, one by one (None: none)."""
     if not s.review.judged:
@@ -185,8 +264,8 @@ def verdict_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
         return None
 
     def work() -> Iterator[None]:
-        for k, coupling, m in responses:
-            _response(k, coupling, m)
+        for r in responses:
+            _response(*r)
             yield
         for t in tables:
             compute.suggested_table(*t)
@@ -204,15 +283,23 @@ def _verdict(s: Snapshot) -> Verdict:
     bands: dict[tuple[str, int], NoiseEdge] = {}
     deliveries = []
     band = _band_settings(s)
+    cars = _cars(s)
+    if s.verdict_band and not _band_judged(s):
+        raise FBSError(
+            "the noise band of the car needs a coherent road: tracks in phase or in "
+            f"anti-phase (now a coherence of {float(s.road):g}); or switch the noise band off"
+        )
     for c in cands:
         m = candidate_models(s.models, c)
         for k in HARMONIC_CASES:
-            responses[(c.name, k)] = _response(k, s.coupling, m)
+            responses[(c.name, k)] = _joined([_response(k, s.coupling, m, car) for car in cars])
             if s.verdict_band:
-                bands[(c.name, k)] = _edge(k, s.coupling, m, band)
+                bands[(c.name, k)] = _joined_edges(
+                    [_edge(k, s.coupling, m, band, car) for car in cars]
+                )
         table = compute.suggested_table(s.threshold, s.f_max, s.coupling, None, m)
         deliveries.append(assess_delivery(c, table["result"]))
-    targets: list[Any] = list(s.review.targets)
+    targets: list[Any] = _judged_targets(s)
     if s.review.incumbent is not None:
         targets.append(s.review.incumbent)
     return verdict(responses, targets, bands or None, candidates=cands, deliveries=deliveries)
@@ -220,11 +307,18 @@ def _verdict(s: Snapshot) -> Verdict:
 
 def _meta(s: Snapshot, cands: CandidateSet) -> dict[str, Any]:
     r = s.review
+    responses = (
+        "the car's velocity at its response points "
+        f"({', '.join(car_points(s)) or 'none with a target'}) per metre of road (eq. 4.1, "
+        "the tire on the four wheels, the four hubs as one interface)"
+        if s.vehicle
+        else "coupled bushing velocity per metre of road (eq. 4.1)"
+    )
     return {
         "view": "review verdict: candidates against the targets (docs/verdict.md)",
-        "responses": "coupled bushing velocity per metre of road (eq. 4.1), every mode each "
-        "candidate delivered, harmonics 1-7",
+        "responses": f"{responses}, every mode each candidate delivered, harmonics 1-7",
         "coupling": s.coupling,
+        **(vehicle_meta(s) if s.vehicle else {"scope": "corner (the bushing's targets)"}),
         "candidates": "; ".join(
             f"{c.name} ({c.supplier or 'no supplier'}, {c.digest})" for c in cands
         ),
@@ -253,7 +347,8 @@ def verdict_result(s: Snapshot) -> Result:
     cands = candidates_of(s)
     meta = _meta(s, cands)
     band = f"_band{s.noise:g}pct_R{s.rounds}_s{s.seed}" if s.verdict_band else ""
-    name = f"verdict_{len(cands)}cand_{s.review.key[:8]}_{s.coupling}{band}.csv"
+    car = f"_car_{_digest_text(repr(s.vehicle_key()))}" if s.vehicle else ""
+    name = f"verdict_{len(cands)}cand_{s.review.key[:8]}_{s.coupling}{band}{car}.csv"
     if not s.review.judged:
         return Result(
             meta=meta,
@@ -261,9 +356,27 @@ def verdict_result(s: Snapshot) -> Result:
             caption="No targets: load a target file, type a target or choose the incumbent.",
             draw={"state": "no targets", "candidates": cands},
         )
+    if not s.vehicle and not _judged_targets(s) and s.review.incumbent is None:
+        return Result(
+            meta=meta,
+            filename=name,
+            caption="No target at the bushing: the targets at the car's response points "
+            "judge the vehicle scope.",
+            draw={"state": "no targets", "candidates": cands},
+        )
+    if s.vehicle and not car_points(s):
+        return Result(
+            meta=meta,
+            filename=name,
+            caption="No target at the car's response points: load targets for its points "
+            "(e.g. bushing_rl:z, seat_fl:z) or choose the incumbent rule; the bushing's "
+            "targets judge the corner scope.",
+            draw={"state": "no targets", "candidates": cands},
+        )
     responses, tables, edges = _missing(s)
     if responses or tables or edges:
-        total = len(cands) * (len(HARMONIC_CASES) * (2 if s.verdict_band else 1) + 1)
+        per = len(HARMONIC_CASES) * len(_cars(s))
+        total = len(cands) * (per * (2 if _band_judged(s) else 1) + 1)
         done = total - len(responses) - len(tables) - len(edges)
         what = "responses and noise bands" if s.verdict_band else "responses"
         return Result(
@@ -298,7 +411,8 @@ def verdict_result(s: Snapshot) -> Result:
         meta=meta,
         filename=name,
         caption=(
-            f"**{len(cands)} candidates** against {len(s.review.targets)} target(s)"
+            f"**{len(cands)} candidates** against {len(_judged_targets(s))} target(s)"
+            + (f" at the car's {', '.join(car_points(s))}" if s.vehicle else "")
             + ("" if s.review.incumbent is None else " and the incumbent rule")
             + (" with the noise band" if s.verdict_band else "")
             + (f"; best: **{best.candidate}** ({best.status})" if best is not None else "")
@@ -319,7 +433,7 @@ CURVES_DEPENDS = (
 def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
     """The target level (dB re 1 SI, NaN outside its range) of the shown DOF and harmonic:
     its own target, else one of every harmonic, else the incumbent rule (None: none)."""
-    dof = f"bushing:{s.dof}"
+    dof = s.output
     mine = [t for t in s.review.targets if t.dof == dof]
     t = next((t for t in mine if t.harmonic == s.harmonic), None) or next(
         (t for t in mine if t.harmonic is None), None
@@ -332,11 +446,12 @@ def _target_of(s: Snapshot, freq: np.ndarray) -> tuple[np.ndarray | None, str]:
         return None, ""
     c = candidates_of(s).get(inc.candidate)
     m = candidate_models(s.models, c)
-    if _key(s.harmonic, s.coupling, m) not in _DONE:
+    car = _car_of(s)
+    if _key(s.harmonic, s.coupling, m, car) not in _DONE:
         return None, ""  # the incumbent's response is being computed (curves_work)
     label = f"incumbent {inc.candidate} {inc.margin_db:+g} dB"
     t = Target.from_response(
-        _response(s.harmonic, s.coupling, m), dof, inc.margin_db, s.harmonic, label
+        _response(s.harmonic, s.coupling, m, car), dof, inc.margin_db, s.harmonic, label
     )
     return np.asarray(t.level_db_at(freq, "mobility", 1.0), float), label
 
@@ -354,33 +469,33 @@ def _others(s: Snapshot, vehicle: bool = False) -> list[tuple[Candidate, Any, in
     ]
 
 
-#: The car's all-modes levels at a point per candidate (one DOF's level per line, the
-#: road's tracks and wheels as the page's), ~15 kB each.
-_CAR = _Kept()
+def _car_of(s: Snapshot) -> Car | None:
+    """Where the page's response is taken in vehicle scope (None: the corner)."""
+    return (s.point, s.road, tuple(s.wheels)) if s.vehicle else None
 
 
 def _car_key(s: Snapshot, models) -> tuple:
-    return (s.harmonic, s.coupling, s.point, s.road, tuple(s.wheels), models.key)
+    return _key(s.harmonic, s.coupling, models, _car_of(s))
 
 
 def _car_levels(s: Snapshot, models) -> np.ndarray:
     """The car's all-modes response level at the page's point (six DOFs, shape (n_f, 6))
     with ``models``' tire on the four wheels, to the page's road (thesis eq. 4.1, the four
-    hubs as one interface)."""
-    key = _car_key(s, models)
-    got = _CAR.get(key)
-    if got is None:
-        resp = vc.response(s.harmonic, None, s.coupling, s.point, s.road, tuple(s.wheels), models)
-        outs = list(resp.response.outputs)
-        got = np.stack([resp.level[:, outs.index(f"{s.point}:{d}")] for d in DIRECTIONS], 1)
-        _CAR.put(key, got)
-    return got
+    hubs as one interface; uncorrelated road components added in power)."""
+    r = _response(s.harmonic, s.coupling, models, _car_of(s))
+    level = response_level(r)
+    outs = list(r.outputs)
+    return np.stack([level[:, outs.index(f"{s.point}:{d}")] for d in DIRECTIONS], 1)
 
 
 def curves_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The other candidates' responses to the shown harmonic not computed yet (None: none)."""
     if s.vehicle:
-        cars = [m for _c, m, _slot in _others(s, True) if _car_key(s, m) not in _CAR]
+        cars = [m for _c, m, _slot in _others(s, True)]
+        inc = s.review.incumbent
+        if inc is not None and inc.candidate in candidates_of(s):
+            cars.append(candidate_models(s.models, candidates_of(s).get(inc.candidate)))
+        cars = [m for m in dict.fromkeys(cars) if _car_key(s, m) not in _DONE]
         if not cars:
             return None
 
@@ -420,7 +535,7 @@ def review_curves_result(s: Snapshot) -> Result:
     lin = s.level_scale != "dB"
     curves, cols, pending = [], {"freq_Hz": freq}, []
     for c, m, slot in _others(s, True) if s.vehicle else ():
-        if _car_key(s, m) not in _CAR:
+        if _car_key(s, m) not in _DONE:
             pending.append(c.name)
             continue
         lv = _car_levels(s, m)[:, j]
@@ -436,7 +551,7 @@ def review_curves_result(s: Snapshot) -> Result:
         db = magnitude_db(h)
         cols[f"{c.name}_dB"] = db
         curves.append({"name": c.name, "slot": slot, "y": np.abs(h) if lin else db, "freq": r.freq})
-    target, label = (None, "") if s.vehicle else _target_of(s, freq)
+    target, label = _target_of(s, freq)
     if target is not None:
         cols["target_dB"] = target
     return Result(
@@ -514,13 +629,15 @@ def _band_edges(s: Snapshot, m) -> dict[str, Any]:
     return got
 
 
+def _digest_text(text: str) -> str:
+    """Eight hex digits of ``text``'s SHA-256: a file name's short, stable tag."""
+    return hashlib.sha256(text.encode()).hexdigest()[:8]
+
+
 def _digest_of(curves: list[dict[str, Any]]) -> str:
     """A short digest of the candidates drawn (their files' digests): a file name of its own
     per set of candidates, not per target."""
-    import hashlib
-
-    digests = "\n".join(str(c["digest"]) for c in curves)
-    return hashlib.sha256(digests.encode()).hexdigest()[:8]
+    return _digest_text("\n".join(str(c["digest"]) for c in curves))
 
 
 def bands_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:

@@ -26,9 +26,9 @@ from panel.viewable import Viewer
 from fbs_core.candidates import MAX_CANDIDATES
 from fbs_core.errors import FBSError
 from fbs_core.targets import AXES, Target
-from fbs_core.vocabulary import DIRECTIONS, HARMONIC_CASES
+from fbs_core.vocabulary import HARMONIC_CASES
 
-from ..datasource import TARGET_ACCEPT, TIRE_ACCEPT
+from ..datasource import TARGET_ACCEPT, TARGET_DOFS, TIRE_ACCEPT
 from ..export import dated
 from ..runtime.draw import on_document, served_document
 from .bind import control
@@ -142,10 +142,10 @@ class ReviewView(Viewer):
         )
         self.seg_dof = W.Select(
             name="DOF",
-            options=[f"bushing:{d}" for d in DIRECTIONS],
+            options=list(TARGET_DOFS),  # the corner's bushing, then the car's points
             value="bushing:z",
             css_classes=["review-seg-dof"],
-            width=110,
+            width=130,
         )
         self.seg_points = W.TextInput(
             name="Points (Hz:dB re 1 (m/s)/m)",
