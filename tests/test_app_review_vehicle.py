@@ -60,8 +60,8 @@ def _flat_csv(dof: str, level_db: float, k: int = H) -> bytes:
     f = fbs_core.harmonic(k).frequencies()
     return (
         "# tire-fbs target\n# quantity: mobility\n# scale: dB\n"
-        f"# harmonic: {k}\nfreq [Hz],{dof}\n{float(f[0])!r},{level_db!r}\n"
-        f"{float(f[-1])!r},{level_db!r}\n"
+        f"# harmonic: {k}\nfreq [Hz],{dof}\n{float(f[0])!r},{float(level_db)!r}\n"
+        f"{float(f[-1])!r},{float(level_db)!r}\n"
     ).encode()
 
 
@@ -161,3 +161,41 @@ def test_the_cars_noise_band_needs_a_coherent_road(tmp_path, soft):
     r = store.verdict
     assert r.draw["state"] == "problem" and "coherent road" in r.caption
     assert "0.3" in r.caption
+
+
+def test_the_cars_noise_band_judges_a_target_only_its_upper_edge_crosses():
+    """A flat target at the seat between the car's nominal peak and its noise band's upper
+    95 % edge there: the nominal passes, the band does not. Truth: the core's own car band
+    (same seed and rounds: the same draws) and the core's verdict of it."""
+    from fbs_core.vehicle import vehicle_scatter_band
+    from fbs_core.verdict import NoiseEdge, verdict
+
+    st = DashboardState()
+    store = Results(st)
+    st.case.param.update(scope="vehicle", tracks="in phase", point="seat_fl")
+    st.noise.param.update(noise=10.0, target="both", rounds=60, seed=5, percentile=90)
+    dof = "seat_fl:z"
+    f = fbs_core.harmonic(H).frequencies()
+    nominal = vehicle_response(H, None, f, tracks="in phase", outputs="seat_fl")
+    band = vehicle_scatter_band(
+        H, noise=0.1, target="both", rounds=60, seed=5, outputs="seat_fl",
+        tracks="in phase", percentiles=(5.0, 95.0),
+    )  # fmt: skip
+    j = list(band.dofs).index(dof)
+    peak = 20 * np.log10(nominal.level[:, list(nominal.outputs).index(dof)].max())
+    edge = 20 * np.log10(band.percentiles[1][:, j].max())
+    assert edge > peak + 0.2  # the band lifts the edge above the nominal peak
+    level = peak + (edge - peak) / 2
+    assert st.data.load_targets(_flat_csv(dof, level), "seat.csv"), st.data.error
+    assert store.verdict.core["verdict"].row("reference", H, dof).status == "pass"
+    st.noise.verdict_band = True
+    r = store.verdict
+    got = r.core["verdict"].row("reference", H, dof)
+    assert got.status == "fails within the noise band"
+    direct = verdict(
+        {("reference", H): nominal.response},
+        st.data.review.targets,
+        {("reference", H): NoiseEdge.of_band(band, 95.0)},
+    ).row("reference", H, dof)
+    assert got.band_worst_db == pytest.approx(direct.band_worst_db, abs=1e-6)
+    assert got.band_freq == direct.band_freq and got.worst_db == pytest.approx(direct.worst_db)
