@@ -453,10 +453,49 @@ def test_the_other_candidates_bands_are_the_cores_bands_of_their_tires(tmp_path,
         src = next(m for m in view._fig.select({"name": f"scatter.candidate{c['slot']}"}))
         np.testing.assert_allclose(src.data["high"], c["high"])
         assert view._cand_items[c["slot"]].visible
-    # the current candidate's band is the page's own, not drawn again; in vehicle scope none
+    # the current candidate's band is the page's own, not drawn again
     st.data.select_candidate("soft.h5")
     assert {c["name"] for c in store.review_bands.draw["curves"]} == {"reference", "stiff.h5"}
-    st.case.scope = "vehicle"
+
+
+def test_in_vehicle_scope_the_other_candidates_bands_are_the_cars(tmp_path, tires):
+    """The car's scatter plot draws the other candidates' bands of the car with their tire
+    on the four wheels, at the page's point and road. Truth: the core's car band of that
+    tire (same seed: the same draws); on an incoherent road none (as the page's band)."""
+    from fbs_core.vehicle import vehicle_scatter_band
+
+    st, store = _session(tmp_path, tires)  # current: stiff.h5
+    st.noise.param.update(noise=5.0, rounds=60, seed=4, percentile=90)
+    st.case.param.update(
+        scope="vehicle", harmonic=3, n_modes=80, point="seat_rl", dof="z", tracks="anti-phase",
+        wheels=["fl", "rl"],
+    )  # fmt: skip
+    r = store.review_bands
+    got = {c["name"]: c for c in r.draw["curves"]}
+    assert set(got) == {"reference", "soft.h5"} and not r.draw["pending"]
+    for name, model in (("reference", None), ("soft.h5", tires["soft.h5"])):
+        kw = {} if model is None else {"tire": model}
+        band = vehicle_scatter_band(
+            3, noise=0.05, rounds=60, seed=4, n_modes=80, outputs="seat_rl",
+            tracks="anti-phase", wheels=("fl", "rl"), percentiles=(5.0, 95.0), **kw,
+        )  # fmt: skip
+        j = list(band.dofs).index("seat_rl:z")
+        np.testing.assert_allclose(got[name]["low"], 20 * np.log10(band.percentiles[0][:, j]))
+        np.testing.assert_allclose(got[name]["high"], 20 * np.log10(band.percentiles[1][:, j]))
+    assert r.meta["response DOF"] == "seat_rl:z" and r.meta["response point"] == "seat_rl"
+    assert "_car_" in r.filename
+    # drawn on the car's band plot beside the page's own band
+    from app.views.scatter import ScatterBandView
+
+    store.request_band(wait=True)
+    view = ScatterBandView(store=store)
+    view.__panel__()
+    for c in got.values():
+        src = next(m for m in view._fig.select({"name": f"scatter.candidate{c['slot']}"}))
+        np.testing.assert_allclose(src.data["high"], c["high"])
+        assert view._cand_items[c["slot"]].visible
+    # an incoherent road has no car band: none drawn
+    st.case.param.update(tracks="coherence", coherence=0.4)
     assert store.review_bands.draw["curves"] == []
 
 

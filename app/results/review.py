@@ -589,6 +589,7 @@ BANDS_DEPENDS = (
     "percentile",
     "scope",
     *BAND_FIELDS[:5],
+    *VEHICLE_FIELDS,
 )
 #: Band edges kept (per candidate, harmonic, N, noise settings and percentile band: the
 #: central band's two edges at the six DOFs, at most ~0.2 MB each).
@@ -600,22 +601,33 @@ def _band_key(s: Snapshot, m) -> tuple:
     return (
         compute.band_key(
             s.harmonic, s.n_modes, s.coupling, s.noise, s.target, s.frequency_dependent,
-            s.rounds, s.seed, m,
+            s.rounds, s.seed, m, s.vehicle_band_key(),
         ),
         int(s.percentile),
     )  # fmt: skip
 
 
+def _bands_drawn(s: Snapshot) -> bool:
+    """Whether the other candidates' bands can be drawn: the car's need a coherent road
+    (as the page's own band)."""
+    return not s.vehicle or vc.coherent(s.road)
+
+
 def _band_edges(s: Snapshot, m) -> dict[str, Any]:
     """The central percentile band of ``models`` at the page's band settings (thesis
-    eqs. 5.2-5.4, N modes as the page's band): its two edges at the six DOFs."""
+    eqs. 5.2-5.4, N modes as the page's band): its two edges at the six DOFs of the
+    corner's bushing, or of the car's point with the tire on its four wheels."""
     key = _band_key(s, m)
     got = _BANDS.get(key)
     if got is None:
-        res = compute.band_once(
-            s.harmonic, s.n_modes, s.coupling, s.noise, s.target, s.frequency_dependent,
-            s.rounds, s.seed, m,
-        )  # fmt: skip
+        bkey = key[0]
+        if bkey.is_car:
+            res = compute.cached_band(bkey) or vc.band(bkey)
+        else:
+            res = compute.band_once(
+                s.harmonic, s.n_modes, s.coupling, s.noise, s.target, s.frequency_dependent,
+                s.rounds, s.seed, m,
+            )  # fmt: skip
         lo, hi = (100 - s.percentile) / 2, (100 + s.percentile) / 2
         q = [float(x) for x in np.asarray(res.q, float)]
         pct = np.asarray(res.percentiles, float)
@@ -642,7 +654,9 @@ def _digest_of(curves: list[dict[str, Any]]) -> str:
 
 def bands_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The other candidates' bands not computed yet (None: none)."""
-    todo = [m for _c, m, _slot in _others(s) if _band_key(s, m) not in _BANDS]
+    if not _bands_drawn(s):
+        return None
+    todo = [m for _c, m, _slot in _others(s, True) if _band_key(s, m) not in _BANDS]
     if not todo:
         return None
 
@@ -656,12 +670,14 @@ def bands_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
 
 def review_bands_result(s: Snapshot) -> Result:
     """The other candidates' central percentile bands at the shown DOF, at the page's band
-    settings (N modes, noise, rounds, seed), for the scatter-band plot (corner scope)."""
-    label = f"bushing:{s.dof}"
+    settings (N modes, noise, rounds, seed), for the scatter-band plot: at the corner's
+    bushing, or in vehicle scope at the car's point with each candidate's tire on the four
+    wheels (a coherent road, as the page's own band)."""
+    label = s.output
     curves, pending = [], []
     freq = np.asarray(compute.frequencies(s.harmonic), float)
     cols: dict[str, np.ndarray] = {"freq_Hz": freq}
-    for c, m, slot in _others(s):
+    for c, m, slot in _others(s, True) if _bands_drawn(s) else ():
         if _band_key(s, m) not in _BANDS:
             pending.append(c.name)
             continue
@@ -674,6 +690,7 @@ def review_bands_result(s: Snapshot) -> Result:
              "high": high}
         )  # fmt: skip
     lo, hi = (100 - s.percentile) / 2, (100 + s.percentile) / 2
+    car = f"_car_{_digest_text(repr(s.vehicle_key()))}" if s.vehicle else ""
     return Result(
         columns=cols,
         meta={
@@ -688,9 +705,11 @@ def review_bands_result(s: Snapshot) -> Result:
             "rounds": s.rounds,
             "seed": s.seed,
             "percentiles": f"{lo:g}-{hi:g}",
+            **(vehicle_meta(s) if s.vehicle else {}),
             "candidates": ", ".join(str(c["name"]) for c in curves) or "none",
             "models": s.models.describe(),
         },
-        filename=f"review_bands_h{s.harmonic}_N{s.n_modes}_{s.dof}_{_digest_of(curves)}.csv",
+        filename=f"review_bands_h{s.harmonic}_N{s.n_modes}_{s.output.replace(':', '_')}"
+        f"{car}_{_digest_of(curves)}.csv",
         draw={"curves": curves, "pending": pending},
     )

@@ -29,8 +29,10 @@ FIRST_ORDER_LEGEND = "first-order band (linearised)"
 #: What the other candidates' bands and the shown band must share to be drawn together.
 BANDS_SAME = (
     "harmonic", "n_modes", "dof", "coupling", "percentile", "noise", "target",
-    "frequency_dependent", "rounds", "seed",
+    "frequency_dependent", "rounds", "seed", "scope",
 )  # fmt: skip
+#: What the car's bands add to :data:`BANDS_SAME` in vehicle scope.
+CAR_SAME = ("point", "wheels", "tracks", "coherence")
 #: The progress bar is hidden when idle (its box kept: no new layout of the page). The rule
 #: follows the bar's own ``active`` class: the bar's ``styles`` are copied onto the inner
 #: ``<progress>`` element once, when it is drawn, so a bar drawn idle stayed hidden for
@@ -189,7 +191,10 @@ class ScatterBandView(LiveView):
         """The other candidates' bands when they are of the band ``r`` shows (its case,
         DOF, percentile band and noise settings)."""
         rb = self.store.review_bands
-        ok = rb is not None and made_of_same(rb, r, BANDS_SAME)
+        fields = BANDS_SAME
+        if r is not None and r.snapshot is not None and r.snapshot.vehicle:
+            fields += CAR_SAME  # the car's road and point too
+        ok = rb is not None and made_of_same(rb, r, fields)
         shown = set()
         for cv in rb.draw["curves"] if ok and rb is not None else []:
             n = len(cv["freq"])
