@@ -191,7 +191,7 @@ class ScatterBandView(LiveView):
         """The other candidates' bands when they are of the band ``r`` shows (its case,
         DOF, percentile band and noise settings)."""
         rb = self.store.review_bands
-        fields = BANDS_SAME
+        fields: tuple[str, ...] = BANDS_SAME
         if r is not None and r.snapshot is not None and r.snapshot.vehicle:
             fields += CAR_SAME  # the car's road and point too
         ok = rb is not None and made_of_same(rb, r, fields)
