@@ -458,6 +458,42 @@ def test_the_other_candidates_bands_are_the_cores_bands_of_their_tires(tmp_path,
     assert {c["name"] for c in store.review_bands.draw["curves"]} == {"reference", "stiff.h5"}
 
 
+def test_the_band_plot_draws_the_target_its_upper_edge_is_judged_against(tmp_path, tires):
+    """The scatter-band plot draws the target of the shown DOF and harmonic (what the
+    verdict's noise band is judged against): a typed target straight in dB, then the
+    incumbent rule's line (its all-modes response + margin). Truth: the typed points, and
+    the core's response of the incumbent's tire."""
+    from app.views.scatter import ScatterBandView
+
+    st, store = _session(tmp_path, tires)
+    st.noise.param.update(rounds=30, seed=2)
+    st.case.param.update(harmonic=H, n_modes=40, dof="y")
+    f = fbs_core.harmonic(H).frequencies()
+    assert st.data.add_target(
+        Target.segments("bushing:y", [(f[0], -30.0), (f[-1], -10.0)], axis="linear")
+    )
+    store.request_band(wait=True)
+    view = ScatterBandView(store=store)
+    view.__panel__()
+    want = -30.0 + 20.0 * (f - f[0]) / (f[-1] - f[0])
+    np.testing.assert_allclose(store.review_bands.draw["target"], want, atol=1e-9)
+    src = next(m for m in view._fig.select({"name": "scatter.target"}))
+    np.testing.assert_allclose(src.data["level"], want, atol=1e-9)
+    assert view._target_item.visible and "bushing:y" in view._target_item.label.value
+    assert "bushing:y" in store.review_bands.meta["target line"]
+    # another DOF without a target: the line goes
+    st.case.dof = "z"
+    store.request_band(wait=True)
+    view.redraw()
+    assert store.review_bands.draw["target"] is None and not view._target_item.visible
+    # the incumbent rule: soft.h5's all-modes response + 2 dB at the shown DOF
+    assert st.data.clear_targets() and st.data.set_incumbent("soft.h5", 2.0)
+    inc = _direct(tires["soft.h5"], H).sel(outputs="bushing:z").data[:, 0, 0]
+    got = store.review_bands.draw
+    np.testing.assert_allclose(got["target"], 20 * np.log10(np.abs(inc)) + 2.0, atol=1e-6)
+    assert "incumbent soft.h5 +2 dB" in got["target_label"]
+
+
 def test_in_vehicle_scope_the_other_candidates_bands_are_the_cars(tmp_path, tires):
     """The car's scatter plot draws the other candidates' bands of the car with their tire
     on the four wheels, at the page's point and road. Truth: the core's car band of that

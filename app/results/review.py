@@ -488,13 +488,21 @@ def _car_levels(s: Snapshot, models) -> np.ndarray:
     return np.stack([level[:, outs.index(f"{s.point}:{d}")] for d in DIRECTIONS], 1)
 
 
+def _incumbent_models(s: Snapshot):
+    """The incumbent rule's candidate's models (None: no rule, or its tire not loaded)."""
+    inc = s.review.incumbent
+    if inc is None or inc.candidate not in candidates_of(s):
+        return None
+    return candidate_models(s.models, candidates_of(s).get(inc.candidate))
+
+
 def curves_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The other candidates' responses to the shown harmonic not computed yet (None: none)."""
     if s.vehicle:
         cars = [m for _c, m, _slot in _others(s, True)]
-        inc = s.review.incumbent
-        if inc is not None and inc.candidate in candidates_of(s):
-            cars.append(candidate_models(s.models, candidates_of(s).get(inc.candidate)))
+        inc = _incumbent_models(s)
+        if inc is not None:
+            cars.append(inc)
         cars = [m for m in dict.fromkeys(cars) if _car_key(s, m) not in _DONE]
         if not cars:
             return None
@@ -506,15 +514,9 @@ def curves_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
 
         return car_work
     todo = [(s.harmonic, s.coupling, m) for _c, m, _slot in _others(s)]
-    inc = s.review.incumbent
-    if inc is not None and not s.vehicle and inc.candidate in candidates_of(s):
-        todo.append(
-            (
-                s.harmonic,
-                s.coupling,
-                candidate_models(s.models, candidates_of(s).get(inc.candidate)),
-            )
-        )
+    inc = _incumbent_models(s)
+    if inc is not None:
+        todo.append((s.harmonic, s.coupling, inc))
     todo = [t for t in dict.fromkeys(todo) if _key(*t) not in _DONE]
     if not todo:
         return None
@@ -654,13 +656,21 @@ def _digest_of(curves: list[dict[str, Any]]) -> str:
 
 def bands_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
     """The other candidates' bands not computed yet (None: none)."""
-    if not _bands_drawn(s):
-        return None
-    todo = [m for _c, m, _slot in _others(s, True) if _band_key(s, m) not in _BANDS]
-    if not todo:
+    inc = _incumbent_models(s)  # the target line of the incumbent rule needs its response
+    car = _car_of(s)
+    need_inc = inc is not None and _key(s.harmonic, s.coupling, inc, car) not in _DONE
+    todo = (
+        [m for _c, m, _slot in _others(s, True) if _band_key(s, m) not in _BANDS]
+        if _bands_drawn(s)
+        else []
+    )
+    if not todo and not need_inc:
         return None
 
     def work() -> Iterator[None]:
+        if need_inc:
+            _response(s.harmonic, s.coupling, inc, car)
+            yield
         for m in todo:
             _band_edges(s, m)
             yield
@@ -670,7 +680,8 @@ def bands_work(s: Snapshot) -> Callable[[], Iterator[None]] | None:
 
 def review_bands_result(s: Snapshot) -> Result:
     """The other candidates' central percentile bands at the shown DOF, at the page's band
-    settings (N modes, noise, rounds, seed), for the scatter-band plot: at the corner's
+    settings (N modes, noise, rounds, seed), and the target there (dB, as
+    :func:`review_curves_result`), for the scatter-band plot: at the corner's
     bushing, or in vehicle scope at the car's point with each candidate's tire on the four
     wheels (a coherent road, as the page's own band)."""
     label = s.output
@@ -689,6 +700,9 @@ def review_bands_result(s: Snapshot) -> Result:
             {"name": c.name, "digest": c.digest, "slot": slot, "freq": e["freq"], "low": low,
              "high": high}
         )  # fmt: skip
+    target, target_label = _target_of(s, freq)
+    if target is not None:
+        cols["target_dB"] = target
     lo, hi = (100 - s.percentile) / 2, (100 + s.percentile) / 2
     car = f"_car_{_digest_text(repr(s.vehicle_key()))}" if s.vehicle else ""
     return Result(
@@ -707,9 +721,16 @@ def review_bands_result(s: Snapshot) -> Result:
             "percentiles": f"{lo:g}-{hi:g}",
             **(vehicle_meta(s) if s.vehicle else {}),
             "candidates": ", ".join(str(c["name"]) for c in curves) or "none",
+            "target line": target_label or "none",
             "models": s.models.describe(),
         },
         filename=f"review_bands_h{s.harmonic}_N{s.n_modes}_{s.output.replace(':', '_')}"
         f"{car}_{_digest_of(curves)}.csv",
-        draw={"curves": curves, "pending": pending},
+        draw={
+            "curves": curves,
+            "pending": pending,
+            "freq": freq,
+            "target": target,
+            "target_label": f"target: {target_label}" if target_label else "",
+        },
     )

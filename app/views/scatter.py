@@ -19,7 +19,14 @@ from bokeh.models import ColumnDataSource, HoverTool, LegendItem
 from fbs_core.candidates import MAX_CANDIDATES
 
 from ..results.base import made_of_same
-from .common import CANDIDATE_COLORS, COLORS, FREQ_LABEL, level_label, level_tooltips
+from .common import (
+    CANDIDATE_COLORS,
+    COLORS,
+    FREQ_LABEL,
+    TARGET_COLOR,
+    level_label,
+    level_tooltips,
+)
 from .layout import font
 from .live import LiveText, LiveView, downloads, inline_html
 from .plots import add_band, add_line, frequency_range, new_figure, set_data
@@ -158,10 +165,22 @@ class ScatterBandView(LiveView):
             LegendItem(label=value(f"candidate {k + 1}"), renderers=[], visible=False)
             for k in range(MAX_CANDIDATES)
         ]
-        fig.legend[0].items = [*fig.legend[0].items, *self._cand_items]
+        # the target at the shown DOF: what the band's upper edge is judged against
+        self._target = ColumnDataSource(
+            {"freq": np.zeros(0), "level": np.zeros(0), "name": []}, name="scatter.target"
+        )
+        target_line = fig.line(
+            "freq", "level", source=self._target, line_color=TARGET_COLOR, line_width=2.6,
+            line_dash="dotdash", visible=False,
+        )  # fmt: skip
+        self._target_item = LegendItem(
+            label=value("target"), renderers=[target_line], visible=False
+        )
+        fig.legend[0].items = [*fig.legend[0].items, *self._cand_items, self._target_item]
         self._cand_tool = HoverTool(
             renderers=[], tooltips=level_tooltips("@name", "level"), mode="vline"
         )
+        self._cand_tool.renderers = [target_line]
         fig.add_tools(self._cand_tool)
         fig.on_event(Tap, self._tapped)
         return [fig]
@@ -214,6 +233,17 @@ class ScatterBandView(LiveView):
                 item.visible = on
                 for line in item.renderers:
                     line.visible = on
+        y = rb.draw.get("target") if ok and rb is not None else None
+        if y is not None and rb is not None:
+            label = rb.draw["target_label"]
+            self._target.data = {"freq": rb.draw["freq"], "level": y, "name": [label] * len(y)}
+            if getattr(self._target_item.label, "value", None) != label:
+                self._target_item.label = value(label)
+        on = y is not None
+        if self._target_item.visible != on:
+            self._target_item.visible = on
+            for line in self._target_item.renderers:
+                line.visible = on
 
     def _overlay(self, r):
         """The published first-order result when it is shown and of the drawn band, DOF and
