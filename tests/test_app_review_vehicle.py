@@ -95,6 +95,11 @@ def test_targets_at_two_points_of_the_car_are_judged_for_every_candidate(tmp_pat
     assert "(strut_fr, seat_fl)" in r.meta["responses"]  # in the car's order of points
     assert "anti-phase" in r.meta["tracks (right against left)"]
     assert "car" in r.filename and "at the car's strut_fr, seat_fl" in r.caption
+    # the report's verdict section says what was judged: the car's points
+    from app.report.content import verdict_section
+
+    text = verdict_section(v).paragraphs[0]
+    assert "the car's strut_fr, seat_fl" in text and "four wheels" in text
 
 
 def test_the_road_and_the_scope_choose_what_is_judged(tmp_path, soft):

@@ -426,9 +426,20 @@ def verdict_section(v: Any) -> Section:
         ),
     )  # fmt: skip
     best = v.ranking[0] if v.ranking else None
+    points = list(dict.fromkeys(r.point for r in v.rows))
+    if points and points != ["bushing"]:  # vehicle scope: the car's response points
+        what = (
+            f"the targets at the car's {', '.join(points)}: each candidate's response of the "
+            "whole car with its tire on the four wheels (eq. 4.1, the four hubs as one "
+            "interface, every mode it delivered)"
+        )
+    else:
+        what = (
+            "the bushing targets: each candidate's coupled bushing response (eq. 4.1, every "
+            "mode it delivered)"
+        )
     text = (
-        "Which candidate tire meets the bushing targets: each candidate's coupled bushing "
-        "response (eq. 4.1, every mode it delivered) against the targets on every harmonic "
+        f"Which candidate tire meets {what} against the targets on every harmonic "
         "(docs/verdict.md)."
         + (f" Best: {best.candidate} ({best.status})." if best is not None else "")
     )
