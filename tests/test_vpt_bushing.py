@@ -292,3 +292,49 @@ def test_too_few_collinear_or_unplaced_bushing_sensors_are_named(rigid) -> None:
     lab = tuple("bushing_a:rx" if o == "bushing_a:x" else o for o in ch.labels)
     with pytest.raises(QuantityError, match=r"'bushing_a:rx' is a rotation"):
         response_point(rot, Channels(lab, ch.positions, ch.directions), r0, "bushing")
+
+
+def test_dashboard_upload_with_bushing_sensors_gives_six_bushing_dofs() -> None:
+    # the page's upload path without a browser: geometry (with the bushing sensors and the
+    # point 'bushing'), then the measured set; the session's chassis has the bushing's six
+    # DOFs, rotations included, within 1 % of the exact chassis' peaks
+    from app.datasource import REFERENCE, DataSource
+
+    grid = np.arange(13.0, 422.01, 0.5)  # every harmonic's analysis grid
+    m = val.knuckle_measurement(grid, "accelerance", bushing="arms")
+    assert m.bushing_sensors is not None
+    geo = geometry_csv(
+        m.layout, "mm", sensors=m.bushing_sensors, points={"bushing": val.bushing_point()}
+    )
+    ds = DataSource()
+    assert ds.load_geometry(geo, "knuckle.csv"), ds.error
+    assert ds.load_chassis(fc.save_frf(m.measured, format="hdf5"), "knuckle.h5"), ds.error
+    assert ds.models is not REFERENCE
+    assert "second virtual point 'bushing'" in ds.chassis_summary
+    f = fc.harmonic(4).frequencies()
+    Y = ds.models.chassis.mobility(f)
+    assert Y.outputs == SPINDLE + BUSHING
+    E = m.exact.to("mobility").data[np.searchsorted(grid, f)]
+    assert rel_to_peak(Y.data, E).max() < 0.01
+
+
+def test_a_sensor_at_the_bushing_itself_joins_the_second_virtual_point() -> None:
+    # the documented way to keep a tri-axial sensor at the bushing with sensors around it:
+    # its node named bushing_0, its row at the bushing point; the result stays exact
+    ch = val.bushing_sensors()
+    r0 = val.bushing_point()
+    lab = [*ch.labels, "bushing_0:x", "bushing_0:y", "bushing_0:z"]
+    with0 = Channels(
+        lab, np.vstack([ch.positions, np.tile(r0, (3, 1))]), np.vstack([ch.directions, np.eye(3)])
+    )
+    m = val.knuckle_measurement(F, "mobility", bushing="rigid", bushing_layout=with0)
+    assert m.exact_bushing is not None
+    frf, geo = _files(m)
+    nodes = NODES | {400: "bushing_0"}
+    frf = fc.save_frf(m.measured, format="uff", nodes=nodes)
+    mc = load_measured_chassis(
+        frf, geo, frf_filename="k.unv", geometry_filename="g.csv", nodes=nodes
+    )
+    assert mc.bushing_vp is not None and len(mc.bushing_vp.sensors) == 12
+    q = mc.bushing_vp.frf.sel(outputs=list(BUSHING)).data
+    assert rel_to_peak(q, m.exact_bushing.data).max() < 1e-8  # through the UFF 58 file
