@@ -311,11 +311,19 @@ def test_dashboard_upload_with_bushing_sensors_gives_six_bushing_dofs() -> None:
     assert ds.load_chassis(fc.save_frf(m.measured, format="hdf5"), "knuckle.h5"), ds.error
     assert ds.models is not REFERENCE
     assert "second virtual point 'bushing'" in ds.chassis_summary
+    assert ds.bushing_vp is not None and ds.bushing_vp.node == "bushing"
+    from app.views.vpt_consistency import report_notes
+
+    spindle_note, bushing_note = report_notes(ds)
+    assert "virtual point 'spindle'" in spindle_note
+    assert "second virtual point 'bushing' (9 sensor channels" in bushing_note
     f = fc.harmonic(4).frequencies()
     Y = ds.models.chassis.mobility(f)
     assert Y.outputs == SPINDLE + BUSHING
     E = m.exact.to("mobility").data[np.searchsorted(grid, f)]
     assert rel_to_peak(Y.data, E).max() < 0.01
+    ds.reset()
+    assert ds.bushing_vp is None and ds.vpt is None
 
 
 def test_a_sensor_at_the_bushing_itself_joins_the_second_virtual_point() -> None:
