@@ -20,7 +20,7 @@ from fbs_core.chassis import BUSHING, SPINDLE
 from fbs_core.errors import DOFError, GeometryError, QuantityError
 from fbs_core.io import load_measured_chassis
 from fbs_core.io.geometry import geometry_csv
-from fbs_core.vpt import Channels, displacement_modes, response_point, transformation
+from fbs_core.vpt import Channels, response_point, transformation
 from fbs_core.vpt import validation as val
 
 F = np.arange(2.0, 450.1, 4.0)
@@ -75,39 +75,15 @@ def test_sensors_on_stiff_arms_are_within_their_compliance() -> None:
     assert rp.consistency.worst()[1] > 0.99
 
 
-def _bound(
-    m: val.KnuckleMeasurement, noise: float, dr: float, angle_deg: float, quantity: str = "mobility"
-) -> np.ndarray:
-    """First-order bound of the second virtual point's error per line and DOF (5 sigma).
-
-    The transformation maps the channels' error ``y - R^ q`` by ``T^``; per channel k that
-    error is its noise (< 5 noise |y_k|), its direction error ``(e_k - e^_k) . u(r_k)``
-    (< 2 sin(angle / 2) |u(r_k)|) and its position error ``e^_k . (theta x dr_k)``
-    (< dr |theta|), so ``|dq_i| <= sum_k |T_ik| (5 noise |y_k| + 2 sin(a/2) |u(r_k)| +
-    dr |theta|)``, with ``u(r_k) = u_b + theta x (r_k - r_b)`` from the FE bushing DOFs."""
-    assert m.bushing_sensors is not None and m.exact_bushing is not None
-    ch, r0 = m.bushing_sensors, val.bushing_point()
-    T = np.abs(transformation(displacement_modes(ch.positions, ch.directions, r0)))
-    qb = m.exact_bushing.to(quantity).data  # (n_f, 6, n_i)
-    u, th = qb[:, :3], qb[:, 3:]
-    arm = ch.positions - r0
-    ur = u[:, None] + np.cross(th[:, None], arm[None, :, :, None], axisa=2, axisb=2, axisc=2)
-    y = m.measured.to(quantity).sel(outputs=list(ch.labels)).data
-    per = (
-        5 * noise * np.abs(y)
-        + 2 * np.sin(np.radians(angle_deg) / 2) * np.linalg.norm(ur, axis=2)
-        + dr * np.linalg.norm(th, axis=1)[:, None]
-    )
-    out: np.ndarray = np.einsum("ik,fkj->fij", T, per)
-    return out
-
-
 def test_a_real_tests_errors_stay_within_the_derived_bound(rigid) -> None:
     # 1 % noise, 2 mm and 2 degrees on the bushing sensors: every line, DOF and impact
     # within the first-order bound; the consistency falls
     assert rigid.bushing_sensors is not None and rigid.exact_bushing is not None
     E = rigid.exact_bushing.data
-    bound = _bound(rigid, 0.01, 0.002, 2.0)
+    # truth: the FE bushing DOFs; tolerance: the first-order bound of the three errors
+    # (validation.bushing_error_bound: T_u on each channel's noise at 5 sigma, direction
+    # and position error)
+    bound = val.bushing_error_bound(rigid, 0.01, 0.002, 2.0)
     clean = response_point(rigid.measured, rigid.bushing_sensors, val.bushing_point(), "bushing")
     for seed in range(3):
         ch = val.perturbed_channels(rigid.bushing_sensors, 0.002, 2.0, seed=seed)
@@ -118,8 +94,6 @@ def test_a_real_tests_errors_stay_within_the_derived_bound(rigid) -> None:
         assert np.all(err <= 1.1 * bound)
         assert rp.consistency.overall()[0] < clean.consistency.overall()[0]
         assert rp.consistency.worst()[1] < 0.99
-        # the documented figure: per DOF, the largest error relative to the DOF's peak
-        assert (err.max(0) / np.abs(E).max(0)).max() < (bound.max(0) / np.abs(E).max(0)).max()
 
 
 def test_uff_files_give_the_chassis_with_six_bushing_dofs_and_its_coupled_response() -> None:
@@ -157,7 +131,7 @@ def test_coupled_response_under_bushing_sensor_errors_stays_within_the_bound() -
     unit[:, 6:12] = np.eye(6)  # bushing rows I: the "bushing response" is g itself
     g = fc.bushing_response(4, chassis=fc.FRFChassis(E.replace(data=unit))).data[:, :, 0]
     Tf = np.abs(transformation(m.layout.modes("impacts")))
-    b = _bound(m, 0.01, 0.002, 2.0)  # (n_f, 6, n_impacts), mobility
+    b = val.bushing_error_bound(m, 0.01, 0.002, 2.0)  # (n_f, 6, n_impacts), mobility
     B = np.einsum("fim,sm,fs->fi", b, Tf, np.abs(g))
     r0 = val.bushing_point()
     v0 = None

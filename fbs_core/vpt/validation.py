@@ -62,6 +62,7 @@ __all__ = [
     "BUSHING_ARMS",
     "bushing_sensors",
     "bushing_arms_flexible_mode",
+    "bushing_error_bound",
 ]
 
 #: Arm tips relative to the spindle (m), vehicle axes: front-upper, rear-upper, lower.
@@ -409,6 +410,62 @@ def _moved(
         t = np.radians(angle_error_deg)
         D.append(e * np.cos(t) + np.cross(a, e) * np.sin(t))
     return Channels(ch.labels, np.array(P), np.array(D), what)
+
+
+def bushing_error_bound(
+    m: KnuckleMeasurement,
+    noise: float = 0.01,
+    position_error: float = 0.002,
+    angle_error_deg: float = 2.0,
+    quantity: str = "mobility",
+    sigmas: float = 5.0,
+) -> FloatArray:
+    """First-order bound of the second virtual point's error under a real test's errors.
+
+    The response transformation maps the channels' error ``y - R^ q`` by ``T_u``
+    (IMAC 2015 eq. 5); per channel k that error is its noise (below ``sigmas * noise *
+    |y_k|``), its direction error ``(e_k - e^_k) . u(r_k)`` (below ``2 sin(angle / 2)
+    |u(r_k)|``) and its position error ``e^_k . (theta x dr_k)`` (below ``dr |theta|``):
+
+        ``|dq_i| <= sum_k |T_ik| (sigmas noise |y_k| + 2 sin(a / 2) |u(r_k)| + dr |theta|)``
+
+    with ``u(r_k) = u_b + theta x (r_k - r_b)`` from the FE model's exact bushing DOFs.
+
+    Parameters
+    ----------
+    m : KnuckleMeasurement
+        Made with sensors around the bushing (``bushing="rigid"`` or ``"arms"``).
+    noise, position_error, angle_error_deg : float
+        Relative noise (standard deviation), point error (m), direction error (degrees), as
+        :func:`noisy`, :func:`perturbed_channels`.
+    quantity : str
+        The FRF quantity of the bound (relative errors are the same in each).
+    sigmas : float
+        Noise bound in standard deviations.
+
+    Returns
+    -------
+    ndarray, shape (n_freq, 6, n_impacts)
+        Bound of ``|q_b - Y_bm|`` per line, bushing DOF and impact.
+    """
+    if m.bushing_sensors is None or m.exact_bushing is None:
+        raise ValueError("the measurement has no sensors around the bushing")
+    ch = m.bushing_sensors
+    r0 = bushing_point()
+    Rb = np.hstack([ch.directions, np.cross(ch.positions - r0, ch.directions)])
+    T = np.abs(np.linalg.pinv(Rb))
+    qb = m.exact_bushing.to(quantity).data
+    u, th = qb[:, :3], qb[:, 3:]
+    arm = ch.positions - r0
+    ur = u[:, None] + np.cross(th[:, None], arm[None, :, :, None], axisa=2, axisb=2, axisc=2)
+    y = m.measured.to(quantity).sel(outputs=list(ch.labels)).data
+    per = (
+        sigmas * noise * np.abs(y)
+        + 2 * np.sin(np.radians(angle_error_deg) / 2) * np.linalg.norm(ur, axis=2)
+        + position_error * np.linalg.norm(th, axis=1)[:, None]
+    )
+    out: FloatArray = np.einsum("ik,fkj->fij", T, per)
+    return out
 
 
 def noisy(frf: FRF, level: float = 0.01, seed: int = 0) -> FRF:
