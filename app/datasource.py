@@ -275,6 +275,11 @@ class DataSource(param.Parameterized):
         doc="The virtual point transformation of a measured chassis in use "
         "(fbs_core.vpt.VirtualPoint), else None.",
     )
+    bushing_vp = param.Parameter(
+        default=None,
+        doc="The second virtual point of a measured chassis whose bushing DOFs come from "
+        "sensors around it (fbs_core.vpt.ResponsePoint), else None.",
+    )
     review = param.ClassSelector(
         class_=Review,
         default=EMPTY_REVIEW,
@@ -394,9 +399,9 @@ class DataSource(param.Parameterized):
         try:
             if self._geometry is None:
                 chassis, summary, key = self._read_chassis(bytes(data), name, sp, bu, interp, q)
-                vpt = None
+                vpt = bvp = None
             else:
-                chassis, summary, key, vpt = self._read_measured(
+                chassis, summary, key, vpt, bvp = self._read_measured(
                     bytes(data), name, sp, bu, interp, q
                 )
             check_pair(self.models.tire, chassis)
@@ -413,6 +418,7 @@ class DataSource(param.Parameterized):
                 error="",
                 chassis_summary=summary,
                 vpt=vpt,
+                bushing_vp=bvp,
             )
             self.models = _models(m.tire, self._tire_key, m.tire_name, chassis, key, name)
         return True
@@ -497,7 +503,7 @@ class DataSource(param.Parameterized):
             interpolate=interpolate,
             **chosen,
         )
-        return chassis, summary, key, mc.vpt
+        return chassis, summary, key, mc.vpt, mc.bushing_vp
 
     def load_tire(self, data: bytes, filename: str | None = None) -> bool:
         """Read a modal tire model upload (project HDF5 format or MATLAB).
@@ -681,6 +687,7 @@ class DataSource(param.Parameterized):
                     chassis_summary="",
                     geometry_summary="",
                     vpt=None,
+                    bushing_vp=None,
                     review=keep,
                 )
                 self.models = REFERENCE

@@ -88,7 +88,9 @@ def consistency_plot(vpt):
 
 
 def report_notes(data) -> tuple[str, ...]:
-    """The report's note on a measured chassis in use (its "Data in use" table), else ()."""
+    """The report's notes on a measured chassis in use (its "Data in use" table), else ():
+    the spindle's virtual point, and the bushing's second one when its sensors were around it.
+    """
     vpt = getattr(data, "vpt", None)
     if vpt is None:
         return ()
@@ -96,9 +98,21 @@ def report_notes(data) -> tuple[str, ...]:
     so, io = c.overall()
     worst, wv = c.worst()
     lev = max({**vpt.sensor_leverage, **vpt.impact_leverage}.items(), key=lambda kv: kv[1])
-    return (
+    notes = (
         f"chassis measured at the knuckle, transformed to the virtual point "
         f"'{vpt.layout.node}' ({len(c.sensors)} sensor channels, {len(c.impacts)} impacts): "
         f"consistency sensors {so:.4f}, impacts {io:.4f}; lowest channel {worst} {wv:.3f}; "
         f"highest leverage {lev[0]} {lev[1]:.2f}",
+    )
+    bvp = getattr(data, "bushing_vp", None)
+    if bvp is None:
+        return notes
+    bc = bvp.consistency
+    bw, bwv = bc.worst()
+    blev = max(bvp.sensor_leverage.items(), key=lambda kv: kv[1])
+    return (
+        *notes,
+        f"bushing DOFs from a second virtual point '{bvp.node}' ({len(bc.sensors)} sensor "
+        f"channels around it): consistency sensors {bc.overall()[0]:.4f}; lowest channel "
+        f"{bw} {bwv:.3f}; highest leverage {blev[0]} {blev[1]:.2f}",
     )

@@ -217,7 +217,13 @@ def load_geometry(
     )
 
 
-def geometry_csv(layout: Layout, unit: str = "m") -> bytes:
+def geometry_csv(
+    layout: Layout,
+    unit: str = "m",
+    *,
+    sensors: Channels | None = None,
+    points: Mapping[str, ArrayLike] | None = None,
+) -> bytes:
     """A layout as the CSV geometry table that :func:`load_geometry` reads.
 
     Parameters
@@ -225,6 +231,10 @@ def geometry_csv(layout: Layout, unit: str = "m") -> bytes:
     layout : Layout
     unit : {"m", "mm", "cm"}
         Length unit of the coordinates written (declared in a ``# length unit`` line).
+    sensors : Channels, optional
+        More sensor rows (e.g. the sensors around the bushing, a second virtual point).
+    points : mapping of str to array_like (3,), optional
+        More points by name (m), e.g. ``{"bushing": xyz}``.
 
     Examples
     --------
@@ -240,15 +250,20 @@ def geometry_csv(layout: Layout, unit: str = "m") -> bytes:
         "channel,role,x,y,z,dx,dy,dz",
     ]
     seen = set()
-    for role, ch in (("sensor", layout.sensors), ("impact", layout.impacts)):
+    groups = [("sensor", layout.sensors), ("impact", layout.impacts)]
+    if sensors is not None:
+        groups.append(("sensor", sensors))
+    for role, ch in groups:
         for lab, p, d in zip(ch.labels, ch.positions, ch.directions, strict=True):
             if lab in seen:
                 continue
             seen.add(lab)
             cells = [lab, role, *(f"{v / f:.12g}" for v in p), *(f"{v:.15g}" for v in d)]
             out.append(",".join(cells))
-    o = ",".join(f"{v / f:.12g}" for v in layout.origin)
-    out.append(f"{layout.node},point,{o},,,")
+    pts = {layout.node: layout.origin, **(points or {})}
+    for name, xyz in pts.items():
+        o = ",".join(f"{v / f:.12g}" for v in np.asarray(xyz, float))
+        out.append(f"{name},point,{o},,,")
     return ("\n".join(out) + "\n").encode()
 
 

@@ -8,7 +8,8 @@ consistent the measurement was (docs/vpt.md):
 
 - :mod:`.geometry`: channels (positions, directions), the layout, the interface
   displacement modes, the observability check;
-- :mod:`.transform`: the least-squares transformations and :func:`virtual_point`;
+- :mod:`.transform`: the least-squares transformations, :func:`virtual_point` and, for a
+  point observed by sensors around it but not excited (the bushing), :func:`response_point`;
 - :mod:`.quality`: sensor and impact consistency, overall and per channel;
 - :mod:`.validation`: the reference chassis with a flexible knuckle, "measured" at a
   realistic layout (the tests' and ``scripts/print_vpt_validation.py``'s truth).
@@ -22,17 +23,29 @@ arithmetic below it).
 from __future__ import annotations
 
 from .geometry import Channels, Layout, check_observable, displacement_modes
-from .quality import Consistency, consistency
-from .transform import VirtualPoint, transformation, virtual_point, vpt_kernel
+from .quality import Consistency, consistency, response_consistency
+from .transform import (
+    ResponsePoint,
+    VirtualPoint,
+    response_kernel,
+    response_point,
+    transformation,
+    virtual_point,
+    vpt_kernel,
+)
 
 __all__ = [
     "Channels",
     "Consistency",
     "Layout",
+    "ResponsePoint",
     "VirtualPoint",
     "check_observable",
     "consistency",
     "displacement_modes",
+    "response_consistency",
+    "response_kernel",
+    "response_point",
     "transformation",
     "virtual_point",
     "vpt_kernel",

@@ -16,6 +16,9 @@ and comparing them with the measured ones the consistency indicators, per line:
   that disagrees with the others in level (a loose sensor above its mount resonance), in
   phase or in sign (a mislabelled direction);
 - the same for the impacts, over the columns (the sensors).
+
+A virtual point transformed on the response side only (sensors around a point that is not
+excited, IMAC 2015 eqs. 5-6 alone) has sensor indicators only: :func:`response_consistency`.
 """
 
 from __future__ import annotations
@@ -29,7 +32,13 @@ from numpy.typing import ArrayLike
 from .._typing import ComplexArray, FloatArray
 from ..vocabulary import readonly
 
-__all__ = ["Consistency", "consistency", "leverage", "specific_consistency"]
+__all__ = [
+    "Consistency",
+    "consistency",
+    "leverage",
+    "response_consistency",
+    "specific_consistency",
+]
 
 
 def leverage(R: FloatArray, T: FloatArray) -> list[float]:
@@ -89,7 +98,8 @@ class Consistency:
     sensors, impacts : tuple of str
         Channel labels.
     sensor_overall, impact_overall : ndarray, shape (n_freq,)
-        ``rho_u``, ``rho_f`` per line.
+        ``rho_u``, ``rho_f`` per line (``impact_overall`` NaN when no impacts were
+        transformed: :func:`response_consistency`).
     sensor_specific : ndarray, shape (n_freq, n_s)
         ``rho_u,k`` per line and sensor channel.
     impact_specific : ndarray, shape (n_freq, n_i)
@@ -193,4 +203,47 @@ def consistency(
         readonly(rf),
         readonly(specific_consistency(Yu, Y, 2)),
         readonly(specific_consistency(Yf, Y, 1)),
+    )
+
+
+def response_consistency(
+    Y: ComplexArray,
+    Ru: FloatArray,
+    Tu: FloatArray,
+    sensors: Sequence[str],
+    freq: ArrayLike,
+) -> Consistency:
+    """Sensor consistency of a response-side virtual point (IMAC 2015 sec. 3.3).
+
+    The sensors around a point that is observed but not excited (a bushing) are filtered
+    as in :func:`consistency`, ``Y~_u = R_u T_u Y``, over whatever inputs the set has; the
+    inputs are not transformed, so there are no impact indicators.
+
+    Parameters
+    ----------
+    Y : ndarray, shape (n_freq, n_s, n_i)
+        Measured FRFs, the point's sensors by the set's inputs.
+    Ru : ndarray, shape (n_s, m)
+    Tu : ndarray, shape (m, n_s)
+    sensors : sequence of str
+    freq : array_like, shape (n_freq,)
+
+    Returns
+    -------
+    Consistency
+        ``impacts`` empty, ``impact_overall`` NaN, ``impact_specific`` of shape
+        ``(n_freq, 0)``.
+    """
+    Yu = np.matmul(Ru @ Tu, Y)
+    norm = np.sqrt(np.sum(np.abs(Y) ** 2, axis=(1, 2)))
+    ru = np.sqrt(np.sum(np.abs(Yu) ** 2, axis=(1, 2))) / np.where(norm > 0, norm, 1.0)
+    n_f = Y.shape[0]
+    return Consistency(
+        readonly(np.asarray(freq, float)),
+        tuple(sensors),
+        (),
+        readonly(ru),
+        readonly(np.full(n_f, np.nan)),
+        readonly(specific_consistency(Yu, Y, 2)),
+        readonly(np.zeros((n_f, 0))),
     )

@@ -11,12 +11,17 @@ squares (IMAC 2015 eqs. 5-9):
 so that the virtual point's mobility (or receptance, accelerance: the quantity of the
 measured set) is ``Y_qm = T_u Y T_f^T`` (IMAC 2015 eq. 10), 6 x 6 per line for the rigid
 IDMs, and the transfer from the virtual point to any other measured channel ``b`` (a
-bushing) is ``Y_bm T_f^T``. The result is an :class:`~fbs_core.frf.FRF` labelled
-``spindle:x`` .. ``spindle:rz`` (and the other channels), ready for
+bushing) is ``Y_bm T_f^T``. A point that is observed but cannot be measured directly (the
+bushing's rotations) gets a second virtual point on the response side only,
+``q_b = T_u,b Y_sb`` over whatever inputs the set has (IMAC 2015 eqs. 5-6 and 10 with
+``T_f = I``), so that its transfer from the spindle is ``T_u,b Y_sb,m T_f^T``. The result
+is an :class:`~fbs_core.frf.FRF` labelled ``spindle:x`` .. ``spindle:rz`` (and the other
+channels), ready for
 :class:`~fbs_core.chassis.FRFChassis` and :func:`~fbs_core.coupling.couple_response`.
 
 :func:`transformation` and :func:`vpt_kernel` are the array kernels; :func:`virtual_point`
-the labelled API that checks the geometry, the channels and their units first.
+the labelled API that checks the geometry, the channels and their units first;
+:func:`response_kernel` and :func:`response_point` the same for the response side alone.
 """
 
 from __future__ import annotations
@@ -28,13 +33,22 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._typing import ComplexArray, FloatArray
+from ..dofs import parse_label
 from ..errors import DataFormatError, DOFError, GeometryError, QuantityError
 from ..frf import FRF
 from ..vocabulary import readonly
-from .geometry import Layout, check_observable, displacement_modes
-from .quality import Consistency, consistency, leverage
+from .geometry import Channels, Layout, check_observable, displacement_modes
+from .quality import Consistency, consistency, leverage, response_consistency
 
-__all__ = ["transformation", "vpt_kernel", "virtual_point", "VirtualPoint"]
+__all__ = [
+    "transformation",
+    "vpt_kernel",
+    "virtual_point",
+    "VirtualPoint",
+    "response_kernel",
+    "response_point",
+    "ResponsePoint",
+]
 
 
 def _weights(w: ArrayLike | None, n: int, what: str) -> FloatArray:
@@ -149,6 +163,31 @@ class VirtualPoint:
             self.layout.impacts.positions, self.layout.impacts.directions, self.layout.origin
         )
         return dict(zip(self.layout.impacts.labels, leverage(Rf, self.Tf[:6]), strict=True))
+
+
+def response_kernel(Y: ArrayLike, Tu: ArrayLike) -> ComplexArray:
+    """``q = T_u Y`` on every line: the response side of IMAC 2015 eq. 10 (``T_f = I``).
+
+    Parameters
+    ----------
+    Y : array_like, shape (n_freq, n_s, n_i)
+        Measured FRFs, the point's sensor channels by any inputs.
+    Tu : array_like, shape (m, n_s)
+        Response transformation (:func:`transformation` of the sensors' IDMs).
+
+    Returns
+    -------
+    ndarray, shape (n_freq, m, n_i)
+        The virtual point's responses to the same inputs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> response_kernel(np.ones((1, 2, 3)), [[0.5, 0.5]]).shape
+    (1, 1, 3)
+    """
+    out: ComplexArray = np.matmul(np.asarray(Tu, float), np.asarray(Y))
+    return out
 
 
 def _check_kinds(Y: FRF, sensors: list[str], impacts: list[str]) -> None:
@@ -277,3 +316,116 @@ def virtual_point(
         extra = FRF(frf.freq, q, names, names, frf.quantity)
     cons = consistency(Y, Ru, Tu, Rf, Tf, sensors, impacts, frf.freq)
     return VirtualPoint(out, layout, readonly(Tu), readonly(Tf), cons, extra)
+
+
+@dataclass(frozen=True, eq=False)
+class ResponsePoint:
+    """A virtual point on the response side only: sensors around a point, its six DOFs.
+
+    Attributes
+    ----------
+    frf : FRF
+        The measured set with the point's sensor channels replaced by ``node:x ..
+        node:rz`` (appended after the other outputs); inputs and quantity unchanged.
+    sensors : Channels
+        The sensor channels transformed (positions, directions).
+    origin : ndarray, shape (3,)
+        The virtual point (m).
+    node : str
+    Tu : ndarray, shape (6, n_s)
+    consistency : Consistency
+        Sensor consistency, overall and per channel, over the set's inputs (no impact
+        indicators: :func:`.quality.response_consistency`).
+    """
+
+    frf: FRF
+    sensors: Channels
+    origin: FloatArray
+    node: str
+    Tu: FloatArray
+    consistency: Consistency
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """``node:x`` .. ``node:rz``."""
+        return tuple(self.frf.outputs[-6:])
+
+    @property
+    def sensor_leverage(self) -> dict[str, float]:
+        """Leverage of each sensor channel (see :attr:`VirtualPoint.sensor_leverage`)."""
+        Ru = displacement_modes(self.sensors.positions, self.sensors.directions, self.origin)
+        return dict(zip(self.sensors.labels, leverage(Ru, self.Tu), strict=True))
+
+
+def response_point(
+    frf: FRF,
+    sensors: Channels,
+    origin: ArrayLike,
+    node: str,
+    *,
+    sensor_weights: ArrayLike | None = None,
+) -> ResponsePoint:
+    """Transform sensor channels around a point to that point's six DOFs (response side).
+
+    The sensors around a point (e.g. three tri-axial accelerometers 5-10 cm around a
+    bushing) see its rigid motion, ``u_s = R_u q + mu`` (IMAC 2015 eq. 2); the weighted
+    least-squares ``q = T_u u``, ``T_u = (R_u^T W_u R_u)^-1 R_u^T W_u`` (eqs. 5-6) gives its
+    translations and the rotations no sensor measures directly, for every input of the set
+    (``q_b = T_u,b Y_sb,m``, eq. 10 with the inputs untransformed).
+
+    Parameters
+    ----------
+    frf : FRF
+        Measured set, ``(n_freq, n_out, n_in)``; its outputs include every channel of
+        ``sensors`` and none at ``node``.
+    sensors : Channels
+        Positions and directions of the point's sensor channels.
+    origin : array_like, shape (3,)
+        The point (m).
+    node : str
+        Its node name: the result's outputs ``node:x .. node:rz``.
+    sensor_weights : array_like, optional
+        Least-squares weights per channel (n,) or (n, n) (default equal).
+
+    Returns
+    -------
+    ResponsePoint
+
+    Raises
+    ------
+    DOFError
+        A sensor channel that is not an output of the FRF, or outputs already at ``node``
+        (measured directly and by sensors around it: one or the other).
+    GeometryError
+        Channels that do not observe the six DOFs (named, with the DOFs they miss).
+    QuantityError
+        Sensor channels that are not translations.
+    """
+    labels = list(sensors.labels)
+    o = np.asarray(origin, float)
+    probe = Layout(sensors, sensors, o, node)  # checks the point and the node name
+    miss = [s for s in labels if s not in frf.outputs]
+    if miss:
+        raise DOFError(
+            f"sensor channel {miss[0]!r} of the virtual point {node!r} is not an output of "
+            f"the measured FRF ({len(miss)} missing; the FRF has outputs "
+            f"{', '.join(frf.outputs[:9])}{' ...' if len(frf.outputs) > 9 else ''})"
+        )
+    direct = [x for x in frf.outputs if parse_label(x)[0] == node]
+    if direct:
+        raise DOFError(
+            f"the measured FRF has outputs at {node!r} itself ({', '.join(direct)}) and "
+            f"{len(labels)} sensor channels around it ({', '.join(labels[:6])}"
+            f"{' ...' if len(labels) > 6 else ''}): give one or the other, not both"
+        )
+    _check_kinds(frf, labels, [])
+    check_observable(sensors, o, "sensor", node)
+    Ru = displacement_modes(sensors.positions, sensors.directions, o)
+    Tu = transformation(Ru, sensor_weights)
+    Y = frf.sel(outputs=labels).data
+    q = response_kernel(Y, Tu)
+    keep = [x for x in frf.outputs if x not in set(labels)]
+    data = np.concatenate([frf.sel(outputs=keep).data, q], axis=1) if keep else q
+    out = FRF(frf.freq, data, keep + list(probe.labels), frf.inputs, frf.quantity)
+    cons = response_consistency(Y, Ru, Tu, labels, frf.freq)
+    return ResponsePoint(out, sensors, readonly(o), node, readonly(Tu), cons)
