@@ -121,7 +121,7 @@ class CampaignBrowser(pn.viewable.Viewer):
         self._lazy = lazy
         self._active = False
         self._listed: str = ""  # why no file is listed ('' when some are)
-        self._doc = None
+        self._doc = served_document()  # the session's page (None: no server)
         self._build()
         self._from_state()
         self._settings.param.watch(lambda *_: self._from_state(), list(self.MIRRORED))
@@ -204,6 +204,9 @@ class CampaignBrowser(pn.viewable.Viewer):
         table = self._store.campaign_cases
         rows = dict(table.draw["rows"]) if table is not None and "rows" in table.draw else {}
         file = table.draw.get("file") if table is not None else None
+        new = table is not self._table_shown  # a new table: listed, a case chosen in it
+        if new:
+            self._table_shown, self._rows = table, rows
         if rows and file != self._tabled_file:  # another file: its filters' choices
             self._tabled_file = file
             noises = sorted({v for v in rows["noise_pct"] if v is not None})
@@ -212,11 +215,8 @@ class CampaignBrowser(pn.viewable.Viewer):
                 self.param.noise.objects = [ALL, *noises]
                 self.param.target.objects = [ALL, *targets]
                 self.param.update(noise=ALL, target=ALL, kind=ALL, status=ALL)
-        if table is not self._table_shown:  # a new table: listed, a case chosen in it
-            self._table_shown = table
-            self._rows = rows
-            if table is None or rows:
-                self._filter()
+        if new and (table is None or rows):
+            self._filter()
         r = self._store.campaign
         self.shown = r if r is not None and r.columns else None
         self._say()
@@ -473,7 +473,7 @@ class CampaignBrowser(pn.viewable.Viewer):
             w.RadioButtonGroup.from_param(self.param.dof, name="DOF", width=260),
             w.Checkbox.from_param(self.param.max_over_dofs, name="Error map: max over DOFs"),
         )
-        self._doc = served_document()
+        self._doc = served_document() or self._doc
         self._draw()
         return pn.Column(
             w.Select.from_param(
