@@ -17,6 +17,7 @@ import param
 from fbs_core.vocabulary import DIRECTIONS
 
 from ..schema import setting
+from .params import Integer
 
 __all__ = ["CampaignState"]
 
@@ -54,10 +55,10 @@ class CampaignState(param.Parameterized):
         default=False,
         doc="A truncation case's error map as the maximum over the 6 DOFs.",
     )
-    harmonic = param.Selector(
+    harmonic = Integer(
         metadata=setting("ch", field="campaign_harmonic"),
         default=0,
-        objects=list(range(8)),
+        bounds=(0, 7),
         doc="Harmonic the case table is filtered by and a variants case is shown at (0: "
         "all; a variants case then shows its first harmonic).",
     )
