@@ -62,6 +62,7 @@ from .results import (
     Result,
     Snapshot,
     analysis,
+    campaign_rows,
     main,
     modes,
     pins,
@@ -422,6 +423,22 @@ TABLE: tuple[Row, ...] = (
         slow=review.bands_work,
         doc="The other candidates' scatter bands (the page's band settings) on the band plot.",
     ),
+    Row(
+        "campaign_cases",
+        campaign_rows.CASES_DEPENDS,
+        campaign_rows.cases_result,
+        slow=campaign_rows.open_work,
+        doc="The campaign file's case table (None until a file is chosen; the file read "
+        "in the background).",
+    ),
+    Row(
+        "campaign",
+        campaign_rows.CASE_DEPENDS,
+        campaign_rows.case_result,
+        slow=campaign_rows.open_work,
+        doc="The chosen case of the campaign file: its band, corridor or error map, with "
+        "its provenance (None until a case is chosen).",
+    ),
     # last: its thread starts once the pass's other results are out (it publishes later)
     Row("band", BAND, None, when=OWN_THREAD, kind=Band, doc="The latest scatter band."),
 )
@@ -511,8 +528,8 @@ class Results(param.Parameterized):
     message = param.String(default="", doc="The last pin action's or link's problem ('' if none).")
     outside = param.Dict(
         default={},
-        doc="Results of views that are no row of the table, as they show them now (the "
-        "campaign browser's case: they come from a file, not the session's state): name -> "
+        doc="Results of views that are no row of the table, as they show them now (a "
+        "measured chassis' consistency: it is the upload's, not the state's): name -> "
         "Result; the report shows each as a section of its own.",
     )
     closed = param.Boolean(default=False, doc="The session has ended: nothing is drawn.")
@@ -978,6 +995,8 @@ WORKING_WORDS = {
     "waves": "looking up the belt waves",
     "selected_modes": "selecting the modes",
     "chassis_truncation": "computing the chassis truncation",
+    "campaign_cases": "listing the campaign's cases",
+    "campaign": "reading the campaign case",
 }
 
 

@@ -1,7 +1,8 @@
 """One source of truth (issue 27): every field of a session's state against every output.
 
 For each field of the state (the case, the noise study, the truncation study, the Analysis
-card's settings, the pins, the uploaded models) the field is changed and every output of
+card's settings, the pins, the uploaded models, the campaign card's file and case) the field
+is changed and every output of
 the session is read again: the published results (their CSV columns, the data they draw,
 their CSV header, file name, caption and plot title block) and the report (its data,
 tables, settings table, file name and title block). Then
@@ -26,7 +27,9 @@ from __future__ import annotations
 import dataclasses
 import datetime as dt
 import re
+import shutil
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -41,6 +44,7 @@ from app.report.session import report_data
 from app.results import FIELDS, Result
 from app.review import EMPTY_REVIEW, Review
 from app.store import TABLE, Results, depends
+from fbs_core.campaign import parse_campaign, run_campaign
 from fbs_core.targets import Target
 from fbs_core.tire import TireModel
 
@@ -90,6 +94,29 @@ BASE = {
     "mode_rank": "loo",
     "waves_all": False,
 }
+#: The campaign file of the walk's session (two scatter cases, one truncation case).
+CAMPAIGN_TOML = """
+[campaign]
+name = "walk"
+seed = 3
+output = "{out}"
+[scatter]
+harmonics = [1]
+noise = [0.05, 0.1]
+targets = ["both"]
+frequency_dependent = [false]
+rounds = 50
+[truncation]
+harmonics = [1]
+n_modes = {{ from = 10, to = 30, step = 10 }}
+thresholds = [0.2]
+f_max = [130.0]
+couplings = ["6dof"]
+"""
+#: Its cases' names (the walk shows the first and changes to the second).
+CAMPAIGN_CASES = [
+    c.name for c in parse_campaign(CAMPAIGN_TOML.format(out="walk.h5"), Path(".")).band_cases
+]
 #: The base state of the walk in vehicle scope (issue 31): the car, its rear-left bushing.
 BASE_VEHICLE = {**BASE, "scope": "vehicle"}
 
@@ -367,6 +394,12 @@ CHANGES = [
     _to("mcursor1", 40.0, r"f1 = 40 Hz"),
     _to("mcursor2", 60.0, r"f2 = 60 Hz"),
     _to("snap", True, r"snapped to the peak nearest"),
+    # the campaign card's file and case (the session's folder: CAMPAIGN_TOML's files)
+    _to("campaign_file", "other.h5", r"other\.h5"),
+    _to("campaign_case", CAMPAIGN_CASES[1], re.escape(CAMPAIGN_CASES[1])),
+    _to("campaign_dof", "x", r"bushing:x\b"),
+    _to("campaign_max", True, r"max over DOFs"),
+    _to("campaign_harmonic", 1, r"harmonic 1\b"),
     # last: the reference models restored after it are a new object (the title blocks name
     # the time the data were set)
     _to("models", UPLOAD, r"tire120\.h5", r"upload"),
@@ -413,8 +446,26 @@ def _names(lines: list[str], patterns: tuple[str, ...]) -> bool:
 
 
 @pytest.fixture(scope="module")
-def session():
-    return Session()
+def campaign_folder(tmp_path_factory) -> Path:
+    """A campaign folder with the walk's campaign file and a copy of it."""
+    d = tmp_path_factory.mktemp("walk")
+    camp = parse_campaign(CAMPAIGN_TOML.format(out=(d / "walk.h5").as_posix()), d)
+    assert run_campaign(camp).status == "complete"
+    shutil.copy(d / "walk.h5", d / "other.h5")
+    return d.resolve()
+
+
+@pytest.fixture(scope="module")
+def session(campaign_folder):
+    campaign = {
+        "campaign_dir": campaign_folder,
+        "campaign_file": "walk.h5",
+        "campaign_case": CAMPAIGN_CASES[0],
+        "campaign_dof": "z",
+        "campaign_max": False,
+        "campaign_harmonic": 0,
+    }
+    return Session({**BASE, **campaign})
 
 
 @pytest.fixture(scope="module")

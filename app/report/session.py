@@ -24,7 +24,7 @@ __all__ = ["BUILTIN_RESULTS", "depends", "provenance_of", "report_data", "settin
 #: (or tuple of them) of the store becomes a section of its own.
 BUILTIN_RESULTS = ("response", "error_map", "suggested", "eigen", "band_curves", "band")
 #: Results that are no section: the pins themselves (their comparison is, ``pinned``).
-NOT_SECTIONS = ("pins", "verdict")
+NOT_SECTIONS = ("pins", "verdict", "campaign_cases")
 
 
 def _digests(key: str) -> dict[str, str]:
@@ -86,6 +86,8 @@ def _sections(current: dict[str, Any]) -> tuple[ExtraSection, ...]:
             continue  # no other candidate and no target: nothing beside the coupled response
         if name == "review_bands" and not value.draw["curves"]:
             continue  # no other candidate's band
+        if name == "campaign" and not value.columns:
+            continue  # the campaign case being read, or why it cannot be shown
         if isinstance(value, Result):
             out.append(ExtraSection.of_result(name, value))
         elif isinstance(value, tuple) and all(isinstance(v, Result) for v in value):
@@ -140,7 +142,7 @@ def report_data(
         When a result of the page is missing (the session is closed).
     """
     s, current = store.current(looked_at=True)
-    outside = dict(getattr(store, "outside", {}))  # views outside the table (a campaign case)
+    outside = dict(getattr(store, "outside", {}))  # views outside the table (a consistency)
     # the car's map and suggested N need a coherent road (with a coherence: not reported)
     needed = ("response", "eigen") if s.vehicle else ("response", "error_map", "suggested", "eigen")
     missing = [n for n in needed if n not in current]

@@ -34,7 +34,9 @@ __all__ = [
     "CACHED_FILES",
     "CAMPAIGN_DIR_ENV",
     "Opened",
+    "cached",
     "campaign_dir",
+    "campaign_path",
     "list_campaigns",
     "open_cached",
     "read_campaign",
@@ -101,6 +103,31 @@ def list_campaigns(directory: Path | None) -> list[str]:
     return out
 
 
+def campaign_path(directory: Path | None, name: str) -> Path:
+    """The campaign result file ``name`` of the campaign folder ``directory``.
+
+    ``name`` comes from a link, so it is only ever a file listed by :func:`list_campaigns`:
+    a plain ``*.h5`` name directly in the folder whose root says it is a campaign result.
+
+    Raises
+    ------
+    CampaignError
+        No folder is set, or ``name`` is no campaign result file of the folder.
+    """
+    if directory is None:
+        raise CampaignError(f"No campaign directory configured (set {CAMPAIGN_DIR_ENV}).")
+    if not name or Path(name).name != name or not name.endswith(".h5") or name in (".", ".."):
+        raise CampaignError(f"{name!r} is not a campaign result file name")
+    path = directory / name
+    try:
+        ok = path.is_file() and path.resolve().parent == directory and _is_campaign(path)
+    except OSError:
+        ok = False
+    if not ok:
+        raise CampaignError(f"{name}: no campaign result file of that name in the campaign folder")
+    return path
+
+
 class Opened:
     """A campaign file as the browser shows it: the result, its case table, its first line."""
 
@@ -159,6 +186,23 @@ def open_cached(path: Path) -> Opened:
             _OPENING.pop(key, None)
             if key in _OPENED:
                 _OPENED.move_to_end(key)
+    if isinstance(got, CampaignError):
+        raise got
+    return got
+
+
+def cached(path: Path) -> Opened | None:
+    """:class:`Opened` of ``path`` when it was read since its last change, without reading
+    it (None: not read yet, :func:`open_cached` reads it).
+
+    Raises
+    ------
+    CampaignError
+        The kept problem of a malformed file (see :func:`open_cached`).
+    """
+    key = _file_key(path)
+    with _OPEN_LOCK:
+        got = _OPENED.get(key)
     if isinstance(got, CampaignError):
         raise got
     return got

@@ -17,6 +17,7 @@ from ..page.layout import PageState
 from ..review import EMPTY_REVIEW, Review
 from ..schema import Schema, setting
 from .analysis import AnalysisState
+from .campaign import CampaignState
 from .params import Integer, Number
 
 __all__ = [
@@ -34,6 +35,7 @@ __all__ = [
     "NoiseState",
     "TruncationState",
     "ResponsePlotState",
+    "CampaignState",
     "DashboardState",
     "URL_KEYS",
     "SCHEMA",
@@ -349,6 +351,11 @@ class DashboardState(param.Parameterized):
         instantiate=False,
         doc="This session's uploads (never shared between sessions).",
     )
+    campaign = param.ClassSelector(
+        class_=CampaignState,
+        instantiate=False,
+        doc="The campaign card's file and case (the folder: the server's FBS_CAMPAIGN_DIR).",
+    )
 
     def __init__(self, **params):
         params.setdefault("case", CaseState())
@@ -357,6 +364,10 @@ class DashboardState(param.Parameterized):
         params.setdefault("data", DataSource())
         params.setdefault("analysis", AnalysisState())
         params.setdefault("plot", ResponsePlotState())
+        if "campaign" not in params:
+            from ..runtime.campaign_files import campaign_dir
+
+            params["campaign"] = CampaignState(directory=campaign_dir())
         super().__init__(**params)
         self.case.param.update(models=self.data.models, review=self.data.review)
         self.data.param.watch(self._use_models, ["models", "review"])
@@ -382,6 +393,7 @@ SCHEMA = Schema(
         "truncation": TruncationState,
         "analysis": AnalysisState,
         "plot": ResponsePlotState,
+        "campaign": CampaignState,
     },
     page={"page": PageState},
 )

@@ -8,18 +8,23 @@ variants case's corridor with its sensitivity leaders, each with its provenance 
 export whose header carries the same provenance.
 
 This module holds the page's side only: :class:`CampaignBrowser` (widgets, filters, the
-figures it draws, the thread that opens a file) and :func:`campaign_card` (the card, or
-:data:`HOW_TO` when the server has no campaign directory). What it shows is made
-elsewhere, so each part can be read and tested without the others:
+figures it draws) and :func:`campaign_card` (the card, or :data:`HOW_TO` when the server
+has no campaign directory). What it shows is made elsewhere, so each part can be read and
+tested without the others:
 
+- :mod:`app.state.campaign`: the file, the case and its view as settings of the session
+  (in the link: a link opens the same file on the same case);
+- :mod:`app.results.campaign_rows`: the case table and the chosen case as rows of the
+  session's store (:data:`app.store.TABLE`), the file read on the store's background
+  worker while the card says so;
 - :mod:`app.runtime.campaign_files`: the campaign files on the server's disk, listed and
   opened, kept per process and read again only when a file changes;
 - :mod:`app.results.campaign`: the case table and each case's :class:`~app.results.Result`
   (pure functions of the opened file; nothing is recomputed).
 
-A page costs no file access: the card's browser opens nothing until the card is expanded
-(:meth:`CampaignBrowser.activate`), and a file is read on a thread of its own while the
-card says so. A malformed file is a message in the card naming the file and the problem
+A page costs no file access until the card is expanded (:meth:`CampaignBrowser.activate`
+lists the files and opens the first) or its link names a campaign file. A malformed file
+is a message in the card naming the file and the problem
 (:class:`~fbs_core.campaign.CampaignError`), never an error of the page.
 """
 
@@ -27,7 +32,6 @@ from __future__ import annotations
 
 import html
 import logging
-import threading
 from pathlib import Path
 
 import numpy as np
@@ -36,25 +40,14 @@ import param
 from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure
 
-from fbs_core.campaign import CampaignError, CampaignResult
 from fbs_core.vocabulary import DIRECTIONS
 
 from ..results import Result
-from ..results.campaign import (
-    case_rows,
-    scatter_case_result,
-    truncation_case_result,
-    variants_case_result,
-)
-from ..runtime.campaign_files import (
-    CAMPAIGN_DIR_ENV,
-    Opened,
-    campaign_dir,
-    list_campaigns,
-    read_campaign,
-    relative_names,
-)
-from ..runtime.draw import served_document
+from ..results.campaign import case_rows, variants_case_result
+from ..runtime.campaign_files import CAMPAIGN_DIR_ENV, campaign_dir, list_campaigns
+from ..runtime.draw import on_document, served_document
+from ..state import DashboardState
+from ..store import Results
 from .common import COLORS, FREQ_LABEL, MODES_LABEL, level_label
 from .live import download_button, inline_html
 
@@ -77,7 +70,16 @@ KINDS = (ALL, "scatter", "truncation", "variants")
 
 
 class CampaignBrowser(pn.viewable.Viewer):
-    """The campaign files of ``directory``, their cases (filtered) and the chosen case."""
+    """The campaign files of ``directory``, their cases (filtered) and the chosen case.
+
+    The file, the case, the DOF, the maximum over the DOFs and the harmonic are the
+    session's settings (``store.state.campaign``, in the link); the browser's parameters
+    of the same names mirror them for its widgets. The case table and the case are the
+    store's published results (``campaign_cases``, ``campaign``), which the browser only
+    draws; the filters other than the harmonic are the browser's own (they choose the
+    rows listed, nothing a result is made of). Without a ``store`` the browser makes one of
+    its own (no server: tests, notebooks).
+    """
 
     directory = param.ClassSelector(class_=Path, allow_None=True, constant=True)
     file = param.Selector(default=None, objects=[], allow_None=True, doc="Campaign file")
@@ -92,84 +94,147 @@ class CampaignBrowser(pn.viewable.Viewer):
     shown = param.ClassSelector(class_=Result, allow_None=True, doc="The chosen case's view")
     message = param.String(default="")
 
-    def __init__(self, directory: Path | None = None, lazy: bool = False, **params):
-        params["directory"] = campaign_dir() if directory is None else Path(directory).resolve()
+    #: Settings of ``state.campaign`` mirrored by the browser's parameter of the same name.
+    MIRRORED = ("file", "case", "dof", "max_over_dofs", "harmonic")
+
+    def __init__(
+        self,
+        directory: Path | None = None,
+        lazy: bool = False,
+        store: Results | None = None,
+        **params,
+    ):
+        if store is None:
+            state = DashboardState()
+            if directory is not None:
+                state.campaign.directory = Path(directory).resolve()
+            store = Results(state, background=False)
+        elif directory is not None:
+            store.state.campaign.directory = Path(directory).resolve()
+        params["directory"] = store.state.campaign.directory
         super().__init__(**params)
-        self._result: CampaignResult | None = None
-        self._rows: dict[str, list] = {}
+        self._store = store
+        self._settings = store.state.campaign
+        self._rows: dict[str, tuple] = {}
+        self._tabled_file: str | None = None
+        self._table_shown: Result | None = None
         self._lazy = lazy
         self._active = False
+        self._listed: str = ""  # why no file is listed ('' when some are)
+        self._doc = served_document()  # the session's page (None: no server)
         self._build()
+        self._from_state()
+        self._settings.param.watch(lambda *_: self._from_state(), list(self.MIRRORED))
+        self.param.watch(self._to_state, list(self.MIRRORED))
+        store.param.watch(lambda *_: self._refresh(), ["campaign_cases", "campaign"])
+        self._refresh()
         if not lazy:
             self.activate()
 
+    @property
+    def store(self) -> Results:
+        """The session's results the browser draws."""
+        return self._store
+
     def activate(self) -> None:
-        """List the campaign files and open the first one (once; a ``lazy`` browser waits
-        for this until its card is expanded, so a page build reads no file)."""
+        """List the campaign files and open the first one unless one is chosen (once; a
+        ``lazy`` browser waits for this until its card is expanded, so a page build reads
+        no file)."""
         if self._active:
             return
         self._active = True
         files = list_campaigns(self.directory)
-        self.param.file.objects = files
-        if files:
-            self.file = files[0]
-        else:
-            self.message = (
+        chosen = self._settings.file
+        self.param.file.objects = files + ([chosen] if chosen and chosen not in files else [])
+        if not files:
+            self._listed = (
                 f"No campaign result files in {self.directory}."
                 if self.directory
                 else f"No campaign directory configured (set {CAMPAIGN_DIR_ENV})."
             )
+        if chosen:
+            self.file = chosen
+        elif files:
+            self.file = files[0]
+        self._say()
 
-    # -- data ------------------------------------------------------------------------------
-    @param.depends("file", watch=True)
-    def _open(self) -> None:
-        self._result = None
-        if not self.file or self.directory is None:
+    # -- the settings and the browser's widgets ---------------------------------------------
+    def _from_state(self) -> None:
+        """The browser's parameters from the session's settings."""
+        st = self._settings
+        for name, objs in (("file", st.file), ("case", st.case)):
+            known = self.param[name].objects
+            if objs and known and objs not in known:
+                self.param[name].objects = [*known, objs]
+        self.param.update(
+            file=st.file or None,
+            case=st.case or None,
+            dof=st.dof,
+            max_over_dofs=st.max_over_dofs,
+            harmonic=st.harmonic or ALL,
+        )
+
+    def _to_state(self, *events) -> None:
+        """The session's settings from the browser's parameters (a file the user chooses
+        opens on its first case, the harmonic filter reset)."""
+        values = {e.name: e.new for e in events}
+        st = self._settings
+        out: dict = {}
+        if "file" in values and (values["file"] or "") != st.file:
+            out.update(file=values["file"] or "", case="", harmonic=0)
+        if "case" in values and "file" not in out:
+            out["case"] = values["case"] or ""
+        for name in ("dof", "max_over_dofs"):
+            if name in values:
+                out[name] = values[name]
+        if "harmonic" in values and "file" not in out:
+            out["harmonic"] = 0 if values["harmonic"] == ALL else int(values["harmonic"])
+        out = {k: v for k, v in out.items() if getattr(st, k) != v}
+        if out:
+            st.param.update(**out)
+
+    # -- the published results ------------------------------------------------------------------
+    def _refresh(self) -> None:
+        """Show the published case table and case (on the session's event loop when served)."""
+        on_document(self._doc, self._apply)
+
+    def _apply(self) -> None:
+        if self._store.closed:
             return
-        file, path = self.file, self.directory / self.file
-        doc = self._doc or served_document()
-        if not self._lazy or doc is None:
-            self._loaded(file, *read_campaign(path))
-            return
-        # a large file takes seconds to read: on a thread of its own, not a worker of the
-        # server's that other sessions need (app.runtime.background's workers take optional
-        # work, one task after the other, and drop what waits beyond their bound: a read the
-        # card waits for would never be answered); the result is applied on the session's loop
-        self.message = f"Reading {file} ..."
+        table = self._store.campaign_cases
+        rows = dict(table.draw["rows"]) if table is not None and "rows" in table.draw else {}
+        file = table.draw.get("file") if table is not None else None
+        new = table is not self._table_shown  # a new table: listed, a case chosen in it
+        if new:
+            self._table_shown, self._rows = table, rows
+        if rows and file != self._tabled_file:  # another file: its filters' choices
+            self._tabled_file = file
+            noises = sorted({v for v in rows["noise_pct"] if v is not None})
+            targets = sorted({v for v in rows["target"] if v})
+            with param.parameterized.batch_call_watchers(self):
+                self.param.noise.objects = [ALL, *noises]
+                self.param.target.objects = [ALL, *targets]
+                self.param.update(noise=ALL, target=ALL, kind=ALL, status=ALL)
+        if new and (table is None or rows):
+            self._filter()
+        r = self._store.campaign
+        self.shown = r if r is not None and r.columns else None
+        self._say()
 
-        def work():
-            outcome = read_campaign(path)
-            doc.add_next_tick_callback(lambda: self._loaded(file, *outcome))
-
-        threading.Thread(target=work, name="campaign-open", daemon=True).start()
-
-    def _loaded(self, file: str, opened: Opened | None, error: str) -> None:
-        if file != self.file:
-            return  # another file was chosen meanwhile
-        if opened is None:
-            self.message = error
-            self._result, self._rows = None, {}
-            self._table.value = _frame({})
-            self.param.case.objects = []
-            self.case = None
-            return
-        self._result = opened.result
-        self.message = opened.headline
-        self._rows = opened.rows
-        noises = sorted({v for v in self._rows["noise_pct"] if v is not None})
-        targets = sorted({v for v in self._rows["target"] if v})
-        with param.parameterized.batch_call_watchers(self):
-            self.param.noise.objects = [ALL, *noises]
-            self.param.target.objects = [ALL, *targets]
-            self.param.update(noise=ALL, target=ALL, kind=ALL, harmonic=ALL, status=ALL)
-            self.case = None  # a case of this file is shown, also one of the same name
-        self._filter()
+    def _say(self) -> None:
+        """The card's message: why nothing is listed, the file being read or its problem,
+        the case's problem, else the file's headline."""
+        table, case = self._store.campaign_cases, self._store.campaign
+        text = self._listed if table is None else table.caption
+        if table is not None and table.draw.get("state") == "done" and case is not None:
+            text = case.draw.get("problem", text)
+        self.message = text
 
     def filtered(self) -> list[int]:
         """Indices of the rows that pass the filters."""
         r = self._rows
         out = []
-        for i in range(len(r.get("case", []))):
+        for i in range(len(r.get("case", ()))):
             if self.kind != ALL and r["kind"][i] != self.kind:
                 continue
             if self.harmonic != ALL and self.harmonic not in _harmonics(r["harmonic"][i]):
@@ -185,39 +250,17 @@ class CampaignBrowser(pn.viewable.Viewer):
 
     @param.depends("kind", "harmonic", "noise", "target", "status", watch=True)
     def _filter(self) -> None:
+        """List the rows that pass the filters; the chosen case stays when listed, else the
+        first listed is chosen (only once the file's table is published: a link's case
+        waits for its file)."""
         idx = self.filtered()
         names = [self._rows["case"][i] for i in idx]
         self._table.value = _frame({k: [v[i] for i in idx] for k, v in self._rows.items()})
         self.param.case.objects = names
-        if self.case not in names:
-            self.case = names[0] if names else None
-
-    @param.depends("case", "dof", "max_over_dofs", "harmonic", watch=True)
-    def _show(self) -> None:
-        if self._result is None or self.case is None:
-            self.shown = None
+        if not self._rows:
             return
-        try:
-            c = self._result.case(self.case)
-            if c.kind == "scatter":
-                self.shown = scatter_case_result(self._result, self.case, self.dof)
-            elif c.kind == "variants":
-                # the harmonic filter picks one of the case's harmonics (else its first)
-                hs = [int(h) for h in c.settings["harmonics"]]
-                h = self.harmonic if self.harmonic in hs else None
-                self.shown = variants_case_result(self._result, self.case, self.dof, h)
-            else:
-                dof = None if self.max_over_dofs else self.dof
-                self.shown = truncation_case_result(self._result, self.case, dof)
-        except CampaignError as exc:  # incomplete, stored without these outputs, malformed
-            self.shown = None
-            self.message = relative_names(str(exc), self.directory)
-        except Exception as exc:  # noqa: BLE001 (a file's problem: said in the card)
-            log.exception("campaign case %s of %s", self.case, self.file)
-            self.shown = None
-            self.message = relative_names(
-                f"{self.file}: case {self.case!r} cannot be shown ({exc})", self.directory
-            )
+        if self._settings.case not in names:  # (the setting: the browser's may lag behind)
+            self._settings.case = names[0] if names else ""
 
     # -- page ------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -324,23 +367,12 @@ class CampaignBrowser(pn.viewable.Viewer):
             css_classes=["campaign-note"],
         )
         self._download = download_button("campaign", lambda: self.shown)
-        self._doc = None
-        self.param.watch(self._redraw, "shown")
+        self.param.watch(lambda _e: self._draw(), "shown")
 
     def _clicked(self, event) -> None:
         names = self._table.value["case"].tolist()
         if 0 <= event.row < len(names):
             self.case = names[event.row]
-
-    def _redraw(self, *_) -> None:
-        """Draw on the session's event loop when served (as :class:`LiveView` does)."""
-        doc = self._doc
-        if doc is None:
-            self._draw()
-        elif served_document() is doc:
-            pn.state.execute(self._draw, schedule=True)
-        else:
-            doc.add_next_tick_callback(self._draw)
 
     def _draw(self) -> None:
         r = self.shown
@@ -441,7 +473,7 @@ class CampaignBrowser(pn.viewable.Viewer):
             w.RadioButtonGroup.from_param(self.param.dof, name="DOF", width=260),
             w.Checkbox.from_param(self.param.max_over_dofs, name="Error map: max over DOFs"),
         )
-        self._doc = served_document()
+        self._doc = served_document() or self._doc
         self._draw()
         return pn.Column(
             w.Select.from_param(
@@ -494,7 +526,9 @@ def campaign_card(parts):
     get one (:data:`HOW_TO`): corridors and campaigns must be findable from the page.
 
     The browser reads nothing until the card is expanded (then it lists the files and opens
-    the first, :meth:`CampaignBrowser.activate`)."""
+    the first, :meth:`CampaignBrowser.activate`) or the link names a file (then the card is
+    shown expanded on it). The shown case is in the session's report: it is a row of the
+    store (``campaign``)."""
     if campaign_dir() is None:
         return parts.card(
             "Corridors and campaigns (not set up on this server)",
@@ -503,22 +537,23 @@ def campaign_card(parts):
             collapsed=True,
             css_classes=["campaign-card"],
         )
-    browser = CampaignBrowser(lazy=True)
+    browser = CampaignBrowser(lazy=True, store=parts.results)
+    linked = bool(parts.results.state.campaign.file)  # a link names a file: shown opened
     card = parts.card(
         "Campaign results (FBS_CAMPAIGN_DIR)",
         browser,
         None,
-        collapsed=True,
+        collapsed=not linked,
         css_classes=["campaign-card"],
     )
+    if linked:
+        browser.activate()
 
     def expanded(event):
         if not event.new:
             browser.activate()
 
     card.param.watch(expanded, "collapsed")
-    # the shown case is in the session's report (a section of its own, from this Result)
-    browser.param.watch(lambda e: parts.results.show_outside("campaign", e.new), "shown")
     card.browser = browser  # for tests
     return card
 
