@@ -29,6 +29,7 @@ from pathlib import Path
 from fbs_core.campaign import CampaignError, CampaignResult, open_campaign
 
 from ..results.campaign import case_rows
+from ..state.campaign import CAMPAIGN_DIR_ENV, campaign_dir
 
 __all__ = [
     "CACHED_FILES",
@@ -45,15 +46,8 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-CAMPAIGN_DIR_ENV = "FBS_CAMPAIGN_DIR"
 #: Opened campaign files kept per process (their case tables with them).
 CACHED_FILES = 4
-
-
-def campaign_dir() -> Path | None:
-    """The configured campaign directory (``$FBS_CAMPAIGN_DIR``), None when unset."""
-    raw = os.environ.get(CAMPAIGN_DIR_ENV, "").strip()
-    return Path(raw).resolve() if raw else None
 
 
 #: path -> ((mtime_ns, size), is a campaign result)

@@ -17,7 +17,7 @@ from ..page.layout import PageState
 from ..review import EMPTY_REVIEW, Review
 from ..schema import Schema, setting
 from .analysis import AnalysisState
-from .campaign import CampaignState
+from .campaign import CampaignState, campaign_dir
 from .params import Integer, Number
 
 __all__ = [
@@ -365,8 +365,6 @@ class DashboardState(param.Parameterized):
         params.setdefault("analysis", AnalysisState())
         params.setdefault("plot", ResponsePlotState())
         if "campaign" not in params:
-            from ..runtime.campaign_files import campaign_dir
-
             params["campaign"] = CampaignState(directory=campaign_dir())
         super().__init__(**params)
         self.case.param.update(models=self.data.models, review=self.data.review)

@@ -10,6 +10,7 @@ not what a result is made of.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import param
@@ -19,7 +20,16 @@ from fbs_core.vocabulary import DIRECTIONS
 from ..schema import setting
 from .params import Integer
 
-__all__ = ["CampaignState"]
+__all__ = ["CAMPAIGN_DIR_ENV", "CampaignState", "campaign_dir"]
+
+#: The environment variable naming the server's campaign folder.
+CAMPAIGN_DIR_ENV = "FBS_CAMPAIGN_DIR"
+
+
+def campaign_dir() -> Path | None:
+    """The configured campaign directory (``$FBS_CAMPAIGN_DIR``), None when unset."""
+    raw = os.environ.get(CAMPAIGN_DIR_ENV, "").strip()
+    return Path(raw).resolve() if raw else None
 
 
 class CampaignState(param.Parameterized):
