@@ -186,7 +186,7 @@ def _edge(k: int, coupling: str, models, band: tuple, car: Car | None = None) ->
             bkey = compute.band_key(
                 k, None, coupling, noise, target, fdep, rounds, seed, models, (wheels, road, point)
             )
-            res = compute.cached_band(bkey) or vc.band(bkey)
+            res = vc.band_once(bkey)
         edge = NoiseEdge.of_band(res, q)
         _EDGES.put(key, edge)
     return edge
@@ -347,7 +347,7 @@ def verdict_result(s: Snapshot) -> Result:
     cands = candidates_of(s)
     meta = _meta(s, cands)
     band = f"_band{s.noise:g}pct_R{s.rounds}_s{s.seed}" if s.verdict_band else ""
-    car = f"_car_{_digest_text(repr(s.vehicle_key()))}" if s.vehicle else ""
+    car = _car_tag(s)
     name = f"verdict_{len(cands)}cand_{s.review.key[:8]}_{s.coupling}{band}{car}.csv"
     if not s.review.judged:
         return Result(
@@ -624,7 +624,7 @@ def _band_edges(s: Snapshot, m) -> dict[str, Any]:
     if got is None:
         bkey = key[0]
         if bkey.is_car:
-            res = compute.cached_band(bkey) or vc.band(bkey)
+            res = vc.band_once(bkey)
         else:
             res = compute.band_once(
                 s.harmonic, s.n_modes, s.coupling, s.noise, s.target, s.frequency_dependent,
@@ -646,6 +646,11 @@ def _band_edges(s: Snapshot, m) -> dict[str, Any]:
 def _digest_text(text: str) -> str:
     """Eight hex digits of ``text``'s SHA-256: a file name's short, stable tag."""
     return hashlib.sha256(text.encode()).hexdigest()[:8]
+
+
+def _car_tag(s: Snapshot) -> str:
+    """``_car_<tag>`` of the car's settings for a file name in vehicle scope, else ``""``."""
+    return f"_car_{_digest_text(repr(s.vehicle_key()))}" if s.vehicle else ""
 
 
 def _digest_of(curves: list[dict[str, Any]]) -> str:
@@ -704,7 +709,7 @@ def review_bands_result(s: Snapshot) -> Result:
     if target is not None:
         cols["target_dB"] = target
     lo, hi = (100 - s.percentile) / 2, (100 + s.percentile) / 2
-    car = f"_car_{_digest_text(repr(s.vehicle_key()))}" if s.vehicle else ""
+    car = _car_tag(s)
     return Result(
         columns=cols,
         meta={

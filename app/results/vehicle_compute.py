@@ -40,7 +40,7 @@ from ..compute import (
 )
 from ..compute import cached_band as compute_cached_band
 
-__all__ = ["band", "coherent", "response", "road", "transfer", "truncation_map"]
+__all__ = ["band", "band_once", "coherent", "response", "road", "transfer", "truncation_map"]
 
 
 def _tire_kw(models) -> dict:
@@ -176,6 +176,12 @@ def cached_band(key: tuple, cancel=None, progress=None):
         res = band(key, cancel=cancel, progress=progress)
         remember_band(key, res)
     return res
+
+
+def band_once(key: tuple):
+    """The car's band of ``key``: the cached one if it was computed, else computed here
+    without keeping it (as :func:`app.compute.band_once` for a corner's band)."""
+    return compute_cached_band(key) or band(key)
 
 
 def band(key: tuple, cancel=None, progress=None):
