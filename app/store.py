@@ -123,6 +123,10 @@ class Row:
         ``slow(snapshot) -> work | None``: what the value still lacks (``make`` uses what
         is computed), done on the background worker (in place without a server), after
         which the row is published again.
+    waited : bool
+        The user waits for ``slow``'s work (a file they chose is read): it runs at the
+        server's priority (:data:`app.runtime.background.AHEAD`), not behind the work
+        nobody waits for at a lower one.
     ahead : callable, optional
         ``ahead(previous, snapshot) -> work | None``: computed ahead of the next change
         (``previous``: the snapshot of the value published before, None the first time).
@@ -152,6 +156,7 @@ class Row:
     doc: str = ""
     vehicle_only: tuple[str, ...] = ()
     wait: Callable[..., None] | None = None
+    waited: bool = False
 
     @property
     def tab(self) -> str | None:
@@ -428,6 +433,7 @@ TABLE: tuple[Row, ...] = (
         campaign_rows.CASES_DEPENDS,
         campaign_rows.cases_result,
         slow=campaign_rows.open_work,
+        waited=True,
         doc="The campaign file's case table (None until a file is chosen; the file read "
         "in the background).",
     ),
@@ -436,6 +442,7 @@ TABLE: tuple[Row, ...] = (
         campaign_rows.CASE_DEPENDS,
         campaign_rows.case_result,
         slow=campaign_rows.open_work,
+        waited=True,
         doc="The chosen case of the campaign file: its band, corridor or error map, with "
         "its provenance (None until a case is chosen).",
     ),
@@ -749,8 +756,10 @@ class Results(param.Parameterized):
                 if not self._stale(row, key):
                     self._publish(row, self.snapshot(), force=True)
 
+        worker = background.AHEAD if row.waited else background.BACKGROUND
+
         def submit() -> None:
-            background.BACKGROUND.submit((self, row.name), task)
+            worker.submit((self, row.name), task)
 
         if served() and not pn.state.loaded:  # after the page is sent: its build stays as fast
             pn.state.onload(submit)

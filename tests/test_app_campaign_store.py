@@ -158,6 +158,29 @@ def test_the_store_publishes_the_case_the_maker_makes_of_the_file(folder, backgr
     store.close()
 
 
+def test_the_file_the_user_chose_is_read_at_the_servers_priority(folder, tmp_path, monkeypatch):
+    """Reading a chosen file is work the user waits for: it runs on the worker at the
+    server's priority, never queued behind the low-priority work nobody waits for."""
+    from app.runtime import background
+
+    asked: dict[str, list] = {"ahead": [], "background": []}
+    for name, worker in (("ahead", background.AHEAD), ("background", background.BACKGROUND)):
+        submit = worker.submit
+        monkeypatch.setattr(
+            worker,
+            "submit",
+            lambda key, work, _n=name, _s=submit: (asked[_n].append(key[1]), _s(key, work)),
+        )
+    _res, band, _trunc = _names(folder)
+    shutil.copy(folder / "linked.h5", tmp_path / "fresh.h5")  # not read by this process yet
+    store = Results(_state(tmp_path), background=True)
+    store.state.campaign.param.update(file="fresh.h5", case=band)
+    _wait(lambda: store.campaign is not None and store.campaign.columns)
+    assert "campaign" in asked["ahead"] or "campaign_cases" in asked["ahead"]
+    assert not {"campaign", "campaign_cases"} & set(asked["background"])
+    store.close()
+
+
 def _published(store: Results) -> dict:
     return {row.name: getattr(store, row.name) for row in TABLE}
 
